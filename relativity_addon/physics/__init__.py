@@ -1,0 +1,5 @@
+"""Physics core of the relativity add-on: numpy (and colour-science for spectra), never bpy.
+
+Every relation is written down in ``shared/PHYSICS.md``; each function names its frame and sign
+conventions in its docstring.
+"""
