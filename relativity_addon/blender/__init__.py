@@ -1,0 +1,36 @@
+"""Blender glue: property groups, node-tree builders, handlers, operators and panels.
+
+Each module listed in ``_MODULES`` may define ``classes`` (registered in order, unregistered in
+reverse) and ``register()`` / ``unregister()`` hooks for anything else it installs (properties
+on ID types, handlers, preset paths). Modules are registered in list order and unregistered in
+reverse, so a module may rely on everything listed before it.
+"""
+
+import importlib
+
+_MODULES = (
+)
+
+
+def _modules():
+    return [importlib.import_module(f".{name}", __name__) for name in _MODULES]
+
+
+def register():
+    import bpy
+
+    for module in _modules():
+        for cls in getattr(module, "classes", ()):
+            bpy.utils.register_class(cls)
+        if hasattr(module, "register"):
+            module.register()
+
+
+def unregister():
+    import bpy
+
+    for module in reversed(_modules()):
+        if hasattr(module, "unregister"):
+            module.unregister()
+        for cls in reversed(getattr(module, "classes", ())):
+            bpy.utils.unregister_class(cls)
