@@ -9,6 +9,8 @@ reverse, so a module may rely on everything listed before it.
 import importlib
 
 _MODULES = (
+    "props",
+    "camera",
 )
 
 

@@ -1,0 +1,232 @@
+"""Batch rendering: the logic behind ``examples/render.py``.
+
+Runs the same way with the ``bpy`` wheel (``python examples/render.py file.blend [options]``)
+and inside Blender (``blender -b file.blend --python examples/render.py -- [options]``).
+Every failure ends in ``BatchError`` with a one-line reason; ``main`` turns it into exit code 1.
+"""
+
+import argparse
+import math
+import os
+import sys
+
+ADDON_PACKAGE = "relativity_addon"
+
+
+class BatchError(Exception):
+    """A one-line reason why the batch render cannot proceed."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise BatchError(f"bad option: {message}")
+
+
+def _vector3(text):
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}")
+    try:
+        return tuple(float(part) for part in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}") from None
+
+
+def _resolution(text):
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
+    if width < 1 or height < 1:
+        raise argparse.ArgumentTypeError(f"resolution must be positive, got {text!r}")
+    return width, height
+
+
+def _positive_int(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+SHUTTER_CHOICES = (
+    "pinhole",
+    "aperture_plane",
+    "detector_plane",
+    "focus_surface",
+    "fixed_point_surface",
+    "arbitrary_plane",
+)
+
+
+def build_parser(with_blend_file):
+    parser = _Parser(
+        prog="render.py",
+        description="Render a .blend with the relativistic camera (Cycles, CPU).",
+    )
+    if with_blend_file:
+        parser.add_argument("blend_file", help=".blend file to render")
+    parser.add_argument("--beta", type=_vector3, help="observer velocity X,Y,Z (world axes, fraction of c); "
+                        "write --beta=-0.5,0,0 when a value starts with '-'")
+    parser.add_argument("--method", choices=("camera", "geometry"), default="camera")
+    parser.add_argument("--reference", action="store_true",
+                        help="render the file's own camera unchanged (no relativistic camera)")
+    parser.add_argument("--samples", type=_positive_int)
+    parser.add_argument("--resolution", type=_resolution, help="WIDTHxHEIGHT in pixels")
+    parser.add_argument("--out", required=True, help="output image: .png, or .exr for linear float")
+    parser.add_argument("--no-doppler", action="store_true")
+    parser.add_argument("--no-searchlight", action="store_true")
+    parser.add_argument("--no-geometry", action="store_true", help="no aberration (testing aid)")
+    parser.add_argument("--lorentz-window", action="store_true")
+    parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
+    parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
+    parser.add_argument("--speed-of-light", type=float, help="scene units per second")
+    parser.add_argument("--frame", type=int)
+    parser.add_argument("--seed", type=int)
+    return parser
+
+
+def _running_inside_blender():
+    return "--python" in sys.argv or "-P" in sys.argv or "--python-expr" in sys.argv
+
+
+def _split_argv(argv):
+    if _running_inside_blender():
+        return (argv[argv.index("--") + 1:] if "--" in argv else []), False
+    return argv[1:], True
+
+
+def enable_addon():
+    """Register the add-on unless it already is (installed extension or this source tree)."""
+    import bpy
+
+    if hasattr(bpy.types.Scene, "relativity"):
+        return
+    import addon_utils
+
+    for module in addon_utils.modules():
+        if module.__name__.split(".")[-1] == ADDON_PACKAGE:
+            addon_utils.enable(module.__name__, default_set=True)
+            if hasattr(bpy.types.Scene, "relativity"):
+                return
+    repo_root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    if repo_root not in sys.path:
+        sys.path.insert(0, repo_root)
+    import importlib
+
+    importlib.import_module(ADDON_PACKAGE).register()
+
+
+def _apply_options(scene, options):
+    settings = scene.relativity
+    if options.beta is not None:
+        if not all(math.isfinite(b) for b in options.beta):
+            raise BatchError("--beta must be finite")
+        settings.beta = options.beta
+    settings.method = options.method.upper()
+    if options.shutter:
+        settings.shutter_model = options.shutter.upper()
+    if options.shutter_time is not None:
+        settings.shutter_time = options.shutter_time
+    if options.speed_of_light is not None:
+        settings.speed_of_light = options.speed_of_light
+    if options.no_doppler:
+        settings.use_doppler = False
+    if options.no_searchlight:
+        settings.use_searchlight = False
+    if options.no_geometry:
+        settings.use_geometry = False
+    if options.lorentz_window:
+        settings.use_lorentz_window = True
+
+
+def _output_settings(scene, out_path):
+    extension = os.path.splitext(out_path)[1].lower()
+    image_settings = scene.render.image_settings
+    if extension == ".png":
+        image_settings.file_format = "PNG"
+        image_settings.color_mode = "RGBA"
+    elif extension == ".exr":
+        image_settings.file_format = "OPEN_EXR"
+        image_settings.color_depth = "32"
+        image_settings.color_mode = "RGBA"
+    else:
+        raise BatchError(f"--out must end in .png or .exr, got {out_path!r}")
+    scene.render.filepath = out_path
+    scene.render.use_file_extension = False
+
+
+def run(argv):
+    import bpy
+
+    arguments, with_blend_file = _split_argv(argv)
+    options = build_parser(with_blend_file).parse_args(arguments)
+    out_path = os.path.abspath(options.out)
+
+    if with_blend_file:
+        if not os.path.isfile(options.blend_file):
+            raise BatchError(f"no such .blend file: {options.blend_file}")
+        try:
+            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(options.blend_file))
+        except RuntimeError as error:
+            raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}")
+    enable_addon()
+    from .blender import camera
+
+    scene = bpy.context.scene
+    if options.frame is not None:
+        scene.frame_set(options.frame)
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    if options.samples is not None:
+        scene.cycles.samples = options.samples
+    if options.seed is not None:
+        scene.cycles.seed = options.seed
+    if options.resolution is not None:
+        scene.render.resolution_x, scene.render.resolution_y = options.resolution
+        scene.render.resolution_percentage = 100
+    _output_settings(scene, out_path)
+
+    if options.reference:
+        camera.remove_relativistic_camera(scene)
+        if scene.camera is None:
+            raise BatchError("scene has no active camera")
+    else:
+        _apply_options(scene, options)
+        try:
+            camera.apply_relativistic_camera(scene)
+        except camera.RelativityError as error:
+            raise BatchError(str(error)) from None
+
+    os.makedirs(os.path.dirname(out_path), exist_ok=True)
+    if os.path.exists(out_path):
+        os.remove(out_path)
+    try:
+        bpy.ops.render.render(write_still=True)
+    except RuntimeError as error:
+        raise BatchError(f"render failed: {str(error).strip().splitlines()[-1]}") from None
+    if not options.reference:
+        cam = scene.camera.data
+        if not cam.cycles_custom.get("settings_valid", False):
+            raise BatchError("relativistic camera became invalid during the render")
+    if not os.path.isfile(out_path):
+        raise BatchError(f"render wrote no file at {out_path}")
+    return out_path
+
+
+def main(argv=None):
+    argv = sys.argv if argv is None else argv
+    try:
+        out_path = run(argv)
+    except BatchError as error:
+        print(f"render.py: error: {error}", file=sys.stderr)
+        return 1
+    except Exception as error:  # noqa: BLE001 - a batch tool reports one line, never a traceback
+        message = str(error).strip().splitlines()
+        print(f"render.py: error: {type(error).__name__}: {message[-1] if message else ''}", file=sys.stderr)
+        return 1
+    print(f"render.py: wrote {out_path}")
+    return 0

@@ -1,0 +1,143 @@
+"""Scene settings of the relativity add-on: ``bpy.types.Scene.relativity``.
+
+Everything lives in the scene (saved with the .blend, animatable, undoable). Changing a setting
+re-syncs the relativistic camera if it is applied (see ``camera.py``).
+"""
+
+import bpy
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    PointerProperty,
+)
+
+METHOD_ITEMS = (
+    ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),
+    ("GEOMETRY", "Apparent Geometry", "Deform meshes to their apparent positions (not built yet)"),
+)
+
+# Order matters: the enum index is the shader's `shutter_model` integer.
+SHUTTER_MODEL_ITEMS = (
+    ("PINHOLE", "Pinhole", "Every ray passes the aperture centre at the shutter time (no depth of field)"),
+    ("APERTURE_PLANE", "Aperture Plane", "Every ray passes its lens point at the shutter time"),
+    ("DETECTOR_PLANE", "Detector Plane", "Every ray reaches the detector at the shutter time (ideal lens)"),
+    ("FOCUS_SURFACE", "Focus Surface", "Every ray passes the focus plane at the shutter time"),
+    (
+        "FIXED_POINT_SURFACE",
+        "Fixed-Point Surface",
+        "Each focus-plane point opens when it is a spatial fixed point of the boost (Gray eq. 4)",
+    ),
+    ("ARBITRARY_PLANE", "Arbitrary Plane", "Every ray crosses a given plane at the shutter time (Gray eq. B5)"),
+)
+SHUTTER_MODELS = tuple(item[0] for item in SHUTTER_MODEL_ITEMS)
+
+
+def _settings_changed(self, context):
+    from . import camera
+
+    scene = self.id_data
+    camera.sync_if_applied(scene)
+
+
+def _speed(self):
+    return sum(component * component for component in self.beta) ** 0.5
+
+
+class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
+    speed_of_light: FloatProperty(
+        name="Speed of Light",
+        description="Speed of light in scene units per second (299792458 for metres and real light)",
+        default=299792458.0,
+        min=1e-9,
+        soft_max=1e9,
+        update=_settings_changed,
+    )
+    beta: FloatVectorProperty(
+        name="Velocity (c)",
+        description="Observer (camera) velocity in world coordinates as a fraction of c; |beta| < 1",
+        size=3,
+        subtype="XYZ",
+        default=(0.0, 0.0, 0.0),
+        soft_min=-0.999,
+        soft_max=0.999,
+        update=_settings_changed,
+    )
+    speed: FloatProperty(
+        name="Speed (c)",
+        description="Observer speed |beta| as a fraction of c",
+        get=_speed,
+    )
+    method: EnumProperty(
+        name="Method",
+        items=METHOD_ITEMS,
+        default="CAMERA",
+        update=_settings_changed,
+    )
+    shutter_model: EnumProperty(
+        name="Shutter",
+        description="Where and when the idealised shutter opens (Gray et al. 2020, section 3)",
+        items=SHUTTER_MODEL_ITEMS,
+        default="PINHOLE",
+        update=_settings_changed,
+    )
+    shutter_time: FloatProperty(
+        name="Shutter Time",
+        description="Camera-frame time t_S (seconds) at which the shutter opens",
+        default=0.0,
+        update=_settings_changed,
+    )
+    shutter_plane_point: FloatVectorProperty(
+        name="Shutter Plane Point",
+        description="A point of the arbitrary shutter plane, in the camera's local coordinates "
+        "(Blender convention: the camera looks down -Z)",
+        size=3,
+        subtype="TRANSLATION",
+        default=(0.0, 0.0, -1.0),
+        update=_settings_changed,
+    )
+    shutter_plane_normal: FloatVectorProperty(
+        name="Shutter Plane Normal",
+        description="Normal of the arbitrary shutter plane, in the camera's local coordinates",
+        size=3,
+        subtype="XYZ",
+        default=(0.0, 0.0, -1.0),
+        update=_settings_changed,
+    )
+    use_lorentz_window: BoolProperty(
+        name="Lorentz Window",
+        description="Shutter and Lorentz-transformation window in the plane of spatial fixed points "
+        "for the shutter time (Gray eq. 6): the photo equals the photo at rest",
+        default=False,
+        update=_settings_changed,
+    )
+    use_geometry: BoolProperty(
+        name="Aberration",
+        description="Relativistic ray geometry (aberration, Lorentz shift of the ray origin)",
+        default=True,
+        update=_settings_changed,
+    )
+    use_doppler: BoolProperty(
+        name="Doppler Colour",
+        description="Doppler colour shift (not implemented yet: no effect)",
+        default=True,
+        update=_settings_changed,
+    )
+    use_searchlight: BoolProperty(
+        name="Searchlight",
+        description="Radiance scales with D^4 (Weiskopf et al. 1999)",
+        default=True,
+        update=_settings_changed,
+    )
+
+
+classes = (RELATIVITY_PG_scene_settings,)
+
+
+def register():
+    bpy.types.Scene.relativity = PointerProperty(type=RELATIVITY_PG_scene_settings)
+
+
+def unregister():
+    del bpy.types.Scene.relativity
