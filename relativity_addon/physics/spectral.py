@@ -1,0 +1,558 @@
+"""Spectral Doppler and searchlight colour: blackbodies and up-sampled Rec.709 colours.
+
+Convention (``shared/PHYSICS.md``): the Doppler factor is ``D = nu_received / nu_emitted``,
+``D > 1`` is a blueshift. Spectral radiance per unit wavelength transforms as
+
+    L_obs(lambda) = D^5 L_emit(lambda D)            (Weiskopf et al. 1999, eq. 14)
+
+and integrated radiance as ``D^4`` (eq. 15). A blackbody at ``T`` is seen as a blackbody at
+``D T``; its *visible* luminance changes by ``Y(D T) / Y(T)``, not by ``D^4``.
+
+Colours are Blender scene linear: linear Rec.709 (= sRGB) primaries, D65 white, CIE 1931 2 degree
+observer. ``XYZ <-> RGB`` uses colour-science's "ITU-R BT.709" colourspace (sRGB's primaries and
+white; its matrices are derived from them at full precision and are exact inverses, whereas the
+"sRGB" entry carries IEC 61966-2-1's 4-decimal matrix, whose round trip is off by ~1e-5), with *no*
+chromatic adaptation and no transfer function: the colourspace white is D65 and the reference
+illuminant of the up-sampled spectra is D65, so the D65 spectrum maps to RGB (1, 1, 1) without any
+adaptation step, and blackbody colours are those an observer adapted to D65 (Blender's
+convention) sees.
+
+Everything here is numpy and colour-science; no ``bpy``. ``docs/spectral-model.md`` describes the
+model, its extension outside the visible band and the lookup-table layouts for the shader.
+
+References
+----------
+- Weiskopf, D., Kraus, U., Ruder, H. (1999). Searchlight and Doppler effects in the visualization
+  of special relativity: a corrected derivation of the transformation of radiance. ACM Transactions
+  on Graphics 18(3), 278-292.
+- Mallett, I., Yuksel, C. (2019). Spectral Primary Decomposition for Rendering with sRGB
+  Reflectance. Eurographics Symposium on Rendering (DL-only track).
+- CIE 15:2004 Colorimetry, 3rd edition (D65 tabulation, linear interpolation of D65).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+import colour
+from colour.colorimetry import planck_law
+
+__all__ = [
+    "CMFS_NAME",
+    "WAVELENGTHS_VISIBLE_NM",
+    "D65_EXTENSION_TEMPERATURE_K",
+    "BLACKBODY_LUT_LOG10_T_RANGE",
+    "DOPPLER_LUT_LOG10_D_RANGE",
+    "XYZ_to_linear_rec709",
+    "linear_rec709_to_XYZ",
+    "luminance_linear_rec709",
+    "gamut_map_linear_rec709",
+    "blackbody_spectral_radiance",
+    "doppler_shifted_spectral_radiance",
+    "blackbody_XYZ",
+    "blackbody_linear_rgb",
+    "blackbody_luminance",
+    "observed_blackbody_temperature",
+    "blackbody_luminance_ratio",
+    "blackbody_lut_log10_t_grid",
+    "blackbody_rgb_lut",
+    "sample_blackbody_rgb_lut",
+    "reflectance_basis_Mallett2019",
+    "illuminant_D65_extended",
+    "doppler_rgb_matrix",
+    "doppler_shift_rgb",
+    "doppler_lut_log10_d_grid",
+    "doppler_matrix_lut",
+    "sample_doppler_matrix_lut",
+]
+
+CMFS_NAME = "CIE 1931 2 Degree Standard Observer"
+"""Observer for every colour in this module (Blender's scene linear is defined with it)."""
+
+WAVELENGTHS_VISIBLE_NM = np.arange(360.0, 831.0, 1.0)
+"""Integration grid (nm): the CIE 1931 colour matching functions' own 1 nm tabulation. The CMFs
+vanish outside it, so no light outside 360-830 nm contributes to XYZ or RGB."""
+
+D65_EXTENSION_TEMPERATURE_K = 6504.0
+"""Planck temperature used to extend D65 outside its 300-780 nm tabulation (D65's CCT)."""
+
+BLACKBODY_LUT_LOG10_T_RANGE = (2.0, 6.0)
+"""Default log10 temperature range (K) of the blackbody table: 100 K to 1e6 K, which covers ``D T``
+for ``D`` in [0.01, 100] for emitters of 1e4 K, and D in [0.1, 20] for 1000-50000 K."""
+
+DOPPLER_LUT_LOG10_D_RANGE = (-2.0, 2.0)
+"""Default log10 Doppler factor range of the matrix table: D from 0.01 to 100."""
+
+_WAVELENGTH_STEP_NM = 1.0
+
+_REC709 = colour.RGB_COLOURSPACES["ITU-R BT.709"]
+
+
+def _validated_positive(values, name: str) -> np.ndarray:
+    """``values`` as a float64 array; ``ValueError`` unless every entry is finite and > 0."""
+
+    array = np.asarray(values, dtype=np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite (got NaN or inf): {values!r}")
+    if not np.all(array > 0):
+        raise ValueError(f"{name} must be > 0: {values!r}")
+    return array
+
+
+def _validated_finite(values, name: str) -> np.ndarray:
+    array = np.asarray(values, dtype=np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite (got NaN or inf): {values!r}")
+    return array
+
+
+@functools.lru_cache(maxsize=None)
+def _cmfs_visible() -> np.ndarray:
+    """CIE 1931 2 degree CMFs on :data:`WAVELENGTHS_VISIBLE_NM`, shape (W, 3), read-only."""
+
+    cmfs = colour.MSDS_CMFS[CMFS_NAME]
+    values = np.stack(
+        [np.interp(WAVELENGTHS_VISIBLE_NM, cmfs.wavelengths, cmfs.values[:, i]) for i in range(3)],
+        axis=-1,
+    )
+    values.setflags(write=False)
+    return values
+
+
+# --- Colour space -------------------------------------------------------------------------------
+
+
+def XYZ_to_linear_rec709(XYZ) -> np.ndarray:
+    """Linear Rec.709 (Blender scene linear) RGB from CIE 1931 XYZ, shape (..., 3).
+
+    colour-science's "ITU-R BT.709" colourspace, no chromatic adaptation (its white and ours are
+    both D65), no transfer function.
+    """
+
+    return colour.XYZ_to_RGB(
+        np.asarray(XYZ, dtype=np.float64),
+        _REC709,
+        illuminant=None,
+        chromatic_adaptation_transform=None,
+        apply_cctf_encoding=False,
+    )
+
+
+def linear_rec709_to_XYZ(RGB) -> np.ndarray:
+    """CIE 1931 XYZ from linear Rec.709 RGB, shape (..., 3); inverse of :func:`XYZ_to_linear_rec709`."""
+
+    return colour.RGB_to_XYZ(
+        np.asarray(RGB, dtype=np.float64),
+        _REC709,
+        illuminant=None,
+        chromatic_adaptation_transform=None,
+        apply_cctf_decoding=False,
+    )
+
+
+@functools.lru_cache(maxsize=None)
+def _rec709_luminance_weights() -> np.ndarray:
+    """Row Y of the Rec.709 RGB -> XYZ matrix (about 0.2126, 0.7152, 0.0722)."""
+
+    weights = np.array(_REC709.matrix_RGB_to_XYZ[1], dtype=np.float64)
+    weights.setflags(write=False)
+    return weights
+
+
+def luminance_linear_rec709(RGB) -> np.ndarray:
+    """Relative luminance ``Y`` of linear Rec.709 RGB, shape (...)."""
+
+    return np.asarray(RGB, dtype=np.float64) @ _rec709_luminance_weights()
+
+
+def gamut_map_linear_rec709(RGB) -> np.ndarray:
+    """Bring linear Rec.709 RGB into the gamut by desaturating toward grey at constant luminance.
+
+    A strongly shifted spectrum (a blackbody below ~1900 K, white seen at ``D << 1``) is a real
+    colour outside the Rec.709 triangle: some components are negative. Negative light breaks
+    compositing and view transforms, so colours are moved along the line to the grey of the same
+    luminance ``Y`` until the smallest component is 0:
+
+        rgb' = Y + (rgb - Y) * Y / (Y - min(rgb))     if min(rgb) < 0, else rgb
+
+    This keeps ``Y`` and the dominant hue, is homogeneous of degree 1 (it commutes with any
+    brightness factor such as ``D^4`` or ``Y(DT)/Y(T)``), and is cheap in a shader. Colours with
+    ``Y <= 0`` (impossible for a non-negative spectrum) map to black.
+    """
+
+    rgb = np.asarray(RGB, dtype=np.float64)
+    luminance = luminance_linear_rec709(rgb)[..., None]
+    smallest = np.min(rgb, axis=-1, keepdims=True)
+    out_of_gamut = smallest < 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        saturation = np.where(out_of_gamut, luminance / (luminance - smallest), 1.0)
+    mapped = luminance + (rgb - luminance) * saturation
+    # In-gamut colours pass through bit-exact (Y + (rgb - Y) would round tiny components to 0).
+    mapped = np.where(out_of_gamut, mapped, rgb)
+    mapped = np.where(luminance > 0, mapped, 0.0)
+    # Rounding can leave -1e-17 where the smallest component was driven to exactly 0.
+    return np.maximum(mapped, 0.0)
+
+
+# --- Blackbody ----------------------------------------------------------------------------------
+
+
+def _planck_outer(wavelength_nm, temperature_K) -> np.ndarray:
+    """:func:`colour.colorimetry.planck_law` as an outer product, shape (W, N), W/(sr m^2 m).
+
+    planck_law evaluates every wavelength at every temperature (flattening both); this keeps that
+    shape explicit, even for a single wavelength or temperature.
+    """
+
+    wavelength_m = np.ravel(wavelength_nm) * 1e-9
+    temperature_K = np.ravel(temperature_K)
+    with np.errstate(over="ignore", under="ignore"):
+        # exp(c2 / (lambda T)) overflows to inf deep in the Wien tail: the radiance is then 0.
+        radiance = planck_law(wavelength_m, temperature_K)
+    return np.reshape(radiance, (wavelength_m.size, temperature_K.size))
+
+
+def blackbody_spectral_radiance(wavelength_nm, temperature_K) -> np.ndarray:
+    """Planck's law ``B_lambda(lambda, T)`` in W sr^-1 m^-2 per metre of wavelength.
+
+    :func:`colour.colorimetry.planck_law` taking nanometres, with numpy broadcasting between
+    ``wavelength_nm`` and ``temperature_K`` (element-wise, not an outer product).
+    """
+
+    temperature_K = _validated_positive(temperature_K, "temperature_K")
+    wavelength_nm = _validated_positive(wavelength_nm, "wavelength_nm")
+    wavelength_nm, temperature_K = np.broadcast_arrays(wavelength_nm, temperature_K)
+    unique_temperatures, index = np.unique(temperature_K, return_inverse=True)
+    radiance = np.empty(wavelength_nm.shape, dtype=np.float64)
+    flat_wavelengths = wavelength_nm.ravel()
+    flat_radiance = radiance.reshape(-1)
+    for k, temperature in enumerate(unique_temperatures):
+        selected = np.ravel(index) == k
+        flat_radiance[selected] = _planck_outer(flat_wavelengths[selected], temperature)[:, 0]
+    return radiance
+
+
+def doppler_shifted_spectral_radiance(wavelength_nm, emitted_spectral_radiance, doppler_factor):
+    """Observed spectral radiance ``L_obs(lambda) = D^5 L_emit(lambda D)``.
+
+    Weiskopf et al. (1999) eq. 14, written for ``D = nu_received / nu_emitted`` (their eq. 1 uses
+    ``lambda' = lambda D`` with the reciprocal ``D``). ``emitted_spectral_radiance`` is a callable of
+    wavelength in nm, in the emitter's rest frame; ``wavelength_nm`` and ``doppler_factor`` broadcast.
+    """
+
+    doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
+    wavelength_nm = _validated_positive(wavelength_nm, "wavelength_nm")
+    return doppler_factor**5 * emitted_spectral_radiance(wavelength_nm * doppler_factor)
+
+
+def blackbody_XYZ(temperature_K) -> np.ndarray:
+    """CIE 1931 XYZ of a blackbody at ``temperature_K``, shape (..., 3), in W sr^-1 m^-2.
+
+    ``X = integral B_lambda(lambda, T) xbar(lambda) dlambda`` over 360-830 nm at 1 nm (the CMFs'
+    tabulation), with no 683 lm/W factor: radiometric units weighted by the dimensionless CMFs,
+    absolute and consistent between temperatures.
+    """
+
+    temperature_K = _validated_positive(temperature_K, "temperature_K")
+    radiance = _planck_outer(WAVELENGTHS_VISIBLE_NM, temperature_K)  # (W, N)
+    XYZ = radiance.T @ _cmfs_visible() * (_WAVELENGTH_STEP_NM * 1e-9)
+    return XYZ.reshape(*temperature_K.shape, 3)
+
+
+def blackbody_linear_rgb(temperature_K, gamut_map: bool = False) -> np.ndarray:
+    """Linear Rec.709 RGB of a blackbody at ``temperature_K``, shape (..., 3), in W sr^-1 m^-2.
+
+    Exact colorimetry by default: below about 1900 K the blue component is negative (and below
+    about 1000 K the green one), because those blackbodies lie outside the Rec.709 gamut. With
+    ``gamut_map=True`` the colour is passed through :func:`gamut_map_linear_rec709`.
+    """
+
+    rgb = XYZ_to_linear_rec709(blackbody_XYZ(temperature_K))
+    return gamut_map_linear_rec709(rgb) if gamut_map else rgb
+
+
+def blackbody_luminance(temperature_K) -> np.ndarray:
+    """CIE ``Y`` of a blackbody at ``temperature_K`` in W sr^-1 m^-2 (CMF-weighted radiance)."""
+
+    return blackbody_XYZ(temperature_K)[..., 1]
+
+
+def observed_blackbody_temperature(temperature_K, doppler_factor) -> np.ndarray:
+    """Temperature ``D T`` of the blackbody an observer sees; the emitter is at ``T`` in its frame.
+
+    Exact because ``D^5 B_lambda(lambda D, T) = B_lambda(lambda, D T)`` (Planck's law with
+    Weiskopf et al. 1999 eq. 14).
+    """
+
+    temperature_K = _validated_positive(temperature_K, "temperature_K")
+    doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
+    return doppler_factor * temperature_K
+
+
+def blackbody_luminance_ratio(temperature_K, doppler_factor) -> np.ndarray:
+    """Observed over emitted visible luminance of a blackbody: ``Y(D T) / Y(T)``.
+
+    This is the searchlight factor for what a camera records; it differs from the bolometric
+    ``D^4`` of Weiskopf et al. (1999) eq. 15 because the band shifts across the Planck curve.
+    Computed as the exponential of a difference of logarithms so that it stays finite where
+    ``Y(T)`` itself underflows double precision.
+    """
+
+    observed = observed_blackbody_temperature(temperature_K, doppler_factor)
+    log_emitted = _log_blackbody_luminance(temperature_K)
+    if not np.all(np.isfinite(log_emitted)):
+        raise ValueError(
+            f"temperature_K too low: the visible luminance is 0 even in log space: {temperature_K!r}"
+        )
+    with np.errstate(over="ignore"):  # Beyond 1e308 (T of 1e-300 K...) the ratio is inf.
+        return np.exp(_log_blackbody_luminance(observed) - log_emitted)
+
+
+def _log_blackbody_luminance(temperature_K) -> np.ndarray:
+    """``ln Y(T)`` computed in log space (finite even where ``Y`` underflows, e.g. T of a few K)."""
+
+    temperature_K = np.asarray(temperature_K, dtype=np.float64)
+    wavelength_m = WAVELENGTHS_VISIBLE_NM * 1e-9
+    c1, c2 = 3.741771e-16, 0.014388  # The constants colour.colorimetry.planck_law uses by default.
+    x = c2 / (wavelength_m * temperature_K[..., None])
+    # ln B = ln(c1 / pi / lambda^5) - ln(exp(x) - 1), with ln(exp(x) - 1) = x + log1p(-exp(-x)).
+    log_radiance = np.log(c1 / np.pi / wavelength_m**5) - (x + np.log1p(-np.exp(-x)))
+    log_weights = np.log(_cmfs_visible()[:, 1] * (_WAVELENGTH_STEP_NM * 1e-9))
+    terms = log_radiance + log_weights
+    peak = np.max(terms, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore"):
+        log_sum = peak[..., 0] + np.log(np.sum(np.exp(terms - peak), axis=-1))
+    return np.where(np.isneginf(peak[..., 0]), -np.inf, log_sum)
+
+
+def blackbody_lut_log10_t_grid(size: int = 2048, log10_t_range=BLACKBODY_LUT_LOG10_T_RANGE):
+    """Evenly spaced ``log10 T`` grid (K) for :func:`blackbody_rgb_lut`."""
+
+    return np.linspace(log10_t_range[0], log10_t_range[1], int(size))
+
+
+def blackbody_rgb_lut(log10_t_grid=None) -> np.ndarray:
+    """Blackbody colour table for the shader, float32, flat, ``4 * N`` values.
+
+    Layout: an ``N x 1`` RGBA float image (Blender ``Image.pixels`` order), pixel ``j`` for
+    ``T_j = 10 ** log10_t_grid[j]``:
+
+        pixels[4 j + 0:3] = gamut-mapped linear Rec.709 RGB of the blackbody at T_j / Y(T_j)
+        pixels[4 j + 3]   = ln Y(T_j), Y in W sr^-1 m^-2 (CMF-weighted, see blackbody_XYZ)
+
+    The RGB has unit luminance and ``ln Y`` carries the brightness, because ``Y`` spans ~1e-75
+    (100 K) to ~1e10 (1e6 K), which no single float32 scale holds. Absolute RGB is
+    ``rgb * exp(a)``; the searchlight ratio of an emitter at ``T`` seen at ``D`` is
+    ``exp(a(D T) - a(T))``. Interpolate all four channels linearly in ``log10 T`` (see
+    :func:`sample_blackbody_rgb_lut`).
+    """
+
+    if log10_t_grid is None:
+        log10_t_grid = blackbody_lut_log10_t_grid()
+    log10_t_grid = _validated_finite(log10_t_grid, "log10_t_grid")
+    temperature_K = 10.0**log10_t_grid
+    log_luminance = _log_blackbody_luminance(temperature_K)
+    # Rescale before converting: the unit-luminance colour is scale-free and never underflows.
+    XYZ = blackbody_XYZ(temperature_K)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        chromatic = XYZ / XYZ[..., 1:2]
+    underflowed = ~np.isfinite(chromatic).all(axis=-1)
+    if np.any(underflowed):
+        raise ValueError(
+            "blackbody_rgb_lut: the visible radiance underflows at "
+            f"T = {temperature_K[underflowed].min():.4g} K; start the grid at a higher T"
+        )
+    rgb = gamut_map_linear_rec709(XYZ_to_linear_rec709(chromatic))
+    table = np.concatenate([rgb, log_luminance[..., None]], axis=-1)
+    return table.astype(np.float32).ravel()
+
+
+def sample_blackbody_rgb_lut(lut, log10_t_grid, temperature_K) -> np.ndarray:
+    """Absolute gamut-mapped RGB at ``temperature_K`` read from :func:`blackbody_rgb_lut`.
+
+    Reference for the shader: linear interpolation in ``log10 T``, clamped at the ends (an image
+    texture with *Linear* interpolation and *Extend* extension sampled at pixel centres).
+    """
+
+    temperature_K = _validated_positive(temperature_K, "temperature_K")
+    table = np.asarray(lut, dtype=np.float64).reshape(-1, 4)
+    x = np.log10(temperature_K)
+    channels = [np.interp(x, log10_t_grid, table[:, c]) for c in range(4)]
+    rgb = np.stack(channels[:3], axis=-1)
+    return rgb * np.exp(channels[3])[..., None]
+
+
+# --- Up-sampled RGB: Mallett & Yuksel (2019) ----------------------------------------------------
+
+
+@functools.lru_cache(maxsize=None)
+def _basis_table():
+    basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
+    return np.array(basis.wavelengths, dtype=np.float64), np.array(basis.values, dtype=np.float64)
+
+
+def reflectance_basis_Mallett2019(wavelength_nm) -> np.ndarray:
+    """Mallett & Yuksel (2019) sRGB reflectance basis at ``wavelength_nm``, shape (..., 3).
+
+    ``reflectance(lambda) = sum_i rgb_i basis_i(lambda)``. Tabulated by colour-science at 5 nm over
+    380-780 nm; linearly interpolated in between (keeps the basis within [0, 1]) and held
+    constant at the edge values outside, as colour-science's own extrapolator does. Held
+    constant because a surface's reflectance varies slowly far from its absorption bands and
+    this basis is already flat (each function ~1/3) at both ends of its range.
+    """
+
+    wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
+    table_nm, values = _basis_table()
+    return np.stack(
+        [np.interp(wavelength_nm, table_nm, values[:, i]) for i in range(3)], axis=-1
+    )
+
+
+@functools.lru_cache(maxsize=None)
+def _d65_table():
+    d65 = colour.SDS_ILLUMINANTS["D65"]
+    wavelengths = np.array(d65.wavelengths, dtype=np.float64)
+    values = np.array(d65.values, dtype=np.float64)
+    planck_at_ends = _planck_outer(wavelengths[[0, -1]], D65_EXTENSION_TEMPERATURE_K)[:, 0]
+    return wavelengths, values, values[[0, -1]] / planck_at_ends
+
+
+def illuminant_D65_extended(wavelength_nm) -> np.ndarray:
+    """Relative spectral power of CIE D65 (100 at 560 nm) at any wavelength > 0, shape (...).
+
+    Inside its 300-780 nm tabulation (colour-science, 5 nm) D65 is interpolated linearly, as CIE
+    15:2004 recommends. Outside, it continues as a 6504 K Planck spectrum scaled separately at
+    each end to meet the tabulated value there (continuous at 300 nm and 780 nm): daylight is
+    sunlight filtered by the atmosphere, close to a blackbody in shape in the infrared, and the
+    Wien tail gives the physically expected fall-off in the ultraviolet and X-ray bands where
+    the table stops (it reaches 0.03 at 300 nm already).
+    """
+
+    wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
+    table_nm, values, end_scales = _d65_table()
+    inside = np.interp(wavelength_nm, table_nm, values)
+    planck = _planck_outer(wavelength_nm, D65_EXTENSION_TEMPERATURE_K).reshape(wavelength_nm.shape)
+    below = wavelength_nm < table_nm[0]
+    above = wavelength_nm > table_nm[-1]
+    return np.where(below, end_scales[0] * planck, np.where(above, end_scales[1] * planck, inside))
+
+
+def _unnormalised_doppler_rgb_matrix(doppler_factor: np.ndarray) -> np.ndarray:
+    """``A(D)``: column ``i`` is the linear Rec.709 RGB seen at ``D`` of basis ``i`` under D65.
+
+    ``A(D)_{:, i} = RGB(integral xyzbar(lambda) D^5 E(lambda D) basis_i(lambda D) dlambda)``
+    (Weiskopf et al. 1999 eq. 14 for the shift; sum over the CMFs' 1 nm grid).
+    """
+
+    emitted_nm = WAVELENGTHS_VISIBLE_NM * doppler_factor[..., None]
+    radiance = illuminant_D65_extended(emitted_nm) * doppler_factor[..., None] ** 5
+    spectra = reflectance_basis_Mallett2019(emitted_nm) * radiance[..., None]  # (..., W, 3)
+    XYZ_columns = np.einsum("wc,...wi->...ci", _cmfs_visible(), spectra) * _WAVELENGTH_STEP_NM
+    return np.asarray(_REC709.matrix_XYZ_to_RGB) @ XYZ_columns
+
+
+@functools.lru_cache(maxsize=None)
+def _inverse_rest_frame_matrix() -> np.ndarray:
+    inverse = np.linalg.inv(_unnormalised_doppler_rgb_matrix(np.array(1.0)))
+    inverse.setflags(write=False)
+    return inverse
+
+
+def doppler_rgb_matrix(doppler_factor) -> np.ndarray:
+    """3x3 matrix ``M(D)``, shape (..., 3, 3): linear Rec.709 RGB emitted -> RGB observed at ``D``.
+
+    The emitter's colour is up-sampled to a reflectance with the Mallett & Yuksel (2019) basis
+    (linear in RGB), lit by D65 (:func:`illuminant_D65_extended`), shifted with
+    ``L_obs(lambda) = D^5 L_emit(lambda D)`` (Weiskopf et al. 1999 eq. 14) and integrated with the
+    CIE 1931 observer. Every step is linear in RGB, so the whole transform is ``M(D) = A(D) A(1)^-1``:
+    ``A(1)^-1`` turns the input RGB into the basis weights whose D65-lit spectrum reproduces
+    exactly that RGB at rest (the bare basis is off by up to ~1e-3 and by D65's scale), so
+    ``M(1)`` is the identity to rounding. Includes the searchlight factor: the total radiance
+    scales by ``D^4`` (eq. 15), the visible luminance by what the shifted band collects (white:
+    ~1e-126 at D = 0.01, 0.64 at 0.9, 1.43 at 1.1, 117 at 10, 1415 at 100).
+
+    Entries can be negative at large shifts (the shifted colour leaves the Rec.709 gamut); use
+    :func:`doppler_shift_rgb` for displayable colours. Below ``D`` of about 0.004 the visible band
+    sees only the far Wien tail of the extended D65 and the matrix underflows to exactly 0.
+    """
+
+    doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
+    return _unnormalised_doppler_rgb_matrix(doppler_factor) @ _inverse_rest_frame_matrix()
+
+
+def doppler_shift_rgb(rgb, doppler_factor, gamut_map: bool = True) -> np.ndarray:
+    """Linear Rec.709 RGB seen at Doppler factor ``D`` of an emitter of colour ``rgb``, (..., 3).
+
+    ``M(D) rgb`` (see :func:`doppler_rgb_matrix`), then, by default, :func:`gamut_map_linear_rec709`
+    so that the result is finite and non-negative for any non-negative ``rgb``. ``rgb`` is the
+    colour the emitter has in its own rest frame (a self-luminous surface, or a surface under a
+    light at rest relative to it) and must be finite; ``rgb`` and ``D`` broadcast.
+    """
+
+    rgb = _validated_finite(rgb, "rgb")
+    matrix = doppler_rgb_matrix(doppler_factor)
+    observed = np.einsum("...ij,...j->...i", matrix, rgb)
+    return gamut_map_linear_rec709(observed) if gamut_map else observed
+
+
+def doppler_lut_log10_d_grid(size: int = 2048, log10_d_range=DOPPLER_LUT_LOG10_D_RANGE):
+    """Evenly spaced ``log10 D`` grid for :func:`doppler_matrix_lut` (default 0.01 to 100)."""
+
+    return np.linspace(log10_d_range[0], log10_d_range[1], int(size))
+
+
+def doppler_matrix_lut(log10_d_grid=None) -> np.ndarray:
+    """Doppler matrix table for the shader, float32, flat, ``12 * N`` values.
+
+    Layout: an ``N x 3`` (width x height) RGBA float image in Blender ``Image.pixels`` order
+    (rows bottom to top, RGBA per pixel). Column ``j`` is ``D_j = 10 ** log10_d_grid[j]``; row
+    ``i`` is row ``i`` of the matrix, ``M(D) = N(D) exp(a(D))``:
+
+        pixels[4 (i N + j) + k] = N(D_j)[i, k]      k = 0, 1, 2
+        pixels[4 (i N + j) + 3] = a(D_j) = ln Y(M(D_j) (1, 1, 1))   (same in the three rows)
+
+    ``exp(a)`` is the luminance of white seen at ``D`` (white at rest has ``Y = 1``), and ``N`` is
+    ``M`` divided by it: the entries of ``M`` span ~1e-126 to ~1e3 over D in [0.01, 100], beyond
+    float32, while ``N`` is of order 1 and ``a`` lies in about [-290, 7.3]. Interpolate all
+    channels linearly in ``log10 D`` and clamp at the ends (image texture, *Linear*, *Extend*,
+    ``u = (j + 0.5) / N``, ``v = (i + 0.5) / 3``); :func:`sample_doppler_matrix_lut` is the
+    reference. In the shader: ``rgb_obs = gamut_map(exp(a) * N rgb)``.
+    """
+
+    if log10_d_grid is None:
+        log10_d_grid = doppler_lut_log10_d_grid()
+    log10_d_grid = _validated_finite(log10_d_grid, "log10_d_grid")
+    matrices = doppler_rgb_matrix(10.0**log10_d_grid)
+    white_luminance = luminance_linear_rec709(matrices.sum(axis=-1))
+    if not np.all(white_luminance > 0):
+        bad = 10.0 ** log10_d_grid[~(white_luminance > 0)]
+        raise ValueError(
+            f"doppler_matrix_lut: white underflows to black at D = {bad.min():.4g}; "
+            "use a narrower log10_d_grid"
+        )
+    normalised = matrices / white_luminance[..., None, None]  # (N, 3, 3)
+    log_scale = np.broadcast_to(np.log(white_luminance)[:, None, None], (len(log10_d_grid), 3, 1))
+    pixels = np.concatenate([normalised, log_scale], axis=-1)  # (N, row i, 4)
+    return np.ascontiguousarray(np.swapaxes(pixels, 0, 1)).astype(np.float32).ravel()
+
+
+def sample_doppler_matrix_lut(lut, log10_d_grid, doppler_factor) -> np.ndarray:
+    """``M(D)``, shape (..., 3, 3), read from :func:`doppler_matrix_lut` as the shader does it.
+
+    Linear interpolation in ``log10 D`` of ``N`` and of ``a = ln Y(white)``, clamped at the ends.
+    """
+
+    doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
+    size = len(log10_d_grid)
+    pixels = np.asarray(lut, dtype=np.float64).reshape(3, size, 4)
+    x = np.log10(doppler_factor)
+    sampled = np.stack(
+        [
+            np.stack([np.interp(x, log10_d_grid, pixels[i, :, k]) for k in range(4)], axis=-1)
+            for i in range(3)
+        ],
+        axis=-2,
+    )  # (..., 3, 4)
+    return sampled[..., :3] * np.exp(sampled[..., :1, 3:4])
