@@ -123,13 +123,25 @@ def _local_to_shader(vector):
 def camera_frame_window(scene, camera_data):
     """Image window of lens-centre rays on the plane at unit distance: left, right, bottom, top.
 
-    Taken from Blender's own view frame, so sensor fit, shift and aspect match the built-in
-    perspective camera.
+    Taken from Blender's own view frame, so sensor fit, aspect and lens shift match the
+    built-in perspective camera. Cycles already adds a lens shift to the raster position it
+    hands a custom camera, but scaled by the image's own width and height where Blender's
+    perspective camera scales both by the sensor-fit dimension (measured with Blender 5.0);
+    the window is offset so that the sum is the perspective camera's shift.
     """
     corners = camera_data.view_frame(scene=scene)
     xs = [corner.x / -corner.z for corner in corners]
     ys = [corner.y / -corner.z for corner in corners]
-    return min(xs), max(xs), min(ys), max(ys)
+    width = max(xs) - min(xs)
+    height = max(ys) - min(ys)
+    offset_x = (max(xs) + min(xs)) / 2.0 - camera_data.shift_x * width
+    offset_y = (max(ys) + min(ys)) / 2.0 - camera_data.shift_y * height
+    return (
+        offset_x - width / 2.0,
+        offset_x + width / 2.0,
+        offset_y - height / 2.0,
+        offset_y + height / 2.0,
+    )
 
 
 def shader_parameters(scene, camera_object):
