@@ -308,7 +308,7 @@ def remove_relativistic_camera(scene, camera_object=None):
     camera_data.type = saved["type"]
     del camera_data[SAVED_STATE_KEY]
     text = bpy.data.texts.get(SHADER_TEXT_NAME)
-    if text is not None and text.users == 0:
+    if text is not None and not any(cam.custom_shader == text for cam in bpy.data.cameras):
         bpy.data.texts.remove(text)
     camera_data.update_tag()
     return True
