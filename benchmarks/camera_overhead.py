@@ -1,0 +1,85 @@
+"""Render time of the relativistic OSL camera against Blender's perspective camera.
+
+    python benchmarks/camera_overhead.py [--samples 32] [--resolution 320x240]
+
+Same lit scene, same seed, Cycles on the CPU; prints the times side by side and their ratio.
+At beta = 0 both cameras trace the same rays, so the ratio is the camera's own cost; at speed
+the view itself changes (more or less geometry in frame), which is not camera overhead.
+"""
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def build_scene(bpy, resolution, samples):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.location = (1.5, -6.0, 2.0)
+    camera.rotation_euler = (math.radians(75.0), 0.0, math.radians(20.0))
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    bpy.ops.mesh.primitive_plane_add(size=20.0)
+    bpy.ops.mesh.primitive_cube_add(size=1.5, location=(0.5, 0.0, 0.75))
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.7, location=(-1.5, 1.0, 0.7))
+    light = bpy.data.objects.new("Light", bpy.data.lights.new("Light", "POINT"))
+    light.data.energy = 800.0
+    light.location = (2.0, -2.0, 4.0)
+    scene.collection.objects.link(light)
+    return scene
+
+
+def timed_render(bpy, scene, path):
+    scene.render.filepath = path
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    return time.perf_counter() - start
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=32)
+    parser.add_argument("--resolution", default="320x240")
+    parser.add_argument("--repeats", type=int, default=2)
+    options = parser.parse_args()
+    resolution = tuple(int(v) for v in options.resolution.lower().split("x"))
+
+    import bpy
+
+    import relativity_addon
+    from relativity_addon.blender import camera
+
+    relativity_addon.register()
+    scene = build_scene(bpy, resolution, options.samples)
+    out = tempfile.mkdtemp(prefix="camera-overhead-")
+    results = {}
+    for label, beta in (("perspective", None), ("relativistic beta=0", (0, 0, 0)),
+                        ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13))):
+        if beta is None:
+            camera.remove_relativistic_camera(scene)
+        else:
+            scene.relativity.beta = beta
+            camera.apply_relativistic_camera(scene)
+        timed_render(bpy, scene, os.path.join(out, "warmup.png"))
+        results[label] = min(timed_render(bpy, scene, os.path.join(out, f"{i}.png")) for i in range(options.repeats))
+    base = results["perspective"]
+    print(f"{options.resolution}, {options.samples} samples, best of {options.repeats}:")
+    for label, seconds in results.items():
+        print(f"  {label:28s} {seconds:7.3f} s   ratio {seconds / base:5.3f}")
+
+
+if __name__ == "__main__":
+    main()
