@@ -1,0 +1,33 @@
+"""The spectral lookup tables shipped with the add-on, read without colour-science.
+
+Blender bundles numpy but not colour-science (nor the scipy it needs), so the tables that the
+shaders sample are computed once from :mod:`relativity_addon.physics.spectral` by
+``tools/build_luts.py`` and shipped as ``data/spectral_luts.npz``;
+``tests/physics/test_shipped_luts.py`` checks that the shipped file equals a fresh computation.
+Layouts: ``docs/spectral-model.md``.
+"""
+
+import functools
+import os
+
+import numpy as np
+
+LUT_PATH = os.path.join(os.path.dirname(__file__), "data", "spectral_luts.npz")
+
+
+@functools.lru_cache(maxsize=1)
+def _tables():
+    with np.load(LUT_PATH) as data:
+        return {name: data[name] for name in data.files}
+
+
+def doppler_matrix_lut():
+    """``(log10_d_grid, pixels)``: the Doppler-matrix table as float32 RGBA image pixels."""
+    tables = _tables()
+    return tables["doppler_log10_d_grid"], tables["doppler_matrix_lut"]
+
+
+def blackbody_rgb_lut():
+    """``(log10_t_grid, pixels)``: the blackbody table as float32 RGBA image pixels."""
+    tables = _tables()
+    return tables["blackbody_log10_t_grid"], tables["blackbody_rgb_lut"]

@@ -1,0 +1,58 @@
+"""Compute the spectral lookup tables with colour-science and write the file the add-on ships.
+
+    .venv/bin/python tools/build_luts.py            # writes relativity_addon/data/spectral_luts.npz
+    .venv/bin/python tools/build_luts.py --check    # exits 1 if the shipped file is stale
+"""
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from relativity_addon import lut_data  # noqa: E402
+from relativity_addon.physics import spectral  # noqa: E402
+
+
+def compute_tables():
+    d_grid = spectral.doppler_lut_log10_d_grid()
+    t_grid = spectral.blackbody_lut_log10_t_grid()
+    return {
+        "doppler_log10_d_grid": d_grid,
+        "doppler_matrix_lut": spectral.doppler_matrix_lut(d_grid),
+        "blackbody_log10_t_grid": t_grid,
+        "blackbody_rgb_lut": spectral.blackbody_rgb_lut(t_grid),
+    }
+
+
+def stale_tables(path=lut_data.LUT_PATH, rtol=1e-6):
+    """Names of the tables whose shipped values differ from a fresh computation."""
+    if not os.path.exists(path):
+        return ["(file missing)"]
+    fresh = compute_tables()
+    with np.load(path) as shipped:
+        return [name for name, values in fresh.items()
+                if name not in shipped.files or shipped[name].shape != values.shape
+                or not np.allclose(shipped[name], values, rtol=rtol, atol=0.0)]
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--check", action="store_true", help="only check that the shipped tables are current")
+    args = parser.parse_args(argv)
+    if args.check:
+        stale = stale_tables()
+        if stale:
+            print(f"stale spectral tables: {', '.join(stale)}; run tools/build_luts.py", file=sys.stderr)
+            return 1
+        print("spectral tables are current")
+        return 0
+    np.savez_compressed(lut_data.LUT_PATH, **compute_tables())
+    print(f"wrote {lut_data.LUT_PATH}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
