@@ -1,0 +1,142 @@
+"""Apparent positions (physics/apparent.py) against PHYSICS.md relations written out here."""
+
+import math
+
+import numpy as np
+import pytest
+
+from relativity_addon.physics import apparent
+
+RNG = np.random.default_rng(4)
+
+
+def light_cone_residual(x_o, tau, x_e, c):
+    """(|x_o - x_e| - c tau) / (c tau), tau = t_o - t_e: zero on the past light cone."""
+    distance = np.linalg.norm(x_o - x_e, axis=-1)
+    return (distance - c * tau) / (c * tau)
+
+
+def boost(t, x, beta, c):
+    """PHYSICS.md: x' = x + (gamma-1)(bhat.x) bhat - gamma beta c t, c t' = gamma (c t - beta.x)."""
+    beta = np.asarray(beta, float)
+    b2 = beta @ beta
+    g = 1.0 / math.sqrt(1.0 - b2)
+    bx = x @ beta
+    xp = x + ((g - 1.0) / b2 * bx - g * c * t)[:, None] * beta
+    return g * (c * t - bx) / c, xp
+
+
+@pytest.mark.parametrize("c", [1.0, 10.0, 299792458.0])
+def test_uniform_motion_lies_on_light_cone_and_matches_closed_form(c):
+    n = 500
+    t_o, x_o = 2.5, np.array([0.3, -1.0, 0.5])
+    p = RNG.normal(size=(n, 3)) * 5.0
+    u = RNG.normal(size=(n, 3))
+    u *= (RNG.uniform(0.0, 0.95, n) / np.linalg.norm(u, axis=1))[:, None]
+    result, tau, _ = apparent.apparent_positions_uniform(t_o, x_o, p, u, c)
+    x_e = p - (c * tau)[:, None] * u
+    np.testing.assert_allclose(result, x_e, rtol=0, atol=1e-12 * 5)
+    assert np.max(np.abs(light_cone_residual(x_o, tau, result, c))) < 1e-9
+    # Closed form of PHYSICS.md written out independently.
+    delta = x_o - p
+    uu = u * c
+    a = np.sum(delta * uu, 1)
+    b = c * c - np.sum(uu * uu, 1)
+    tau_expected = (a + np.sqrt(a * a + b * np.sum(delta * delta, 1))) / b
+    np.testing.assert_allclose(tau, tau_expected, rtol=1e-6)
+    # The general solver on the same world lines agrees with the closed form within 1e-6 relative.
+    general, tau_general, _ = apparent.apparent_positions(
+        lambda t, i: p[i] + ((t - t_o) * c)[:, None] * u[i], t_o, x_o, c, n)
+    np.testing.assert_allclose(tau_general, tau_expected, rtol=1e-6)
+    scale = np.linalg.norm(general - x_o, axis=1)
+    assert np.max(np.linalg.norm(general - result, axis=1) / scale) < 1e-6
+
+
+def test_moving_observer_sees_aberrated_direction_at_doppler_distance():
+    c = 3.0
+    beta = np.array([0.5, -0.3, 0.6])
+    x_o = np.array([1.0, 2.0, -0.5])
+    p = x_o + RNG.normal(size=(200, 3)) * 4.0
+    seen, tau, beta_seen = apparent.apparent_positions_uniform(1.0, x_o, p, np.zeros(3), c, beta)
+    r = np.linalg.norm(p - x_o, axis=1)
+    k = (x_o - p) / r[:, None]  # photon propagation direction, scene frame
+    g = 1.0 / math.sqrt(1.0 - beta @ beta)
+    bhat = beta / np.linalg.norm(beta)
+    k_prime = (k + (g - 1.0) * (k @ bhat)[:, None] * bhat - g * beta) / (g * (1.0 - k @ beta))[:, None]
+    r_seen = np.linalg.norm(seen - x_o, axis=1)
+    np.testing.assert_allclose((x_o - seen) / r_seen[:, None], k_prime, atol=1e-12)
+    doppler = g * (1.0 - k @ beta)
+    np.testing.assert_allclose(r_seen, doppler * r, rtol=1e-12)
+    np.testing.assert_allclose(tau, r / c, rtol=1e-12)
+    np.testing.assert_allclose(beta_seen, np.broadcast_to(-beta, (200, 3)), atol=1e-15)
+
+
+def test_moving_observer_equals_scene_moving_past_observer_at_rest():
+    """Seen from the camera frame, a static scene moves with -beta: solve the light cone there."""
+    c = 2.0
+    beta = np.array([0.0, 0.8, 0.1])
+    t_o, x_o = 0.7, np.array([0.5, 0.0, 1.0])
+    p = x_o + RNG.normal(size=(300, 3)) * 3.0
+    seen, _, _ = apparent.apparent_positions_uniform(t_o, x_o, p, np.zeros(3), c, beta)
+    # Camera-frame world lines of the scene points: x'(t') = x'_0 + (-beta c) t' after boosting the
+    # events (0, p - x_o); the light-cone equation is solved by fixed-point iteration.
+    t0p, x0p = boost(np.zeros(len(p)), p - x_o, beta, c)
+    tp = np.zeros(len(p))
+    for _ in range(400):
+        position = x0p + ((tp - t0p) * c)[:, None] * (-beta)
+        tp = -np.linalg.norm(position, axis=1) / c
+    position = x0p + ((tp - t0p) * c)[:, None] * (-beta)
+    np.testing.assert_allclose(seen - x_o, position, atol=1e-9)
+
+
+def rigid_wheel(omega, radius, centre_velocity, c):
+    def matrix(t):
+        a = omega * t
+        m = np.zeros(np.shape(t) + (4, 4))
+        m[..., 0, 0], m[..., 0, 1] = np.cos(a), -np.sin(a)
+        m[..., 1, 0], m[..., 1, 1] = np.sin(a), np.cos(a)
+        m[..., 2, 2] = m[..., 3, 3] = 1.0
+        m[..., :3, 3] = np.multiply.outer(t, centre_velocity)
+        return m
+    return matrix
+
+
+def test_sampled_rotating_wheel_satisfies_light_cone_with_exact_motion():
+    c, radius = 10.0, 1.0
+    omega = 0.9 * c / radius  # rim at 0.9 c (plus the centre's drift)
+    matrix = rigid_wheel(omega, radius, np.array([1.0, 0.0, 0.0]), c)
+    angles = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    local = np.stack([radius * np.cos(angles), radius * np.sin(angles), np.zeros_like(angles)], 1)
+    times = np.arange(-1.0, 0.6, 1.0 / 240.0)
+    motion = apparent.SampledRigidMotion(times, matrix(times), local)
+    t_o, x_o = 0.5, np.array([0.0, -3.0, 1.0])
+    seen, tau, beta_seen = apparent.apparent_positions(
+        motion.positions, t_o, x_o, c, len(local), velocity=motion.velocities)
+    t_e = t_o - tau
+    exact = np.einsum("nij,nj->ni", matrix(t_e)[:, :3, :3], local) + matrix(t_e)[:, :3, 3]
+    assert np.max(np.abs(light_cone_residual(x_o, tau, exact, c))) < 1e-6
+    assert np.max(np.linalg.norm(seen - exact, axis=1) / (c * tau)) < 1e-6
+    # Rim speed measured from the motion: |omega x r + v| / c.
+    expected_velocity = np.stack([-omega * (exact[:, 1] - 0.0), omega * (exact[:, 0] - t_e * 1.0),
+                                  np.zeros_like(t_e)], 1) + np.array([1.0, 0.0, 0.0])
+    # Velocities (for the Doppler shaders) come from the cubic's slope: 1e-3 of c is plenty.
+    np.testing.assert_allclose(beta_seen, expected_velocity / c, atol=1e-3)
+    assert np.max(np.linalg.norm(beta_seen, axis=1)) < 1.0
+
+
+def test_velocity_seen_by_moving_observer_is_relativistic_difference():
+    observer = np.array([0.6, 0.0, 0.0])
+    point = np.array([[0.6, 0.0, 0.0], [-0.6, 0.0, 0.0], [0.0, 0.5, 0.0]])
+    seen = apparent.velocity_seen_by_observer(point, observer)
+    np.testing.assert_allclose(seen[0], 0.0, atol=1e-15)
+    np.testing.assert_allclose(seen[1], [-1.2 / 1.36, 0.0, 0.0], rtol=1e-12)
+    # Transverse: u'_y = u_y / (gamma (1 - v u_x)), u'_x = -v.
+    np.testing.assert_allclose(seen[2], [-0.6, 0.5 * 0.8, 0.0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("bad", [(1.0, 0.0, 0.0), (float("nan"), 0.0, 0.0)])
+def test_bad_velocities_raise(bad):
+    with pytest.raises(ValueError):
+        apparent.apparent_positions_uniform(0.0, np.zeros(3), np.ones((2, 3)), np.zeros(3), 1.0, bad)
+    with pytest.raises(ValueError):
+        apparent.apparent_positions_uniform(0.0, np.zeros(3), np.ones((2, 3)), bad, 1.0)
