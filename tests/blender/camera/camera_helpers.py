@@ -260,3 +260,19 @@ def centroid(intensity, center, half_window):
         return None, 0.0
     ys, xs = np.mgrid[y0:y1, x0:x1]
     return np.array([((xs + 0.5) * patch).sum() / total, ((ys + 0.5) * patch).sum() / total]), total
+
+
+def rms_radius(intensity, center, half_window):
+    """RMS distance (pixels) of the intensity from ``center``, within a square window around it:
+    the square root of the intensity-weighted second moment, a size measure of a spot."""
+    height, width = intensity.shape
+    cx, cy = int(round(center[0])), int(round(center[1]))
+    x0, x1 = max(cx - half_window, 0), min(cx + half_window + 1, width)
+    y0, y1 = max(cy - half_window, 0), min(cy + half_window + 1, height)
+    patch = intensity[y0:y1, x0:x1]
+    total = patch.sum()
+    if total <= 0.0:
+        return float("nan")
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    squared = (xs + 0.5 - center[0]) ** 2 + (ys + 0.5 - center[1]) ** 2
+    return math.sqrt((squared * patch).sum() / total)
