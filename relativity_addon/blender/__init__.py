@@ -11,6 +11,8 @@ import importlib
 _MODULES = (
     "props",
     "camera",
+    "objects",
+    "geometry",
 )
 
 

@@ -1,0 +1,484 @@
+"""Apparent geometry of moving objects: a geometry-nodes modifier fed by a per-object cache.
+
+Route (DESIGN-NOTES.md, "Feeding Python-computed positions to geometry nodes"):
+
+1. The add-on's modifier (node group ``Relativity Apparent Geometry``) subdivides the mesh, stores
+   the tessellated rest positions in the point attribute ``relativity_rest``, then sets the
+   positions sampled by index from a cache mesh object, but only when the point counts match.
+2. ``update_object`` reads ``relativity_rest`` from the *evaluated* mesh (stored before Set
+   Position, so the output never feeds back), computes apparent positions with numpy
+   (``physics/apparent.py``) and writes them, with the point velocities relative to the observer
+   (attribute ``relativity_beta``, for the Doppler shaders), into the cache mesh.
+3. A persistent ``frame_change_post`` handler does that for every frame, and a
+   ``depsgraph_update_post`` handler whenever an input (observer velocity, c, camera or object
+   transform, object settings) changed: the result depends only on the scene state at the frame.
+
+The cache object is not linked into any scene; the modifier holds the only user, so it is saved
+with the .blend and a render farm worker needs nothing else. Removing the effect removes the
+modifier, the cache and (when unused) the node group: the original mesh data is never written.
+
+Frames: the scene frame is the observer's frame S only when ``scene.relativity.beta`` is zero.
+The mesh path renders in the camera's frame (axes parallel to world): an object at rest in the
+scene appears moving with ``-beta``.
+"""
+
+import math
+
+import bpy
+import numpy as np
+from bpy.app.handlers import persistent
+
+from ..physics import apparent
+from .camera import RelativityError
+
+NODE_GROUP_NAME = "Relativity Apparent Geometry"
+MODIFIER_NAME = "Relativity Apparent Geometry"
+REST_ATTRIBUTE = "relativity_rest"
+BETA_ATTRIBUTE = "relativity_beta"
+CACHE_PREFIX = "RelativityCache"
+SIGNATURE_KEY = "relativity_signature"
+# The node group's interface: (name, socket type, in/out). Builder and modifier use these names.
+INTERFACE = (
+    ("Geometry", "NodeSocketGeometry", "INPUT"),
+    ("Tessellation", "NodeSocketInt", "INPUT"),
+    ("Cache", "NodeSocketObject", "INPUT"),
+    ("Geometry", "NodeSocketGeometry", "OUTPUT"),
+)
+# Bump when the tree below changes: an older group in a file is rebuilt.
+NODE_GROUP_VERSION = 1
+
+
+# --- node group ------------------------------------------------------------------------------
+
+# Declarative description of the tree: nodes (key, type, properties, input defaults) and links
+# ((from key, output socket), (to key, input socket)). Socket names pick the first available one.
+_NODES = (
+    ("input", "NodeGroupInput", {}, {}),
+    ("output", "NodeGroupOutput", {}, {}),
+    ("subdivide", "GeometryNodeSubdivideMesh", {}, {}),
+    ("position", "GeometryNodeInputPosition", {}, {}),
+    ("store_rest", "GeometryNodeStoreNamedAttribute",
+     {"data_type": "FLOAT_VECTOR", "domain": "POINT"}, {"Name": REST_ATTRIBUTE}),
+    ("cache_info", "GeometryNodeObjectInfo", {"transform_space": "ORIGINAL"}, {}),
+    ("cache_size", "GeometryNodeAttributeDomainSize", {"component": "MESH"}, {}),
+    ("mesh_size", "GeometryNodeAttributeDomainSize", {"component": "MESH"}, {}),
+    ("counts_match", "FunctionNodeCompare", {"data_type": "INT", "operation": "EQUAL"}, {}),
+    ("index", "GeometryNodeInputIndex", {}, {}),
+    ("sample_position", "GeometryNodeSampleIndex", {"data_type": "FLOAT_VECTOR", "domain": "POINT"}, {}),
+    ("cache_beta", "GeometryNodeInputNamedAttribute", {"data_type": "FLOAT_VECTOR"}, {"Name": BETA_ATTRIBUTE}),
+    ("sample_beta", "GeometryNodeSampleIndex", {"data_type": "FLOAT_VECTOR", "domain": "POINT"}, {}),
+    ("set_position", "GeometryNodeSetPosition", {}, {}),
+    ("store_beta", "GeometryNodeStoreNamedAttribute",
+     {"data_type": "FLOAT_VECTOR", "domain": "POINT"}, {"Name": BETA_ATTRIBUTE}),
+)
+_LINKS = (
+    (("input", "Geometry"), ("subdivide", "Mesh")),
+    (("input", "Tessellation"), ("subdivide", "Level")),
+    (("subdivide", "Mesh"), ("store_rest", "Geometry")),
+    (("position", "Position"), ("store_rest", "Value")),
+    (("input", "Cache"), ("cache_info", "Object")),
+    (("cache_info", "Geometry"), ("cache_size", "Geometry")),
+    (("store_rest", "Geometry"), ("mesh_size", "Geometry")),
+    (("cache_size", "Point Count"), ("counts_match", "A")),
+    (("mesh_size", "Point Count"), ("counts_match", "B")),
+    (("cache_info", "Geometry"), ("sample_position", "Geometry")),
+    (("position", "Position"), ("sample_position", "Value")),
+    (("index", "Index"), ("sample_position", "Index")),
+    (("cache_info", "Geometry"), ("sample_beta", "Geometry")),
+    (("cache_beta", "Attribute"), ("sample_beta", "Value")),
+    (("index", "Index"), ("sample_beta", "Index")),
+    (("store_rest", "Geometry"), ("set_position", "Geometry")),
+    (("counts_match", "Result"), ("set_position", "Selection")),
+    (("sample_position", "Value"), ("set_position", "Position")),
+    (("set_position", "Geometry"), ("store_beta", "Geometry")),
+    (("counts_match", "Result"), ("store_beta", "Selection")),
+    (("sample_beta", "Value"), ("store_beta", "Value")),
+    (("store_beta", "Geometry"), ("output", "Geometry")),
+)
+
+
+def _socket(sockets, name):
+    for socket in sockets:
+        if socket.name == name and getattr(socket, "enabled", True) and not getattr(socket, "is_unavailable", False):
+            return socket
+    raise KeyError(f"no available socket {name!r}")
+
+
+def build_node_group():
+    """The add-on's node group, built from ``_NODES``/``_LINKS`` (rebuilt if outdated)."""
+    group = bpy.data.node_groups.get(NODE_GROUP_NAME)
+    if group is not None and group.get("relativity_version") == NODE_GROUP_VERSION:
+        return group
+    if group is None:
+        group = bpy.data.node_groups.new(NODE_GROUP_NAME, "GeometryNodeTree")
+    group.nodes.clear()
+    group.interface.clear()
+    for name, socket_type, in_out in INTERFACE:
+        socket = group.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+        if name == "Tessellation":
+            socket.min_value, socket.max_value, socket.default_value = 0, 6, 1
+    nodes = {}
+    for column, (key, node_type, properties, defaults) in enumerate(_NODES):
+        node = group.nodes.new(node_type)
+        node.name = node.label = key
+        node.location = (200.0 * column, 0.0)
+        for attribute, value in properties.items():
+            setattr(node, attribute, value)
+        for socket_name, value in defaults.items():
+            _socket(node.inputs, socket_name).default_value = value
+        nodes[key] = node
+    for (from_key, from_name), (to_key, to_name) in _LINKS:
+        group.links.new(_socket(nodes[from_key].outputs, from_name), _socket(nodes[to_key].inputs, to_name))
+    group["relativity_version"] = NODE_GROUP_VERSION
+    return group
+
+
+def _input_identifier(group, name):
+    for item in group.interface.items_tree:
+        if item.item_type == "SOCKET" and item.in_out == "INPUT" and item.name == name:
+            return item.identifier
+    raise KeyError(name)
+
+
+# --- modifier and cache ----------------------------------------------------------------------
+
+
+def find_modifier(obj):
+    for modifier in obj.modifiers:
+        if modifier.type == "NODES" and modifier.node_group is not None and modifier.node_group.name == NODE_GROUP_NAME:
+            return modifier
+    return None
+
+
+def cache_object(obj):
+    modifier = find_modifier(obj)
+    if modifier is None:
+        return None
+    return modifier.get(_input_identifier(modifier.node_group, "Cache"))
+
+
+def _ensure_modifier(obj):
+    group = build_node_group()
+    modifier = find_modifier(obj)
+    if modifier is None:
+        modifier = obj.modifiers.new(MODIFIER_NAME, "NODES")
+        modifier.node_group = group
+    cache = cache_object(obj)
+    if cache is None:
+        mesh = bpy.data.meshes.new(f"{CACHE_PREFIX} {obj.name}")
+        cache = bpy.data.objects.new(f"{CACHE_PREFIX} {obj.name}", mesh)
+        modifier[_input_identifier(group, "Cache")] = cache
+    identifier = _input_identifier(group, "Tessellation")
+    if modifier.get(identifier) != int(obj.relativity.tessellation):
+        modifier[identifier] = int(obj.relativity.tessellation)
+    return modifier, cache
+
+
+def applied_objects(scene):
+    return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None]
+
+
+def _remove_object_effect(obj):
+    modifier = find_modifier(obj)
+    if modifier is None:
+        return False
+    cache = cache_object(obj)
+    obj.modifiers.remove(modifier)
+    if cache is not None:
+        mesh = cache.data
+        bpy.data.objects.remove(cache)
+        if mesh is not None and mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    return True
+
+
+# --- inputs ----------------------------------------------------------------------------------
+
+
+def _finite_velocity(beta, what):
+    beta = tuple(float(b) for b in beta)
+    if not all(math.isfinite(b) for b in beta):
+        raise RelativityError(f"{what} is not a finite vector")
+    speed = math.sqrt(sum(b * b for b in beta))
+    if speed >= 1.0:
+        raise RelativityError(f"{what}: speed |beta| = {speed:.6g} must be below 1 (the speed of light)")
+    return np.array(beta)
+
+
+def observer_event(scene):
+    """(t_o seconds, camera world position, observer beta, c) from the scene; RelativityError if invalid."""
+    settings = scene.relativity
+    c = float(settings.speed_of_light)
+    if not (math.isfinite(c) and c > 0.0):
+        raise RelativityError("speed of light must be a positive finite number")
+    beta = _finite_velocity(settings.beta, "observer velocity beta")
+    camera = scene.camera
+    if camera is None:
+        raise RelativityError(f"scene {scene.name!r} has no active camera")
+    fps = scene.render.fps / scene.render.fps_base
+    t_o = (scene.frame_current + scene.frame_subframe) / fps
+    return t_o, np.array(camera.matrix_world.translation, dtype=np.float64), beta, c
+
+
+def _matrix_array(matrix):
+    return np.array([list(row) for row in matrix], dtype=np.float64)
+
+
+def _channelbag(obj):
+    from bpy_extras import anim_utils
+
+    animation = obj.animation_data
+    if animation is None or animation.action is None:
+        return None
+    return anim_utils.action_get_channelbag_for_slot(animation.action, animation.action_slot)
+
+
+class _TransformAnimation:
+    """The object's keyframed transform (F-curves of its action), evaluated without frame_set.
+
+    Covers location, rotation (Euler, quaternion, axis-angle) and scale; the parent chain (and
+    the parent inverse) is taken as it is at the current frame. Constraints and drivers are not
+    evaluated at other times.
+    """
+
+    def __init__(self, obj):
+        self.obj = obj
+        channelbag = _channelbag(obj)
+        curves = {}
+        if channelbag is not None:
+            for fcurve in channelbag.fcurves:
+                curves[(fcurve.data_path, fcurve.array_index)] = fcurve
+        self.curves = curves
+        self.parent = _matrix_array(obj.matrix_world) @ np.linalg.inv(_matrix_array(obj.matrix_basis))
+
+    def _values(self, path, count, frame):
+        current = getattr(self.obj, path)
+        return [self.curves[(path, i)].evaluate(frame) if (path, i) in self.curves else current[i] for i in range(count)]
+
+    def matrices(self, frames):
+        from mathutils import Euler, Matrix, Quaternion, Vector
+
+        obj = self.obj
+        result = np.empty((len(frames), 4, 4))
+        for k, frame in enumerate(frames):
+            location = Vector(self._values("location", 3, frame))
+            scale = Vector(self._values("scale", 3, frame))
+            mode = obj.rotation_mode
+            if mode == "QUATERNION":
+                rotation = Quaternion(self._values("rotation_quaternion", 4, frame)).normalized()
+            elif mode == "AXIS_ANGLE":
+                angle, *axis = self._values("rotation_axis_angle", 4, frame)
+                rotation = Quaternion(axis, angle)
+            else:
+                rotation = Euler(self._values("rotation_euler", 3, frame), mode).to_quaternion()
+            result[k] = _matrix_array(Matrix.LocRotScale(location, rotation, scale))
+        return self.parent @ result
+
+
+def _evaluated_rest_positions(obj, depsgraph):
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        attribute = mesh.attributes.get(REST_ATTRIBUTE)
+        if attribute is None:
+            return None
+        rest = np.empty(len(attribute.data) * 3, dtype=np.float32)
+        attribute.data.foreach_get("vector", rest)
+    finally:
+        obj_eval.to_mesh_clear()
+    return rest.reshape(-1, 3).astype(np.float64)
+
+
+def _to_world(matrix, points):
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4):
+    """Apparent world positions and beta of an ANIMATION object (rigid keyframed transform)."""
+    fps = scene.render.fps / scene.render.fps_base
+    animation = _TransformAnimation(obj)
+    samples_per_frame = int(obj.relativity.samples_per_frame)
+    step = 1.0 / (samples_per_frame * fps)
+    world_now = _to_world(_matrix_array(obj.matrix_world), rest_local)
+    reach = float(np.max(np.linalg.norm(world_now - world_now.mean(0), axis=1))) if len(world_now) else 0.0
+    centre_tau = float(np.linalg.norm(x_o - world_now.mean(0))) / c if len(world_now) else 0.0
+    low, high = t_o - centre_tau - 2.0 * reach / c - 2 * step, t_o - centre_tau + 2.0 * reach / c + 2 * step
+    for _ in range(max_tries):
+        low_index, high_index = math.floor(low / step) - 2, math.ceil(high / step) + 2
+        if high_index - low_index > 200000:
+            raise RelativityError(f"object {obj.name!r}: light-travel times span too many animation samples")
+        times = np.arange(low_index, high_index + 1) * step
+        motion = apparent.SampledRigidMotion(times, animation.matrices(times * fps), rest_local)
+        result = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(rest_local), beta_o,
+                                             velocity=motion.velocities)
+        t_e = t_o - result[1]
+        if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
+            return result
+        margin = 4 * step
+        low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)
+    raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
+
+
+def object_signature(scene, obj):
+    settings, relativity = scene.relativity, obj.relativity
+    camera = scene.camera
+    parts = [
+        scene.frame_current, scene.frame_subframe, settings.speed_of_light, tuple(settings.beta),
+        camera.name if camera else "", tuple(map(tuple, camera.matrix_world)) if camera else (),
+        tuple(map(tuple, obj.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
+        relativity.tessellation, relativity.samples_per_frame, scene.render.fps, scene.render.fps_base,
+    ]
+    return repr(parts)
+
+
+def update_object(scene, obj, depsgraph=None):
+    """Recompute the cache of one object for the scene's current frame. Raises RelativityError."""
+    modifier, cache = _ensure_modifier(obj)
+    enabled = bool(obj.relativity.enabled)
+    if modifier.show_viewport != enabled or modifier.show_render != enabled:
+        modifier.show_viewport = modifier.show_render = enabled
+    if depsgraph is None:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+    rest = _evaluated_rest_positions(obj, depsgraph)
+    if rest is None:
+        raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {REST_ATTRIBUTE!r} attribute")
+    t_o, x_o, beta_o, c = observer_event(scene)
+    matrix_now = _matrix_array(obj.matrix_world)
+    motion = obj.relativity.motion
+    if motion == "ANIMATION":
+        world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c)
+    else:
+        beta_u = _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity") if motion == "CONSTANT" else np.zeros(3)
+        world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, _to_world(matrix_now, rest), beta_u, c, beta_o)
+    local = _to_world(np.linalg.inv(matrix_now), world)
+    _write_cache(cache.data, local, beta_seen)
+    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
+    obj.update_tag()
+    return len(local)
+
+
+def _write_cache(mesh, positions, beta):
+    count = len(positions)
+    if len(mesh.vertices) != count:
+        mesh.clear_geometry()
+        mesh.vertices.add(count)
+    mesh.vertices.foreach_set("co", np.ascontiguousarray(positions, dtype=np.float32).ravel())
+    attribute = mesh.attributes.get(BETA_ATTRIBUTE)
+    if attribute is None:
+        attribute = mesh.attributes.new(BETA_ATTRIBUTE, "FLOAT_VECTOR", "POINT")
+    attribute.data.foreach_set("vector", np.ascontiguousarray(beta, dtype=np.float32).ravel())
+    mesh.update()
+
+
+def update_object_if_applied(scene, obj):
+    """Property-update entry point: never raises (the viewport keeps the last valid state)."""
+    if obj.type != "MESH" or find_modifier(obj) is None:
+        return
+    try:
+        update_object(scene, obj)
+    except RelativityError as error:
+        print(f"Relativity: {error}")
+
+
+def update_scene(scene, depsgraph=None, only_changed=False):
+    """Recompute every object carrying the modifier. Returns the number of objects updated."""
+    updated = 0
+    for obj in applied_objects(scene):
+        cache = cache_object(obj)
+        if only_changed and cache is not None and cache.data is not None and \
+                cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj):
+            continue
+        update_object(scene, obj, depsgraph)
+        updated += 1
+    return updated
+
+
+# --- public API ------------------------------------------------------------------------------
+
+
+def apply_apparent_geometry(scene, objects=None):
+    """Add the apparent-geometry modifier to ``objects`` (default: every mesh of the scene whose
+    ``relativity.enabled`` is on) and compute the current frame. Returns the objects.
+
+    Raises RelativityError (one line) if the scene or an object's settings are invalid; nothing
+    is changed in that case.
+    """
+    observer_event(scene)
+    if objects is None:
+        objects = [obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled]
+    for obj in objects:
+        if obj.relativity.motion == "CONSTANT":
+            _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
+    try:
+        for obj in objects:
+            _ensure_modifier(obj)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        for obj in objects:
+            update_object(scene, obj, depsgraph)
+    except RelativityError:
+        for obj in objects:
+            _remove_object_effect(obj)
+        _remove_unused_group()
+        raise
+    return list(objects)
+
+
+def _remove_unused_group():
+    group = bpy.data.node_groups.get(NODE_GROUP_NAME)
+    if group is not None and group.users == 0:
+        bpy.data.node_groups.remove(group)
+
+
+def remove_apparent_geometry(scene, objects=None):
+    """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
+    objects = applied_objects(scene) if objects is None else objects
+    restored = [obj for obj in objects if _remove_object_effect(obj)]
+    _remove_unused_group()
+    return restored
+
+
+# --- handlers --------------------------------------------------------------------------------
+
+
+@persistent
+def _frame_change_post(scene, depsgraph=None):
+    try:
+        update_scene(scene, depsgraph)
+    except RelativityError as error:
+        print(f"Relativity: {error}")
+
+
+_busy = False
+
+
+@persistent
+def _depsgraph_update_post(scene, depsgraph=None):
+    """Recompute objects whose inputs changed (observer velocity, camera, transforms)."""
+    global _busy
+    if _busy:
+        return
+    _busy = True
+    try:
+        update_scene(scene, None, only_changed=True)
+    except RelativityError as error:
+        print(f"Relativity: {error}")
+    finally:
+        _busy = False
+
+
+_HANDLERS = (
+    (bpy.app.handlers.frame_change_post, _frame_change_post),
+    (bpy.app.handlers.depsgraph_update_post, _depsgraph_update_post),
+)
+
+
+def register():
+    for handlers, handler in _HANDLERS:
+        if handler not in handlers:
+            handlers.append(handler)
+
+
+def unregister():
+    for handlers, handler in _HANDLERS:
+        if handler in handlers:
+            handlers.remove(handler)

@@ -1,0 +1,86 @@
+"""Per-object settings of the apparent-geometry path: ``bpy.types.Object.relativity``.
+
+Saved with the .blend and animatable. Changing a setting recomputes the object's apparent
+positions for the current frame at once (see ``geometry.py``), so the viewport follows.
+"""
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
+
+MOTION_ITEMS = (
+    ("STATIC", "Static", "At rest in the scene (still seen moving when the observer moves)"),
+    ("CONSTANT", "Constant Velocity", "Uniform motion with the velocity below (world axes, fraction of c); "
+     "the object is where Blender draws it at the current frame"),
+    ("ANIMATION", "Animation", "The object's own keyframed transform, evaluated at each vertex's retarded time"),
+)
+
+
+def _settings_changed(self, context):
+    from . import geometry
+
+    obj = self.id_data
+    scene = context.scene if context is not None and context.scene is not None else None
+    if scene is not None:
+        geometry.update_object_if_applied(scene, obj)
+
+
+class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
+    enabled: BoolProperty(
+        name="Apparent Geometry",
+        description="Deform this mesh to where the observer sees it (light-travel time, observer boost)",
+        default=True,
+        update=_settings_changed,
+    )
+    motion: EnumProperty(
+        name="Motion",
+        description="Where the object's world line comes from",
+        items=MOTION_ITEMS,
+        default="STATIC",
+        update=_settings_changed,
+    )
+    beta: FloatVectorProperty(
+        name="Velocity (c)",
+        description="Constant velocity in world coordinates as a fraction of c; |beta| < 1",
+        size=3,
+        subtype="XYZ",
+        default=(0.0, 0.0, 0.0),
+        soft_min=-0.999,
+        soft_max=0.999,
+        update=_settings_changed,
+    )
+    temperature: FloatProperty(
+        name="Blackbody Temperature",
+        description="Emitter temperature in kelvin for Doppler-shifted blackbody emission (0: not an emitter)",
+        default=0.0,
+        min=0.0,
+        soft_max=40000.0,
+        subtype="TEMPERATURE",
+        update=_settings_changed,
+    )
+    tessellation: IntProperty(
+        name="Tessellation",
+        description="Subdivision levels added before deforming (straight edges can look curved)",
+        default=1,
+        min=0,
+        max=6,
+        update=_settings_changed,
+    )
+    samples_per_frame: IntProperty(
+        name="Samples per Frame",
+        description="Animation samples per frame used to interpolate the motion at retarded times",
+        default=8,
+        min=1,
+        max=256,
+        update=_settings_changed,
+    )
+
+
+classes = (RELATIVITY_PG_object_settings,)
+
+
+def register():
+    bpy.types.Object.relativity = PointerProperty(type=RELATIVITY_PG_object_settings)
+
+
+def unregister():
+    del bpy.types.Object.relativity
