@@ -2,11 +2,16 @@
 
     python examples/render.py scene.blend --beta=0,0.9,0 --out out/frame.exr
     blender -b scene.blend --python examples/render.py -- --beta=0,0.9,0 --out out/frame.png
+    python examples/render.py flythrough.blend --frames 1-24 --velocity-from-animation --out out/fly.png
 
-Options: --beta=X,Y,Z (world axes, fraction of c), --method camera|geometry, --samples N,
---resolution WxH, --out PATH (.png, or .exr for linear float), --no-doppler, --no-searchlight,
---shutter MODEL, --shutter-time S, --lorentz-window, --frame N, --seed N, --reference (render the
-file's own camera unchanged). Exits non-zero with a one-line reason on any failure.
+Options: --beta=X,Y,Z (world axes, fraction of c), --velocity-from-animation (the active camera's
+keyframed motion; refused with the frame number if it reaches c), --method camera|geometry,
+--samples N, --resolution WxH, --out PATH (.png, or .exr for linear float), --no-doppler,
+--no-searchlight, --shutter MODEL, --shutter-time S, --lorentz-window, --speed-of-light C,
+--frame N or --frames A-B (several frames: the frame number goes before the extension,
+out/fly_0001.png, or replaces a run of '#' in PATH), --seed N, --reference (render the file's own
+camera unchanged). Prints one progress line per frame with the time left. Exits non-zero with a
+one-line reason on any failure.
 """
 
 import os

@@ -52,6 +52,18 @@ def _positive_int(text):
     return value
 
 
+def _frame_range(text):
+    import re
+
+    match = re.fullmatch(r"\s*(-?\d+)\s*-\s*(-?\d+)\s*", text)
+    if not match:
+        raise argparse.ArgumentTypeError(f"expected FIRST-LAST, got {text!r}")
+    first, last = int(match.group(1)), int(match.group(2))
+    if last < first:
+        raise argparse.ArgumentTypeError(f"last frame before first in {text!r}")
+    return first, last
+
+
 SHUTTER_CHOICES = (
     "pinhole",
     "aperture_plane",
@@ -84,17 +96,22 @@ def build_parser(with_blend_file):
     parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
     parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
     parser.add_argument("--speed-of-light", type=float, help="scene units per second")
-    parser.add_argument("--frame", type=int)
+    frames = parser.add_mutually_exclusive_group()
+    frames.add_argument("--frame", type=int, help="render this frame (default: the file's current frame)")
+    frames.add_argument("--frames", type=_frame_range, help="render frames A-B (inclusive); the frame "
+                        "number is inserted before the extension of --out, or replaces a run of '#'")
+    parser.add_argument("--velocity-from-animation", action="store_true",
+                          help="observer velocity from the active camera's keyframed motion")
     parser.add_argument("--seed", type=int)
     return parser
 
 
-def _running_inside_blender():
-    return "--python" in sys.argv or "-P" in sys.argv or "--python-expr" in sys.argv
+def _running_inside_blender(argv):
+    return "--python" in argv or "-P" in argv or "--python-expr" in argv
 
 
 def _split_argv(argv):
-    if _running_inside_blender():
+    if _running_inside_blender(argv):
         return (argv[argv.index("--") + 1:] if "--" in argv else []), False
     return argv[1:], True
 
@@ -123,9 +140,14 @@ def enable_addon():
 def _apply_options(scene, options):
     settings = scene.relativity
     if options.beta is not None:
+        if options.velocity_from_animation:
+            raise BatchError("give either --beta or --velocity-from-animation, not both")
         if not all(math.isfinite(b) for b in options.beta):
             raise BatchError("--beta must be finite")
+        settings.velocity_source = "MANUAL"
         settings.beta = options.beta
+    if options.velocity_from_animation:
+        settings.velocity_source = "CAMERA_ANIMATION"
     settings.method = options.method.upper()
     if options.shutter:
         settings.shutter_model = options.shutter.upper()
@@ -143,7 +165,7 @@ def _apply_options(scene, options):
         settings.use_lorentz_window = True
 
 
-def _output_settings(scene, out_path):
+def _output_format(scene, out_path):
     extension = os.path.splitext(out_path)[1].lower()
     image_settings = scene.render.image_settings
     if extension == ".png":
@@ -155,11 +177,64 @@ def _output_settings(scene, out_path):
         image_settings.color_mode = "RGBA"
     else:
         raise BatchError(f"--out must end in .png or .exr, got {out_path!r}")
-    scene.render.filepath = out_path
     scene.render.use_file_extension = False
 
 
-def run(argv):
+def frame_output_path(out_path, frame, several):
+    """The file for ``frame``: a run of '#' becomes the zero-padded frame number; otherwise,
+    when several frames are rendered, ``_NNNN`` is inserted before the extension."""
+    import re
+
+    directory, name = os.path.split(out_path)
+    run = re.search(r"#+", name)
+    if run:
+        width = len(run.group(0))
+        number = f"-{abs(frame):0{max(width - 1, 1)}d}" if frame < 0 else f"{frame:0{width}d}"
+        return os.path.join(directory, name[:run.start()] + number + name[run.end():])
+    if not several:
+        return out_path
+    stem, extension = os.path.splitext(name)
+    number = f"-{abs(frame):03d}" if frame < 0 else f"{frame:04d}"
+    return os.path.join(directory, f"{stem}_{number}{extension}")
+
+
+def _frames(scene, options):
+    if options.frames is not None:
+        first, last = options.frames
+        return list(range(first, last + 1))
+    if options.frame is not None:
+        return [options.frame]
+    return [scene.frame_current]
+
+
+def _format_seconds(seconds):
+    if seconds < 60.0:
+        return f"{seconds:.1f} s"
+    minutes, seconds = divmod(int(round(seconds)), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
+
+
+def _render_frame(bpy, scene, frame, path, relativistic):
+    scene.frame_set(frame)
+    scene.render.filepath = path
+    if os.path.exists(path):
+        os.remove(path)
+    try:
+        bpy.ops.render.render(write_still=True)
+    except RuntimeError as error:
+        raise BatchError(f"render of frame {frame} failed: {str(error).strip().splitlines()[-1]}") from None
+    if relativistic and scene.relativity.method == "CAMERA":
+        cam = scene.camera.data
+        if not cam.cycles_custom.get("settings_valid", False):
+            raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
+    if not os.path.isfile(path):
+        raise BatchError(f"render wrote no file at {path}")
+
+
+def run(argv, log=print):
+    import time
+
     import bpy
 
     arguments, with_blend_file = _split_argv(argv)
@@ -174,11 +249,10 @@ def run(argv):
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}")
     enable_addon()
-    from .blender import camera
+    from .blender import camera, ops
 
     scene = bpy.context.scene
-    if options.frame is not None:
-        scene.frame_set(options.frame)
+    frames = _frames(scene, options)
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     if options.samples is not None:
@@ -188,39 +262,42 @@ def run(argv):
     if options.resolution is not None:
         scene.render.resolution_x, scene.render.resolution_y = options.resolution
         scene.render.resolution_percentage = 100
-    _output_settings(scene, out_path)
+    _output_format(scene, out_path)
 
-    if options.reference:
-        camera.remove_relativistic_camera(scene)
-        if scene.camera is None:
-            raise BatchError("scene has no active camera")
-    else:
-        _apply_options(scene, options)
-        try:
-            camera.apply_relativistic_camera(scene)
-        except camera.RelativityError as error:
-            raise BatchError(str(error)) from None
-
-    os.makedirs(os.path.dirname(out_path), exist_ok=True)
-    if os.path.exists(out_path):
-        os.remove(out_path)
+    relativistic = not options.reference
     try:
-        bpy.ops.render.render(write_still=True)
-    except RuntimeError as error:
-        raise BatchError(f"render failed: {str(error).strip().splitlines()[-1]}") from None
-    if not options.reference:
-        cam = scene.camera.data
-        if not cam.cycles_custom.get("settings_valid", False):
-            raise BatchError("relativistic camera became invalid during the render")
-    if not os.path.isfile(out_path):
-        raise BatchError(f"render wrote no file at {out_path}")
-    return out_path
+        if options.reference:
+            camera.remove_relativistic_camera(scene)
+            if scene.camera is None:
+                raise BatchError("scene has no active camera")
+        else:
+            _apply_options(scene, options)
+            scene.frame_set(frames[0])
+            ops.apply_effect(scene, frame_range=(frames[0], frames[-1]))
+    except camera.RelativityError as error:
+        raise BatchError(str(error)) from None
+
+    several = len(frames) > 1
+    paths = [frame_output_path(out_path, frame, several) for frame in frames]
+    os.makedirs(os.path.dirname(out_path), exist_ok=True)
+    started = time.monotonic()
+    for done, (frame, path) in enumerate(zip(frames, paths), start=1):
+        frame_started = time.monotonic()
+        _render_frame(bpy, scene, frame, path, relativistic)
+        now = time.monotonic()
+        left = (now - started) / done * (len(frames) - done)
+        log(
+            f"render.py: frame {frame} ({done}/{len(frames)}) in {_format_seconds(now - frame_started)}, "
+            f"about {_format_seconds(left)} left: {path}",
+            flush=True,
+        )
+    return paths
 
 
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
-        out_path = run(argv)
+        paths = run(argv)
     except BatchError as error:
         print(f"render.py: error: {error}", file=sys.stderr)
         return 1
@@ -228,5 +305,5 @@ def main(argv=None):
         message = str(error).strip().splitlines()
         print(f"render.py: error: {type(error).__name__}: {message[-1] if message else ''}", file=sys.stderr)
         return 1
-    print(f"render.py: wrote {out_path}")
+    print(f"render.py: wrote {len(paths)} file{'s' if len(paths) != 1 else ''}")
     return 0

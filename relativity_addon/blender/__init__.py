@@ -13,6 +13,10 @@ _MODULES = (
     "camera",
     "objects",
     "geometry",
+    "animation",
+    "presets",
+    "ops",
+    "panel",
 )
 
 

@@ -34,11 +34,28 @@ SHUTTER_MODEL_ITEMS = (
 SHUTTER_MODELS = tuple(item[0] for item in SHUTTER_MODEL_ITEMS)
 
 
+VELOCITY_SOURCE_ITEMS = (
+    ("MANUAL", "Manual", "The observer velocity is the Velocity setting"),
+    (
+        "CAMERA_ANIMATION",
+        "Camera Animation",
+        "The observer velocity follows the active camera's keyframed motion at each frame "
+        "(see animation.py); the Velocity setting is overwritten before every frame and render",
+    ),
+)
+
+
 def _settings_changed(self, context):
     from . import camera
 
     scene = self.id_data
     camera.sync_if_applied(scene)
+
+
+def _velocity_source_changed(self, context):
+    from . import animation
+
+    animation.sync_velocity_if_animated(self.id_data)
 
 
 def _speed(self):
@@ -63,6 +80,12 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         soft_min=-0.999,
         soft_max=0.999,
         update=_settings_changed,
+    )
+    velocity_source: EnumProperty(
+        name="Velocity From",
+        items=VELOCITY_SOURCE_ITEMS,
+        default="MANUAL",
+        update=_velocity_source_changed,
     )
     speed: FloatProperty(
         name="Speed (c)",

@@ -1,0 +1,6 @@
+import bpy
+
+settings = bpy.context.scene.relativity
+settings.shutter_model = 'FIXED_POINT_SURFACE'
+settings.shutter_time = 0.0
+settings.use_lorentz_window = False
