@@ -1,6 +1,14 @@
-"""Render the demo still: a small scene built from scratch, with the Relativity add-on enabled.
+"""Render the demo still: a small scene built from scratch, photographed by the relativistic camera.
 
-    python examples/demo_still.py --out out/demo.png [--samples 32] [--width 320 --height 240]
+    python examples/demo_still.py --out out/demo.png [--speed 0.9] [--samples 32] [--width 320 --height 240]
+
+The camera flies toward the scene at ``--speed`` (fraction of c, along its view direction; 0
+renders the photo at rest). Aberration pulls the view toward the direction of motion, so the
+scene looks smaller and farther away, and the searchlight effect brightens it by D^4 (D about 4.4
+straight ahead at 0.9c): the film exposure is lowered by log2(D^4) stops at the image centre, as
+a photographer would, so the brightness falls off toward the edges as it really does. A 55 mm
+lens replaces the 28 mm one when moving, to frame the shrunken view. Colours are not Doppler
+shifted by the camera (only the D^4 searchlight is applied).
 
 Runs on the ``bpy`` wheel (Cycles on the CPU, no GPU needed). The add-on is enabled straight from
 this checkout (repository root on ``sys.path``, ``addon_utils.enable("relativity_addon")``), so the
@@ -9,6 +17,7 @@ failure, which Blender would not do on its own.
 """
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -20,6 +29,7 @@ REPO_ROOT = EXAMPLES_DIR.parent
 sys.path[:0] = [str(REPO_ROOT), str(EXAMPLES_DIR)]
 
 import addon_utils  # noqa: E402  (ships with bpy, importable once bpy is)
+from mathutils import Vector  # noqa: E402
 from scenes import build_demo_scene  # noqa: E402
 
 
@@ -46,15 +56,36 @@ def configure_render(scene, out_path, width, height, samples):
     scene.render.filepath = str(out_path)
 
 
-def render_demo(out_path, width=320, height=240, samples=32):
+def fly_camera(scene, camera_object, speed, lens_mm=55.0):
+    """Move the camera at ``speed`` (fraction of c) along its view direction through the
+    relativistic camera; compensate the searchlight brightening at the image centre.
+
+    Aberration shrinks the view ahead (by about 1/D), so a longer lens (``lens_mm``) frames the
+    objects at a useful size while the floor still shows its bend at the image edges.
+    """
+    from relativity_addon.blender import camera as relativistic_camera
+
+    camera_object.data.lens = lens_mm
+    bpy.context.view_layer.update()  # matrix_world of a just-built camera is stale until then
+    forward = camera_object.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))
+    scene.relativity.beta = tuple(speed * forward.normalized())
+    relativistic_camera.apply_relativistic_camera(scene)
+    # Doppler factor straight ahead: D = gamma (1 + beta) (PHYSICS.md, observer moving).
+    doppler_ahead = math.sqrt((1.0 + speed) / (1.0 - speed))
+    scene.view_settings.exposure = -4.0 * math.log2(doppler_ahead)
+
+
+def render_demo(out_path, width=320, height=240, samples=32, speed=0.9):
     """Reset Blender, build the demo scene, render it to ``out_path`` (PNG); return the path."""
     out_path = Path(out_path).resolve()
     out_path.parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     enable_addon()
     scene = bpy.context.scene
-    build_demo_scene(scene)
+    camera_object = build_demo_scene(scene)
     configure_render(scene, out_path, width, height, samples)
+    if speed:
+        fly_camera(scene, camera_object, speed)
     bpy.ops.render.render(write_still=True, scene=scene.name)
     if not out_path.is_file():
         raise RuntimeError(f"render finished but {out_path} was not written")
@@ -67,10 +98,14 @@ def main(argv=None):
     parser.add_argument("--width", type=int, default=320)
     parser.add_argument("--height", type=int, default=240)
     parser.add_argument("--samples", type=int, default=32)
+    parser.add_argument("--speed", type=float, default=0.9,
+                        help="camera speed toward the scene, fraction of c (0: photo at rest)")
     args = parser.parse_args(argv)
+    if not 0.0 <= args.speed < 1.0:
+        parser.error(f"--speed must be in [0, 1), got {args.speed}")
 
     start = time.perf_counter()
-    out_path = render_demo(args.out, args.width, args.height, args.samples)
+    out_path = render_demo(args.out, args.width, args.height, args.samples, args.speed)
     print(f"wrote {out_path} ({time.perf_counter() - start:.1f} s)")
     return 0
 
