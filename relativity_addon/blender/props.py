@@ -143,7 +143,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
     )
     use_doppler: BoolProperty(
         name="Doppler Colour",
-        description="Doppler colour shift (not implemented yet: no effect)",
+        description="Doppler colour shift: blackbodies seen at D T, other colours through the spectral Doppler matrix",
         default=True,
         update=_settings_changed,
     )
@@ -151,6 +151,13 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         name="Searchlight",
         description="Radiance scales with D^4 (Weiskopf et al. 1999)",
         default=True,
+        update=_settings_changed,
+    )
+    use_chang_searchlight: BoolProperty(
+        name="Chang Searchlight (Wrong)",
+        description="Comparison only: scale radiance by a single power of D as Chang et al. (1996) "
+        "did, which Weiskopf et al. (1999) show is wrong by D^3. Materials only",
+        default=False,
         update=_settings_changed,
     )
 

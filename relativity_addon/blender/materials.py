@@ -1,0 +1,506 @@
+"""Doppler colour and searchlight in materials: shader node groups and attaching them.
+
+Where the Doppler factor is computed in the shader: the group ``Relativity Doppler Factor``
+(:data:`DOPPLER_FACTOR`), from the geometry's Incoming vector ``k`` (the direction the photon
+propagates, toward the viewer) and two velocities in fractions of c:
+
+    D = gamma_o (1 - beta_o . k) / (gamma_s (1 - beta_s . k))          (PHYSICS.md)
+
+``beta_s`` is the point attribute ``relativity_beta`` (the apparent-geometry modifier writes the
+emitter's velocity relative to the observer; 0 where absent), ``beta_o`` the observer velocity
+(the scene's ``beta`` on the exact-camera path, 0 on the mesh path, whose meshes already live in
+the observer frame).
+
+Colour (``docs/spectral-model.md``): ordinary colours go through the packed Doppler matrix table,
+``rgb_obs = exp(a(D)) gamut_map(N(D) rgb)``; colours that come from Blender's Blackbody node are
+seen as a blackbody at ``D T`` with luminance ratio ``Y(D T) / Y(T)`` from the packed blackbody
+table. Every group is declared once as data (:class:`Group`) and built by :func:`build_group`.
+
+Settings reach the shaders through one shared group, ``Relativity Settings``, whose constant
+nodes :func:`sync_settings` rewrites from ``scene.relativity`` (before every render too), so
+materials never need to be touched again after :func:`attach`.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import bpy
+
+from . import luts
+
+BETA_ATTRIBUTE = "relativity_beta"
+DONE_AOV = "relativity_colour_done"
+# ID property on a material while the effect is attached: what was inserted where.
+ATTACHED_KEY = "relativity_doppler_nodes"
+NODE_PREFIX = "Relativity Doppler"
+EXP_LIMIT = 80.0  # float32 exp overflows past ~88: clamp the log brightness before exp
+
+
+@dataclass
+class Node:
+    """One node: ``inputs`` maps socket (name or index) to a constant or a reference.
+
+    A reference is ``"node"`` (first output), ``"node.Output Name"``, ``"node.2"`` (output index)
+    or ``"group.Input Name"`` (the group's own input).
+    """
+
+    kind: str
+    inputs: dict = field(default_factory=dict)
+    props: dict = field(default_factory=dict)
+
+
+@dataclass
+class Group:
+    name: str
+    tree_type: str
+    inputs: tuple  # (name, socket type, default or None)
+    outputs: tuple  # (name, socket type, reference)
+    nodes: dict
+
+
+def fmath(operation, a, b=0.0, c=0.0, clamp=False):
+    return Node("ShaderNodeMath", {0: a, 1: b, 2: c}, {"operation": operation, "use_clamp": clamp})
+
+
+def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
+    inputs = {0: a, 1: b}
+    if scale is not None:
+        inputs["Scale"] = scale
+    return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
+
+
+def group_node(group_name, inputs=None):
+    return Node("ShaderNodeGroup", inputs or {}, {"node_tree": group_name})
+
+
+def _socket(sockets, key):
+    if isinstance(key, int):
+        return sockets[key]
+    if key.isdigit():
+        return sockets[int(key)]
+    for socket in sockets:  # enabled socket of that name first (Math/Mix have hidden twins)
+        if socket.name == key and socket.enabled:
+            return socket
+    return sockets[key]
+
+
+def build_group(spec):
+    """Create or rebuild the node group described by ``spec`` (a :class:`Group`)."""
+    tree = bpy.data.node_groups.get(spec.name)
+    if tree is None or tree.bl_idname != spec.tree_type:
+        tree = bpy.data.node_groups.new(spec.name, spec.tree_type)
+    tree.nodes.clear()
+    tree.interface.clear()
+    for name, socket_type, default in spec.inputs:
+        socket = tree.interface.new_socket(name, in_out="INPUT", socket_type=socket_type)
+        if default is not None:
+            socket.default_value = default
+    for name, socket_type, _reference in spec.outputs:
+        tree.interface.new_socket(name, in_out="OUTPUT", socket_type=socket_type)
+    group_in = tree.nodes.new("NodeGroupInput")
+    group_out = tree.nodes.new("NodeGroupOutput")
+    built = {}
+    for index, (name, node_spec) in enumerate(spec.nodes.items()):
+        node = tree.nodes.new(node_spec.kind)
+        node.name = node.label = name
+        node.location = (200.0 * (index % 8), -200.0 * (index // 8))
+        for prop, value in node_spec.props.items():
+            if prop == "node_tree":
+                value = bpy.data.node_groups[value]
+            elif prop == "image":
+                value = bpy.data.images[value]
+            setattr(node, prop, value)
+        built[name] = node
+
+    def resolve(reference):
+        node_name, _, socket_key = reference.partition(".")
+        if node_name == "group":
+            return _socket(group_in.outputs, socket_key)
+        return _socket(built[node_name].outputs, socket_key or 0)
+
+    for name, node_spec in spec.nodes.items():
+        for key, value in node_spec.inputs.items():
+            target = _socket(built[name].inputs, key)
+            if isinstance(value, str):
+                tree.links.new(resolve(value), target)
+            else:
+                target.default_value = value
+    for name, _socket_type, reference in spec.outputs:
+        if isinstance(reference, str):
+            tree.links.new(resolve(reference), _socket(group_out.inputs, name))
+    return tree
+
+
+# --- the groups -----------------------------------------------------------------------------
+
+SETTINGS = "Relativity Settings"
+DOPPLER_FACTOR = "Relativity Doppler Factor"
+GAMUT_MAP = "Relativity Gamut Map"
+DOPPLER_MATRIX = "Relativity Doppler Matrix"
+BLACKBODY_SHIFT = "Relativity Blackbody Shift"
+DOPPLER_EMISSION = "Relativity Doppler Colour"
+
+LN10 = math.log(10.0)
+E = math.e
+# Rec.709 luminance weights (row Y of RGB -> XYZ); see physics/spectral.py.
+LUMINANCE_WEIGHTS = (0.2126729, 0.7151522, 0.0721750)
+
+
+def settings_group():
+    """Constants written by :func:`sync_settings` (one place for every material)."""
+    values = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Camera Path")
+    nodes = {name: Node("ShaderNodeValue") for name in values}
+    nodes["Observer Beta"] = Node("ShaderNodeCombineXYZ", {0: 0.0, 1: 0.0, 2: 0.0})
+    outputs = tuple((name, "NodeSocketFloat", name) for name in values)
+    outputs += (("Observer Beta", "NodeSocketVector", "Observer Beta"),)
+    return Group(SETTINGS, "ShaderNodeTree", (), outputs, nodes)
+
+
+def doppler_factor_group():
+    """``ln D`` for the photon reaching the camera from this shading point."""
+    nodes = {
+        "geometry": Node("ShaderNodeNewGeometry"),
+        "beta_s": Node("ShaderNodeAttribute", props={"attribute_name": BETA_ATTRIBUTE, "attribute_type": "GEOMETRY"}),
+        "bo_k": vmath("DOT_PRODUCT", "group.Observer Beta", "geometry.Incoming"),
+        "bo_bo": vmath("DOT_PRODUCT", "group.Observer Beta", "group.Observer Beta"),
+        "bs_k": vmath("DOT_PRODUCT", "beta_s.Vector", "geometry.Incoming"),
+        "bs_bs": vmath("DOT_PRODUCT", "beta_s.Vector", "beta_s.Vector"),
+        # ln D = ln(1 - bo.k) - ln(1 - bs.k) + ln gamma_o - ln gamma_s, ln gamma = -ln(1 - b^2) / 2
+        "one_bo_k": fmath("MAXIMUM", "ns_bo_k", 1e-12),
+        "ns_bo_k": fmath("SUBTRACT", 1.0, "bo_k.Value"),
+        "one_bs_k": fmath("MAXIMUM", "ns_bs_k", 1e-12),
+        "ns_bs_k": fmath("SUBTRACT", 1.0, "bs_k.Value"),
+        "one_bo2": fmath("MAXIMUM", "ns_bo2", 1e-12),
+        "ns_bo2": fmath("SUBTRACT", 1.0, "bo_bo.Value"),
+        "one_bs2": fmath("MAXIMUM", "ns_bs2", 1e-12),
+        "ns_bs2": fmath("SUBTRACT", 1.0, "bs_bs.Value"),
+        "ln_num": fmath("LOGARITHM", "one_bo_k", E),
+        "ln_den": fmath("LOGARITHM", "one_bs_k", E),
+        "ln_go2": fmath("LOGARITHM", "one_bo2", E),  # = -2 ln gamma_o
+        "ln_gs2": fmath("LOGARITHM", "one_bs2", E),
+        "half_diff": fmath("SUBTRACT", "ln_gs2", "ln_go2"),
+        "kinematic": fmath("SUBTRACT", "ln_num", "ln_den"),
+        "ln_d": fmath("MULTIPLY_ADD", "half_diff", 0.5, "kinematic"),
+    }
+    return Group(
+        DOPPLER_FACTOR,
+        "ShaderNodeTree",
+        (("Observer Beta", "NodeSocketVector", None),),
+        (("Log Doppler", "NodeSocketFloat", "ln_d"),),
+        nodes,
+    )
+
+
+def gamut_map_group():
+    """``rgb' = max(Y + (rgb - Y) clamp(Y / (Y - min rgb)), 0)`` (spectral.gamut_map_linear_rec709)."""
+    nodes = {
+        "luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
+        "split": Node("ShaderNodeSeparateXYZ", {0: "group.Color"}),
+        "min_rg": fmath("MINIMUM", "split.X", "split.Y"),
+        "smallest": fmath("MINIMUM", "min_rg", "split.Z"),
+        "spread": fmath("SUBTRACT", "luminance.Value", "smallest"),
+        "safe_spread": fmath("MAXIMUM", "spread", 1e-30),
+        "saturation": fmath("DIVIDE", "luminance.Value", "safe_spread", clamp=True),
+        "grey": Node("ShaderNodeCombineXYZ", {0: "luminance.Value", 1: "luminance.Value", 2: "luminance.Value"}),
+        "chroma": vmath("SUBTRACT", "group.Color", "grey"),
+        "scaled": vmath("SCALE", "chroma", scale="saturation"),
+        "mapped": vmath("ADD", "scaled", "grey"),
+        "clipped": vmath("MAXIMUM", "mapped", (0.0, 0.0, 0.0)),
+    }
+    return Group(
+        GAMUT_MAP,
+        "ShaderNodeTree",
+        (("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),),
+        (("Color", "NodeSocketColor", "clipped"),),
+        nodes,
+    )
+
+
+def _lut_texture(image_name, u_reference, v):
+    return {
+        "uv": Node("ShaderNodeCombineXYZ", {0: u_reference, 1: v, 2: 0.0}),
+        "texture": Node(
+            "ShaderNodeTexImage",
+            props={"image": image_name, "interpolation": "Linear", "extension": "EXTEND"},
+        ),
+    }
+
+
+def doppler_matrix_group():
+    """``gamut_map(N(D) rgb)`` and ``a(D)``: ``M(D) rgb`` mapped is ``exp(a)`` times the colour."""
+    scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
+    nodes = {"u": fmath("MULTIPLY_ADD", "group.Log Doppler", scale / LN10, offset)}
+    for row in range(3):
+        lookup = _lut_texture(luts.DOPPLER_LUT_NAME, "u", (row + 0.5) / 3.0)
+        nodes[f"uv{row}"] = lookup["uv"]
+        nodes[f"row{row}"] = lookup["texture"]
+        nodes[f"row{row}"].inputs = {"Vector": f"uv{row}"}
+        nodes[f"dot{row}"] = vmath("DOT_PRODUCT", f"row{row}.Color", "group.Color")
+    nodes["product"] = Node("ShaderNodeCombineXYZ", {0: "dot0.Value", 1: "dot1.Value", 2: "dot2.Value"})
+    nodes["mapped"] = group_node(GAMUT_MAP, {0: "product"})
+    return Group(
+        DOPPLER_MATRIX,
+        "ShaderNodeTree",
+        (("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)), ("Log Doppler", "NodeSocketFloat", 0.0)),
+        (("Color", "NodeSocketColor", "mapped"), ("Log White Luminance", "NodeSocketFloat", "row0.Alpha")),
+        nodes,
+    )
+
+
+def blackbody_shift_group():
+    """Unit-luminance colour of the blackbody at ``D T`` and ``ln(Y(D T) / Y(T))``."""
+    scale, offset = luts.texture_u_scale_offset(luts.BLACKBODY_LOG10_RANGE)
+    nodes = {
+        "ln_t": fmath("LOGARITHM", "safe_t", E),
+        "safe_t": fmath("MAXIMUM", "group.Temperature", 1.0),
+        "ln_dt": fmath("ADD", "ln_t", "group.Log Doppler"),
+        "u_t": fmath("MULTIPLY_ADD", "ln_t", scale / LN10, offset),
+        "u_dt": fmath("MULTIPLY_ADD", "ln_dt", scale / LN10, offset),
+    }
+    for key in ("t", "dt"):
+        lookup = _lut_texture(luts.BLACKBODY_LUT_NAME, f"u_{key}", 0.5)
+        nodes[f"uv_{key}"] = lookup["uv"]
+        nodes[f"lut_{key}"] = lookup["texture"]
+        nodes[f"lut_{key}"].inputs = {"Vector": f"uv_{key}"}
+    nodes["log_ratio"] = fmath("SUBTRACT", "lut_dt.Alpha", "lut_t.Alpha")
+    return Group(
+        BLACKBODY_SHIFT,
+        "ShaderNodeTree",
+        (("Temperature", "NodeSocketFloat", 5762.0), ("Log Doppler", "NodeSocketFloat", 0.0)),
+        (("Color", "NodeSocketColor", "lut_dt.Color"), ("Log Luminance Ratio", "NodeSocketFloat", "log_ratio")),
+        nodes,
+    )
+
+
+def doppler_colour_group():
+    """Observed colour of a surface colour ``Color`` (or a blackbody at ``Temperature``).
+
+    ``out = base exp(E)``, with ``base`` the Doppler-shifted colour (unshifted when Doppler is
+    off) and ``E`` the log brightness: the exact visible factor (``a``, or ``ln Y(DT)/Y(T)``)
+    when Doppler and the searchlight are both on, else ``p ln D`` with ``p`` = 4 (searchlight
+    without colour) or 1 (Chang et al.'s comparison), minus the ``D^4`` the exact camera applies.
+    On the exact-camera path ordinary colours pass unchanged (the compositor shifts them) and
+    blackbodies write the ``relativity_colour_done`` AOV so the compositor leaves them alone.
+    """
+    nodes = {
+        "settings": group_node(SETTINGS),
+        "doppler": group_node(DOPPLER_FACTOR, {"Observer Beta": "settings.Observer Beta"}),
+        "matrix": group_node(DOPPLER_MATRIX, {"Color": "group.Color", "Log Doppler": "doppler"}),
+        "blackbody": group_node(BLACKBODY_SHIFT, {"Temperature": "group.Temperature", "Log Doppler": "doppler"}),
+        # brightness exponent shared by both branches: (p - camera p) ln D
+        "power": fmath("SUBTRACT", "settings.Power of D", "settings.Camera Power"),
+        "power_term": fmath("MULTIPLY", "power", "doppler"),
+        # ordinary colour
+        "rgb_base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "matrix.Color"},
+                         {"data_type": "VECTOR"}),
+        "rgb_log": fmath("MULTIPLY_ADD", "matrix.Log White Luminance", "settings.Spectral Searchlight", "power_term"),
+        "rgb_log_safe": fmath("MINIMUM", "rgb_log", EXP_LIMIT),
+        "rgb_gain": fmath("EXPONENT", "rgb_log_safe"),
+        "rgb_shifted": vmath("SCALE", "rgb_base.Result", scale="rgb_gain"),
+        "rgb_out": Node("ShaderNodeMix", {"Factor": "settings.Camera Path", 4: "rgb_shifted", 5: "group.Color"},
+                        {"data_type": "VECTOR"}),
+        # blackbody: the LUT colour has unit luminance; keep the input colour's luminance
+        "bb_luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
+        "bb_shifted_colour": vmath("SCALE", "blackbody.Color", scale="bb_luminance.Value"),
+        "bb_base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "bb_shifted_colour"},
+                        {"data_type": "VECTOR"}),
+        "bb_log": fmath("MULTIPLY_ADD", "blackbody.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
+        "bb_log_safe": fmath("MINIMUM", "bb_log", EXP_LIMIT),
+        "bb_gain": fmath("EXPONENT", "bb_log_safe"),
+        "bb_out": vmath("SCALE", "bb_base.Result", scale="bb_gain"),
+        "out": Node("ShaderNodeMix", {"Factor": "group.Is Blackbody", 4: "rgb_out.Result", 5: "bb_out"},
+                    {"data_type": "VECTOR"}),
+        "done": fmath("MULTIPLY", "group.Is Blackbody", "settings.Camera Path"),
+        "aov": Node("ShaderNodeOutputAOV", {"Value": "done"}, {"aov_name": DONE_AOV}),
+    }
+    return Group(
+        DOPPLER_EMISSION,
+        "ShaderNodeTree",
+        (
+            ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
+            ("Temperature", "NodeSocketFloat", 5762.0),
+            ("Is Blackbody", "NodeSocketFloat", 0.0),
+        ),
+        (("Color", "NodeSocketColor", "out.Result"),),
+        nodes,
+    )
+
+
+GROUP_BUILDERS = (
+    settings_group,
+    doppler_factor_group,
+    gamut_map_group,
+    doppler_matrix_group,
+    blackbody_shift_group,
+    doppler_colour_group,
+)
+
+
+GROUPS_VERSION_KEY = "relativity_group_version"
+GROUPS_VERSION = 1
+
+
+def ensure_node_groups():
+    """Pack the LUTs and build any missing or outdated group, dependencies first.
+
+    Existing up-to-date groups are left alone: rebuilding a group's interface would drop the
+    links of every material node that uses it. Returns the top group.
+    """
+    luts.ensure_doppler_matrix_lut()
+    luts.ensure_blackbody_lut()
+    for builder in GROUP_BUILDERS:
+        spec = builder()
+        tree = bpy.data.node_groups.get(spec.name)
+        if tree is None or tree.get(GROUPS_VERSION_KEY) != GROUPS_VERSION:
+            tree = build_group(spec)
+            tree[GROUPS_VERSION_KEY] = GROUPS_VERSION
+    return bpy.data.node_groups[DOPPLER_EMISSION]
+
+
+# --- settings -------------------------------------------------------------------------------
+
+
+def settings_values(scene, camera_path):
+    """Constants for ``Relativity Settings`` from ``scene.relativity``."""
+    settings = scene.relativity
+    use_doppler = bool(settings.use_doppler)
+    use_searchlight = bool(settings.use_searchlight)
+    chang = bool(getattr(settings, "use_chang_searchlight", False))
+    spectral = use_searchlight and use_doppler and not chang
+    if not use_searchlight or spectral:
+        power = 0.0
+    else:
+        power = 1.0 if chang else 4.0
+    camera_power = 4.0 if (camera_path and use_searchlight) else 0.0
+    return {
+        "Use Doppler": 1.0 if use_doppler else 0.0,
+        "Spectral Searchlight": 1.0 if spectral else 0.0,
+        "Power of D": power,
+        "Camera Power": camera_power,
+        "Camera Path": 1.0 if camera_path else 0.0,
+        "Observer Beta": tuple(settings.beta) if camera_path else (0.0, 0.0, 0.0),
+    }
+
+
+def sync_settings(scene, camera_path):
+    tree = bpy.data.node_groups.get(SETTINGS)
+    if tree is None:
+        return False
+    for name, value in settings_values(scene, camera_path).items():
+        node = tree.nodes[name]
+        if name == "Observer Beta":
+            for i in range(3):
+                node.inputs[i].default_value = value[i]
+        else:
+            node.outputs[0].default_value = value
+    tree.update_tag()
+    return True
+
+
+# --- attaching to materials -----------------------------------------------------------------
+
+# (node type, input names) whose colour is an emitted or reflected rest-frame colour.
+COLOUR_INPUTS = (
+    ("ShaderNodeEmission", ("Color",)),
+    ("ShaderNodeBsdfPrincipled", ("Base Color", "Emission Color")),
+    ("ShaderNodeBsdfDiffuse", ("Color",)),
+)
+
+
+def _targets(material):
+    for node in list(material.node_tree.nodes):
+        for kind, names in COLOUR_INPUTS:
+            if node.bl_idname == kind:
+                for name in names:
+                    socket = node.inputs.get(name)
+                    if socket is not None:
+                        yield node, socket
+
+
+def is_attached(material):
+    return material is not None and ATTACHED_KEY in material
+
+
+def attach(material):
+    """Insert the Doppler colour group in front of every colour input of ``material``."""
+    if material is None or not material.use_nodes or is_attached(material):
+        return False
+    group = bpy.data.node_groups.get(DOPPLER_EMISSION) or ensure_node_groups()
+    tree = material.node_tree
+    records = []
+    for target_node, socket in list(_targets(material)):
+        source = socket.links[0].from_socket if socket.is_linked else None
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = group
+        node.name = node.label = f"{NODE_PREFIX} {target_node.name} {socket.identifier}"
+        node.location = (target_node.location.x - 220.0, target_node.location.y)
+        node.hide = True
+        if source is not None:
+            tree.links.new(source, node.inputs["Color"])
+            if source.node.bl_idname == "ShaderNodeBlackbody":
+                node.inputs["Is Blackbody"].default_value = 1.0
+                temperature = source.node.inputs["Temperature"]
+                if temperature.is_linked:
+                    tree.links.new(temperature.links[0].from_socket, node.inputs["Temperature"])
+                else:
+                    node.inputs["Temperature"].default_value = temperature.default_value
+        else:
+            node.inputs["Color"].default_value = socket.default_value
+        tree.links.new(node.outputs["Color"], socket)
+        records.append(
+            {
+                "group_node": node.name,
+                "target": target_node.name,
+                "socket": socket.identifier,
+                "source_node": source.node.name if source is not None else "",
+                "source_socket": source.identifier if source is not None else "",
+            }
+        )
+    material[ATTACHED_KEY] = records
+    return True
+
+
+def detach(material):
+    """Remove the inserted groups and restore the original links exactly."""
+    if not is_attached(material):
+        return False
+    tree = material.node_tree
+    for record in material[ATTACHED_KEY].to_list() if hasattr(material[ATTACHED_KEY], "to_list") else material[ATTACHED_KEY]:
+        record = dict(record)
+        node = tree.nodes.get(record["group_node"])
+        if node is not None:
+            tree.nodes.remove(node)
+        target = tree.nodes.get(record["target"])
+        if target is None:
+            continue
+        socket = next((s for s in target.inputs if s.identifier == record["socket"]), None)
+        source_node = tree.nodes.get(record["source_node"]) if record["source_node"] else None
+        if socket is not None and source_node is not None:
+            source = next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+            if source is not None:
+                tree.links.new(source, socket)
+    del material[ATTACHED_KEY]
+    return True
+
+
+def scene_materials(scene):
+    found = []
+    for obj in scene.objects:
+        for slot in getattr(obj, "material_slots", ()):
+            if slot.material is not None and slot.material not in found:
+                found.append(slot.material)
+    return found
+
+
+def apply_doppler_colour(scene, camera_path=False):
+    """Attach the Doppler colour group to every material of ``scene`` and sync its settings."""
+    ensure_node_groups()
+    for material in scene_materials(scene):
+        attach(material)
+    sync_settings(scene, camera_path)
+
+
+def remove_doppler_colour(scene):
+    """Detach from every material (the node groups and LUTs stay in the file, unused)."""
+    for material in bpy.data.materials:
+        detach(material)
