@@ -349,7 +349,9 @@ def update_object(scene, obj, depsgraph=None):
         world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c)
     else:
         beta_u = _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity") if motion == "CONSTANT" else np.zeros(3)
-        world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, _to_world(matrix_now, rest), beta_u, c, beta_o)
+        # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion.
+        world_now = apparent.lorentz_contract(_to_world(matrix_now, rest), matrix_now[:3, 3], beta_u)
+        world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
     local = _to_world(np.linalg.inv(matrix_now), world)
     _write_cache(cache.data, local, beta_seen)
     cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
@@ -372,16 +374,35 @@ def _write_cache(mesh, positions, beta):
 
 def update_object_if_applied(scene, obj):
     """Property-update entry point: never raises (the viewport keeps the last valid state)."""
-    if obj.type != "MESH" or find_modifier(obj) is None:
+    if obj.type != "MESH" or find_modifier(obj) is None or _Computing.depth:
         return
     try:
-        update_object(scene, obj)
+        with _Computing():
+            update_object(scene, obj)
     except RelativityError as error:
         print(f"Relativity: {error}")
 
 
+class _Computing:
+    """Re-entrancy guard: evaluating the depsgraph inside our own update fires the depsgraph
+    handlers again, and a nested evaluation from a handler crashes Blender."""
+
+    depth = 0
+
+    def __enter__(self):
+        _Computing.depth += 1
+
+    def __exit__(self, *exc):
+        _Computing.depth -= 1
+
+
 def update_scene(scene, depsgraph=None, only_changed=False):
     """Recompute every object carrying the modifier. Returns the number of objects updated."""
+    with _Computing():
+        return _update_scene(scene, depsgraph, only_changed)
+
+
+def _update_scene(scene, depsgraph, only_changed):
     updated = 0
     for obj in applied_objects(scene):
         cache = cache_object(obj)
@@ -410,11 +431,12 @@ def apply_apparent_geometry(scene, objects=None):
         if obj.relativity.motion == "CONSTANT":
             _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
     try:
-        for obj in objects:
-            _ensure_modifier(obj)
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        for obj in objects:
-            update_object(scene, obj, depsgraph)
+        with _Computing():
+            for obj in objects:
+                _ensure_modifier(obj)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            for obj in objects:
+                update_object(scene, obj, depsgraph)
     except RelativityError:
         for obj in objects:
             _remove_object_effect(obj)
@@ -442,28 +464,24 @@ def remove_apparent_geometry(scene, objects=None):
 
 @persistent
 def _frame_change_post(scene, depsgraph=None):
+    if _Computing.depth:
+        return
     try:
         update_scene(scene, depsgraph)
     except RelativityError as error:
         print(f"Relativity: {error}")
 
 
-_busy = False
-
-
 @persistent
 def _depsgraph_update_post(scene, depsgraph=None):
-    """Recompute objects whose inputs changed (observer velocity, camera, transforms)."""
-    global _busy
-    if _busy:
+    """Recompute objects whose inputs changed (observer velocity, camera, transforms): the
+    signature stored with each cache stops the loop that writing the cache would start."""
+    if _Computing.depth:
         return
-    _busy = True
     try:
-        update_scene(scene, None, only_changed=True)
+        update_scene(scene, depsgraph, only_changed=True)
     except RelativityError as error:
         print(f"Relativity: {error}")
-    finally:
-        _busy = False
 
 
 _HANDLERS = (

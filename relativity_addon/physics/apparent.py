@@ -69,6 +69,21 @@ def apparent_positions_uniform(observer_time, observer_position, positions_now, 
     return apparent, tau, beta_seen
 
 
+def lorentz_contract(points, centre, beta):
+    """Rest-frame shape -> its shape in a frame where it moves with ``beta``: the component of
+    ``points - centre`` along ``beta`` shrinks by ``1 / gamma`` (simultaneity in that frame)."""
+    points = vector_array(points, "points")
+    beta = velocity_array(beta, "beta")
+    speed_squared = float(np.dot(beta, beta))
+    if speed_squared == 0.0:
+        return points.copy()
+    gamma = 1.0 / np.sqrt(1.0 - speed_squared)
+    bhat = beta / np.sqrt(speed_squared)
+    relative = points - centre
+    along = relative @ bhat
+    return points - ((1.0 - 1.0 / gamma) * along)[:, None] * bhat
+
+
 class SampledRigidMotion:
     """A rigid motion ``x(t) = A(t) p + b(t)`` sampled on a uniform time grid.
 

@@ -140,3 +140,18 @@ def test_bad_velocities_raise(bad):
         apparent.apparent_positions_uniform(0.0, np.zeros(3), np.ones((2, 3)), np.zeros(3), 1.0, bad)
     with pytest.raises(ValueError):
         apparent.apparent_positions_uniform(0.0, np.zeros(3), np.ones((2, 3)), bad, 1.0)
+
+
+def test_lorentz_contraction_is_simultaneous_boost_of_rest_shape():
+    """Rest-frame points, boosted into the frame where they move with beta, at equal times there."""
+    beta = np.array([0.3, 0.6, -0.2])
+    centre = np.array([1.0, 2.0, 3.0])
+    rest = centre + RNG.normal(size=(50, 3))
+    contracted = apparent.lorentz_contract(rest, centre, beta)
+    # Rest frame R moves with beta in S. Event (t_R, x_R) -> S via the boost with -beta; choose t_R
+    # per point so that the S times are all 0 (c t = gamma (c t_R + beta.x_R) = 0).
+    c = 1.0
+    x_r = rest - centre
+    t_r = -(x_r @ beta) / c
+    _, x_s = boost(t_r, x_r, -beta, c)
+    np.testing.assert_allclose(contracted - centre, x_s, atol=1e-12)
