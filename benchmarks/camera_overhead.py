@@ -1,8 +1,11 @@
 """Render time of the relativistic OSL camera against Blender's perspective camera.
 
-    python benchmarks/camera_overhead.py [--samples 32] [--resolution 320x240]
+    python benchmarks/camera_overhead.py [--samples 128] [--resolution 160x120] [--repeats 5]
 
-Same lit scene, same seed, Cycles on the CPU; prints the times side by side and their ratio.
+Same lit scene, same seed, Cycles on the CPU. The cameras are rendered alternately (perspective,
+relativistic at rest, relativistic at speed, then again) so that load from other processes hits
+all of them alike; each round's times are divided by that round's perspective time and the
+median ratio over the rounds is printed, next to the median times.
 At beta = 0 both cameras trace the same rays, so the ratio is the camera's own cost; at speed
 the view itself changes (more or less geometry in frame), which is not camera overhead.
 """
@@ -10,6 +13,7 @@ the view itself changes (more or less geometry in frame), which is not camera ov
 import argparse
 import math
 import os
+import statistics
 import sys
 import tempfile
 import time
@@ -51,9 +55,9 @@ def timed_render(bpy, scene, path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=32)
-    parser.add_argument("--resolution", default="320x240")
-    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--samples", type=int, default=128)
+    parser.add_argument("--resolution", default="160x120")
+    parser.add_argument("--repeats", type=int, default=5)
     options = parser.parse_args()
     resolution = tuple(int(v) for v in options.resolution.lower().split("x"))
 
@@ -65,21 +69,29 @@ def main():
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
     out = tempfile.mkdtemp(prefix="camera-overhead-")
-    results = {}
-    for label, beta in (("perspective", None), ("relativistic beta=0", (0, 0, 0)),
-                        ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13))):
+    cases = (("perspective", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
+             ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)))
+
+    def render(beta, name):
         if beta is None:
             camera.remove_relativistic_camera(scene)
         else:
             scene.relativity.beta = beta
             camera.apply_relativistic_camera(scene)
-        timed_render(bpy, scene, os.path.join(out, "warmup.png"))
-        results[label] = min(timed_render(bpy, scene, os.path.join(out, f"{i}.png")) for i in range(options.repeats))
-    base = results["perspective"]
-    print(f"{options.resolution}, {options.samples} samples, best of {options.repeats}:")
-    for label, seconds in results.items():
-        print(f"  {label:28s} {seconds:7.3f} s   ratio {seconds / base:5.3f}")
+        return timed_render(bpy, scene, os.path.join(out, name))
 
+    for label, beta in cases:  # warm-up: shader compilation, kernel loading, caches
+        render(beta, "warmup.png")
+    times = {label: [] for label, _ in cases}
+    for round_index in range(options.repeats):
+        for label, beta in cases:
+            times[label].append(render(beta, f"{round_index}.png"))
+    base = times["perspective"]
+    print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
+    for label, _ in cases:
+        ratios = [seconds / reference for seconds, reference in zip(times[label], base)]
+        print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
+              f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
 
 if __name__ == "__main__":
     main()
