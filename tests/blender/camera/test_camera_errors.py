@@ -113,7 +113,8 @@ def test_render_script_fails_with_one_line_reasons(factory_blender, tmp_path):
         "--beta=nan,0,0": "finite",
         "--beta=0,0": "X,Y,Z",
         "--samples=zero": "integer",
-        "--method=geometry": "not implemented",
+        "--method=sideways": "invalid choice",  # (geometry is a method now: tests/blender/geometry)
+        "--resolution=0x10": "positive",
         "--shutter=sideways": "invalid choice",
     }
     for option, reason in cases.items():
