@@ -7,8 +7,8 @@ renders the photo at rest). Aberration pulls the view toward the direction of mo
 scene looks smaller and farther away, and the searchlight effect brightens it by D^4 (D about 4.4
 straight ahead at 0.9c): the film exposure is lowered by log2(D^4) stops at the image centre, as
 a photographer would, so the brightness falls off toward the edges as it really does. A 55 mm
-lens replaces the 28 mm one when moving, to frame the shrunken view. Colours are not Doppler
-shifted by the camera (only the D^4 searchlight is applied).
+lens replaces the 28 mm one when moving, to frame the shrunken view. Doppler colour follows the
+scene's ``use_doppler`` setting (its default).
 
 Runs on the ``bpy`` wheel (Cycles on the CPU, no GPU needed). The add-on is enabled straight from
 this checkout (repository root on ``sys.path``, ``addon_utils.enable("relativity_addon")``), so the
