@@ -256,23 +256,49 @@ class _TransformAnimation:
         return [self.curves[(path, i)].evaluate(frame) if (path, i) in self.curves else current[i] for i in range(count)]
 
     def matrices(self, frames):
-        from mathutils import Euler, Matrix, Quaternion, Vector
-
+        """Object-to-world matrices, shape ``(K, 4, 4)``, built in float64 (mathutils is float32)."""
         obj = self.obj
-        result = np.empty((len(frames), 4, 4))
-        for k, frame in enumerate(frames):
-            location = Vector(self._values("location", 3, frame))
-            scale = Vector(self._values("scale", 3, frame))
-            mode = obj.rotation_mode
-            if mode == "QUATERNION":
-                rotation = Quaternion(self._values("rotation_quaternion", 4, frame)).normalized()
-            elif mode == "AXIS_ANGLE":
-                angle, *axis = self._values("rotation_axis_angle", 4, frame)
-                rotation = Quaternion(axis, angle)
-            else:
-                rotation = Euler(self._values("rotation_euler", 3, frame), mode).to_quaternion()
-            result[k] = _matrix_array(Matrix.LocRotScale(location, rotation, scale))
+        count = len(frames)
+        location = np.array([self._values("location", 3, frame) for frame in frames]).reshape(count, 3)
+        scale = np.array([self._values("scale", 3, frame) for frame in frames]).reshape(count, 3)
+        mode = obj.rotation_mode
+        if mode == "QUATERNION":
+            rotation = _quaternion_matrices(np.array([self._values("rotation_quaternion", 4, f) for f in frames]))
+        elif mode == "AXIS_ANGLE":
+            values = np.array([self._values("rotation_axis_angle", 4, f) for f in frames])
+            axis = values[:, 1:] / np.maximum(np.linalg.norm(values[:, 1:], axis=1, keepdims=True), 1e-300)
+            half = 0.5 * values[:, 0:1]
+            rotation = _quaternion_matrices(np.concatenate([np.cos(half), np.sin(half) * axis], axis=1))
+        else:
+            angles = np.array([self._values("rotation_euler", 3, frame) for frame in frames]).reshape(count, 3)
+            rotation = np.broadcast_to(np.eye(3), (count, 3, 3))
+            for axis_name in mode:  # "XYZ": X applied first, R = Rz Ry Rx
+                axis = "XYZ".index(axis_name)
+                rotation = _axis_rotations(axis, angles[:, axis]) @ rotation
+        result = np.zeros((count, 4, 4))
+        result[:, :3, :3] = rotation * scale[:, None, :]
+        result[:, :3, 3] = location
+        result[:, 3, 3] = 1.0
         return self.parent @ result
+
+
+def _axis_rotations(axis, angles):
+    c, s = np.cos(angles), np.sin(angles)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m = np.zeros((len(angles), 3, 3))
+    m[:, axis, axis] = 1.0
+    m[:, i, i], m[:, i, j], m[:, j, i], m[:, j, j] = c, -s, s, c
+    return m
+
+
+def _quaternion_matrices(q):
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q.T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], axis=1)
 
 
 def _evaluated_rest_positions(obj, depsgraph):

@@ -111,8 +111,10 @@ class SampledRigidMotion:
 
     def _weights(self, t):
         s = (np.asarray(t, dtype=np.float64) - self.start) / self.step
-        index = np.clip(np.floor(s).astype(np.int64), 0, self._samples.shape[0] - 4)
-        f = s - index
+        last = self._samples.shape[0] - 3  # index of the last original sample
+        clamped = np.clip(s, 0.0, float(last))
+        index = np.minimum(np.floor(clamped).astype(np.int64), last - 1)
+        f = clamped - index
         f2 = f * f
         f3 = f2 * f
         # Catmull-Rom basis for samples index-1 .. index+2 (padded arrays start one earlier).
@@ -122,15 +124,22 @@ class SampledRigidMotion:
             0.5 * (-3.0 * f3 + 4.0 * f2 + f),
             0.5 * (f3 - f2),
         ], axis=-1)
-        return index, weights
+        return index, weights, s - clamped
 
     def affine_at(self, t):
-        """Interpolated 3x4 object-to-world matrices, shape ``t.shape + (3, 4)``."""
-        index, weights = self._weights(t)
+        """Interpolated 3x4 object-to-world matrices, shape ``t.shape + (3, 4)``. Outside the
+        sampled range the end intervals continue linearly (a cubic would run away and make the
+        retarded-time solver's trial points superluminal)."""
+        index, weights, beyond = self._weights(t)
         samples = self._samples
         result = weights[..., 0, None] * samples[index]
         for j in range(1, 4):
             result += weights[..., j, None] * samples[index + j]
+        if np.any(beyond):
+            start_slope = samples[2] - samples[1]
+            end_slope = samples[-2] - samples[-3]
+            slope = np.where((beyond < 0.0)[..., None], start_slope, end_slope)
+            result += beyond[..., None] * slope
         return result.reshape(np.shape(t) + (3, 4))
 
     def positions(self, t, index):

@@ -1,0 +1,144 @@
+"""Retarded positions on the evaluated mesh (depsgraph), not on the add-on's Python arrays.
+
+For every vertex of the evaluated mesh at apparent position x_a, seen by a camera at rest at
+(t_o, x_o): t_e = t_o - |x_o - x_a| / c, and the vertex's true world line evaluated at t_e
+(analytically for the wheel, by Blender's own animation evaluation for the keyframed path) must
+be x_a: |x_o - x_e(t_e)| = c (t_o - t_e) to 1e-6 relative.
+"""
+
+import math
+
+import numpy as np
+
+import geometry_helpers as gh
+from geometry_helpers import ch
+
+C = 10.0
+FPS = 24
+
+
+def _scene(bpy):
+    scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
+    scene.relativity.speed_of_light = C
+    scene.render.fps, scene.render.fps_base = FPS, 1.0
+    return scene, camera_object
+
+
+def _keyframe(obj, path, index, points, interpolation):
+    for frame, value in points:
+        obj.keyframe_insert(path, index=index, frame=frame)
+        fcurve = _fcurve(obj, path, index)
+        fcurve.keyframe_points[-1].co = (frame, value)
+    fcurve = _fcurve(obj, path, index)
+    for point in fcurve.keyframe_points:
+        point.interpolation = interpolation
+    fcurve.extrapolation = "LINEAR"
+    fcurve.update()
+    return fcurve
+
+
+def _fcurve(obj, path, index):
+    from bpy_extras import anim_utils
+
+    animation = obj.animation_data
+    bag = anim_utils.action_get_channelbag_for_slot(animation.action, animation.action_slot)
+    return next(f for f in bag.fcurves if f.data_path == path and f.array_index == index)
+
+
+def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, camera_object = _scene(bpy)
+    radius = 1.0
+    omega = 0.9 * C / radius
+    mesh = bpy.data.meshes.new("Wheel")
+    angles = np.linspace(0.0, 2.0 * math.pi, 96, endpoint=False)
+    rim = [(radius * math.cos(a), radius * math.sin(a), 0.0) for a in angles]
+    mesh.from_pydata(rim + [(0.0, 0.0, 0.0)], [], [(i, (i + 1) % 96, 96) for i in range(96)])
+    wheel = bpy.data.objects.new("Wheel", mesh)
+    wheel.location = (0.5, 0.0, -4.0)
+    wheel.rotation_mode = "ZXY"  # spin about the axle (local Z) first, then tilt
+    wheel.rotation_euler = (0.3, 0.0, 0.0)  # tilted towards the camera
+    scene.collection.objects.link(wheel)
+    # Angle omega * t: linear keys, linear extrapolation; the frame range covers every t_e.
+    _keyframe(wheel, "rotation_euler", 2, [(0.0, 0.0), (FPS, omega)], "LINEAR")
+    wheel.relativity.motion = "ANIMATION"
+    wheel.relativity.tessellation = 0
+    wheel.relativity.samples_per_frame = 32
+    scene.frame_set(30)
+    geometry = gh.geometry_module()
+    geometry.apply_apparent_geometry(scene)
+    x_a, beta_seen = gh.evaluated_points(bpy, wheel, "relativity_beta")
+    rest = _ev_attribute(bpy, wheel, "relativity_rest")
+
+    x_o = np.array(camera_object.matrix_world.translation)
+    t_o = 30 / FPS
+    tau = np.linalg.norm(x_a - x_o, axis=1) / C
+    t_e = t_o - tau
+    tilt = np.array([[1, 0, 0], [0, math.cos(0.3), -math.sin(0.3)], [0, math.sin(0.3), math.cos(0.3)]])
+    a = omega * t_e
+    spun = np.stack([np.cos(a) * rest[:, 0] - np.sin(a) * rest[:, 1],
+                     np.sin(a) * rest[:, 0] + np.cos(a) * rest[:, 1], rest[:, 2]], axis=1)
+    x_e = spun @ tilt.T + np.array(wheel.location)
+    residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - C * tau) / (C * tau)
+    mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
+    print(f"max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}")
+    assert residual.max() < 1e-6
+    assert mismatch.max() < 1e-6
+    # The evaluated rim really spans different retarded times (a rigid render would not).
+    assert np.ptp(t_e[:96]) > 0.05
+    # relativity_beta: omega x r at t_e, over c.
+    omega_vector = tilt @ np.array([0.0, 0.0, omega])
+    expected_beta = np.cross(omega_vector, x_e - np.array(wheel.location)) / C
+    assert np.max(np.abs(beta_seen - expected_beta)) < 1e-3
+    assert abs(np.linalg.norm(beta_seen[:96], axis=1).mean() - 0.9) < 1e-3
+
+
+def _ev_attribute(bpy, obj, name):
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        data = mesh.attributes[name].data
+        values = np.empty(len(data) * 3)
+        data.foreach_get("vector", values)
+    finally:
+        obj_eval.to_mesh_clear()
+    return values.reshape(-1, 3)
+
+
+def test_accelerated_keyframed_path(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, camera_object = _scene(bpy)
+    bpy.ops.mesh.primitive_cube_add(size=0.6, location=(0.0, 0.0, -3.0))
+    box = bpy.context.object
+    # Eased (Bezier) path along x: accelerates from rest, peak speed below c.
+    _keyframe(box, "location", 0, [(0.0, -6.0), (48.0, 6.0)], "BEZIER")
+    box.relativity.motion = "ANIMATION"
+    box.relativity.tessellation = 1
+    box.relativity.samples_per_frame = 16
+    frame = 36
+    scene.frame_set(frame)
+    geometry = gh.geometry_module()
+    geometry.apply_apparent_geometry(scene)
+    x_a, _ = gh.evaluated_points(bpy, box)
+    rest = _ev_attribute(bpy, box, "relativity_rest")
+    x_o = np.array(camera_object.matrix_world.translation)
+    tau = np.linalg.norm(x_a - x_o, axis=1) / C
+    t_e = frame / FPS - tau
+    fcurve = _fcurve(box, "location", 0)
+    speeds = [abs(fcurve.evaluate(f + 0.01) - fcurve.evaluate(f - 0.01)) / (0.02 / FPS) for f in np.arange(0, 48, 0.5)]
+    assert 0.5 * C < max(speeds) < C
+    # Blender's own evaluation of the object at each vertex's retarded (sub-)frame.
+    x_e = np.empty_like(x_a)
+    for i, t in enumerate(t_e):
+        whole = math.floor(t * FPS)
+        scene.frame_set(whole, subframe=t * FPS - whole)
+        matrix = np.array(box.matrix_world)
+        x_e[i] = matrix[:3, :3] @ rest[i] + matrix[:3, 3]
+    mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
+    residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - C * tau) / (C * tau)
+    print(f"max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
+          f"retarded frames {t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
+    assert residual.max() < 1e-6
+    assert mismatch.max() < 1e-6
+    assert np.ptp(t_e) * FPS > 0.5
