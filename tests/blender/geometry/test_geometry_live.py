@@ -1,0 +1,73 @@
+"""Live behaviour: the result depends only on the frame, settings updates apply at once, and
+bad input gives a one-line error (API and batch script)."""
+
+import numpy as np
+import pytest
+
+import geometry_helpers as gh
+from geometry_helpers import ch
+
+
+def _scene(bpy):
+    scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
+    scene.relativity.speed_of_light = 4.0
+    obj = ch.add_sphere(bpy, scene, (0.0, 0.0, -5.0), 1.0, ch.emission_material(bpy), name="Ball",
+                        segments=16, rings=8)
+    return scene, camera_object, obj
+
+
+def test_frames_are_independent_of_history(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, camera_object, obj = _scene(bpy)
+    obj.keyframe_insert("location", index=0, frame=1)
+    obj.location.x = 3.0
+    obj.keyframe_insert("location", index=0, frame=20)
+    obj.relativity.motion = "ANIMATION"
+    scene.relativity.beta = (0.0, 0.3, 0.0)
+    scene.frame_set(12)
+    gh.geometry_module().apply_apparent_geometry(scene)
+    alone, _ = gh.evaluated_points(bpy, obj)
+    for frame in (1, 20, 5, 12):
+        scene.frame_set(frame)
+        if frame == 5:
+            at_five, _ = gh.evaluated_points(bpy, obj)
+    in_sequence, _ = gh.evaluated_points(bpy, obj)
+    assert np.array_equal(alone, in_sequence)
+    assert not np.allclose(at_five, alone)
+
+
+def test_velocity_changes_update_at_once(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, camera_object, obj = _scene(bpy)
+    obj.relativity.motion = "CONSTANT"
+    gh.geometry_module().apply_apparent_geometry(scene)
+    at_rest, _ = gh.evaluated_points(bpy, obj)
+    obj.relativity.beta = (0.6, 0.0, 0.0)  # update callback
+    moving, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
+    # Light left the sphere (~5 units away, c = 4) ~1.25 s ago, when it was ~3 units to -x.
+    shift = moving.mean(axis=0) - at_rest.mean(axis=0)
+    assert shift[0] < -2.0
+    assert np.allclose(beta, [0.6, 0.0, 0.0], atol=1e-6)
+    scene.relativity.beta = (0.0, 0.0, 0.5)  # observer velocity: picked up by the depsgraph handler
+    bpy.context.view_layer.update()
+    _, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
+    gamma = 1.0 / np.sqrt(1.0 - 0.25)
+    # Composition: u' = (u / gamma - v) for u perpendicular to v.
+    assert np.allclose(beta, [0.6 / gamma, 0.0, -0.5], atol=1e-6)
+
+
+def test_superluminal_object_velocity_is_a_one_line_error(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    geometry = gh.geometry_module()
+    scene, camera_object, obj = _scene(bpy)
+    obj.relativity.motion = "CONSTANT"
+    obj.relativity.beta = (1.2, 0.0, 0.0)
+    with pytest.raises(geometry.RelativityError, match="below 1"):
+        geometry.apply_apparent_geometry(scene)
+    assert geometry.find_modifier(obj) is None  # nothing changed
+    blend = ch.save_blend(bpy, tmp_path / "fast.blend")
+    result = ch.run_render_script(blend, tmp_path / "fast.png", "--method=geometry", check=False)
+    assert result.returncode == 1
+    lines = result.stderr.strip().splitlines()
+    assert "Traceback" not in result.stderr
+    assert "below 1" in lines[-1]
