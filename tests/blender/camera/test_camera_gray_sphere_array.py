@@ -81,7 +81,7 @@ def _build_array(bpy, tmp_path, model, shutter_time):
 
 def _render(bpy, blend, out, *options):
     return ch.luminance(ch.render_image(bpy, blend, out, BETA_OPTION, "--speed-of-light=1",
-                                        "--no-searchlight", "--seed=1", *options))
+                                        "--no-searchlight", "--no-doppler", "--seed=1", *options))
 
 
 def _spots(image, pixels):
