@@ -83,7 +83,8 @@ def build_parser(with_blend_file):
         parser.add_argument("blend_file", help=".blend file to render")
     parser.add_argument("--beta", type=_vector3, help="observer velocity X,Y,Z (world axes, fraction of c); "
                         "write --beta=-0.5,0,0 when a value starts with '-'")
-    parser.add_argument("--method", choices=("camera", "geometry"), default="camera")
+    parser.add_argument("--method", choices=("camera", "geometry"),
+                        help="render method (default: the file's setting, Exact Camera in a new file)")
     parser.add_argument("--reference", action="store_true",
                         help="render the file's own camera unchanged (no relativistic camera)")
     parser.add_argument("--samples", type=_positive_int)
@@ -148,7 +149,8 @@ def _apply_options(scene, options):
         settings.beta = options.beta
     if options.velocity_from_animation:
         settings.velocity_source = "CAMERA_ANIMATION"
-    settings.method = options.method.upper()
+    if options.method is not None:
+        settings.method = options.method.upper()
     if options.shutter:
         settings.shutter_model = options.shutter.upper()
     if options.shutter_time is not None:
