@@ -335,8 +335,7 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
             raise RelativityError(f"object {obj.name!r}: light-travel times span too many animation samples")
         times = np.arange(low_index, high_index + 1) * step
         motion = apparent.SampledRigidMotion(times, animation.matrices(times * fps), rest_local)
-        result = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(rest_local), beta_o,
-                                             velocity=motion.velocities)
+        result = apparent.apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
         t_e = t_o - result[1]
         if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
             return result
@@ -369,6 +368,18 @@ def update_object(scene, obj, depsgraph=None):
     if rest is None:
         raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {REST_ATTRIBUTE!r} attribute")
     t_o, x_o, beta_o, c = observer_event(scene)
+    try:
+        world, beta_seen = _apparent_world_positions(scene, obj, rest, t_o, x_o, beta_o, c)
+    except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
+        raise RelativityError(f"object {obj.name!r}: {error}") from None
+    local = _to_world(np.linalg.inv(_matrix_array(obj.matrix_world)), world)
+    _write_cache(cache.data, local, beta_seen)
+    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
+    obj.update_tag()
+    return len(local)
+
+
+def _apparent_world_positions(scene, obj, rest, t_o, x_o, beta_o, c):
     matrix_now = _matrix_array(obj.matrix_world)
     motion = obj.relativity.motion
     if motion == "ANIMATION":
@@ -378,11 +389,7 @@ def update_object(scene, obj, depsgraph=None):
         # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion.
         world_now = apparent.lorentz_contract(_to_world(matrix_now, rest), matrix_now[:3, 3], beta_u)
         world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
-    local = _to_world(np.linalg.inv(matrix_now), world)
-    _write_cache(cache.data, local, beta_seen)
-    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
-    obj.update_tag()
-    return len(local)
+    return world, beta_seen
 
 
 def _write_cache(mesh, positions, beta):
