@@ -352,6 +352,7 @@ def object_signature(scene, obj):
         camera.name if camera else "", tuple(map(tuple, camera.matrix_world)) if camera else (),
         tuple(map(tuple, obj.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
         relativity.tessellation, relativity.samples_per_frame, scene.render.fps, scene.render.fps_base,
+        len(obj.data.vertices),
     ]
     return repr(parts)
 
@@ -495,14 +496,44 @@ def remove_apparent_geometry(scene, objects=None):
 # --- handlers --------------------------------------------------------------------------------
 
 
+ERROR_KEY = "relativity_error"
+
+
+def scene_errors(scene):
+    """One-line errors of the last update of each object (empty when every cache is current)."""
+    errors = []
+    for obj in applied_objects(scene):
+        cache = cache_object(obj)
+        if cache is not None and cache.data is not None and cache.data.get(ERROR_KEY):
+            errors.append(cache.data[ERROR_KEY])
+    return errors
+
+
+def _update_scene_reporting(scene, depsgraph, only_changed):
+    """Handler body: update each object, recording a failure on its cache instead of raising."""
+    with _Computing():
+        for obj in applied_objects(scene):
+            cache = cache_object(obj)
+            if only_changed and cache is not None and cache.data is not None and \
+                    cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj):
+                continue
+            try:
+                update_object(scene, obj, depsgraph)
+                if cache is not None and cache.data is not None and ERROR_KEY in cache.data:
+                    del cache.data[ERROR_KEY]
+            except RelativityError as error:
+                print(f"Relativity: {error}")
+                cache = cache_object(obj)
+                if cache is not None and cache.data is not None:
+                    cache.data[ERROR_KEY] = str(error)
+                    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
+
+
 @persistent
 def _frame_change_post(scene, depsgraph=None):
     if _Computing.depth:
         return
-    try:
-        update_scene(scene, depsgraph)
-    except RelativityError as error:
-        print(f"Relativity: {error}")
+    _update_scene_reporting(scene, depsgraph, only_changed=False)
 
 
 @persistent
@@ -511,10 +542,7 @@ def _depsgraph_update_post(scene, depsgraph=None):
     signature stored with each cache stops the loop that writing the cache would start."""
     if _Computing.depth:
         return
-    try:
-        update_scene(scene, depsgraph, only_changed=True)
-    except RelativityError as error:
-        print(f"Relativity: {error}")
+    _update_scene_reporting(scene, depsgraph, only_changed=True)
 
 
 _HANDLERS = (
