@@ -205,7 +205,13 @@ def _finite_velocity(beta, what):
     return np.array(beta)
 
 
-def observer_event(scene):
+def _evaluated(obj, depsgraph):
+    """The object as evaluated for the frame being computed. Blender's animation render does not
+    write transforms back to the original objects, so their matrix_world may be stale there."""
+    return obj.evaluated_get(depsgraph) if depsgraph is not None else obj
+
+
+def observer_event(scene, depsgraph=None):
     """(t_o seconds, camera world position, observer beta, c) from the scene; RelativityError if invalid."""
     settings = scene.relativity
     c = float(settings.speed_of_light)
@@ -217,7 +223,7 @@ def observer_event(scene):
         raise RelativityError(f"scene {scene.name!r} has no active camera")
     fps = scene.render.fps / scene.render.fps_base
     t_o = (scene.frame_current + scene.frame_subframe) / fps
-    return t_o, np.array(camera.matrix_world.translation, dtype=np.float64), beta, c
+    return t_o, np.array(_evaluated(camera, depsgraph).matrix_world.translation, dtype=np.float64), beta, c
 
 
 def _matrix_array(matrix):
@@ -241,15 +247,15 @@ class _TransformAnimation:
     evaluated at other times.
     """
 
-    def __init__(self, obj):
-        self.obj = obj
+    def __init__(self, obj, obj_eval):
+        self.obj = obj_eval
         channelbag = _channelbag(obj)
         curves = {}
         if channelbag is not None:
             for fcurve in channelbag.fcurves:
                 curves[(fcurve.data_path, fcurve.array_index)] = fcurve
         self.curves = curves
-        self.parent = _matrix_array(obj.matrix_world) @ np.linalg.inv(_matrix_array(obj.matrix_basis))
+        self.parent = _matrix_array(obj_eval.matrix_world) @ np.linalg.inv(_matrix_array(obj_eval.matrix_basis))
 
     def _values(self, path, count, frame):
         current = getattr(self.obj, path)
@@ -319,13 +325,14 @@ def _to_world(matrix, points):
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4):
+def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None):
     """Apparent world positions and beta of an ANIMATION object (rigid keyframed transform)."""
     fps = scene.render.fps / scene.render.fps_base
-    animation = _TransformAnimation(obj)
+    obj_eval = obj if obj_eval is None else obj_eval
+    animation = _TransformAnimation(obj, obj_eval)
     samples_per_frame = int(obj.relativity.samples_per_frame)
     step = 1.0 / (samples_per_frame * fps)
-    world_now = _to_world(_matrix_array(obj.matrix_world), rest_local)
+    world_now = _to_world(_matrix_array(obj_eval.matrix_world), rest_local)
     reach = float(np.max(np.linalg.norm(world_now - world_now.mean(0), axis=1))) if len(world_now) else 0.0
     centre_tau = float(np.linalg.norm(x_o - world_now.mean(0))) / c if len(world_now) else 0.0
     low, high = t_o - centre_tau - 2.0 * reach / c - 2 * step, t_o - centre_tau + 2.0 * reach / c + 2 * step
@@ -344,13 +351,13 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
     raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
 
 
-def object_signature(scene, obj):
+def object_signature(scene, obj, depsgraph=None):
     settings, relativity = scene.relativity, obj.relativity
-    camera = scene.camera
+    camera = _evaluated(scene.camera, depsgraph) if scene.camera is not None else None
     parts = [
         scene.frame_current, scene.frame_subframe, settings.speed_of_light, tuple(settings.beta),
         camera.name if camera else "", tuple(map(tuple, camera.matrix_world)) if camera else (),
-        tuple(map(tuple, obj.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
+        tuple(map(tuple, _evaluated(obj, depsgraph).matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
         relativity.tessellation, relativity.samples_per_frame, scene.render.fps, scene.render.fps_base,
         len(obj.data.vertices),
     ]
@@ -368,23 +375,24 @@ def update_object(scene, obj, depsgraph=None):
     rest = _evaluated_rest_positions(obj, depsgraph)
     if rest is None:
         raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {REST_ATTRIBUTE!r} attribute")
-    t_o, x_o, beta_o, c = observer_event(scene)
+    t_o, x_o, beta_o, c = observer_event(scene, depsgraph)
+    obj_eval = obj.evaluated_get(depsgraph)
     try:
-        world, beta_seen = _apparent_world_positions(scene, obj, rest, t_o, x_o, beta_o, c)
+        world, beta_seen = _apparent_world_positions(scene, obj, obj_eval, rest, t_o, x_o, beta_o, c)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"object {obj.name!r}: {error}") from None
-    local = _to_world(np.linalg.inv(_matrix_array(obj.matrix_world)), world)
+    local = _to_world(np.linalg.inv(_matrix_array(obj_eval.matrix_world)), world)
     _write_cache(cache.data, local, beta_seen)
-    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
+    cache.data[SIGNATURE_KEY] = object_signature(scene, obj, depsgraph)
     obj.update_tag()
     return len(local)
 
 
-def _apparent_world_positions(scene, obj, rest, t_o, x_o, beta_o, c):
-    matrix_now = _matrix_array(obj.matrix_world)
+def _apparent_world_positions(scene, obj, obj_eval, rest, t_o, x_o, beta_o, c):
+    matrix_now = _matrix_array(obj_eval.matrix_world)
     motion = obj.relativity.motion
     if motion == "ANIMATION":
-        world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c)
+        world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
     else:
         beta_u = _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity") if motion == "CONSTANT" else np.zeros(3)
         # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion.
@@ -441,7 +449,7 @@ def _update_scene(scene, depsgraph, only_changed):
     for obj in applied_objects(scene):
         cache = cache_object(obj)
         if only_changed and cache is not None and cache.data is not None and \
-                cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj):
+                cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj, depsgraph):
             continue
         update_object(scene, obj, depsgraph)
         updated += 1
@@ -515,7 +523,7 @@ def _update_scene_reporting(scene, depsgraph, only_changed):
         for obj in applied_objects(scene):
             cache = cache_object(obj)
             if only_changed and cache is not None and cache.data is not None and \
-                    cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj):
+                    cache.data.get(SIGNATURE_KEY) == object_signature(scene, obj, depsgraph):
                 continue
             try:
                 update_object(scene, obj, depsgraph)
@@ -526,7 +534,7 @@ def _update_scene_reporting(scene, depsgraph, only_changed):
                 cache = cache_object(obj)
                 if cache is not None and cache.data is not None:
                     cache.data[ERROR_KEY] = str(error)
-                    cache.data[SIGNATURE_KEY] = object_signature(scene, obj)
+                    cache.data[SIGNATURE_KEY] = object_signature(scene, obj, depsgraph)
 
 
 @persistent
