@@ -11,6 +11,7 @@ import importlib
 _MODULES = (
     "props",
     "camera",
+    "compositing",
     "objects",
     "geometry",
     "animation",

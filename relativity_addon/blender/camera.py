@@ -254,6 +254,9 @@ def apply_relativistic_camera(scene):
         if SAVED_STATE_KEY in camera_data:
             remove_relativistic_camera(scene)
         raise
+    from . import compositing  # Doppler colour stage (materials + compositor), undone on remove
+
+    compositing.apply_camera_colour(scene)
     return camera_object
 
 
@@ -294,6 +297,9 @@ def remove_relativistic_camera(scene, camera_object=None):
     camera_data = camera_object.data
     if not is_applied(camera_data):
         return False
+    from . import compositing
+
+    compositing.remove_camera_colour(scene)
     saved = camera_data[SAVED_STATE_KEY].to_dict()
     custom = camera_data.cycles_custom
     for key in list(custom.keys()):

@@ -36,6 +36,10 @@ NODE_PREFIX = "Relativity Doppler"
 EXP_LIMIT = 80.0  # float32 exp overflows past ~88: clamp the log brightness before exp
 
 
+class Menu(str):
+    """A menu socket value (a string that is not a reference)."""
+
+
 @dataclass
 class Node:
     """One node: ``inputs`` maps socket (name or index) to a constant or a reference.
@@ -69,8 +73,8 @@ def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
     return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
 
 
-def group_node(group_name, inputs=None):
-    return Node("ShaderNodeGroup", inputs or {}, {"node_tree": group_name})
+def group_node(group_name, inputs=None, kind="ShaderNodeGroup"):
+    return Node(kind, inputs or {}, {"node_tree": group_name})
 
 
 def _socket(sockets, key):
@@ -121,7 +125,7 @@ def build_group(spec):
     for name, node_spec in spec.nodes.items():
         for key, value in node_spec.inputs.items():
             target = _socket(built[name].inputs, key)
-            if isinstance(value, str):
+            if isinstance(value, str) and not isinstance(value, Menu):
                 tree.links.new(resolve(value), target)
             else:
                 target.default_value = value
@@ -139,6 +143,8 @@ GAMUT_MAP = "Relativity Gamut Map"
 DOPPLER_MATRIX = "Relativity Doppler Matrix"
 BLACKBODY_SHIFT = "Relativity Blackbody Shift"
 DOPPLER_EMISSION = "Relativity Doppler Colour"
+DOPPLER_AOV = "Relativity Doppler AOV"
+LOG_DOPPLER_AOV = "relativity_log_doppler"
 
 LN10 = math.log(10.0)
 E = math.e
@@ -191,7 +197,7 @@ def doppler_factor_group():
     )
 
 
-def gamut_map_group():
+def gamut_map_group(name=None, tree_type="ShaderNodeTree"):
     """``rgb' = max(Y + (rgb - Y) clamp(Y / (Y - min rgb)), 0)`` (spectral.gamut_map_linear_rec709)."""
     nodes = {
         "luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
@@ -208,8 +214,8 @@ def gamut_map_group():
         "clipped": vmath("MAXIMUM", "mapped", (0.0, 0.0, 0.0)),
     }
     return Group(
-        GAMUT_MAP,
-        "ShaderNodeTree",
+        name or GAMUT_MAP,
+        tree_type,
         (("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),),
         (("Color", "NodeSocketColor", "clipped"),),
         nodes,
@@ -326,6 +332,21 @@ def doppler_colour_group():
     )
 
 
+def doppler_aov_group():
+    """Writes ``ln D`` of the first camera hit to the ``relativity_log_doppler`` AOV.
+
+    The exact camera's compositor stage reads ``D`` from it: computed by Cycles per sample from
+    the scene-frame photon direction, so it is right for every shutter model, depth of field and
+    the Lorentz window, and it follows per-frame velocity changes in animation renders.
+    """
+    nodes = {
+        "settings": group_node(SETTINGS),
+        "doppler": group_node(DOPPLER_FACTOR, {"Observer Beta": "settings.Observer Beta"}),
+        "aov": Node("ShaderNodeOutputAOV", {"Value": "doppler"}, {"aov_name": LOG_DOPPLER_AOV}),
+    }
+    return Group(DOPPLER_AOV, "ShaderNodeTree", (), (), nodes)
+
+
 GROUP_BUILDERS = (
     settings_group,
     doppler_factor_group,
@@ -333,11 +354,12 @@ GROUP_BUILDERS = (
     doppler_matrix_group,
     blackbody_shift_group,
     doppler_colour_group,
+    doppler_aov_group,
 )
 
 
 GROUPS_VERSION_KEY = "relativity_group_version"
-GROUPS_VERSION = 1
+GROUPS_VERSION = 2
 
 
 def ensure_node_groups():
@@ -382,7 +404,53 @@ def settings_values(scene, camera_path):
     }
 
 
+# The compositor stage reads the effect flags through drivers (see compositing.py); every
+# expression is a "simple expression", evaluated without Python.
+SCENE_FLAG_VARIABLES = (
+    ("dop", "relativity.use_doppler"),
+    ("sl", "relativity.use_searchlight"),
+    ("ch", "relativity.use_chang_searchlight"),
+)
+FLAG_EXPRESSIONS = {
+    "Use Doppler": "dop",
+    "Spectral Searchlight": "sl * dop * (1 - ch)",
+    "Power of D": "sl * (1 - dop * (1 - ch)) * (4 - 3 * ch)",
+}
+
+
+def drive(tree, data_path, expression, variables, index=-1):
+    """(Re)create the driver of ``tree``'s ``data_path``; ``variables`` = (name, ID, path)."""
+    tree.driver_remove(data_path, index)
+    driver = tree.driver_add(data_path, index).driver
+    driver.type = "SCRIPTED"
+    for name, target_id, target_path in variables:
+        variable = driver.variables.new()
+        variable.name = name
+        variable.targets[0].id_type = "CAMERA" if isinstance(target_id, bpy.types.Camera) else "SCENE"
+        variable.targets[0].id = target_id
+        variable.targets[0].data_path = target_path
+    driver.expression = expression
+    return driver
+
+
+def value_path(node_name, output=0):
+    return f'nodes["{node_name}"].outputs[{output}].default_value'
+
+
+def input_path(node_name, index):
+    return f'nodes["{node_name}"].inputs[{index}].default_value'
+
+
+def drive_flags(tree, scene, camera_power):
+    """Drivers for the effect flags shared by the material and compositor groups."""
+    flags = [(name, scene, path) for name, path in SCENE_FLAG_VARIABLES]
+    for node_name, expression in FLAG_EXPRESSIONS.items():
+        drive(tree, value_path(node_name), expression, flags)
+    drive(tree, value_path("Camera Power"), f"{camera_power} * sl", flags[1:2])
+
+
 def sync_settings(scene, camera_path):
+    """Write the settings (Cycles reads shader values written in render_pre for every frame)."""
     tree = bpy.data.node_groups.get(SETTINGS)
     if tree is None:
         return False
@@ -421,9 +489,14 @@ def is_attached(material):
     return material is not None and ATTACHED_KEY in material
 
 
-def attach(material):
-    """Insert the Doppler colour group in front of every colour input of ``material``."""
-    if material is None or not material.use_nodes or is_attached(material):
+def attach(material, temperature=None):
+    """Insert the Doppler colour group in front of every colour input of ``material``.
+
+    A colour fed by a Blackbody node is shifted as a blackbody at that node's temperature. With
+    ``temperature`` (an object marked as a blackbody emitter, ``Object.relativity.temperature``)
+    every emission colour is a blackbody at that temperature, with the material's luminance.
+    """
+    if material is None or material.node_tree is None or is_attached(material):
         return False
     group = bpy.data.node_groups.get(DOPPLER_EMISSION) or ensure_node_groups()
     tree = material.node_tree
@@ -446,6 +519,10 @@ def attach(material):
                     node.inputs["Temperature"].default_value = temperature.default_value
         else:
             node.inputs["Color"].default_value = socket.default_value
+        is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
+        if temperature and is_emission and not node.inputs["Is Blackbody"].default_value:
+            node.inputs["Is Blackbody"].default_value = 1.0
+            node.inputs["Temperature"].default_value = temperature
         tree.links.new(node.outputs["Color"], socket)
         records.append(
             {
@@ -456,6 +533,11 @@ def attach(material):
                 "source_socket": source.identifier if source is not None else "",
             }
         )
+    aov = tree.nodes.new("ShaderNodeGroup")
+    aov.node_tree = bpy.data.node_groups[DOPPLER_AOV]
+    aov.name = aov.label = f"{NODE_PREFIX} AOV"
+    aov.hide = True
+    records.append({"group_node": aov.name, "target": "", "socket": "", "source_node": "", "source_socket": ""})
     material[ATTACHED_KEY] = records
     return True
 
@@ -465,8 +547,8 @@ def detach(material):
     if not is_attached(material):
         return False
     tree = material.node_tree
-    for record in material[ATTACHED_KEY].to_list() if hasattr(material[ATTACHED_KEY], "to_list") else material[ATTACHED_KEY]:
-        record = dict(record)
+    for record in list(material[ATTACHED_KEY]):
+        record = record.to_dict()
         node = tree.nodes.get(record["group_node"])
         if node is not None:
             tree.nodes.remove(node)
@@ -484,23 +566,52 @@ def detach(material):
 
 
 def scene_materials(scene):
-    found = []
+    """``(material, blackbody temperature or None)`` for every material used in ``scene``."""
+    found = {}
     for obj in scene.objects:
+        object_settings = getattr(obj, "relativity", None)
+        temperature = getattr(object_settings, "temperature", 0.0) or None
         for slot in getattr(obj, "material_slots", ()):
-            if slot.material is not None and slot.material not in found:
-                found.append(slot.material)
-    return found
+            if slot.material is not None:
+                found[slot.material] = found.get(slot.material) or temperature
+    return list(found.items())
 
 
 def apply_doppler_colour(scene, camera_path=False):
     """Attach the Doppler colour group to every material of ``scene`` and sync its settings."""
     ensure_node_groups()
-    for material in scene_materials(scene):
-        attach(material)
+    for material, temperature in scene_materials(scene):
+        attach(material, temperature)
+    if camera_path:
+        attach_world(scene.world)
     sync_settings(scene, camera_path)
 
 
+def attach_world(world):
+    """The world writes the Doppler AOV too, so background pixels get their D."""
+    if world is None or world.node_tree is None or ATTACHED_KEY in world:
+        return False
+    node = world.node_tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = bpy.data.node_groups[DOPPLER_AOV]
+    node.name = node.label = f"{NODE_PREFIX} AOV"
+    node.hide = True
+    world[ATTACHED_KEY] = node.name
+    return True
+
+
+def detach_world(world):
+    if world is None or ATTACHED_KEY not in world:
+        return False
+    node = world.node_tree.nodes.get(world[ATTACHED_KEY]) if world.node_tree else None
+    if node is not None:
+        world.node_tree.nodes.remove(node)
+    del world[ATTACHED_KEY]
+    return True
+
+
 def remove_doppler_colour(scene):
-    """Detach from every material (the node groups and LUTs stay in the file, unused)."""
+    """Detach from every material and world (the groups and LUTs stay in the file, unused)."""
     for material in bpy.data.materials:
         detach(material)
+    for world in bpy.data.worlds:
+        detach_world(world)

@@ -1,0 +1,336 @@
+"""Doppler colour stage of the exact (OSL) camera, in the compositor.
+
+The camera shader multiplies every camera ray's throughput by ``D^4`` (searchlight). The colour
+change needs the spectrum, which a camera shader cannot touch, so this stage applies the
+spectral Doppler matrix per pixel after the render, with no second render:
+
+- ``D`` per pixel from the pixel's camera-frame direction ``d`` (the pinhole ray through the
+  pixel centre, the same ``d`` the shader uses): ``D = 1 / (gamma (1 - beta . d))`` with ``beta``
+  in camera coordinates (PHYSICS.md, ``D = 1 / (gamma (1 + beta . k'))`` with ``k' = -d``), or
+  ``D = gamma (1 + beta . d)`` behind a Lorentz window, as in the shader.
+- ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),
+  and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
+  (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
+  with Map UV (bilinear, extend), ``E = a(D)`` with searchlight and Doppler, ``4 ln D`` without
+  Doppler. All exponents are added before one ``exp`` so that nothing overflows float32.
+- Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
+  written by ``materials``) keep their rendered colour.
+
+The group is inserted after every Render Layers node of the scene's compositor (a tree is
+created if the scene has none); :func:`remove_colour_stage` restores the compositor exactly.
+"""
+
+import bpy
+
+from . import luts, materials
+from .materials import Group, Menu, Node, fmath, group_node, vmath
+
+COMPOSITOR_GROUP = "Relativity Doppler Compositor"
+COMPOSITOR_GAMUT_MAP = "Relativity Gamut Map (Compositor)"
+SCENE_TREE_NAME = "Relativity Compositing"
+SAVED_KEY = "relativity_compositor_saved"
+GROUP_VERSION = 3
+VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
+
+
+def compositor_group():
+    scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
+    nodes = {}
+    nodes.update({
+        # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group)
+        "ln_d": fmath("ADD", "group.Log Doppler", 0.0),
+        "u": fmath("MULTIPLY_ADD", "ln_d", scale / materials.LN10, offset),
+        "lut": Node("CompositorNodeImage", props={"image": luts.DOPPLER_LUT_NAME}),
+    })
+    for row in range(3):
+        nodes[f"uv{row}"] = Node("ShaderNodeCombineXYZ", {0: "u", 1: (row + 0.5) / 3.0, 2: 1.0})  # z: UV alpha
+        nodes[f"row{row}"] = Node("CompositorNodeMapUV", {
+            "Image": "lut.Image", "UV": f"uv{row}", "Interpolation": Menu("Bilinear"),
+            "Extension X": Menu("Extend"), "Extension Y": Menu("Extend"),
+        })
+        nodes[f"dot{row}"] = vmath("DOT_PRODUCT", f"row{row}", "group.Image")
+    nodes.update({
+        "row0_split": Node("CompositorNodeSeparateColor", {0: "row0"}),
+        "product": Node("ShaderNodeCombineXYZ", {0: "dot0.Value", 1: "dot1.Value", 2: "dot2.Value"}),
+        "mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: "product"}, kind="CompositorNodeGroup"),
+        "base": Node("ShaderNodeMix", {"Factor": "group.Use Doppler", 4: "group.Image", 5: "mapped"},
+                     {"data_type": "VECTOR"}),
+        "power": fmath("SUBTRACT", "group.Power of D", "group.Camera Power"),
+        "power_term": fmath("MULTIPLY", "power", "ln_d"),
+        "log_gain": fmath("MULTIPLY_ADD", "row0_split.Alpha", "group.Spectral Searchlight", "power_term"),
+        "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
+        "gain": fmath("EXPONENT", "safe_log_gain"),
+        "shifted": vmath("SCALE", "base.Result", scale="gain"),
+        "kept": Node("ShaderNodeMix", {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
+                     {"data_type": "VECTOR", "clamp_factor": True}),
+        "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
+        "out_split": Node("ShaderNodeSeparateXYZ", {0: "kept.Result"}),
+        "out": Node("CompositorNodeCombineColor", {0: "out_split.X", 1: "out_split.Y", 2: "out_split.Z",
+                                                   3: "source_split.Alpha"}),
+    })
+    return Group(
+        COMPOSITOR_GROUP,
+        "CompositorNodeTree",
+        (
+            ("Image", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("Log Doppler", "NodeSocketFloat", 0.0),
+            ("Done", "NodeSocketFloat", 0.0),
+        )
+        + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
+        (("Image", "NodeSocketColor", "out"),),
+        nodes,
+    )
+
+
+def ensure_compositor_group():
+    luts.ensure_doppler_matrix_lut()
+    gamut = bpy.data.node_groups.get(COMPOSITOR_GAMUT_MAP)
+    if gamut is None or gamut.get(materials.GROUPS_VERSION_KEY) != GROUP_VERSION:
+        gamut = materials.build_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"))
+        gamut[materials.GROUPS_VERSION_KEY] = GROUP_VERSION
+    tree = bpy.data.node_groups.get(COMPOSITOR_GROUP)
+    if tree is None or tree.get(materials.GROUPS_VERSION_KEY) != GROUP_VERSION:
+        tree = materials.build_group(compositor_group())
+        tree[materials.GROUPS_VERSION_KEY] = GROUP_VERSION
+    return tree
+
+
+def colour_stage_values(scene):
+    """Values of the compositor group's flag inputs, from ``scene.relativity``."""
+    values = materials.settings_values(scene, camera_path=True)
+    return {name: values[name] for name in VALUE_NAMES}
+
+
+def _inserted_nodes(scene):
+    tree = scene.compositing_node_group
+    if tree is None or not is_applied(scene):
+        return tree, []
+    names = [record["group_node"] for record in scene[SAVED_KEY]["inserted"]]
+    return tree, [tree.nodes[name] for name in names if name in tree.nodes]
+
+
+def _node_input_path(node, name):
+    return f'nodes["{node.name}"].inputs["{name}"].default_value'
+
+
+def _drive_node(tree, node, scene):
+    """Drivers on the inserted group node's flag inputs, so animated flags follow each frame.
+
+    ``D`` itself comes from the AOV (Cycles, per frame). Values written from Python in a
+    handler would reach Blender's animation render one frame late (measured with 5.0.1: the
+    compositor of frame N sees what a render_pre or frame_change_pre handler wrote at N - 1).
+    All are simple expressions, evaluated without Python.
+    """
+    flags = [(name, scene, path) for name, path in materials.SCENE_FLAG_VARIABLES]
+    for name, expression in materials.FLAG_EXPRESSIONS.items():
+        materials.drive(tree, _node_input_path(node, name), expression, flags)
+    materials.drive(tree, _node_input_path(node, "Camera Power"), "4 * sl", flags[1:2])
+    node["relativity_driven_by"] = scene.name
+
+
+def sync_colour_stage(scene):
+    """Write the current values into the inserted group nodes (and drive them per frame)."""
+    tree, nodes = _inserted_nodes(scene)
+    if not nodes or scene.camera is None:
+        return False
+    values = colour_stage_values(scene)
+    for node in nodes:
+        for name, value in values.items():
+            node.inputs[name].default_value = value
+        if node.get("relativity_driven_by") != scene.name:
+            _drive_node(tree, node, scene)
+    return True
+
+
+def is_applied(scene):
+    return SAVED_KEY in scene
+
+
+def apply_colour_stage(scene):
+    """Insert the Doppler colour group after the scene's Render Layers nodes and sync it."""
+    group = ensure_compositor_group()
+    if not is_applied(scene):
+        saved = {
+            "tree": scene.compositing_node_group.name if scene.compositing_node_group else "",
+            "use_compositing": scene.render.use_compositing,
+            "added_aovs": [],
+            "inserted": [],
+            "created_tree": "",
+            "had_animation_data": False,
+        }
+        tree = scene.compositing_node_group
+        if tree is None:
+            tree = bpy.data.node_groups.new(SCENE_TREE_NAME, "CompositorNodeTree")
+            tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+            layers = tree.nodes.new("CompositorNodeRLayers")
+            output = tree.nodes.new("NodeGroupOutput")
+            output.location = (400.0, 0.0)
+            tree.links.new(layers.outputs["Image"], output.inputs[0])
+            scene.compositing_node_group = tree
+            saved["created_tree"] = tree.name
+        saved["had_animation_data"] = tree.animation_data is not None
+        for view_layer in scene.view_layers:
+            for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV):
+                if aov_name not in view_layer.aovs:
+                    aov = view_layer.aovs.add()
+                    aov.name = aov_name
+                    aov.type = "VALUE"
+                    saved["added_aovs"].append([view_layer.name, aov_name])
+        for layers in [node for node in tree.nodes if node.bl_idname == "CompositorNodeRLayers"]:
+            image = layers.outputs["Image"]
+            targets = [(link.to_node.name, link.to_socket.identifier) for link in image.links]
+            node = tree.nodes.new("CompositorNodeGroup")
+            node.node_tree = group
+            node.name = node.label = f"{COMPOSITOR_GROUP} {layers.name}"
+            node.location = (layers.location.x + 250.0, layers.location.y)
+            tree.links.new(image, node.inputs["Image"])
+            for aov_name, socket_name in ((materials.DONE_AOV, "Done"), (materials.LOG_DOPPLER_AOV, "Log Doppler")):
+                aov_output = layers.outputs.get(aov_name)
+                if aov_output is not None:
+                    tree.links.new(aov_output, node.inputs[socket_name])
+            for to_node, to_socket in targets:
+                socket = next(s for s in tree.nodes[to_node].inputs if s.identifier == to_socket)
+                tree.links.new(node.outputs["Image"], socket)
+            saved["inserted"].append({"group_node": node.name, "layers": layers.name, "targets": targets})
+        scene.render.use_compositing = True
+        scene[SAVED_KEY] = saved
+    sync_colour_stage(scene)
+
+
+def remove_colour_stage(scene):
+    """Restore the compositor (tree, links, AOVs, the compositing switch) exactly."""
+    if not is_applied(scene):
+        return False
+    saved = scene[SAVED_KEY].to_dict()
+    tree = scene.compositing_node_group
+    if tree is not None:
+        for record in saved["inserted"]:
+            prefix = f'nodes["{record["group_node"]}"]'
+            if tree.animation_data is not None:
+                for fcurve in [f for f in tree.animation_data.drivers if f.data_path.startswith(prefix)]:
+                    tree.animation_data.drivers.remove(fcurve)
+            node = tree.nodes.get(record["group_node"])
+            if node is not None:
+                tree.nodes.remove(node)
+            layers = tree.nodes.get(record["layers"])
+            for to_node, to_socket in record["targets"]:
+                target = tree.nodes.get(to_node)
+                if layers is None or target is None:
+                    continue
+                socket = next((s for s in target.inputs if s.identifier == to_socket), None)
+                if socket is not None:
+                    tree.links.new(layers.outputs["Image"], socket)
+        if not saved.get("had_animation_data") and tree.animation_data is not None and not (
+            tree.animation_data.drivers or tree.animation_data.action
+        ):
+            tree.animation_data_clear()
+    for view_layer_name, aov_name in saved["added_aovs"]:
+        view_layer = scene.view_layers.get(view_layer_name)
+        if view_layer is not None and aov_name in view_layer.aovs:
+            view_layer.aovs.remove(view_layer.aovs[aov_name])
+    scene.compositing_node_group = bpy.data.node_groups.get(saved["tree"]) if saved["tree"] else None
+    if saved["created_tree"]:
+        created = bpy.data.node_groups.get(saved["created_tree"])
+        if created is not None and created.users == 0:
+            bpy.data.node_groups.remove(created)
+    scene.render.use_compositing = saved["use_compositing"]
+    del scene[SAVED_KEY]
+    return True
+
+
+# --- the exact camera's colour stage as a whole -------------------------------------------------
+
+
+def apply_camera_colour(scene):
+    """Called by ``camera.apply_relativistic_camera``: materials (blackbodies) + compositor."""
+    materials.apply_doppler_colour(scene, camera_path=True)
+    apply_colour_stage(scene)
+
+
+def remove_camera_colour(scene):
+    """Called by ``camera.remove_relativistic_camera``: undo :func:`apply_camera_colour`."""
+    remove_colour_stage(scene)
+    materials.remove_doppler_colour(scene)
+    if not any(is_applied(other) for other in bpy.data.scenes):
+        remove_unused_data()
+
+
+def remove_unused_data():
+    """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
+    if any(materials.is_attached(material) for material in bpy.data.materials):
+        return False
+    names = (COMPOSITOR_GROUP, COMPOSITOR_GAMUT_MAP) + tuple(
+        builder().name for builder in reversed(materials.GROUP_BUILDERS)
+    )
+    for name in names:
+        tree = bpy.data.node_groups.get(name)
+        if tree is not None:
+            bpy.data.node_groups.remove(tree)
+    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME):
+        image = bpy.data.images.get(name)
+        if image is not None:
+            bpy.data.images.remove(image)
+    return True
+
+
+def sync_camera_colour(scene):
+    if is_applied(scene):
+        materials.sync_settings(scene, camera_path=True)
+        sync_colour_stage(scene)
+
+
+@bpy.app.handlers.persistent
+def _sync_handler(scene, _depsgraph=None):
+    try:
+        sync_camera_colour(scene)
+    except Exception as error:  # noqa: BLE001 - a handler must never stop the render
+        print(f"Relativity: Doppler colour stage not synced: {error}")
+
+
+# render_pre alone is not enough: Blender's animation render changes the frame (and the
+# animation handlers the velocity) after render_pre, so the stage re-syncs on frame_change_pre
+# too, appended after the handlers that write this frame's velocity.
+_HANDLER_LISTS = ("render_pre", "frame_change_pre")
+
+
+def revalidate_drivers():
+    """Re-enable the stage's drivers that failed while the add-on was not registered.
+
+    A farm worker opens the .blend before enabling the add-on: drivers reading
+    ``scene.relativity`` fail to resolve then, and Blender stops evaluating invalid drivers.
+    """
+    for tree in bpy.data.node_groups:
+        animation = tree.animation_data
+        if animation is None:
+            continue
+        for fcurve in animation.drivers:
+            if COMPOSITOR_GROUP in fcurve.data_path and not fcurve.driver.is_valid:
+                fcurve.driver.is_valid = True
+                tree.update_tag()
+
+
+@bpy.app.handlers.persistent
+def _load_post(_filepath=None, _unused=None):
+    revalidate_drivers()
+
+
+def register():
+    if _load_post not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(_load_post)
+    try:
+        revalidate_drivers()
+    except AttributeError:  # bpy.data is restricted while Blender itself starts up
+        pass
+    for name in _HANDLER_LISTS:
+        handlers = getattr(bpy.app.handlers, name)
+        if _sync_handler not in handlers:
+            handlers.append(_sync_handler)
+
+
+def unregister():
+    if _load_post in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_load_post)
+    for name in _HANDLER_LISTS:
+        handlers = getattr(bpy.app.handlers, name)
+        if _sync_handler in handlers:
+            handlers.remove(_sync_handler)
