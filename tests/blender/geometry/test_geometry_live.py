@@ -71,3 +71,29 @@ def test_superluminal_object_velocity_is_a_one_line_error(relativity_addon, fact
     lines = result.stderr.strip().splitlines()
     assert "Traceback" not in result.stderr
     assert "below 1" in lines[-1]
+
+
+def test_relativity_beta_reaches_the_shader(relativity_addon, factory_blender, tmp_path):
+    """A material reading the point attribute relativity_beta (Attribute node) renders its value:
+    the Doppler shaders get the velocity relative to the observer, in the observer's frame."""
+    bpy = factory_blender
+    scene, camera_object, obj = _scene(bpy)
+    material = obj.data.materials[0]
+    tree = material.node_tree
+    attribute = tree.nodes.new("ShaderNodeAttribute")
+    attribute.attribute_type = "GEOMETRY"
+    attribute.attribute_name = "relativity_beta"
+    tree.links.new(attribute.outputs["Vector"], tree.nodes["Emission"].inputs["Color"])
+    obj.relativity.motion = "CONSTANT"
+    obj.relativity.beta = (0.5, 0.0, 0.0)
+    obj.location = (2.5, 0.0, -5.0)  # seen where it was 5 / c ago: straight ahead, 5 units away
+    blend = ch.save_blend(bpy, tmp_path / "beta.blend")
+    image = ch.render_image(bpy, blend, tmp_path / "beta.exr", "--method=geometry", "--beta=0,0.2,0",
+                            "--resolution=64x48")
+    lit = image.sum(-1) > 0.05
+    assert lit.sum() > 50
+    colour = np.median(image[lit], axis=0)
+    # Velocity addition, u perpendicular to v: u' = (u / gamma_v, -v, 0) (linear EXR keeps signs).
+    expected = np.array([0.5 * np.sqrt(1.0 - 0.2**2), -0.2, 0.0])
+    print(f"rendered relativity_beta {colour}, expected {expected}")
+    assert np.allclose(colour, expected, atol=2e-3)
