@@ -183,7 +183,10 @@ def _remove_object_effect(obj):
     if modifier is None:
         return False
     cache = cache_object(obj)
+    baked = bake_mesh(obj)
     obj.modifiers.remove(modifier)
+    if baked is not None:
+        bpy.data.meshes.remove(baked)
     if cache is not None:
         mesh = cache.data
         bpy.data.objects.remove(cache)
@@ -351,6 +354,87 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
     raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
 
 
+BAKE_PREFIX = "RelativityBake"
+BAKE_KEY = "relativity_bake"  # on the cache mesh: name of the bake mesh and its time grid
+
+
+def bake_mesh(obj):
+    cache = cache_object(obj)
+    if cache is None or cache.data is None or BAKE_KEY not in cache.data:
+        return None
+    return bpy.data.meshes.get(cache.data[BAKE_KEY]["mesh"])
+
+
+def bake_deformation(scene, obj, frame_start=None, frame_end=None):
+    """Sample the evaluated (tessellated, deformed) world positions of ``obj`` from ``frame_start``
+    to ``frame_end`` (default: the scene's range, plus the light-travel margin the user must
+    cover) at ``relativity.samples_per_frame`` sub-frames, for per-vertex retarded times of a
+    deforming mesh. Steps the scene through the frames (frame_set), so it runs outside handlers;
+    the scene's frame is restored. The samples live in a mesh datablock kept with the .blend
+    (fake user) and are removed with the effect. Returns the number of samples.
+    """
+    modifier, cache = _ensure_modifier(obj)
+    fps = scene.render.fps / scene.render.fps_base
+    first = scene.frame_start if frame_start is None else frame_start
+    last = scene.frame_end if frame_end is None else frame_end
+    per_frame = int(obj.relativity.samples_per_frame)
+    frames = first + np.arange(int(round((last - first) * per_frame)) + 1) / per_frame
+    if len(frames) < 2:
+        raise RelativityError(f"object {obj.name!r}: bake range needs at least two samples")
+    saved_frame, saved_subframe = scene.frame_current, scene.frame_subframe
+    samples = []
+    with _Computing():
+        try:
+            for frame in frames:
+                whole = int(np.floor(frame))
+                scene.frame_set(whole, subframe=float(frame - whole))
+                depsgraph = bpy.context.evaluated_depsgraph_get()
+                rest = _evaluated_rest_positions(obj, depsgraph)
+                if rest is None or (samples and len(rest) != len(samples[0])):
+                    raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
+                samples.append(_to_world(_matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest))
+        finally:
+            scene.frame_set(saved_frame, subframe=saved_subframe)
+    mesh = bake_mesh(obj)
+    if mesh is None:
+        mesh = bpy.data.meshes.new(f"{BAKE_PREFIX} {obj.name}")
+        mesh.use_fake_user = True
+    mesh.clear_geometry()
+    count = len(samples[0])
+    mesh.vertices.add(count)
+    for i, positions in enumerate(samples):
+        attribute = mesh.attributes.new(f"sample_{i:05d}", "FLOAT_VECTOR", "POINT")
+        attribute.data.foreach_set("vector", positions.astype(np.float32).ravel())
+    cache.data[BAKE_KEY] = {"mesh": mesh.name, "start": float(frames[0] / fps), "step": 1.0 / (per_frame * fps),
+                            "samples": len(samples), "points": count}
+    with _Computing():
+        update_object(scene, obj)
+    return len(samples)
+
+
+def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
+    """Apparent positions of a deforming object from its baked samples (per-vertex retarded times)."""
+    cache = cache_object(obj)
+    mesh = bake_mesh(obj)
+    if mesh is None:
+        raise RelativityError(f"object {obj.name!r} is deforming but not baked: run bake_deformation first")
+    info = cache.data[BAKE_KEY]
+    if info["points"] != count:
+        raise RelativityError(f"object {obj.name!r}: the mesh changed since the deformation bake; bake again")
+    positions = np.empty((info["samples"], count * 3), dtype=np.float32)
+    for i in range(info["samples"]):
+        mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
+    times = info["start"] + info["step"] * np.arange(info["samples"])
+    motion = apparent.SampledPointMotion(times, positions.reshape(info["samples"], count, 3).astype(np.float64))
+    result = apparent.apparent_positions(motion.positions, t_o, x_o, c, count, beta_o, velocity=motion.velocities)
+    t_e = t_o - result[1]
+    if t_e.min() < times[0] or t_e.max() > times[-1]:
+        raise RelativityError(
+            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"baked range {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+    return result
+
+
 def object_signature(scene, obj, depsgraph=None):
     settings, relativity = scene.relativity, obj.relativity
     camera = _evaluated(scene.camera, depsgraph) if scene.camera is not None else None
@@ -359,6 +443,7 @@ def object_signature(scene, obj, depsgraph=None):
         camera.name if camera else "", tuple(map(tuple, camera.matrix_world)) if camera else (),
         tuple(map(tuple, _evaluated(obj, depsgraph).matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
         relativity.tessellation, relativity.samples_per_frame, scene.render.fps, scene.render.fps_base,
+        relativity.use_deformation,
         len(obj.data.vertices),
     ]
     return repr(parts)
@@ -391,7 +476,9 @@ def update_object(scene, obj, depsgraph=None):
 def _apparent_world_positions(scene, obj, obj_eval, rest, t_o, x_o, beta_o, c):
     matrix_now = _matrix_array(obj_eval.matrix_world)
     motion = obj.relativity.motion
-    if motion == "ANIMATION":
+    if motion == "ANIMATION" and obj.relativity.use_deformation:
+        world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
+    elif motion == "ANIMATION":
         world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
     else:
         beta_u = _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity") if motion == "CONSTANT" else np.zeros(3)

@@ -65,6 +65,13 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         max=6,
         update=_settings_changed,
     )
+    use_deformation: BoolProperty(
+        name="Deforming",
+        description="The mesh deforms (armature, shape keys, modifiers before this one): use evaluated "
+        "vertex positions baked over the frame range (bake_deformation) instead of the keyframed transform",
+        default=False,
+        update=_settings_changed,
+    )
     samples_per_frame: IntProperty(
         name="Samples per Frame",
         description="Animation samples per frame used to interpolate the motion at retarded times",

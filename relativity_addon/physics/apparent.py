@@ -238,6 +238,49 @@ class SampledRigidMotion:
         return self.positions_and_velocities(t, index)[1]
 
 
+class SampledPointMotion:
+    """Arbitrary (deforming) motion of N points sampled on a uniform time grid: ``positions`` has
+    shape ``(K, N, 3)`` (world positions at each of the K ``times``). Each coordinate follows a
+    Catmull-Rom cubic in time between samples and continues linearly beyond the grid, like
+    :class:`SampledRigidMotion`. Use with :func:`apparent_positions` (``positions`` is its
+    ``world_line``, ``velocities`` its ``velocity``)."""
+
+    def __init__(self, times, positions):
+        times = finite_array(times, "times")
+        positions = finite_array(positions, "positions")
+        if times.ndim != 1 or times.size < 2 or positions.ndim != 3 or positions.shape[0] != times.size \
+                or positions.shape[2] != 3:
+            raise ValueError("need at least 2 sample times and positions of shape (times, points, 3)")
+        steps = np.diff(times)
+        if np.any(steps <= 0.0) or np.ptp(steps) > 1e-9 * max(abs(times[-1]), abs(steps[0]), 1.0):
+            raise ValueError("sample times must be increasing and uniformly spaced")
+        self.start = float(times[0])
+        self.step = float(steps[0])
+        self.intervals = times.size - 1
+        self._samples = np.concatenate(
+            [2 * positions[:1] - positions[1:2], positions, 2 * positions[-1:] - positions[-2:-1]])
+
+    def positions_and_velocities(self, t, index):
+        index = np.asarray(index)
+        s = (np.broadcast_to(np.asarray(t, dtype=np.float64), index.shape) - self.start) / self.step
+        k = np.clip(np.floor(s), 0, self.intervals - 1).astype(np.int64)
+        f = s - k
+        g = np.clip(f, 0.0, 1.0)[:, None]
+        p0, p1, p2, p3 = (self._samples[k + j, index] for j in range(4))
+        c1 = 0.5 * (p2 - p0)
+        c2 = p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3
+        c3 = 0.5 * (p3 - p0) + 1.5 * (p1 - p2)
+        rate = (3.0 * c3 * g + 2.0 * c2) * g + c1
+        position = ((c3 * g + c2) * g + c1) * g + p1 + (f[:, None] - g) * rate
+        return position, rate / self.step
+
+    def positions(self, t, index):
+        return self.positions_and_velocities(t, index)[0]
+
+    def velocities(self, t, index):
+        return self.positions_and_velocities(t, index)[1]
+
+
 def apparent_positions_sampled(motion, observer_time, observer_position, c, observer_beta=(0.0, 0.0, 0.0),
                                relative_tolerance=1e-10, max_iterations=30):
     """Apparent positions of the points of a :class:`SampledRigidMotion` (per-point retarded times).

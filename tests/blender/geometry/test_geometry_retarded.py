@@ -9,6 +9,7 @@ be x_a: |x_o - x_e(t_e)| = c (t_o - t_e) to 1e-6 relative.
 import math
 
 import numpy as np
+import pytest
 
 import geometry_helpers as gh
 from geometry_helpers import ch
@@ -142,3 +143,63 @@ def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     assert residual.max() < 1e-6
     assert mismatch.max() < 1e-6
     assert np.ptp(t_e) * FPS > 0.5
+
+
+def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory_blender):
+    """Shape-key deformation (eased keys): each vertex is seen where Blender's own evaluation of the
+    deformed mesh puts it at that vertex's retarded time."""
+    bpy = factory_blender
+    scene, camera_object = _scene(bpy)
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.3, 0.2, -3.0))
+    blob = bpy.context.object
+    blob.shape_key_add(name="Basis")
+    stretched = blob.shape_key_add(name="Stretch")
+    for i, point in enumerate(stretched.data):
+        point.co = point.co * 2.5
+        point.co.x += i % 2
+    stretched.value = 0.0
+    stretched.keyframe_insert("value", frame=0)
+    stretched.value = 1.0
+    stretched.keyframe_insert("value", frame=24)
+    blob.relativity.motion = "ANIMATION"
+    blob.relativity.use_deformation = True
+    blob.relativity.tessellation = 0
+    blob.relativity.samples_per_frame = 16
+    geometry = gh.geometry_module()
+    frame = 20
+    scene.frame_set(frame)
+    with pytest.raises(geometry.RelativityError, match="not baked"):
+        geometry.apply_apparent_geometry(scene)
+    assert geometry.find_modifier(blob) is None  # nothing applied
+    blob.relativity.use_deformation = False
+    geometry.apply_apparent_geometry(scene)
+    blob.relativity.use_deformation = True
+    assert geometry.bake_deformation(scene, blob, 0, 24) == 24 * 16 + 1
+    assert scene.frame_current == frame
+    x_a, _ = gh.evaluated_points(bpy, blob)
+    x_o = np.array(camera_object.matrix_world.translation)
+    tau = np.linalg.norm(x_a - x_o, axis=1) / C
+    t_e = frame / FPS - tau
+    # Blender's own evaluation of the deformed mesh at each vertex's retarded (sub-)frame.
+    x_e = np.empty_like(x_a)
+    for i, t in enumerate(t_e):
+        whole = math.floor(t * FPS)
+        scene.frame_set(whole, subframe=t * FPS - whole)
+        x_e[i] = _ev_attribute(bpy, blob, "relativity_rest")[i] + np.array(blob.location)
+    mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
+    print(f"deforming: max position mismatch {mismatch.max():.2e}, retarded frames "
+          f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
+    assert mismatch.max() < 1e-6
+    speeds = np.linalg.norm(x_e - _ev_points_at(bpy, scene, blob, t_e - 1e-3), axis=1) / 1e-3
+    assert speeds.max() > 0.1 * C  # the deformation is fast enough to matter
+    geometry.remove_apparent_geometry(scene)
+    assert not any(mesh.name.startswith("RelativityBake") for mesh in bpy.data.meshes)
+
+
+def _ev_points_at(bpy, scene, obj, times):
+    out = np.empty((len(times), 3))
+    for i, t in enumerate(times):
+        whole = math.floor(t * FPS)
+        scene.frame_set(whole, subframe=t * FPS - whole)
+        out[i] = _ev_attribute(bpy, obj, "relativity_rest")[i] + np.array(obj.location)
+    return out
