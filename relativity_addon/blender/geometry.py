@@ -37,6 +37,7 @@ REST_ATTRIBUTE = "relativity_rest"
 BETA_ATTRIBUTE = "relativity_beta"
 CACHE_PREFIX = "RelativityCache"
 SIGNATURE_KEY = "relativity_signature"
+ERROR_KEY = "relativity_error"  # on the cache mesh: why the last handler update failed
 # The node group's interface: (name, socket type, in/out). Builder and modifier use these names.
 INTERFACE = (
     ("Geometry", "NodeSocketGeometry", "INPUT"),
@@ -367,8 +368,8 @@ def bake_mesh(obj):
 
 def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     """Sample the evaluated (tessellated, deformed) world positions of ``obj`` from ``frame_start``
-    to ``frame_end`` (default: the scene's range, plus the light-travel margin the user must
-    cover) at ``relativity.samples_per_frame`` sub-frames, for per-vertex retarded times of a
+    to ``frame_end`` (default: the scene's range, starting earlier by twice the current
+    light-travel time to the farthest vertex) at ``relativity.samples_per_frame`` sub-frames, for per-vertex retarded times of a
     deforming mesh. Steps the scene through the frames (frame_set), so it runs outside handlers;
     the scene's frame is restored. The samples live in a mesh datablock kept with the .blend
     (fake user) and are removed with the effect. Returns the number of samples.
@@ -377,6 +378,15 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     fps = scene.render.fps / scene.render.fps_base
     first = scene.frame_start if frame_start is None else frame_start
     last = scene.frame_end if frame_end is None else frame_end
+    if frame_start is None:
+        # Light seen at the first frame left up to ~2 d / c earlier (d: camera to farthest vertex now).
+        with _Computing():
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            rest = _evaluated_rest_positions(obj, depsgraph)
+        _, x_o, _, c = observer_event(scene, depsgraph)
+        if rest is not None and len(rest):
+            world = _to_world(_matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest)
+            first -= math.ceil(2.0 * float(np.max(np.linalg.norm(world - x_o, axis=1))) / c * fps) + 2
     per_frame = int(obj.relativity.samples_per_frame)
     frames = first + np.arange(int(round((last - first) * per_frame)) + 1) / per_frame
     if len(frames) < 2:
@@ -469,6 +479,8 @@ def update_object(scene, obj, depsgraph=None):
     local = _to_world(np.linalg.inv(_matrix_array(obj_eval.matrix_world)), world)
     _write_cache(cache.data, local, beta_seen)
     cache.data[SIGNATURE_KEY] = object_signature(scene, obj, depsgraph)
+    if ERROR_KEY in cache.data:
+        del cache.data[ERROR_KEY]
     obj.update_tag()
     return len(local)
 
@@ -591,9 +603,6 @@ def remove_apparent_geometry(scene, objects=None):
 # --- handlers --------------------------------------------------------------------------------
 
 
-ERROR_KEY = "relativity_error"
-
-
 def scene_errors(scene):
     """One-line errors of the last update of each object (empty when every cache is current)."""
     errors = []
@@ -614,8 +623,6 @@ def _update_scene_reporting(scene, depsgraph, only_changed):
                 continue
             try:
                 update_object(scene, obj, depsgraph)
-                if cache is not None and cache.data is not None and ERROR_KEY in cache.data:
-                    del cache.data[ERROR_KEY]
             except RelativityError as error:
                 print(f"Relativity: {error}")
                 cache = cache_object(obj)
@@ -638,6 +645,38 @@ def _depsgraph_update_post(scene, depsgraph=None):
     if _Computing.depth:
         return
     _update_scene_reporting(scene, depsgraph, only_changed=True)
+
+
+class RELATIVITY_OT_bake_deformation(bpy.types.Operator):
+    """Sample the active object's deformed vertex positions over the scene's frame range, so each
+    vertex can be shown at its own retarded time"""
+
+    bl_idname = "relativity.bake_deformation"
+    bl_label = "Bake Deformation"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        if obj is None or obj.type != "MESH" or context.scene is None or not hasattr(context.scene, "relativity"):
+            cls.poll_message_set("Select a mesh object")
+            return False
+        return True
+
+    def execute(self, context):
+        scene, obj = context.scene, context.active_object
+        obj.relativity.use_deformation = True
+        obj.relativity.motion = "ANIMATION"
+        try:
+            count = bake_deformation(scene, obj)
+        except RelativityError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Baked {count} samples of {obj.name!r}")
+        return {"FINISHED"}
+
+
+classes = (RELATIVITY_OT_bake_deformation,)
 
 
 _HANDLERS = (

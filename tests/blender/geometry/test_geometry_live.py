@@ -97,3 +97,21 @@ def test_relativity_beta_reaches_the_shader(relativity_addon, factory_blender, t
     expected = np.array([0.5 * np.sqrt(1.0 - 0.2**2), -0.2, 0.0])
     print(f"rendered relativity_beta {colour}, expected {expected}")
     assert np.allclose(colour, expected, atol=2e-3)
+
+
+def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, camera_object, obj = _scene(bpy)
+    bpy.context.view_layer.objects.active = obj
+    geometry = gh.geometry_module()
+    with pytest.raises(geometry.RelativityError, match="at least two samples"):
+        geometry.bake_deformation(scene, obj, 1, 1)
+    scene.camera = None
+    with pytest.raises(RuntimeError, match="no active camera"):
+        bpy.ops.relativity.bake_deformation()
+    scene.camera = camera_object
+    scene.frame_start, scene.frame_end = 1, 3
+    obj.relativity.samples_per_frame = 2
+    assert bpy.ops.relativity.bake_deformation() == {"FINISHED"}
+    assert geometry.bake_mesh(obj) is not None
+    assert geometry.scene_errors(scene) == []
