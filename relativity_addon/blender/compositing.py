@@ -109,36 +109,23 @@ def _inserted_nodes(scene):
     return tree, [tree.nodes[name] for name in names if name in tree.nodes]
 
 
-def _node_input_path(node, name):
-    return f'nodes["{node.name}"].inputs["{name}"].default_value'
-
-
-def _drive_node(tree, node, scene):
-    """Drivers on the inserted group node's flag inputs, so animated flags follow each frame.
-
-    ``D`` itself comes from the AOV (Cycles, per frame). Values written from Python in a
-    handler would reach Blender's animation render one frame late (measured with 5.0.1: the
-    compositor of frame N sees what a render_pre or frame_change_pre handler wrote at N - 1).
-    All are simple expressions, evaluated without Python.
-    """
-    flags = [(name, scene, path) for name, path in materials.SCENE_FLAG_VARIABLES]
-    for name, expression in materials.FLAG_EXPRESSIONS.items():
-        materials.drive(tree, _node_input_path(node, name), expression, flags)
-    materials.drive(tree, _node_input_path(node, "Camera Power"), "4 * sl", flags[1:2])
-    node["relativity_driven_by"] = scene.name
-
-
 def sync_colour_stage(scene):
-    """Write the current values into the inserted group nodes (and drive them per frame)."""
-    tree, nodes = _inserted_nodes(scene)
-    if not nodes or scene.camera is None:
+    """Write the effect flags into the inserted group nodes (only where they changed).
+
+    ``D`` itself comes from the AOV, computed by Cycles for every frame. The flags are written
+    whenever the scene changes (depsgraph_update_post), not only before a render: Blender's
+    animation render shows its compositor what a render_pre or frame_change_pre handler wrote
+    one frame late (measured with 5.0.1). They are plain values, not drivers, so the file
+    renders the same without the add-on.
+    """
+    _tree, nodes = _inserted_nodes(scene)
+    if not nodes:
         return False
     values = colour_stage_values(scene)
     for node in nodes:
         for name, value in values.items():
-            node.inputs[name].default_value = value
-        if node.get("relativity_driven_by") != scene.name:
-            _drive_node(tree, node, scene)
+            if node.inputs[name].default_value != value:
+                node.inputs[name].default_value = value
     return True
 
 
@@ -287,40 +274,13 @@ def _sync_handler(scene, _depsgraph=None):
         print(f"Relativity: Doppler colour stage not synced: {error}")
 
 
-# render_pre alone is not enough: Blender's animation render changes the frame (and the
-# animation handlers the velocity) after render_pre, so the stage re-syncs on frame_change_pre
-# too, appended after the handlers that write this frame's velocity.
-_HANDLER_LISTS = ("render_pre", "frame_change_pre")
-
-
-def revalidate_drivers():
-    """Re-enable the stage's drivers that failed while the add-on was not registered.
-
-    A farm worker opens the .blend before enabling the add-on: drivers reading
-    ``scene.relativity`` fail to resolve then, and Blender stops evaluating invalid drivers.
-    """
-    for tree in bpy.data.node_groups:
-        animation = tree.animation_data
-        if animation is None:
-            continue
-        for fcurve in animation.drivers:
-            if COMPOSITOR_GROUP in fcurve.data_path and not fcurve.driver.is_valid:
-                fcurve.driver.is_valid = True
-                tree.update_tag()
-
-
-@bpy.app.handlers.persistent
-def _load_post(_filepath=None, _unused=None):
-    revalidate_drivers()
+# The materials' observer velocity must follow each frame (Cycles reads shader values written
+# in render_pre and frame_change_pre, appended after the handlers that write the velocity);
+# the compositor's flags must be in place before the render starts (depsgraph_update_post).
+_HANDLER_LISTS = ("render_pre", "frame_change_pre", "depsgraph_update_post")
 
 
 def register():
-    if _load_post not in bpy.app.handlers.load_post:
-        bpy.app.handlers.load_post.append(_load_post)
-    try:
-        revalidate_drivers()
-    except AttributeError:  # bpy.data is restricted while Blender itself starts up
-        pass
     for name in _HANDLER_LISTS:
         handlers = getattr(bpy.app.handlers, name)
         if _sync_handler not in handlers:
@@ -328,8 +288,6 @@ def register():
 
 
 def unregister():
-    if _load_post in bpy.app.handlers.load_post:
-        bpy.app.handlers.load_post.remove(_load_post)
     for name in _HANDLER_LISTS:
         handlers = getattr(bpy.app.handlers, name)
         if _sync_handler in handlers:

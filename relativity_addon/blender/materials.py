@@ -404,51 +404,6 @@ def settings_values(scene, camera_path):
     }
 
 
-# The compositor stage reads the effect flags through drivers (see compositing.py); every
-# expression is a "simple expression", evaluated without Python.
-SCENE_FLAG_VARIABLES = (
-    ("dop", "relativity.use_doppler"),
-    ("sl", "relativity.use_searchlight"),
-    ("ch", "relativity.use_chang_searchlight"),
-)
-FLAG_EXPRESSIONS = {
-    "Use Doppler": "dop",
-    "Spectral Searchlight": "sl * dop * (1 - ch)",
-    "Power of D": "sl * (1 - dop * (1 - ch)) * (4 - 3 * ch)",
-}
-
-
-def drive(tree, data_path, expression, variables, index=-1):
-    """(Re)create the driver of ``tree``'s ``data_path``; ``variables`` = (name, ID, path)."""
-    tree.driver_remove(data_path, index)
-    driver = tree.driver_add(data_path, index).driver
-    driver.type = "SCRIPTED"
-    for name, target_id, target_path in variables:
-        variable = driver.variables.new()
-        variable.name = name
-        variable.targets[0].id_type = "CAMERA" if isinstance(target_id, bpy.types.Camera) else "SCENE"
-        variable.targets[0].id = target_id
-        variable.targets[0].data_path = target_path
-    driver.expression = expression
-    return driver
-
-
-def value_path(node_name, output=0):
-    return f'nodes["{node_name}"].outputs[{output}].default_value'
-
-
-def input_path(node_name, index):
-    return f'nodes["{node_name}"].inputs[{index}].default_value'
-
-
-def drive_flags(tree, scene, camera_power):
-    """Drivers for the effect flags shared by the material and compositor groups."""
-    flags = [(name, scene, path) for name, path in SCENE_FLAG_VARIABLES]
-    for node_name, expression in FLAG_EXPRESSIONS.items():
-        drive(tree, value_path(node_name), expression, flags)
-    drive(tree, value_path("Camera Power"), f"{camera_power} * sl", flags[1:2])
-
-
 def sync_settings(scene, camera_path):
     """Write the settings (Cycles reads shader values written in render_pre for every frame)."""
     tree = bpy.data.node_groups.get(SETTINGS)
@@ -456,12 +411,11 @@ def sync_settings(scene, camera_path):
         return False
     for name, value in settings_values(scene, camera_path).items():
         node = tree.nodes[name]
-        if name == "Observer Beta":
-            for i in range(3):
-                node.inputs[i].default_value = value[i]
-        else:
-            node.outputs[0].default_value = value
-    tree.update_tag()
+        sockets = node.inputs[:3] if name == "Observer Beta" else node.outputs[:1]
+        components = value if name == "Observer Beta" else (value,)
+        for socket, component in zip(sockets, components):
+            if socket.default_value != component:  # also runs on depsgraph updates: no loops
+                socket.default_value = component
     return True
 
 

@@ -1,0 +1,108 @@
+"""Applying the exact camera sets up the Doppler colour stage; removing it restores the file.
+
+Also: a .blend saved with the effect renders the same final colours without the add-on and
+without colour-science (LUTs and node groups are packed in the file).
+"""
+
+import subprocess
+import sys
+
+import numpy as np
+
+import doppler_helpers as dh
+from doppler_helpers import ch
+
+
+def _signature(bpy, scene):
+    """Everything the stage touches, as comparable plain data."""
+    def tree_signature(tree):
+        if tree is None:
+            return None
+        nodes = sorted((node.name, node.bl_idname) for node in tree.nodes)
+        links = sorted((l.from_node.name, l.from_socket.identifier, l.to_node.name, l.to_socket.identifier)
+                       for l in tree.links)
+        drivers = [] if tree.animation_data is None else sorted(f.data_path for f in tree.animation_data.drivers)
+        return nodes, links, drivers, tree.animation_data is not None
+
+    return {
+        "materials": {m.name: (tree_signature(m.node_tree), sorted(m.keys())) for m in bpy.data.materials},
+        "worlds": {w.name: (tree_signature(w.node_tree), sorted(w.keys())) for w in bpy.data.worlds},
+        "compositor": (scene.compositing_node_group.name if scene.compositing_node_group else None,
+                       tree_signature(scene.compositing_node_group), scene.render.use_compositing),
+        "aovs": {v.name: sorted(a.name for a in v.aovs) for v in scene.view_layers},
+        "node_groups": sorted(g.name for g in bpy.data.node_groups),
+        "images": sorted(i.name for i in bpy.data.images),
+        "scene_keys": sorted(scene.keys()),
+    }
+
+
+def _scene_with_user_compositor(bpy):
+    scene, camera = dh.emitter_scene(bpy)
+    dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.3, 0.6, 0.2), beta=None)
+    dh.add_emitter_plane(bpy, scene, "Sun", (-0.5, 0.5), (-0.5, 0.5), beta=None, temperature=5762.0, depth=4.0)
+    # The user's own compositor: Render Layers -> Exposure -> output.
+    tree = bpy.data.node_groups.new("User Compositing", "CompositorNodeTree")
+    tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    exposure = tree.nodes.new("CompositorNodeExposure")
+    output = tree.nodes.new("NodeGroupOutput")
+    tree.links.new(layers.outputs["Image"], exposure.inputs["Image"])
+    tree.links.new(exposure.outputs["Image"], output.inputs[0])
+    scene.compositing_node_group = tree
+    scene.render.use_compositing = False
+    return scene, camera
+
+
+def test_apply_then_remove_restores_everything(relativity_addon, factory_blender):
+    bpy = factory_blender
+    camera_module = dh.addon_module(relativity_addon, "camera")
+    scene, _camera = _scene_with_user_compositor(bpy)
+    before = _signature(bpy, scene)
+
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    camera_module.apply_relativistic_camera(scene)
+    applied = _signature(bpy, scene)
+    assert applied != before
+    user_tree = bpy.data.node_groups["User Compositing"]
+    assert scene.compositing_node_group == user_tree  # the user's tree is kept, the stage inserted
+    assert any(n.bl_idname == "CompositorNodeGroup" for n in user_tree.nodes)
+    assert scene.render.use_compositing
+    # Applying twice changes nothing more.
+    camera_module.apply_relativistic_camera(scene)
+    assert _signature(bpy, scene) == applied
+
+    camera_module.remove_relativistic_camera(scene)
+    after = _signature(bpy, scene)
+    assert after == before
+
+
+def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    camera_module = dh.addon_module(relativity_addon, "camera")
+    scene, camera = dh.emitter_scene(bpy, samples=4)
+    dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.3, 0.6, 0.2), beta=None)
+    dh.add_emitter_plane(bpy, scene, "Sun", (-0.5, 0.5), (-0.5, 0.5), beta=None, temperature=5762.0, depth=4.0)
+    scene.relativity.beta = (0.2, 0.0, -0.5)
+    camera_module.apply_relativistic_camera(scene)
+    reference = dh.render(bpy, scene, tmp_path / "with_addon.exr")
+    blend = ch.save_blend(bpy, tmp_path / "packed.blend")
+
+    worker = (
+        "import sys\n"
+        "sys.modules['colour'] = None  # colour-science must not be needed to render\n"
+        "import bpy\n"
+        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r})\n"
+        "scene = bpy.context.scene\n"
+        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
+        f"scene.render.filepath = {str(tmp_path / 'plain.exr')!r}\n"
+        "bpy.ops.render.render(write_still=True)\n"
+    )
+    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    plain = ch.read_exr(bpy, tmp_path / "plain.exr")
+    difference = np.abs(plain - reference).max() / reference.max()
+    print(f"max |plain - with add-on| / max = {difference:.2e}; reference max {reference.max():.3f}")
+    assert np.isfinite(plain).all()
+    assert difference < 1e-5
+    # And the stage really acted: the wall is not its rest colour.
+    assert np.abs(reference[5, 5] - (0.3, 0.6, 0.2)).max() > 0.05
