@@ -494,8 +494,11 @@ def _apparent_world_positions(scene, obj, obj_eval, rest, t_o, x_o, beta_o, c):
         world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
     else:
         beta_u = _finite_velocity(obj.relativity.beta, f"object {obj.name!r} velocity") if motion == "CONSTANT" else np.zeros(3)
-        # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion.
-        world_now = apparent.lorentz_contract(_to_world(matrix_now, rest), matrix_now[:3, 3], beta_u)
+        # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion
+        # about the object's origin (folded into the object matrix: one affine map per vertex).
+        contracted = matrix_now.copy()
+        contracted[:3, :3] = apparent.lorentz_contraction_matrix(beta_u) @ matrix_now[:3, :3]
+        world_now = _to_world(contracted, rest)
         world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
     return world, beta_seen
 

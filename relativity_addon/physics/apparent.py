@@ -128,6 +128,17 @@ def lorentz_contract(points, centre, beta):
     return points - ((1.0 - 1.0 / gamma) * along)[:, None] * bhat
 
 
+def lorentz_contraction_matrix(beta):
+    """The linear map of :func:`lorentz_contract` (about the origin): ``I - (1 - 1/gamma) bhat bhat^T``."""
+    beta = velocity_array(beta, "beta")
+    speed_squared = float(np.dot(beta, beta))
+    if speed_squared == 0.0:
+        return np.eye(3)
+    gamma = 1.0 / np.sqrt(1.0 - speed_squared)
+    bhat = beta / np.sqrt(speed_squared)
+    return np.eye(3) - (1.0 - 1.0 / gamma) * np.outer(bhat, bhat)
+
+
 class SampledRigidMotion:
     """A rigid motion ``x(t) = A(t) p + b(t)`` sampled on a uniform time grid.
 

@@ -200,3 +200,10 @@ def test_sampled_point_motion_deforming_points_on_light_cone():
     assert np.max(np.linalg.norm(seen - truth, axis=1) / (c * tau)) < 1e-9
     assert np.max(np.abs(light_cone_residual(x_o, tau, truth, c))) < 1e-9
     np.testing.assert_allclose(beta_seen, acc * (t_o - tau)[:, None] / c, atol=1e-9)
+
+
+def test_contraction_matrix_is_the_contraction_about_the_origin():
+    beta = np.array([0.2, -0.7, 0.4])
+    points = RNG.normal(size=(20, 3))
+    np.testing.assert_allclose(points @ apparent.lorentz_contraction_matrix(beta).T,
+                               apparent.lorentz_contract(points, np.zeros(3), beta), atol=1e-14)
