@@ -4,15 +4,18 @@ The camera shader multiplies every camera ray's throughput by ``D^4`` (searchlig
 change needs the spectrum, which a camera shader cannot touch, so this stage applies the
 spectral Doppler matrix per pixel after the render, with no second render:
 
-- ``D`` per pixel from the pixel's camera-frame direction ``d`` (the pinhole ray through the
-  pixel centre, the same ``d`` the shader uses): ``D = 1 / (gamma (1 - beta . d))`` with ``beta``
-  in camera coordinates (PHYSICS.md, ``D = 1 / (gamma (1 + beta . k'))`` with ``k' = -d``), or
-  ``D = gamma (1 + beta . d)`` behind a Lorentz window, as in the shader.
+- ``ln D`` per pixel comes from the ``relativity_log_doppler`` AOV, written by every material
+  and the world at the first camera hit (``materials.doppler_aov_group``):
+  ``D = gamma (1 - beta . k)`` with ``k`` the scene-frame photon direction (the Incoming vector)
+  and ``beta`` the observer velocity (PHYSICS.md). Computed by Cycles per sample, so it holds
+  for every shutter model, depth of field and the Lorentz window, and it follows the velocity
+  frame by frame in animation renders.
 - ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),
   and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
   (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
   with Map UV (bilinear, extend), ``E = a(D)`` with searchlight and Doppler, ``4 ln D`` without
-  Doppler. All exponents are added before one ``exp`` so that nothing overflows float32.
+  Doppler (``1 ln D`` for Chang et al.'s comparison). All exponents are added before one
+  ``exp`` so that nothing overflows float32.
 - Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
   written by ``materials``) keep their rendered colour.
 
@@ -143,7 +146,6 @@ def apply_colour_stage(scene):
             "added_aovs": [],
             "inserted": [],
             "created_tree": "",
-            "had_animation_data": False,
         }
         tree = scene.compositing_node_group
         if tree is None:
@@ -155,7 +157,6 @@ def apply_colour_stage(scene):
             tree.links.new(layers.outputs["Image"], output.inputs[0])
             scene.compositing_node_group = tree
             saved["created_tree"] = tree.name
-        saved["had_animation_data"] = tree.animation_data is not None
         for view_layer in scene.view_layers:
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV):
                 if aov_name not in view_layer.aovs:
@@ -192,10 +193,6 @@ def remove_colour_stage(scene):
     tree = scene.compositing_node_group
     if tree is not None:
         for record in saved["inserted"]:
-            prefix = f'nodes["{record["group_node"]}"]'
-            if tree.animation_data is not None:
-                for fcurve in [f for f in tree.animation_data.drivers if f.data_path.startswith(prefix)]:
-                    tree.animation_data.drivers.remove(fcurve)
             node = tree.nodes.get(record["group_node"])
             if node is not None:
                 tree.nodes.remove(node)
@@ -207,10 +204,6 @@ def remove_colour_stage(scene):
                 socket = next((s for s in target.inputs if s.identifier == to_socket), None)
                 if socket is not None:
                     tree.links.new(layers.outputs["Image"], socket)
-        if not saved.get("had_animation_data") and tree.animation_data is not None and not (
-            tree.animation_data.drivers or tree.animation_data.action
-        ):
-            tree.animation_data_clear()
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:
