@@ -256,7 +256,11 @@ def apply_relativistic_camera(scene):
         raise
     from . import compositing  # Doppler colour stage (materials + compositor), undone on remove
 
-    compositing.apply_camera_colour(scene)
+    try:
+        compositing.apply_camera_colour(scene)
+    except RelativityError:
+        remove_relativistic_camera(scene)
+        raise
     return camera_object
 
 

@@ -222,9 +222,21 @@ def remove_colour_stage(scene):
 
 
 def apply_camera_colour(scene):
-    """Called by ``camera.apply_relativistic_camera``: materials (blackbodies) + compositor."""
-    materials.apply_doppler_colour(scene, camera_path=True)
-    apply_colour_stage(scene)
+    """Called by ``camera.apply_relativistic_camera``: materials (blackbodies) + compositor.
+
+    Raises ``camera.RelativityError`` (one line) after undoing any partial change.
+    """
+    from .camera import RelativityError
+
+    try:
+        materials.apply_doppler_colour(scene, camera_path=True)
+        apply_colour_stage(scene)
+    except (ImportError, ValueError, KeyError, RuntimeError) as error:
+        remove_camera_colour(scene)
+        message = str(error).strip().splitlines()
+        raise RelativityError(
+            f"Doppler colour stage could not be set up: {type(error).__name__}: {message[-1] if message else ''}"
+        ) from error
 
 
 def remove_camera_colour(scene):

@@ -43,24 +43,34 @@ def _packed_float_image(name, width, height, pixels):
     return image
 
 
+def _spectral():
+    try:
+        from ..physics import spectral
+    except ImportError as error:
+        raise ImportError(
+            f"colour-science is needed once to build the lookup tables ({error})"
+        ) from error
+    return spectral
+
+
 def ensure_doppler_matrix_lut():
     """The packed ``N x 3`` Doppler matrix table (``spectral.doppler_matrix_lut``)."""
-    from ..physics import spectral
 
     image = bpy.data.images.get(DOPPLER_LUT_NAME)
     if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
+    spectral = _spectral()
     grid = spectral.doppler_lut_log10_d_grid(LUT_SIZE, DOPPLER_LOG10_RANGE)
     return _packed_float_image(DOPPLER_LUT_NAME, LUT_SIZE, 3, spectral.doppler_matrix_lut(grid))
 
 
 def ensure_blackbody_lut():
     """The packed ``N x 1`` blackbody table (``spectral.blackbody_rgb_lut``)."""
-    from ..physics import spectral
 
     image = bpy.data.images.get(BLACKBODY_LUT_NAME)
     if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
+    spectral = _spectral()
     grid = spectral.blackbody_lut_log10_t_grid(LUT_SIZE, BLACKBODY_LOG10_RANGE)
     return _packed_float_image(BLACKBODY_LUT_NAME, LUT_SIZE, 1, spectral.blackbody_rgb_lut(grid))
 

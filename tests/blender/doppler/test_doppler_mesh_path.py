@@ -132,3 +132,29 @@ def test_deep_shift_sweep_is_finite(relativity_addon, factory_blender, tmp_path)
     assert np.all(np.isfinite(image))
     assert image.min() >= 0.0
     assert image.max() > 1000.0  # white at D = 100 is ~1400 times brighter, not clipped to black
+
+
+def test_reflected_radiance_scales_with_d4(relativity_addon, factory_blender, tmp_path):
+    """A diffuse grey wall lit by a sun lamp at rest relative to it, moving sideways."""
+    bpy = factory_blender
+    scene, camera = _setup(bpy, relativity_addon, use_doppler=False)
+    beta = (0.6, 0.0, 0.0)
+    wall = dh.add_emitter_plane(bpy, scene, "Wall", (-3.0, 3.0), (-2.5, 2.5), GREY, beta)
+    material = wall.data.materials[0]
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Emission"])
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (*GREY, 1.0)
+    tree.links.new(diffuse.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    scene.collection.objects.link(sun)
+    _apply(relativity_addon, scene)
+    image = dh.render(bpy, scene, tmp_path / "diffuse.exr")
+    d = dh.source_doppler_factor(dh.pixel_photon_directions(bpy, scene, camera), beta)
+    bright, dim = (slice(20, 28), slice(2, 6)), (slice(20, 28), slice(58, 62))
+    measured = image[bright][..., 1].mean() / image[dim][..., 1].mean()
+    expected = (d[bright] ** 4).mean() / (d[dim] ** 4).mean()
+    print(f"diffuse: ratio {measured:.4f}, D^4 ratio {expected:.4f}")
+    assert image[dim].min() > 0.0
+    assert measured == pytest.approx(expected, rel=0.02)

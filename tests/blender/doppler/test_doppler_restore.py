@@ -106,3 +106,33 @@ def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, fa
     assert difference < 1e-5
     # And the stage really acted: the wall is not its rest colour.
     assert np.abs(reference[5, 5] - (0.3, 0.6, 0.2)).max() > 0.05
+
+
+def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(relativity_addon, factory_blender):
+    """colour-science unavailable while the LUTs must be built: a clear error, nothing changed."""
+    bpy = factory_blender
+    camera_module = dh.addon_module(relativity_addon, "camera")
+    scene, _camera = _scene_with_user_compositor(bpy)
+    before = _signature(bpy, scene)
+    saved = {name: module for name, module in sys.modules.items() if name == "colour" or name.startswith("colour.")}
+    spectral_name = f"{relativity_addon}.physics.spectral"
+    saved_spectral = sys.modules.pop(spectral_name, None)
+    try:
+        for name in saved:
+            del sys.modules[name]
+        sys.modules["colour"] = None  # import colour -> ImportError
+        try:
+            camera_module.apply_relativistic_camera(scene)
+        except camera_module.RelativityError as error:
+            message = str(error)
+        else:
+            raise AssertionError("apply succeeded without colour-science")
+    finally:
+        del sys.modules["colour"]
+        sys.modules.update(saved)
+        if saved_spectral is not None:
+            sys.modules[spectral_name] = saved_spectral
+    print(message)
+    assert "\n" not in message and "Doppler colour" in message and "colour-science" in message
+    assert _signature(bpy, scene) == before
+    assert scene.camera.data.type == "PERSP"
