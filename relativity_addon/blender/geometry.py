@@ -20,6 +20,18 @@ modifier, the cache and (when unused) the node group: the original mesh data is 
 Frames: the scene frame is the observer's frame S only when ``scene.relativity.beta`` is zero.
 The mesh path renders in the camera's frame (axes parallel to world): an object at rest in the
 scene appears moving with ``-beta``.
+
+Motion sources (``Object.relativity.motion``): STATIC; CONSTANT (the mesh is the rest-frame
+shape, Lorentz-contracted along ``beta`` about the object origin; closed-form retarded times);
+ANIMATION (the keyframed transform, read from the F-curves in float64 on a sub-frame grid without
+``frame_set``, per-vertex retarded times); ANIMATION with ``use_deformation`` (evaluated vertex
+positions baked over a frame range by :func:`bake_deformation`, which steps frames and so runs
+outside handlers). Not covered at retarded times: constraints, drivers, delta transforms and
+animated parents (they are taken at the current frame) and, without a bake, deformation.
+
+API: :func:`apply_apparent_geometry`, :func:`remove_apparent_geometry`, :func:`update_object`,
+:func:`update_scene`, :func:`bake_deformation`, :func:`applied_objects`, :func:`scene_errors`,
+operator ``relativity.bake_deformation``. Errors are ``RelativityError`` with a one-line message.
 """
 
 import math
@@ -38,6 +50,7 @@ BETA_ATTRIBUTE = "relativity_beta"
 CACHE_PREFIX = "RelativityCache"
 SIGNATURE_KEY = "relativity_signature"
 ERROR_KEY = "relativity_error"  # on the cache mesh: why the last handler update failed
+OWNER_KEY = "relativity_owner"  # on the cache mesh: the name of the object it serves
 # The node group's interface: (name, socket type, in/out). Builder and modifier use these names.
 INTERFACE = (
     ("Geometry", "NodeSocketGeometry", "INPUT"),
@@ -165,14 +178,24 @@ def _ensure_modifier(obj):
         modifier = obj.modifiers.new(MODIFIER_NAME, "NODES")
         modifier.node_group = group
     cache = cache_object(obj)
+    if cache is not None and _shared_with_another_object(obj, cache):
+        cache = None  # a duplicated object copied the modifier and its cache pointer: own one
     if cache is None:
         mesh = bpy.data.meshes.new(f"{CACHE_PREFIX} {obj.name}")
         cache = bpy.data.objects.new(f"{CACHE_PREFIX} {obj.name}", mesh)
         modifier[_input_identifier(group, "Cache")] = cache
+    if cache.data.get(OWNER_KEY) != obj.name:
+        cache.data[OWNER_KEY] = obj.name  # set on creation, and follows a rename
     identifier = _input_identifier(group, "Tessellation")
     if modifier.get(identifier) != int(obj.relativity.tessellation):
         modifier[identifier] = int(obj.relativity.tessellation)
     return modifier, cache
+
+
+def _shared_with_another_object(obj, cache):
+    """True if ``cache`` belongs to another object (its recorded owner) that still uses it."""
+    owner = bpy.data.objects.get(cache.data.get(OWNER_KEY, "")) if cache.data is not None else None
+    return owner is not None and owner != obj and cache_object(owner) == cache
 
 
 def applied_objects(scene):
@@ -185,6 +208,8 @@ def _remove_object_effect(obj):
         return False
     cache = cache_object(obj)
     baked = bake_mesh(obj)
+    if cache is not None and _shared_with_another_object(obj, cache):
+        cache = baked = None  # the owner keeps them
     obj.modifiers.remove(modifier)
     if baked is not None:
         bpy.data.meshes.remove(baked)

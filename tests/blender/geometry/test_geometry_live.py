@@ -115,3 +115,24 @@ def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blen
     assert bpy.ops.relativity.bake_deformation() == {"FINISHED"}
     assert geometry.bake_mesh(obj) is not None
     assert geometry.scene_errors(scene) == []
+
+
+def test_duplicated_object_gets_its_own_cache(relativity_addon, factory_blender):
+    bpy = factory_blender
+    geometry = gh.geometry_module()
+    scene, camera_object, obj = _scene(bpy)
+    obj.relativity.motion = "CONSTANT"
+    obj.relativity.beta = (0.5, 0.0, 0.0)
+    geometry.apply_apparent_geometry(scene)
+    twin = obj.copy()  # what Shift+D does: the modifier (and its cache pointer) is copied
+    twin.location = (1.5, 1.0, -6.0)
+    scene.collection.objects.link(twin)
+    twin.relativity.beta = (0.0, 0.0, 0.0)  # update callback
+    assert geometry.cache_object(twin) != geometry.cache_object(obj)
+    first, _ = gh.evaluated_points(bpy, obj)
+    second, beta = gh.evaluated_points(bpy, twin, "relativity_beta")
+    assert np.allclose(beta, 0.0)
+    assert not np.allclose(first, second)
+    geometry.remove_apparent_geometry(scene)
+    assert not any(o.name.startswith("RelativityCache") for o in bpy.data.objects)
+    assert not any(m.name.startswith("RelativityCache") for m in bpy.data.meshes)
