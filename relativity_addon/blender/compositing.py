@@ -265,10 +265,16 @@ def remove_unused_data():
     return True
 
 
-def sync_camera_colour(scene):
-    if is_applied(scene):
-        materials.sync_settings(scene, camera_path=True)
-        sync_colour_stage(scene)
+def sync_camera_colour(scene, attach_new_materials=False):
+    """Re-write the settings; before a render also attach materials added since applying."""
+    if not is_applied(scene):
+        return
+    if attach_new_materials:
+        for material, temperature in materials.scene_materials(scene):
+            materials.attach(material, temperature)  # no-op for attached ones
+        materials.attach_world(scene.world)
+    materials.sync_settings(scene, camera_path=True)
+    sync_colour_stage(scene)
 
 
 @bpy.app.handlers.persistent
@@ -279,21 +285,33 @@ def _sync_handler(scene, _depsgraph=None):
         print(f"Relativity: Doppler colour stage not synced: {error}")
 
 
+@bpy.app.handlers.persistent
+def _render_pre(scene, _depsgraph=None):
+    try:
+        sync_camera_colour(scene, attach_new_materials=True)
+    except Exception as error:  # noqa: BLE001 - a handler must never stop the render
+        print(f"Relativity: Doppler colour stage not synced: {error}")
+
+
 # The materials' observer velocity must follow each frame (Cycles reads shader values written
 # in render_pre and frame_change_pre, appended after the handlers that write the velocity);
 # the compositor's flags must be in place before the render starts (depsgraph_update_post).
-_HANDLER_LISTS = ("render_pre", "frame_change_pre", "depsgraph_update_post")
+_HANDLERS = (
+    ("render_pre", _render_pre),
+    ("frame_change_pre", _sync_handler),
+    ("depsgraph_update_post", _sync_handler),
+)
 
 
 def register():
-    for name in _HANDLER_LISTS:
+    for name, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
-        if _sync_handler not in handlers:
-            handlers.append(_sync_handler)
+        if handler not in handlers:
+            handlers.append(handler)
 
 
 def unregister():
-    for name in _HANDLER_LISTS:
+    for name, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
-        if _sync_handler in handlers:
-            handlers.remove(_sync_handler)
+        if handler in handlers:
+            handlers.remove(handler)

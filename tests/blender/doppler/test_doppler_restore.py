@@ -141,3 +141,21 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
     after["scene_keys"] = [key for key in after["scene_keys"] if key != "relativity"]  # the settings themselves
     assert after == before
     assert bpy.context.scene.camera.data.type == "PERSP"
+
+
+def test_material_added_after_apply_is_shifted_at_render(relativity_addon, factory_blender, tmp_path):
+    from relativity_addon.physics import spectral
+
+    bpy = factory_blender
+    camera_module = dh.addon_module(relativity_addon, "camera")
+    scene, camera = dh.emitter_scene(bpy, samples=4)
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    camera_module.apply_relativistic_camera(scene)
+    colour = (0.3, 0.6, 0.2)
+    dh.add_emitter_plane(bpy, scene, "Late", (-400.0, 400.0), (-400.0, 400.0), colour, beta=None)
+    image = dh.render(bpy, scene, tmp_path / "late.exr")
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    d = 1.0 / (1.0 / np.sqrt(1.0 - 0.25) * (1.0 - view @ np.array([0.0, 0.0, -0.5])))
+    expected = spectral.doppler_shift_rgb(colour, d[24, 32])
+    print("late material:", image[24, 32], "expected", expected)
+    np.testing.assert_allclose(image[24, 32], expected, rtol=0.01)
