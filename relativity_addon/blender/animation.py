@@ -99,7 +99,7 @@ def world_matrix_at(obj, frame):
     return matrix
 
 
-def _check_supported(obj):
+def check_supported(obj):
     """Refuse set-ups whose motion the keyframe evaluation would get wrong."""
     while obj is not None:
         if any(constraint.enabled for constraint in obj.constraints):
@@ -120,7 +120,7 @@ def _animated_camera(scene):
     camera_object = scene.camera
     if camera_object is None:
         raise RelativityError(f"scene {scene.name!r} has no active camera")
-    _check_supported(camera_object)
+    check_supported(camera_object)
     return camera_object
 
 

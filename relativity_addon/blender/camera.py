@@ -111,9 +111,27 @@ def validate_scene(scene, require_perspective=True):
     return camera_object
 
 
-def _world_to_camera_rotation(camera_object):
+def camera_world_matrix(scene, camera_object):
+    """The camera's world matrix at the scene's current (sub-)frame.
+
+    During Blender's own animation render the original camera object is not re-evaluated, so
+    its ``matrix_world`` is that of the frame the file was saved at; a farm worker would then
+    render a turning camera wrongly. Keyframed transforms (with object parents) are therefore
+    evaluated from the F-curves at the frame itself; only a camera moved by constraints, drivers
+    or NLA falls back to ``matrix_world``.
+    """
+    from . import animation
+
+    try:
+        animation.check_supported(camera_object)
+        return animation.world_matrix_at(camera_object, scene.frame_current + scene.frame_subframe)
+    except RelativityError:
+        return camera_object.matrix_world
+
+
+def _world_to_camera_rotation(scene, camera_object):
     """Rotation taking world vectors to the camera's local axes (scale and shear removed)."""
-    return camera_object.matrix_world.to_quaternion().to_matrix().transposed()
+    return camera_world_matrix(scene, camera_object).to_quaternion().to_matrix().transposed()
 
 
 def _local_to_shader(vector):
@@ -150,7 +168,7 @@ def shader_parameters(scene, camera_object):
 
     settings = scene.relativity
     camera_data = camera_object.data
-    rotation = _world_to_camera_rotation(camera_object)
+    rotation = _world_to_camera_rotation(scene, camera_object)
     beta_local = rotation @ Vector(settings.beta)
     left, right, bottom, top = camera_frame_window(scene, camera_data)
     unit_scale = scene.unit_settings.scale_length or 1.0
