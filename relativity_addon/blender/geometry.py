@@ -41,6 +41,8 @@ import numpy as np
 from bpy.app.handlers import persistent
 
 from ..physics import apparent
+from . import camera as camera_module
+from . import compositing, materials
 from .camera import RelativityError
 
 NODE_GROUP_NAME = "Relativity Apparent Geometry"
@@ -573,6 +575,8 @@ def update_scene(scene, depsgraph=None, only_changed=False):
 
 def _update_scene(scene, depsgraph, only_changed):
     updated = 0
+    if applied_objects(scene):
+        materials.sync_settings(scene, camera_path=False)
     for obj in applied_objects(scene):
         cache = cache_object(obj)
         if only_changed and cache is not None and cache.data is not None and \
@@ -606,12 +610,33 @@ def apply_apparent_geometry(scene, objects=None):
             depsgraph = bpy.context.evaluated_depsgraph_get()
             for obj in objects:
                 update_object(scene, obj, depsgraph)
+        _apply_doppler_colour(scene)
     except RelativityError:
         for obj in objects:
             _remove_object_effect(obj)
         _remove_unused_group()
         raise
     return list(objects)
+
+
+def _apply_doppler_colour(scene):
+    """Searchlight and Doppler colour in the materials, from each point's ``relativity_beta``."""
+    try:
+        materials.apply_doppler_colour(scene, camera_path=False)
+    except (ImportError, ValueError, KeyError, RuntimeError) as error:
+        _remove_doppler_colour(scene)
+        message = str(error).strip().splitlines()
+        raise RelativityError(
+            f"Doppler colour could not be set up: {type(error).__name__}: {message[-1] if message else ''}"
+        ) from error
+
+
+def _remove_doppler_colour(scene):
+    camera = scene.camera
+    if camera is not None and camera.type == "CAMERA" and camera_module.is_applied(camera.data):
+        return  # the exact camera's colour stage owns the materials now
+    materials.remove_doppler_colour(scene)
+    compositing.remove_unused_data()
 
 
 def _remove_unused_group():
@@ -625,6 +650,8 @@ def remove_apparent_geometry(scene, objects=None):
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if _remove_object_effect(obj)]
     _remove_unused_group()
+    if not applied_objects(scene):
+        _remove_doppler_colour(scene)
     return restored
 
 
