@@ -1,13 +1,17 @@
 """Lookup-table images for the Doppler colour shaders, packed into the .blend.
 
-The tables come from ``physics/spectral.py`` (colour-science, numpy); their layouts are described
-in ``docs/spectral-model.md``. They are stored as packed 32-bit float images with the
+The tables are computed by ``physics/spectral.py`` (colour-science) once, at development time,
+and shipped with the add-on (``relativity_lut_data``, built by ``tools/build_luts.py``), because
+Blender bundles numpy but not colour-science; their layouts are described in
+``docs/spectral-model.md``. They are stored as packed 32-bit float images with the
 ``Non-Color`` colour space, so a render (F12, a render-farm worker, the batch script) reads them
 from the file alone: neither colour-science nor the add-on is needed to render.
 """
 
 import bpy
 import numpy as np
+
+from .. import lut_data
 
 DOPPLER_LUT_NAME = "Relativity Doppler Matrix LUT"
 BLACKBODY_LUT_NAME = "Relativity Blackbody LUT"
@@ -43,14 +47,14 @@ def _packed_float_image(name, width, height, pixels):
     return image
 
 
-def _spectral():
+def _shipped_table(load, log10_range):
     try:
-        from ..physics import spectral
-    except ImportError as error:
-        raise ImportError(
-            f"colour-science is needed once to build the lookup tables ({error})"
-        ) from error
-    return spectral
+        grid, pixels = load()
+    except OSError as error:
+        raise RuntimeError(f"the add-on's spectral lookup tables cannot be read ({error})") from error
+    if grid.size != LUT_SIZE or not np.allclose((grid[0], grid[-1]), log10_range):
+        raise RuntimeError("the add-on's spectral lookup tables do not match this version; reinstall it")
+    return pixels
 
 
 def ensure_doppler_matrix_lut():
@@ -59,9 +63,8 @@ def ensure_doppler_matrix_lut():
     image = bpy.data.images.get(DOPPLER_LUT_NAME)
     if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
-    spectral = _spectral()
-    grid = spectral.doppler_lut_log10_d_grid(LUT_SIZE, DOPPLER_LOG10_RANGE)
-    return _packed_float_image(DOPPLER_LUT_NAME, LUT_SIZE, 3, spectral.doppler_matrix_lut(grid))
+    pixels = _shipped_table(lut_data.doppler_matrix_lut, DOPPLER_LOG10_RANGE)
+    return _packed_float_image(DOPPLER_LUT_NAME, LUT_SIZE, 3, pixels)
 
 
 def ensure_blackbody_lut():
@@ -70,9 +73,8 @@ def ensure_blackbody_lut():
     image = bpy.data.images.get(BLACKBODY_LUT_NAME)
     if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
-    spectral = _spectral()
-    grid = spectral.blackbody_lut_log10_t_grid(LUT_SIZE, BLACKBODY_LOG10_RANGE)
-    return _packed_float_image(BLACKBODY_LUT_NAME, LUT_SIZE, 1, spectral.blackbody_rgb_lut(grid))
+    pixels = _shipped_table(lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE)
+    return _packed_float_image(BLACKBODY_LUT_NAME, LUT_SIZE, 1, pixels)
 
 
 def texture_u_scale_offset(log10_range, size=LUT_SIZE):

@@ -109,21 +109,30 @@ def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, fa
 
 
 def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_blender, tmp_path):
-    """Without colour-science the LUTs cannot be built: one clear error line, nothing changed."""
+    """Applying needs no colour-science (a real Blender has none: the tables ship with the
+    add-on); when the shipped tables cannot be read: one clear error line, nothing changed."""
     bpy = factory_blender
     scene, _camera = _scene_with_user_compositor(bpy)
     blend = ch.save_blend(bpy, tmp_path / "no_colour.blend")
     worker = (
         "import sys\n"
-        "sys.modules['colour'] = None  # colour-science missing\n"
+        "sys.modules['colour'] = None  # colour-science missing, as in a real Blender\n"
         f"sys.path.insert(0, {str(ch.REPO_ROOT)!r})\n"
         "import bpy\n"
         f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r})\n"
         "from relativity_addon import batch\n"
         "batch.enable_addon()\n"
+        "from relativity_addon import lut_data\n"
         "from relativity_addon.blender import camera\n"
         "scene = bpy.context.scene\n"
         "scene.relativity.beta = (0.0, 0.0, -0.5)\n"
+        "camera.apply_relativistic_camera(scene)  # works without colour-science\n"
+        "print('APPLIED:' + scene.camera.data.type)\n"
+        "camera.remove_relativistic_camera(scene)\n"
+        "lut_data.LUT_PATH = '/nonexistent/spectral_luts.npz'\n"
+        "lut_data._tables.cache_clear()\n"
+        "for image in [i for i in bpy.data.images if i.name.startswith('Relativity')]:\n"
+        "    bpy.data.images.remove(image)\n"
         "try:\n"
         "    camera.apply_relativistic_camera(scene)\n"
         "except camera.RelativityError as error:\n"
@@ -134,7 +143,8 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
     assert result.returncode == 0, result.stderr[-2000:]
     errors = [line for line in result.stdout.splitlines() if line.startswith("ERROR:")]
     print(errors)
-    assert len(errors) == 1 and "Doppler colour" in errors[0] and "colour-science" in errors[0]
+    assert "APPLIED:CUSTOM" in result.stdout.splitlines()
+    assert len(errors) == 1 and "Doppler colour" in errors[0] and "lookup tables" in errors[0]
     before = _signature(bpy, scene)
     bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "after.blend"))
     after = _signature(bpy, bpy.context.scene)
