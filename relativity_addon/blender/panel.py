@@ -142,6 +142,9 @@ class RELATIVITY_PT_observer(Panel):
         column.prop(settings, "use_geometry")
         column.prop(settings, "use_doppler")
         column.prop(settings, "use_searchlight")
+        row = column.row()
+        row.active = settings.use_searchlight
+        row.prop(settings, "use_chang_searchlight")
 
         for warning in scene_warnings(scene):
             layout.label(text=warning, icon="ERROR")
