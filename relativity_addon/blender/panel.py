@@ -46,7 +46,7 @@ def scene_warnings(scene):
     elif camera_object.data.type != "PERSP" and not ops.camera.is_applied(camera_object.data):
         warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
     if settings.method == "GEOMETRY" and ops.geometry_module() is None:
-        warnings.append("Apparent Geometry is not built yet: use Exact Camera")
+        warnings.append("Apparent Geometry could not be loaded: use Exact Camera")
     return warnings
 
 
@@ -75,10 +75,12 @@ def object_warnings(scene, obj):
     warnings = []
     if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
         return warnings
-    fraction = longest_edge_fraction(scene, obj)
+    # the modifier halves every edge once per tessellation level before moving the vertices
+    levels = obj.relativity.tessellation if hasattr(obj, "relativity") else 0
+    fraction = longest_edge_fraction(scene, obj) / 2**levels
     if fraction > COARSE_EDGE_FRACTION:
         warnings.append(
-            f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, subdivide"
+            f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
         )
     return warnings
 

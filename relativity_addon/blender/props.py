@@ -15,7 +15,7 @@ from bpy.props import (
 
 METHOD_ITEMS = (
     ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),
-    ("GEOMETRY", "Apparent Geometry", "Deform meshes to their apparent positions (not built yet)"),
+    ("GEOMETRY", "Apparent Geometry", "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
 )
 
 # Order matters: the enum index is the shader's `shutter_model` integer.

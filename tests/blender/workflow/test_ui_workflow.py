@@ -187,9 +187,14 @@ def test_coarse_mesh_warning_for_the_geometry_method(relativity_addon, factory_b
     scene.relativity.method = "GEOMETRY"
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, wall)
     # The quad's four sides are 4 long; their midpoints are sqrt(2^2 + 4^2) from the camera:
-    # 4 / sqrt(20) = 0.894 > 0.25.
+    # 4 / sqrt(20) = 0.894, halved by the default tessellation level (1): 0.447 > 0.25.
+    assert wall.relativity.tessellation == 1
     warnings = [e[1] for e in log if e[0] == "label" and e[2] == "ERROR"]
-    assert len(warnings) == 1 and "0.89x" in warnings[0], warnings
+    assert len(warnings) == 1 and "0.45x" in warnings[0], warnings
+    wall.relativity.tessellation = 2  # 0.224: fine enough
+    log = draw_panel(bpy, "RELATIVITY_PT_object", scene, wall)
+    assert not [e for e in log if e[0] == "label" and e[2] == "ERROR"]
+    wall.relativity.tessellation = 1
     scene.relativity.method = "CAMERA"  # the exact camera needs no tessellation
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, wall)
     assert not [e for e in log if e[0] == "label" and e[2] == "ERROR"]
