@@ -276,3 +276,28 @@ def rms_radius(intensity, center, half_window):
     ys, xs = np.mgrid[y0:y1, x0:x1]
     squared = (xs + 0.5 - center[0]) ** 2 + (ys + 0.5 - center[1]) ** 2
     return math.sqrt((squared * patch).sum() / total)
+
+
+def tangent_plane_axis_ratio(camera, coverage):
+    """Axis ratio of a silhouette measured in angle space (on the tangent plane of the sky at its
+    centre, so perspective projection does not stretch it) and the silhouette's axis."""
+    ys, xs = np.nonzero(coverage > 0.0)
+    weights = coverage[ys, xs]
+    directions = camera.pixel_direction(xs + 0.5, ys + 0.5)  # camera-local unit vectors
+    # Pixel solid angle is proportional to |u_z|^3 per image-plane area.
+    solid_angle = weights * np.abs(directions[:, 2]) ** 3
+    axis = normalized((directions * solid_angle[:, None]).sum(axis=0))
+    for _ in range(5):
+        e1 = normalized(np.cross(axis, [0.0, 1.0, 0.0]))
+        e2 = np.cross(axis, e1)
+        cos_axis = directions @ axis
+        plane = directions / cos_axis[:, None]
+        coords = np.stack([plane @ e1, plane @ e2], axis=1)
+        # Area on the tangent plane = solid angle / cos^3 of the angle to its normal.
+        area = solid_angle / cos_axis ** 3
+        mean = (coords * area[:, None]).sum(axis=0) / area.sum()
+        axis = normalized(axis + mean[0] * e1 + mean[1] * e2)
+    centred = coords - mean
+    covariance = (centred.T * area) @ centred / area.sum()
+    eigenvalues = np.linalg.eigvalsh(covariance)
+    return math.sqrt(eigenvalues[0] / eigenvalues[1]), axis

@@ -13,29 +13,6 @@ import numpy as np
 import camera_helpers as ch
 
 
-def _tangent_plane_axis_ratio(camera, coverage):
-    ys, xs = np.nonzero(coverage > 0.0)
-    weights = coverage[ys, xs]
-    directions = camera.pixel_direction(xs + 0.5, ys + 0.5)  # camera-local unit vectors
-    # Pixel solid angle is proportional to |u_z|^3 per image-plane area.
-    solid_angle = weights * np.abs(directions[:, 2]) ** 3
-    axis = ch.normalized((directions * solid_angle[:, None]).sum(axis=0))
-    for _ in range(5):
-        e1 = ch.normalized(np.cross(axis, [0.0, 1.0, 0.0]))
-        e2 = np.cross(axis, e1)
-        cos_axis = directions @ axis
-        plane = directions / cos_axis[:, None]
-        coords = np.stack([plane @ e1, plane @ e2], axis=1)
-        # Area on the tangent plane = solid angle / cos^3 of the angle to its normal.
-        area = solid_angle / cos_axis ** 3
-        mean = (coords * area[:, None]).sum(axis=0) / area.sum()
-        axis = ch.normalized(axis + mean[0] * e1 + mean[1] * e2)
-    centred = coords - mean
-    covariance = (centred.T * area) @ centred / area.sum()
-    eigenvalues = np.linalg.eigvalsh(covariance)
-    return math.sqrt(eigenvalues[0] / eigenvalues[1]), axis
-
-
 def test_sphere_outline_stays_circular_at_0_9c(factory_blender, tmp_path):
     bpy = factory_blender
     scene, camera_object = ch.new_scene(bpy, resolution=(320, 240), samples=4)
@@ -58,7 +35,7 @@ def test_sphere_outline_stays_circular_at_0_9c(factory_blender, tmp_path):
                             "--no-searchlight")
     coverage = np.clip(ch.luminance(image), 0.0, 1.0)
     assert coverage.max() > 0.99, "sphere not fully resolved"
-    ratio, axis = _tangent_plane_axis_ratio(camera, coverage)
+    ratio, axis = ch.tangent_plane_axis_ratio(camera, coverage)
 
     print(f"axis ratio {ratio:.4f} (Lorentz-contracted would be {1.0 / gamma:.3f})")
     assert abs(ratio - 1.0) < 0.02

@@ -2,7 +2,6 @@
 plus evaluated-mesh readers. Expected values come from PHYSICS.md written out in the tests."""
 
 import importlib
-import math
 import sys
 from pathlib import Path
 
@@ -40,23 +39,4 @@ def evaluated_points(bpy, obj, attribute=None):
     return world, values
 
 
-def tangent_plane_axis_ratio(camera, coverage):
-    """Axis ratio of a silhouette in angle space (the camera tests' measure) and its axis."""
-    ys, xs = np.nonzero(coverage > 0.0)
-    weights = coverage[ys, xs]
-    directions = camera.pixel_direction(xs + 0.5, ys + 0.5)
-    solid_angle = weights * np.abs(directions[:, 2]) ** 3
-    axis = ch.normalized((directions * solid_angle[:, None]).sum(axis=0))
-    for _ in range(5):
-        e1 = ch.normalized(np.cross(axis, [0.0, 1.0, 0.0]))
-        e2 = np.cross(axis, e1)
-        cos_axis = directions @ axis
-        plane = directions / cos_axis[:, None]
-        coords = np.stack([plane @ e1, plane @ e2], axis=1)
-        area = solid_angle / cos_axis ** 3
-        mean = (coords * area[:, None]).sum(axis=0) / area.sum()
-        axis = ch.normalized(axis + mean[0] * e1 + mean[1] * e2)
-    centred = coords - mean
-    covariance = (centred.T * area) @ centred / area.sum()
-    eigenvalues = np.linalg.eigvalsh(covariance)
-    return math.sqrt(eigenvalues[0] / eigenvalues[1]), axis
+tangent_plane_axis_ratio = ch.tangent_plane_axis_ratio  # the camera tests' measure
