@@ -5,7 +5,9 @@ positions for the current frame at once (see ``geometry.py``), so the viewport f
 """
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+from .props import velocity_property
 
 MOTION_ITEMS = (
     ("STATIC", "Static", "At rest in the scene (still seen moving when the observer moves)"),
@@ -38,16 +40,7 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         default="STATIC",
         update=_settings_changed,
     )
-    beta: FloatVectorProperty(
-        name="Velocity (c)",
-        description="Constant velocity in world coordinates as a fraction of c; |beta| < 1",
-        size=3,
-        subtype="XYZ",
-        default=(0.0, 0.0, 0.0),
-        soft_min=-0.999,
-        soft_max=0.999,
-        update=_settings_changed,
-    )
+    beta: velocity_property("Constant velocity", _settings_changed)
     temperature: FloatProperty(
         name="Blackbody Temperature",
         description="Emitter temperature in kelvin for Doppler-shifted blackbody emission (0: not an emitter)",

@@ -45,6 +45,20 @@ VELOCITY_SOURCE_ITEMS = (
 )
 
 
+def velocity_property(what, update):
+    """A velocity as a fraction of c in world axes (``|beta| < 1`` is checked where it is used)."""
+    return FloatVectorProperty(
+        name="Velocity (c)",
+        description=f"{what} in world coordinates as a fraction of c; |beta| < 1",
+        size=3,
+        subtype="XYZ",
+        default=(0.0, 0.0, 0.0),
+        soft_min=-0.999,
+        soft_max=0.999,
+        update=update,
+    )
+
+
 def _settings_changed(self, context):
     from . import camera
 
@@ -71,16 +85,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         soft_max=1e9,
         update=_settings_changed,
     )
-    beta: FloatVectorProperty(
-        name="Velocity (c)",
-        description="Observer (camera) velocity in world coordinates as a fraction of c; |beta| < 1",
-        size=3,
-        subtype="XYZ",
-        default=(0.0, 0.0, 0.0),
-        soft_min=-0.999,
-        soft_max=0.999,
-        update=_settings_changed,
-    )
+    beta: velocity_property("Observer (camera) velocity", _settings_changed)
     velocity_source: EnumProperty(
         name="Velocity From",
         items=VELOCITY_SOURCE_ITEMS,
