@@ -145,8 +145,9 @@ def emission_material(bpy, name="Emitter", strength=1.0):
     return material
 
 
-def new_scene(bpy, resolution=(320, 240), samples=4, rotation_euler=(0.0, 0.0, 0.0), location=(0.0, 0.0, 0.0)):
-    """Empty Cycles scene: black world, one perspective camera, no denoising."""
+def reset_cycles_scene(bpy, resolution, samples):
+    """The current scene emptied of objects: Cycles on the CPU, black world, no denoising or
+    adaptive sampling, Standard view transform (pixels are linear radiance up to clipping)."""
     scene = bpy.context.scene
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
@@ -162,6 +163,12 @@ def new_scene(bpy, resolution=(320, 240), samples=4, rotation_euler=(0.0, 0.0, 0
     world.color = (0.0, 0.0, 0.0)
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
+    return scene
+
+
+def new_scene(bpy, resolution=(320, 240), samples=4, rotation_euler=(0.0, 0.0, 0.0), location=(0.0, 0.0, 0.0)):
+    """Empty Cycles scene: black world, one perspective camera, no denoising."""
+    scene = reset_cycles_scene(bpy, resolution, samples)
     camera_data = bpy.data.cameras.new("Camera")
     camera_data.clip_start = 0.001
     camera_data.clip_end = 1000.0

@@ -1,9 +1,10 @@
 """Helpers for the workflow tests: small scenes, the batch script run as a user would, image reading.
 
-Physics expectations are written out here from PHYSICS.md (aberration), independently of the add-on.
+Physics expectations (aberration) are the camera tests' own, written out from PHYSICS.md in
+tests/blender/camera/camera_helpers.py independently of the add-on; scenes are built with the
+same helpers.
 """
 
-import math
 import os
 import subprocess
 import sys
@@ -11,63 +12,26 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
+import camera_helpers as ch  # noqa: E402
+
 REPO_ROOT = Path(__file__).resolve().parents[3]
 RENDER_SCRIPT = REPO_ROOT / "examples" / "render.py"
 FLYTHROUGH_SCRIPT = REPO_ROOT / "examples" / "flythrough.py"
 
 
-def aberrate(k, beta):
-    """PHYSICS.md: propagation direction k (scene frame) -> k' in the frame moving with beta."""
-    k, beta = np.asarray(k, float), np.asarray(beta, float)
-    b2 = beta @ beta
-    gamma = 1.0 / math.sqrt(1.0 - b2)
-    bhat = beta / math.sqrt(b2)
-    return (k + (gamma - 1.0) * (bhat @ k) * bhat - gamma * beta) / (gamma * (1.0 - beta @ k))
-
-
-def emission_material(bpy, name="Emitter", strength=1.0):
-    material = bpy.data.materials.new(name)
-    tree = material.node_tree
-    tree.nodes.clear()
-    emission = tree.nodes.new("ShaderNodeEmission")
-    emission.inputs["Strength"].default_value = strength
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(emission.outputs[0], output.inputs["Surface"])
-    return material
+aberrate = ch.aberrate
+emission_material = ch.emission_material
 
 
 def add_sphere(bpy, scene, location, radius, material, name="Marker"):
-    import bmesh
-
-    mesh = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=32, v_segments=16, radius=radius)
-    bm.to_mesh(mesh)
-    bm.free()
-    mesh.materials.append(material)
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = location
-    scene.collection.objects.link(obj)
-    return obj
+    return ch.add_sphere(bpy, scene, location, radius, material, name=name, segments=32, rings=16)
 
 
 def new_scene(bpy, resolution=(64, 48), samples=2, with_camera=True):
     """Cycles scene with a black world, an emissive sphere off-axis and (optionally) a camera at
     the origin looking down -Z. Returns (scene, camera or None, sphere)."""
-    scene = bpy.context.scene
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj)
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    world = bpy.data.worlds.new("Black")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    scene = ch.reset_cycles_scene(bpy, resolution, samples)
     camera = None
     if with_camera:
         data = bpy.data.cameras.new("Camera")
