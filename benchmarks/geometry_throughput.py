@@ -89,28 +89,11 @@ def addon_throughput(bpy, geometry, count, repeats):
 
 
 def build_render_scene(bpy, resolution, samples):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
+    """The camera benchmark's lit room (plane, cube, sphere, point light), with a fixed seed."""
+    from camera_overhead import build_scene
+
+    scene = build_scene(bpy, resolution, samples)
     scene.cycles.seed = 0
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.location = (1.5, -6.0, 2.0)
-    camera.rotation_euler = (math.radians(75.0), 0.0, math.radians(20.0))
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-    bpy.ops.mesh.primitive_plane_add(size=20.0)
-    bpy.ops.mesh.primitive_cube_add(size=1.5, location=(0.5, 0.0, 0.75))
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.7, location=(-1.5, 1.0, 0.7))
-    light = bpy.data.objects.new("Light", bpy.data.lights.new("Light", "POINT"))
-    light.data.energy = 800.0
-    light.location = (2.0, -2.0, 4.0)
-    scene.collection.objects.link(light)
     scene.relativity.speed_of_light = 299792458.0
     return scene
 
