@@ -8,9 +8,10 @@ scene looks smaller and farther away, and the searchlight effect brightens it by
 straight ahead at 0.9c): the film exposure is lowered by log2(D^4) stops at the image centre, as
 a photographer would, so the brightness falls off toward the edges as it really does. A 55 mm
 lens replaces the 28 mm one when moving, to frame the shrunken view. Doppler colour is off unless
-``--doppler`` is given: its spectral model extends reflectances outside the visible band as
-grey (docs/spectral-model.md), so at D = 4.4 every surface comes out a dim blue-grey, which is
-what the model says but not what the demo is for.
+``--doppler`` is given: at D = 4.4 the visible band shows what surfaces reflect at 1.7-3.4 um,
+which RGB says little about. The spectral model (docs/spectral-model.md) holds reflectances
+flat outside 420-655 nm, so every surface takes the blue of the shifted white light and only
+its brightness tells the colours apart (the red sphere, bright in the infrared, stays bright).
 
 Runs on the ``bpy`` wheel (Cycles on the CPU, no GPU needed). The add-on is enabled straight from
 this checkout (repository root on ``sys.path``, ``addon_utils.enable("relativity_addon")``), so the

@@ -12,10 +12,9 @@ Colours are Blender scene linear: linear Rec.709 (= sRGB) primaries, D65 white, 
 observer. ``XYZ <-> RGB`` uses colour-science's "ITU-R BT.709" colourspace (sRGB's primaries and
 white; its matrices are derived from them at full precision and are exact inverses, whereas the
 "sRGB" entry carries IEC 61966-2-1's 4-decimal matrix, whose round trip is off by ~1e-5), with *no*
-chromatic adaptation and no transfer function: the colourspace white is D65 and the reference
-illuminant of the up-sampled spectra is D65, so the D65 spectrum maps to RGB (1, 1, 1) without any
-adaptation step, and blackbody colours are those an observer adapted to D65 (Blender's
-convention) sees.
+chromatic adaptation and no transfer function: the colourspace white is D65, blackbody colours are
+those an observer adapted to D65 (Blender's convention) sees, and up-sampled colours are lit by a
+6504 K blackbody normalised to RGB (1, 1, 1) at rest.
 
 Everything here is numpy and colour-science; no ``bpy``. ``docs/spectral-model.md`` describes the
 model, its extension outside the visible band and the lookup-table layouts for the shader.
@@ -27,7 +26,8 @@ References
   on Graphics 18(3), 278-292.
 - Mallett, I., Yuksel, C. (2019). Spectral Primary Decomposition for Rendering with sRGB
   Reflectance. Eurographics Symposium on Rendering (DL-only track).
-- CIE 15:2004 Colorimetry, 3rd edition (D65 tabulation, linear interpolation of D65).
+- Jakob, W., Hanika, J. (2019). A Low-Dimensional Function Space for Efficient Spectral
+  Upsampling. Computer Graphics Forum 38(2) (the out-of-band behaviour the basis extension follows).
 """
 
 from __future__ import annotations
@@ -42,7 +42,8 @@ from colour.colorimetry import planck_law
 __all__ = [
     "CMFS_NAME",
     "WAVELENGTHS_VISIBLE_NM",
-    "D65_EXTENSION_TEMPERATURE_K",
+    "WHITE_TEMPERATURE_K",
+    "BASIS_PLATEAU_FRACTION",
     "BLACKBODY_LUT_LOG10_T_RANGE",
     "DOPPLER_LUT_LOG10_D_RANGE",
     "XYZ_to_linear_rec709",
@@ -60,7 +61,8 @@ __all__ = [
     "blackbody_rgb_lut",
     "sample_blackbody_rgb_lut",
     "reflectance_basis_Mallett2019",
-    "illuminant_D65_extended",
+    "basis_constrained_band_nm",
+    "illuminant_white",
     "doppler_rgb_matrix",
     "doppler_shift_rgb",
     "doppler_lut_log10_d_grid",
@@ -75,8 +77,11 @@ WAVELENGTHS_VISIBLE_NM = np.arange(360.0, 831.0, 1.0)
 """Integration grid (nm): the CIE 1931 colour matching functions' own 1 nm tabulation. The CMFs
 vanish outside it, so no light outside 360-830 nm contributes to XYZ or RGB."""
 
-D65_EXTENSION_TEMPERATURE_K = 6504.0
-"""Planck temperature used to extend D65 outside its 300-780 nm tabulation (D65's CCT)."""
+WHITE_TEMPERATURE_K = 6504.0
+"""Temperature of the blackbody that lights up-sampled colours (D65's correlated colour temperature)."""
+
+BASIS_PLATEAU_FRACTION = 0.9
+"""Fraction of its peak at which the red (blue) basis function is taken to leave its plateau."""
 
 BLACKBODY_LUT_LOG10_T_RANGE = (2.0, 6.0)
 """Default log10 temperature range (K) of the blackbody table: 100 K to 1e6 K, which covers ``D T``
@@ -393,61 +398,70 @@ def _basis_table():
     return np.array(basis.wavelengths, dtype=np.float64), np.array(basis.values, dtype=np.float64)
 
 
-def reflectance_basis_Mallett2019(wavelength_nm) -> np.ndarray:
-    """Mallett & Yuksel (2019) sRGB reflectance basis at ``wavelength_nm``, shape (..., 3).
+@functools.lru_cache(maxsize=None)
+def basis_constrained_band_nm() -> tuple[float, float]:
+    """``(lambda_lo, lambda_hi)``: where the Mallett & Yuksel basis still says something (420, 655 nm).
 
-    ``reflectance(lambda) = sum_i rgb_i basis_i(lambda)``. Tabulated by colour-science at 5 nm over
-    380-780 nm; linearly interpolated in between (keeps the basis within [0, 1]) and held
-    constant at the edge values outside, as colour-science's own extrapolator does. Held
-    constant because a surface's reflectance varies slowly far from its absorption bands and
-    this basis is already flat (each function ~1/3) at both ends of its range.
+    The basis was fitted to reproduce sRGB through the CIE observer, so it is only determined where
+    the observer sees. Toward both ends of its 380-780 nm table, where the observer is nearly blind,
+    every function drifts to ~1/3 (the fit's smoothness term, not a property of any colour). The band
+    runs from where the blue function first reaches ``BASIS_PLATEAU_FRACTION`` of its peak to where
+    the red function last does.
+    """
+
+    table_nm, values = _basis_table()
+    red, blue = values[:, 0], values[:, 2]
+    lo = table_nm[np.argmax(blue >= BASIS_PLATEAU_FRACTION * blue.max())]
+    hi = table_nm[len(red) - 1 - np.argmax(red[::-1] >= BASIS_PLATEAU_FRACTION * red.max())]
+    return float(lo), float(hi)
+
+
+def reflectance_basis_Mallett2019(wavelength_nm) -> np.ndarray:
+    """Mallett & Yuksel (2019) sRGB reflectance basis, extended to all wavelengths, shape (..., 3).
+
+    ``reflectance(lambda) = sum_i w_i basis_i(lambda)``. Tabulated by colour-science at 5 nm;
+    linearly interpolated inside :func:`basis_constrained_band_nm` (keeps the basis within
+    [0, 1], summing to 1) and held at the band's edge values outside it: beyond 655 nm a colour
+    reflects as much as its red part does at the red plateau's end, below 420 nm as much as its
+    blue part does at the blue plateau's start. So reds stay bright in the infrared, blues in the
+    ultraviolet, greens dark at both ends, and white reflects 1 everywhere. (Jakob & Hanika's
+    sigmoid spectra of the same colours agree on those three; their parabola also turns reds up
+    in the ultraviolet and blues up in the infrared, which is not followed here.)
     """
 
     wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
     table_nm, values = _basis_table()
-    return np.stack(
-        [np.interp(wavelength_nm, table_nm, values[:, i]) for i in range(3)], axis=-1
-    )
+    lo, hi = basis_constrained_band_nm()
+    clipped = np.clip(wavelength_nm, lo, hi)
+    return np.stack([np.interp(clipped, table_nm, values[:, i]) for i in range(3)], axis=-1)
 
 
-@functools.lru_cache(maxsize=None)
-def _d65_table():
-    d65 = colour.SDS_ILLUMINANTS["D65"]
-    wavelengths = np.array(d65.wavelengths, dtype=np.float64)
-    values = np.array(d65.values, dtype=np.float64)
-    planck_at_ends = _planck_outer(wavelengths[[0, -1]], D65_EXTENSION_TEMPERATURE_K)[:, 0]
-    return wavelengths, values, values[[0, -1]] / planck_at_ends
+def illuminant_white(wavelength_nm) -> np.ndarray:
+    """Relative spectral power of the white light of up-sampled colours, 1 at 560 nm, shape (...).
 
-
-def illuminant_D65_extended(wavelength_nm) -> np.ndarray:
-    """Relative spectral power of CIE D65 (100 at 560 nm) at any wavelength > 0, shape (...).
-
-    Inside its 300-780 nm tabulation (colour-science, 5 nm) D65 is interpolated linearly, as CIE
-    15:2004 recommends. Outside, it continues as a 6504 K Planck spectrum scaled separately at
-    each end to meet the tabulated value there (continuous at 300 nm and 780 nm): daylight is
-    sunlight filtered by the atmosphere, close to a blackbody in shape in the infrared, and the
-    Wien tail gives the physically expected fall-off in the ultraviolet and X-ray bands where
-    the table stops (it reaches 0.03 at 300 nm already).
+    A blackbody at ``WHITE_TEMPERATURE_K`` (6504 K, D65's correlated colour temperature). Not CIE
+    D65 itself: D65 is daylight under Earth's atmosphere, with ozone's ultraviolet cut-off below
+    320 nm and oxygen and water bands near 760 and 820 nm. A relativistic observer is in space, and
+    at ``D`` between 0.2 and 0.6 (or near 1.3) those atmospheric features would sweep through the
+    visible band as spurious colour. The blackbody is smooth and defined at every wavelength. Its
+    colour differs slightly from D65 (it lies on the Planckian locus); the normalisation in
+    :func:`doppler_rgb_matrix` makes it RGB (1, 1, 1) at rest.
     """
 
     wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
-    table_nm, values, end_scales = _d65_table()
-    inside = np.interp(wavelength_nm, table_nm, values)
-    planck = _planck_outer(wavelength_nm, D65_EXTENSION_TEMPERATURE_K).reshape(wavelength_nm.shape)
-    below = wavelength_nm < table_nm[0]
-    above = wavelength_nm > table_nm[-1]
-    return np.where(below, end_scales[0] * planck, np.where(above, end_scales[1] * planck, inside))
+    radiance = _planck_outer(wavelength_nm, WHITE_TEMPERATURE_K).reshape(wavelength_nm.shape)
+    return radiance / _planck_outer(560.0, WHITE_TEMPERATURE_K)[0, 0]
 
 
 def _unnormalised_doppler_rgb_matrix(doppler_factor: np.ndarray) -> np.ndarray:
-    """``A(D)``: column ``i`` is the linear Rec.709 RGB seen at ``D`` of basis ``i`` under D65.
+    """``A(D)``: column ``i`` is the linear Rec.709 RGB seen at ``D`` of basis ``i`` in white light.
 
     ``A(D)_{:, i} = RGB(integral xyzbar(lambda) D^5 E(lambda D) basis_i(lambda D) dlambda)``
     (Weiskopf et al. 1999 eq. 14 for the shift; sum over the CMFs' 1 nm grid).
     """
 
     emitted_nm = WAVELENGTHS_VISIBLE_NM * doppler_factor[..., None]
-    radiance = illuminant_D65_extended(emitted_nm) * doppler_factor[..., None] ** 5
+    radiance = illuminant_white(emitted_nm) * doppler_factor[..., None] ** 5
     spectra = reflectance_basis_Mallett2019(emitted_nm) * radiance[..., None]  # (..., W, 3)
     XYZ_columns = np.einsum("wc,...wi->...ci", _cmfs_visible(), spectra) * _WAVELENGTH_STEP_NM
     return np.asarray(_REC709.matrix_XYZ_to_RGB) @ XYZ_columns
@@ -464,18 +478,20 @@ def doppler_rgb_matrix(doppler_factor) -> np.ndarray:
     """3x3 matrix ``M(D)``, shape (..., 3, 3): linear Rec.709 RGB emitted -> RGB observed at ``D``.
 
     The emitter's colour is up-sampled to a reflectance with the Mallett & Yuksel (2019) basis
-    (linear in RGB), lit by D65 (:func:`illuminant_D65_extended`), shifted with
+    (linear in RGB, extended outside the visible band by :func:`reflectance_basis_Mallett2019`), lit
+    by a 6504 K blackbody (:func:`illuminant_white`), shifted with
     ``L_obs(lambda) = D^5 L_emit(lambda D)`` (Weiskopf et al. 1999 eq. 14) and integrated with the
     CIE 1931 observer. Every step is linear in RGB, so the whole transform is ``M(D) = A(D) A(1)^-1``:
-    ``A(1)^-1`` turns the input RGB into the basis weights whose D65-lit spectrum reproduces
-    exactly that RGB at rest (the bare basis is off by up to ~1e-3 and by D65's scale), so
+    ``A(1)^-1`` turns the input RGB into the basis weights whose lit spectrum reproduces exactly
+    that RGB at rest (the bare basis is off by up to ~1e-3, the blackbody by its scale and its
+    small distance from D65; white's weights are within 4 % of equal), so
     ``M(1)`` is the identity to rounding. Includes the searchlight factor: the total radiance
     scales by ``D^4`` (eq. 15), the visible luminance by what the shifted band collects (white:
-    ~1e-126 at D = 0.01, 0.64 at 0.9, 1.43 at 1.1, 117 at 10, 1415 at 100).
+    ~2e-123 at D = 0.01, 0.63 at 0.9, 1.42 at 1.1, 107 at 10, 1295 at 100).
 
     Entries can be negative at large shifts (the shifted colour leaves the Rec.709 gamut); use
     :func:`doppler_shift_rgb` for displayable colours. Below ``D`` of about 0.004 the visible band
-    sees only the far Wien tail of the extended D65 and the matrix underflows to exactly 0.
+    sees only the far Wien tail of the blackbody and the matrix underflows to exactly 0.
     """
 
     doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
