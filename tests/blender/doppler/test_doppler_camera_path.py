@@ -89,6 +89,24 @@ def test_searchlight_ratio_is_d4_without_doppler_colour(factory_blender, tmp_pat
     assert grey_spread < 1e-4 * image.max()
 
 
+def test_chang_comparison_scales_by_one_power_of_d(relativity_addon, factory_blender, tmp_path):
+    """Chang et al.'s (wrong) searchlight, the labelled comparison option, on the camera path."""
+    bpy = factory_blender
+    scene, camera = dh.emitter_scene(bpy)
+    dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.5, 0.5, 0.5), beta=None)
+    scene.relativity.use_chang_searchlight = True
+    blend = ch.save_blend(bpy, tmp_path / "chang.blend")
+    beta = (0.6, 0.0, 0.0)
+    image = _render(bpy, blend, tmp_path / "chang.exr", beta, "--no-doppler")
+    d = _camera_frame_doppler(bpy, scene, camera, beta)
+    bright, dim = (slice(20, 28), slice(58, 62)), (slice(20, 28), slice(2, 6))
+    measured = image[bright][..., 1].mean() / image[dim][..., 1].mean()
+    expected = d[bright].mean() / d[dim].mean()
+    print(f"Chang: ratio {measured:.4f}, D^1 ratio {expected:.4f}, D^4 ratio {expected ** 4:.4f}")
+    assert measured == pytest.approx(expected, rel=0.02)
+    assert abs(measured - expected ** 4) > 0.5
+
+
 @pytest.mark.parametrize("beta_z", [-0.5, 0.5])
 def test_blackbody_seen_at_dt_by_moving_observer(factory_blender, tmp_path, beta_z):
     bpy = factory_blender
