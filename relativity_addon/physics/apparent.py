@@ -394,7 +394,7 @@ def _uniform_motion_start(motion, t_o, x_o, c):
     """Start values of the light-travel times, shape ``(N,)``: each point moving uniformly with
     its velocity at the retarded time of the points' centroid (found by Newton steps first)."""
     grid = float(motion._grid(t_o))
-    centroid = motion.local_points.mean(axis=0)
+    centroid = motion._rows.mean(axis=1)
     tau_c = 0.0
     for _ in range(60):
         position_map, velocity_map = motion._affine_maps(grid - tau_c / motion.step)
