@@ -39,11 +39,11 @@ CONSTANT_VELOCITY_TARGET = 10e6
 
 def print_throughput_table(rows):
     """``rows``: (label, vertices, measured vertices/s, target vertices/s or None)."""
-    print(f"{'throughput, M vertices/s':<52}{'measured':>9}{'target':>8}")
+    print(f"{'throughput, M vertices/s':<56}{'measured':>9}{'target':>8}")
     for label, vertices, measured, target in rows:
         target_text = "-" if target is None else f"{target / 1e6:.0f}"
         verdict = "" if target is None else ("  met" if measured >= target else "  MISSED")
-        print(f"{f'{label}, {vertices} vertices':<52}{measured / 1e6:>9.2f}{target_text:>8}{verdict}")
+        print(f"{f'{label}, {vertices} vertices':<56}{measured / 1e6:>9.2f}{target_text:>8}{verdict}")
 
 
 def best_time(function, repeats):
