@@ -80,32 +80,68 @@ def _apparent_positions_one_velocity(observer_position, p, u, c, observer_beta):
     beta_o = velocity_array(observer_beta, "observer_beta")
     velocity = u * c
     rows = np.ascontiguousarray(p.T) - x_o[:, None]  # emitter minus observer, -Delta
+    tau = _light_travel_time_rows(rows, velocity, c)
+    for k in range(3):  # emission event relative to the observer event
+        if velocity[k]:
+            rows[k] -= tau * velocity[k]
+    _boost_rows(tau, rows, beta_o, c)
+    rows += x_o[:, None]
+    beta_seen = np.broadcast_to(velocity_seen_by_observer(u, beta_o), p.shape)
+    return rows.T, tau, beta_seen
+
+
+def _light_travel_time_rows(rows, velocity, c):
+    """Closed form of :func:`retarded.light_travel_time_uniform` on coordinate rows: ``rows``
+    (``(3, n)``) are the emitters at ``t_o`` minus the observer, ``velocity`` (scene units per
+    second) is one 3-vector or rows ``(3, n)``; the caller has checked ``|velocity| < c``."""
     a = -_row_dot(rows, velocity)  # Delta·u
     q = _row_dot(rows, rows)
-    b = c * c - float(velocity @ velocity)
+    b = c * c - _row_dot(velocity, velocity)
     root = a * a
     root += b * q
     np.sqrt(root, out=root)
     # (a + root) / b when a >= 0; the equal q / (root - a) when a < 0 (no cancellation); 0 at q = 0.
     tau = np.zeros_like(a)
     ahead = a >= 0.0
-    np.divide(a + root, b, out=tau, where=ahead)
-    denominator = root - a
-    np.divide(q, denominator, out=tau, where=~ahead & (denominator > 0.0))
-    for k in range(3):  # emission event relative to the observer event
-        if velocity[k]:
-            rows[k] -= tau * velocity[k]
-    if np.any(beta_o):
-        gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
-        # x' = x + (gamma^2/(gamma+1)) (beta·x) beta - gamma beta c t, with t = -tau.
-        coefficient = (gamma * gamma / (gamma + 1.0)) * _row_dot(rows, beta_o)
-        coefficient += (gamma * c) * tau
-        for k in range(3):
-            if beta_o[k]:
-                rows[k] += coefficient * beta_o[k]
-    rows += x_o[:, None]
-    beta_seen = np.broadcast_to(velocity_seen_by_observer(u, beta_o), p.shape)
-    return rows.T, tau, beta_seen
+    root_plus_a = a + root
+    np.divide(root_plus_a, b, out=tau, where=ahead)
+    root -= a
+    np.divide(q, root, out=tau, where=~ahead & (root > 0.0))
+    return tau
+
+
+def _boost_rows(tau, rows, beta_o, c):
+    """:func:`boost_emission_events` in place on rows ``(3, n)`` of emission positions minus the
+    observer position (events ``(-tau, rows)``); the observer's ``beta_o`` is already checked."""
+    if not np.any(beta_o):
+        return
+    gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
+    # x' = x + (gamma^2/(gamma+1)) (beta·x) beta - gamma beta c t, with t = -tau.
+    coefficient = (gamma * gamma / (gamma + 1.0)) * _row_dot(rows, beta_o)
+    coefficient += (gamma * c) * tau
+    for k in range(3):
+        if beta_o[k]:
+            rows[k] += coefficient * beta_o[k]
+
+
+def _velocity_seen_rows(point_beta, beta_o):
+    """:func:`velocity_seen_by_observer` in place on rows ``(3, n)`` of checked velocities
+    (fractions of c): relativistic addition of ``-beta_o`` (lorentz.compose_velocities)."""
+    if not np.any(beta_o):
+        return
+    v = -beta_o
+    gamma = 1.0 / np.sqrt(1.0 - float(v @ v))
+    v_u = _row_dot(point_beta, v)
+    # u' = [u / gamma + v (1 + (gamma / (gamma + 1)) v·u)] / (1 + v·u)
+    along = (gamma / (gamma + 1.0)) * v_u
+    along += 1.0
+    v_u += 1.0
+    np.reciprocal(v_u, out=v_u)
+    along *= v_u
+    point_beta *= v_u / gamma
+    for k in range(3):
+        if v[k]:
+            point_beta[k] += along * v[k]
 
 
 def _row_dot(rows, vector):
@@ -173,6 +209,7 @@ class SampledRigidMotion:
             p1, 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2),
         ], axis=1)  # (intervals, 4, 3, 4)
         # Rows 3j..3j+2 of linear @ p + offset are coefficient j applied to p.
+        self._coefficients = coefficients
         self._linear = np.ascontiguousarray(coefficients[..., :3].reshape(self.intervals, 12, 3))
         self._offset = np.ascontiguousarray(coefficients[..., 3].reshape(self.intervals, 12, 1))
         self.local_points = vector_array(local_points, "local_points")
@@ -184,6 +221,17 @@ class SampledRigidMotion:
     def _interval_keys(self, s):
         interval = np.clip(np.floor(s), 0, self.intervals - 1)
         return interval.astype(np.int16 if self.intervals < 32000 else np.int64)
+
+    def _affine_maps(self, s):
+        """Position and velocity (per second) at the single grid coordinate ``s`` as affine maps
+        of the local point ``p``, each ``(3, 4)``: ``x = M[:, :3] p + M[:, 3]``."""
+        interval = int(self._interval_keys(s))
+        f = float(s) - interval
+        g = min(max(f, 0.0), 1.0)
+        c0, c1, c2, c3 = self._coefficients[interval]
+        rate = c1 + (2.0 * c2 + 3.0 * c3 * g) * g
+        position = c0 + (c1 + (c2 + c3 * g) * g) * g + (f - g) * rate
+        return position, rate / self.step
 
     def _evaluate_rows(self, s, keys, rows, with_acceleration=False):
         """Positions, velocities (per second) and optionally accelerations, each ``(3, n)``, at
@@ -200,26 +248,28 @@ class SampledRigidMotion:
             f = s[a:b] - interval
             g = np.clip(f, 0.0, 1.0)
             y0, y1, y2, y3 = y[0:3], y[3:6], y[6:9], y[9:12]
-            position = y3 * g
+            # Horner, written into the output slices: no temporaries of shape (3, n).
+            position, rate = positions[:, a:b], velocities[:, a:b]
+            np.multiply(y3, g, out=position)
             position += y2
             position *= g
             position += y1
             position *= g
             position += y0
-            rate = y3 * (3.0 * g)
-            rate += 2.0 * y2
+            np.multiply(y3, 3.0 * g, out=rate)
+            rate += y2
+            rate += y2
             rate *= g
             rate += y1
             beyond = f - g
             if np.any(beyond):
                 position += beyond * rate
-            positions[:, a:b] = position
-            velocities[:, a:b] = rate
             if with_acceleration:
-                curvature = y3 * (6.0 * g)
-                curvature += 2.0 * y2
+                curvature = accelerations[:, a:b]
+                np.multiply(y3, 6.0 * g, out=curvature)
+                curvature += y2
+                curvature += y2
                 curvature[:, beyond != 0.0] = 0.0
-                accelerations[:, a:b] = curvature
         velocities /= self.step
         if with_acceleration:
             accelerations /= self.step * self.step
@@ -292,6 +342,12 @@ class SampledPointMotion:
         return self.positions_and_velocities(t, index)[1]
 
 
+# Points the sampled solver handles together: the temporaries of a block stay in the CPU caches
+# (whole-array passes over a million points spend most of their time on memory) and its small
+# matrix products stay single-threaded (larger ones make BLAS start threads on a busy machine).
+_BLOCK_SIZE = 1 << 14
+
+
 def apparent_positions_sampled(motion, observer_time, observer_position, c, observer_beta=(0.0, 0.0, 0.0),
                                relative_tolerance=1e-10, max_iterations=30):
     """Apparent positions of the points of a :class:`SampledRigidMotion` (per-point retarded times).
@@ -300,87 +356,118 @@ def apparent_positions_sampled(motion, observer_time, observer_position, c, obse
     velocity and acceleration (Newton where the curvature would misguide it): ``g' = c - (D·v)/|D|``
     lies in ``[c - |v|, c + |v|]``, positive for sub-luminal motion. The start is the retarded
     time ``t_c`` of the points' centroid plus, per point, the closed form for uniform motion with
-    its velocity at ``t_c``, so two or three steps reach ``relative_tolerance``. Points are kept
-    sorted by sample interval between steps (re-sorted only when one changes interval); points
-    left over after ``max_iterations`` go to :func:`retarded.light_travel_time`.
-    Returns ``(apparent, tau, beta_seen)``.
+    its velocity at ``t_c``, so two or three steps reach ``relative_tolerance``; each step
+    evaluates only the points not yet converged. Points are sorted by the sample interval of
+    their start and solved in blocks of consecutive points (re-sorted within a block only when
+    one changes interval); points left over after ``max_iterations`` go to
+    :func:`retarded.light_travel_time`. Returns ``(apparent, tau, beta_seen)``.
     """
     c = speed_of_light(c)
     x_o = vector_array(observer_position, "observer_position")
+    beta_o = velocity_array(observer_beta, "observer_beta")
     t_o = float(finite_array(observer_time, "observer_time"))
     count = len(motion.local_points)
-    xo = x_o[:, None]
-    grid = float(motion._grid(t_o))
+    apparent = np.empty((count, 3))
+    tau = np.empty(count)
+    beta_seen = np.empty((count, 3))
+    if count == 0:
+        return apparent, tau, beta_seen
+    start = _uniform_motion_start(motion, t_o, x_o, c)
+    order = np.argsort(motion._interval_keys(motion._grid(t_o) - start / motion.step), kind="stable")
+    for first in range(0, count, _BLOCK_SIZE):
+        block = order[first:first + _BLOCK_SIZE]
+        for index, block_tau, emitted, velocity in _retarded_emissions(
+                motion, block, start[block], t_o, x_o, c, relative_tolerance, max_iterations):
+            emitted -= x_o[:, None]
+            _boost_rows(block_tau, emitted, beta_o, c)
+            emitted += x_o[:, None]
+            velocity /= c
+            _velocity_seen_rows(velocity, beta_o)
+            tau[index] = block_tau
+            for k in range(3):  # one coordinate at a time: numpy's fast path for a scatter
+                apparent[:, k][index] = emitted[k]
+                beta_seen[:, k][index] = velocity[k]
+    return apparent, tau, beta_seen
 
-    centroid = motion.local_points.mean(axis=0)[:, None]
+
+def _uniform_motion_start(motion, t_o, x_o, c):
+    """Start values of the light-travel times, shape ``(N,)``: each point moving uniformly with
+    its velocity at the retarded time of the points' centroid (found by Newton steps first)."""
+    grid = float(motion._grid(t_o))
+    centroid = motion._rows.mean(axis=1)
     tau_c = 0.0
     for _ in range(60):
-        s_c = np.array([grid - tau_c / motion.step])
-        x_c, v_c = motion._evaluate_rows(s_c, motion._interval_keys(s_c), centroid)
-        d_c = (xo - x_c)[:, 0]
+        position_map, velocity_map = motion._affine_maps(grid - tau_c / motion.step)
+        d_c = x_o - (position_map[:, :3] @ centroid + position_map[:, 3])
         r_c = float(np.sqrt(d_c @ d_c))
-        slope = c - float(d_c @ v_c[:, 0]) / r_c if r_c > 0.0 else c
+        v_c = velocity_map[:, :3] @ centroid + velocity_map[:, 3]
+        slope = c - float(d_c @ v_c) / r_c if r_c > 0.0 else c
         step = (c * tau_c - r_c) / (slope if slope > 0.0 else c)
         tau_c = max(tau_c - step, 0.0)
         if abs(step) <= 1e-12 * (tau_c + 1e-300):
             break
-    s_c = np.full(count, grid - tau_c / motion.step)
-    position, velocity = motion._evaluate_rows(s_c, motion._interval_keys(s_c), motion._rows)
-    speed_squared = _row_dot(velocity, velocity)
-    if np.any(speed_squared >= c * c):
-        raise ValueError("the sampled motion is not slower than light")
-    position += tau_c * velocity  # uniform extrapolation to t_o
-    delta = xo - position
-    a = _row_dot(delta, velocity)
-    q = _row_dot(delta, delta)
-    b = c * c - speed_squared
-    root = np.sqrt(a * a + b * q)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.where(a >= 0.0, (a + root) / b, q / np.where(root - a > 0.0, root - a, 1.0))
+    position_map, velocity_map = motion._affine_maps(grid - tau_c / motion.step)
+    position_map = position_map + tau_c * velocity_map  # uniform extrapolation to t_o
+    position_map[:, 3] -= x_o  # relative to the observer
+    start = np.empty(len(motion.local_points))
+    for first in range(0, len(start), _BLOCK_SIZE):
+        rows = motion._rows[:, first:first + _BLOCK_SIZE]
+        velocity = velocity_map[:, :3] @ rows
+        velocity += velocity_map[:, 3:]
+        if np.any(_row_dot(velocity, velocity) >= c * c):
+            raise ValueError("the sampled motion is not slower than light")
+        relative = position_map[:, :3] @ rows
+        relative += position_map[:, 3:]
+        start[first:first + _BLOCK_SIZE] = _light_travel_time_rows(relative, velocity, c)
+    return start
 
-    order = np.argsort(motion._interval_keys(grid - tau / motion.step), kind="stable")
-    tau = tau[order]
-    rows = motion._rows[:, order]
+
+def _retarded_emissions(motion, index, tau, t_o, x_o, c, relative_tolerance, max_iterations):
+    """Halley iteration of :func:`apparent_positions_sampled` for the points ``index`` from the
+    start values ``tau``. Yields ``(index, tau, emitted, velocity)`` for the points as they
+    converge: their light-travel times, emission positions and velocities (scene units per
+    second) as rows ``(3, n)``."""
+    xo = x_o[:, None]
+    grid = float(motion._grid(t_o))
+    tolerance = relative_tolerance + 16.0 * np.finfo(float).eps
     rounding = 8.0 * np.finfo(float).eps * np.abs(x_o).sum()
-    converged = False
+    rows = np.take(motion.local_points, index, axis=0).T
     for _ in range(max_iterations):
         s = grid - tau / motion.step
         keys = motion._interval_keys(s)
         if np.any(keys[1:] < keys[:-1]):
             resort = np.argsort(keys, kind="stable")
-            order, tau, rows, s, keys = order[resort], tau[resort], rows[:, resort], s[resort], keys[resort]
-        position, velocity, acceleration = motion._evaluate_rows(s, keys, rows, with_acceleration=True)
+            index, tau, s, keys = index[resort], tau[resort], s[resort], keys[resort]
+            rows = np.take(rows, resort, axis=1)
+        position, rate, acceleration = motion._evaluate_rows(s, keys, rows, with_acceleration=True)
+        speed_squared = _row_dot(rate, rate)
+        if np.any(speed_squared >= c * c):
+            raise ValueError("the sampled motion is not slower than light")
         delta = xo - position
         distance = np.sqrt(_row_dot(delta, delta))
         g = c * tau - distance
-        pending = np.abs(g) > (relative_tolerance + 16.0 * np.finfo(float).eps) * distance + rounding
+        pending = np.abs(g) > tolerance * distance + rounding
         if not np.any(pending):
-            converged = True
-            break
-        speed_squared = _row_dot(velocity, velocity)
-        if np.any(speed_squared >= c * c):
-            raise ValueError("the sampled motion is not slower than light")
+            yield index, tau, position, rate
+            return
+        done = ~pending
+        if np.any(done):
+            yield index[done], tau[done], np.compress(done, position, axis=1), np.compress(done, rate, axis=1)
         # Halley: g' = c - D·v/|D|, g'' = -[(v·v - D·a)/|D| - (D·v/|D|)^2/|D|], D = x_o - x(t_o - tau).
         with np.errstate(divide="ignore", invalid="ignore"):
-            d_v = _row_dot(delta, velocity) / distance
+            d_v = _row_dot(delta, rate) / distance
             slope = c - d_v
             curvature = -((speed_squared - _row_dot(delta, acceleration)) - d_v * d_v) / distance
             slope = np.where(slope > 0.0, slope, c)
             denominator = 2.0 * slope * slope - g * curvature
             step = np.where(denominator > slope * slope, 2.0 * g * slope / denominator, g / slope)
-        tau = np.where(pending, np.maximum(tau - step, 0.0), tau)
-    position, velocity = position.T, velocity.T
-    if not converged:
-        left = np.flatnonzero(pending)
-        tau[left] = light_travel_time(lambda t, i: motion.positions(t, order[left][i]), t_o, x_o, c, count=left.size)
-        position[left], velocity[left] = motion.positions_and_velocities(t_o - tau[left], order[left])
-    result_tau = np.empty(count)
-    emitted = np.empty((count, 3))
-    point_velocity = np.empty((count, 3))
-    result_tau[order], emitted[order], point_velocity[order] = tau, position, velocity
-    apparent = boost_emission_events(result_tau, emitted, x_o, observer_beta, c)
-    beta_seen = velocity_seen_by_observer(point_velocity / c, observer_beta)
-    return apparent, result_tau, np.broadcast_to(beta_seen, (count, 3))
+        index, rows = index[pending], np.compress(pending, rows, axis=1)
+        tau = np.maximum(tau[pending] - step[pending], 0.0)
+    tau = light_travel_time(lambda t, i: motion.positions(t, index[i]), t_o, x_o, c, count=index.size)
+    position, rate = (np.ascontiguousarray(array.T) for array in motion.positions_and_velocities(t_o - tau, index))
+    if np.any(_row_dot(rate, rate) >= c * c):
+        raise ValueError("the sampled motion is not slower than light")
+    yield index, tau, position, rate
 
 
 def apparent_positions(world_line, observer_time, observer_position, c, count,

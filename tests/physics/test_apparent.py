@@ -176,6 +176,26 @@ def test_sampled_motion_with_moving_observer_matches_general_solver():
     np.testing.assert_allclose(fast[2], general[2], atol=1e-9)
 
 
+@pytest.mark.parametrize("max_iterations", [1, 30])
+def test_sampled_solver_in_blocks_and_its_fallback_match_general_solver(max_iterations):
+    """More points than one solver block, in random order (so they are sorted across blocks);
+    with a single Halley step most points finish in the bracketed fallback solver."""
+    c = 10.0
+    matrix = rigid_wheel(4.0, 1.0, np.array([2.0, 0.0, 0.0]), c)  # fastest point below 6.2 < c
+    local = RNG.uniform(-1.0, 1.0, size=(2 * apparent._BLOCK_SIZE + 123, 3))
+    times = np.arange(-2.0, 1.5, 1.0 / 192.0)
+    motion = apparent.SampledRigidMotion(times, matrix(times), local)
+    t_o, x_o = 1.0, np.array([0.0, 0.0, 6.0])
+    fast = apparent.apparent_positions_sampled(motion, t_o, x_o, c, (0.0, 0.3, 0.0), max_iterations=max_iterations)
+    general = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(local), (0.0, 0.3, 0.0),
+                                          velocity=motion.velocities)
+    np.testing.assert_allclose(fast[1], general[1], rtol=1e-8)
+    np.testing.assert_allclose(fast[0], general[0], atol=1e-9)
+    np.testing.assert_allclose(fast[2], general[2], atol=1e-9)
+    emitted = motion.positions(t_o - fast[1], np.arange(len(local)))
+    assert np.max(np.abs(light_cone_residual(x_o, fast[1], emitted, c))) < 1e-9
+
+
 def test_superluminal_sampled_motion_raises():
     matrix = rigid_wheel(20.0, 1.0, np.zeros(3), 1.0)
     times = np.arange(-5.0, 1.0, 0.01)
