@@ -184,9 +184,11 @@ def world_matrix_at(obj, frame):
     return Matrix(world_matrices(obj, [frame])[0].tolist())
 
 
-def keyframe_motion_problem(obj):
-    """Why keyframes alone do not give the object's world matrix at other frames (one line,
-    naming the object or ancestor at fault), or None when :func:`world_matrices` is exact."""
+def keyframe_motion_problem(obj, scene=None):
+    """Why keyframes alone do not give the object's world matrix at other frames of ``scene`` (one
+    line, naming the object or ancestor at fault), or None when :func:`world_matrices` is exact."""
+    if scene is not None and scene.render.frame_map_old != scene.render.frame_map_new:
+        return f"scene {scene.name!r} remaps time (Time Stretching)"
     while obj is not None:
         if any(constraint.enabled for constraint in obj.constraints):
             return f"{obj.name!r} has constraints"
@@ -208,9 +210,9 @@ def keyframe_motion_problem(obj):
     return None
 
 
-def check_supported(obj):
+def check_supported(obj, scene=None):
     """Refuse set-ups whose motion the keyframe evaluation would get wrong."""
-    problem = keyframe_motion_problem(obj)
+    problem = keyframe_motion_problem(obj, scene)
     if problem is not None:
         raise RelativityError(
             f"velocity from animation reads keyframes only, and {problem}; "
@@ -222,7 +224,7 @@ def _animated_camera(scene):
     camera_object = scene.camera
     if camera_object is None:
         raise RelativityError(f"scene {scene.name!r} has no active camera")
-    check_supported(camera_object)
+    check_supported(camera_object, scene)
     return camera_object
 
 

@@ -292,7 +292,7 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
     bake = motion_bake(obj)
     if bake is not None:
         return _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c)
-    problem = animation.keyframe_motion_problem(obj)
+    problem = animation.keyframe_motion_problem(obj, scene)
     if problem is not None:
         raise RelativityError(
             f"object {obj.name!r} is moved by more than its keyframes ({problem}): "

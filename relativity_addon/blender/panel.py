@@ -84,7 +84,7 @@ def object_warnings(scene, obj):
         )
     geometry = ops.geometry_module()
     error = geometry.object_error(obj) if geometry is not None else None
-    bake = bake_status(obj)
+    bake = bake_status(scene, obj)
     if error is not None:  # the last update failed: the viewport shows an older state
         warnings.append(error)
     elif bake is not None and bake[1] is None and bake[2] is not None:
@@ -92,7 +92,7 @@ def object_warnings(scene, obj):
     return warnings
 
 
-def bake_status(obj):
+def bake_status(scene, obj):
     """For an ANIMATION mesh: (bake operator, what is baked or None, why a bake is needed or None);
     None for other objects. A needed bake that is missing is an object warning."""
     geometry = ops.geometry_module()
@@ -107,7 +107,7 @@ def bake_status(obj):
         first, per_frame, matrices = bake
         last = first + (len(matrices) - 1) / per_frame
         return "relativity.bake_motion", f"Motion baked: frames {first:g} to {last:g}", None
-    problem = animation.keyframe_motion_problem(obj)
+    problem = animation.keyframe_motion_problem(obj, scene)
     needed = f"{problem}: keyframes are not its motion, press Bake Motion" if problem else None
     return "relativity.bake_motion", None, needed
 
@@ -210,7 +210,7 @@ class RELATIVITY_PT_object(Panel):
             for prop in settings.bl_rna.properties:
                 if prop.identifier not in {"rna_type", "name"}:
                     layout.prop(settings, prop.identifier)
-        bake = bake_status(obj)
+        bake = bake_status(context.scene, obj)
         if bake is not None:
             operator, baked, _ = bake
             if baked is not None:
