@@ -42,11 +42,11 @@ def evaluated_points(bpy, obj, attribute=None):
 tangent_plane_axis_ratio = ch.tangent_plane_axis_ratio  # the camera tests' measure
 
 
-def retarded_residuals(x_a, x_e, x_o, t_o, c):
+def retarded_residuals(x_a, x_e, x_o):
     """For apparent positions ``x_a`` seen from ``(t_o, x_o)`` and the true positions ``x_e`` at
-    each point's retarded time ``t_e = t_o - |x_o - x_a| / c``: the light-cone residual
-    ``||x_o - x_e| - c (t_o - t_e)| / (c (t_o - t_e))`` and the position mismatch
-    ``|x_a - x_e| / (c (t_o - t_e))`` per point."""
+    each point's retarded time ``t_e = t_o - |x_o - x_a| / c`` (so ``c (t_o - t_e) = |x_o - x_a|``):
+    the light-cone residual ``||x_o - x_e| - c (t_o - t_e)| / (c (t_o - t_e))`` and the position
+    mismatch ``|x_a - x_e| / (c (t_o - t_e))`` per point."""
     light_path = np.linalg.norm(x_a - x_o, axis=1)
     residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - light_path) / light_path
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / light_path

@@ -64,7 +64,7 @@ def _measure(bpy, scene, camera_object, obj, with_beta=False, remove=True):
     t_o = FRAME / FPS
     t_e = t_o - np.linalg.norm(x_a - x_o, axis=1) / C
     x_e = gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e, FPS)
-    residual, mismatch = gh.retarded_residuals(x_a, x_e, x_o, t_o, C)
+    residual, mismatch = gh.retarded_residuals(x_a, x_e, x_o)
     print(f"{obj.name}: max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
           f"retarded frames {t_e.min() * FPS:.3f}..{t_e.max() * FPS:.3f}")
     if not with_beta:
