@@ -23,15 +23,18 @@ scene appears moving with ``-beta``.
 
 Motion sources (``Object.relativity.motion``): STATIC; CONSTANT (the mesh is the rest-frame
 shape, Lorentz-contracted along ``beta`` about the object origin; closed-form retarded times);
-ANIMATION (the keyframed transform, read from the F-curves in float64 on a sub-frame grid without
-``frame_set``, per-vertex retarded times); ANIMATION with ``use_deformation`` (evaluated vertex
-positions baked over a frame range by :func:`bake_deformation`, which steps frames and so runs
-outside handlers). Not covered at retarded times: constraints, drivers, delta transforms and
-animated parents (they are taken at the current frame) and, without a bake, deformation.
+ANIMATION (rigid: world matrices on a sub-frame grid, per-vertex retarded times), from the keyframes
+of the object and its object-parent chain (deltas included; ``animation.world_matrices``, float64,
+no ``frame_set``) or, when the object has one, from a motion bake (:func:`bake_motion`: world
+matrices sampled through the depsgraph, so constraints, drivers, NLA and any parent count). An
+object whose keyframes are not its motion (``animation.keyframe_motion_problem``) and that has no
+motion bake is refused with an error naming the fix. ANIMATION with ``use_deformation``: evaluated
+vertex positions baked by :func:`bake_deformation`. Bakes step frames and so run outside handlers.
 
 API: :func:`apply_apparent_geometry`, :func:`remove_apparent_geometry`, :func:`update_object`,
-:func:`update_scene`, :func:`bake_deformation`, :func:`applied_objects`, :func:`scene_errors`,
-operator ``relativity.bake_deformation``. Errors are ``RelativityError`` with a one-line message.
+:func:`update_scene`, :func:`bake_deformation`, :func:`bake_motion`, :func:`applied_objects`,
+:func:`scene_errors`, operators ``relativity.bake_deformation`` and ``relativity.bake_motion``.
+Errors are ``RelativityError`` with a one-line message.
 """
 
 import math
@@ -42,7 +45,7 @@ from bpy.app.handlers import persistent
 
 from ..physics import apparent
 from . import camera as camera_module
-from . import compositing, materials
+from . import animation, compositing, materials
 from .camera import RelativityError
 
 NODE_GROUP_NAME = "Relativity Apparent Geometry"
@@ -261,83 +264,6 @@ def _matrix_array(matrix):
     return np.array([list(row) for row in matrix], dtype=np.float64)
 
 
-def _channelbag(obj):
-    from bpy_extras import anim_utils
-
-    animation = obj.animation_data
-    if animation is None or animation.action is None:
-        return None
-    return anim_utils.action_get_channelbag_for_slot(animation.action, animation.action_slot)
-
-
-class _TransformAnimation:
-    """The object's keyframed transform (F-curves of its action), evaluated without frame_set.
-
-    Covers location, rotation (Euler, quaternion, axis-angle) and scale; the parent chain (and
-    the parent inverse) is taken as it is at the current frame. Constraints and drivers are not
-    evaluated at other times.
-    """
-
-    def __init__(self, obj, obj_eval):
-        self.obj = obj_eval
-        channelbag = _channelbag(obj)
-        curves = {}
-        if channelbag is not None:
-            for fcurve in channelbag.fcurves:
-                curves[(fcurve.data_path, fcurve.array_index)] = fcurve
-        self.curves = curves
-        self.parent = _matrix_array(obj_eval.matrix_world) @ np.linalg.inv(_matrix_array(obj_eval.matrix_basis))
-
-    def _values(self, path, count, frame):
-        current = getattr(self.obj, path)
-        return [self.curves[(path, i)].evaluate(frame) if (path, i) in self.curves else current[i] for i in range(count)]
-
-    def matrices(self, frames):
-        """Object-to-world matrices, shape ``(K, 4, 4)``, built in float64 (mathutils is float32)."""
-        obj = self.obj
-        count = len(frames)
-        location = np.array([self._values("location", 3, frame) for frame in frames]).reshape(count, 3)
-        scale = np.array([self._values("scale", 3, frame) for frame in frames]).reshape(count, 3)
-        mode = obj.rotation_mode
-        if mode == "QUATERNION":
-            rotation = _quaternion_matrices(np.array([self._values("rotation_quaternion", 4, f) for f in frames]))
-        elif mode == "AXIS_ANGLE":
-            values = np.array([self._values("rotation_axis_angle", 4, f) for f in frames])
-            axis = values[:, 1:] / np.maximum(np.linalg.norm(values[:, 1:], axis=1, keepdims=True), 1e-300)
-            half = 0.5 * values[:, 0:1]
-            rotation = _quaternion_matrices(np.concatenate([np.cos(half), np.sin(half) * axis], axis=1))
-        else:
-            angles = np.array([self._values("rotation_euler", 3, frame) for frame in frames]).reshape(count, 3)
-            rotation = np.broadcast_to(np.eye(3), (count, 3, 3))
-            for axis_name in mode:  # "XYZ": X applied first, R = Rz Ry Rx
-                axis = "XYZ".index(axis_name)
-                rotation = _axis_rotations(axis, angles[:, axis]) @ rotation
-        result = np.zeros((count, 4, 4))
-        result[:, :3, :3] = rotation * scale[:, None, :]
-        result[:, :3, 3] = location
-        result[:, 3, 3] = 1.0
-        return self.parent @ result
-
-
-def _axis_rotations(axis, angles):
-    c, s = np.cos(angles), np.sin(angles)
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    m = np.zeros((len(angles), 3, 3))
-    m[:, axis, axis] = 1.0
-    m[:, i, i], m[:, i, j], m[:, j, i], m[:, j, j] = c, -s, s, c
-    return m
-
-
-def _quaternion_matrices(q):
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], axis=1)
-
-
 def _evaluated_rest_positions(obj, depsgraph):
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
@@ -357,10 +283,20 @@ def _to_world(matrix, points):
 
 
 def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None):
-    """Apparent world positions and beta of an ANIMATION object (rigid keyframed transform)."""
+    """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
+    world matrices when it has a motion bake, else from its keyframes under its parent chain
+    (:func:`animation.world_matrices`). An object whose keyframes are not its motion
+    (constraints, transform drivers, NLA, ...) and that has no bake raises RelativityError."""
     fps = scene.render.fps / scene.render.fps_base
     obj_eval = obj if obj_eval is None else obj_eval
-    animation = _TransformAnimation(obj, obj_eval)
+    bake = motion_bake(obj)
+    if bake is not None:
+        return _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c)
+    problem = animation.keyframe_motion_problem(obj, scene)
+    if problem is not None:
+        raise RelativityError(
+            f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
+            "bake its motion (Bake Motion in the Relativity panel)")
     samples_per_frame = int(obj.relativity.samples_per_frame)
     step = 1.0 / (samples_per_frame * fps)
     world_now = _to_world(_matrix_array(obj_eval.matrix_world), rest_local)
@@ -372,7 +308,7 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
         if high_index - low_index > 200000:
             raise RelativityError(f"object {obj.name!r}: light-travel times span too many animation samples")
         times = np.arange(low_index, high_index + 1) * step
-        motion = apparent.SampledRigidMotion(times, animation.matrices(times * fps), rest_local)
+        motion = apparent.SampledRigidMotion(times, animation.world_matrices(obj, times * fps), rest_local)
         result = apparent.apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
         t_e = t_o - result[1]
         if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
@@ -382,8 +318,32 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
     raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
 
 
+def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c):
+    first_frame, per_frame, matrices = bake
+    frame_now = t_o * fps
+    index = (frame_now - first_frame) * per_frame
+    if abs(index - round(index)) < 1e-6 and 0 <= round(index) < len(matrices):
+        # The bake holds this very frame: if the object is elsewhere now, the bake is stale.
+        now = _matrix_array(obj_eval.matrix_world)
+        if np.max(np.abs(matrices[round(index)] - now)) > 1e-5 * (1.0 + np.max(np.abs(now))):
+            raise RelativityError(
+                f"object {obj.name!r} moves differently from its motion bake at frame {frame_now:g}: "
+                "bake its motion again")
+    start, step = first_frame / fps, 1.0 / (per_frame * fps)
+    times = start + step * np.arange(len(matrices))
+    result = apparent.apparent_positions_sampled(apparent.SampledRigidMotion(times, matrices, rest_local),
+                                                 t_o, x_o, c, beta_o)
+    t_e = t_o - result[1]
+    if t_e.size and (t_e.min() < times[0] or t_e.max() > times[-1]):
+        raise RelativityError(
+            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"baked motion {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+    return result
+
+
 BAKE_PREFIX = "RelativityBake"
 BAKE_KEY = "relativity_bake"  # on the cache mesh: name of the bake mesh and its time grid
+MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world matrices and their frames
 
 
 def bake_mesh(obj):
@@ -393,15 +353,21 @@ def bake_mesh(obj):
     return bpy.data.meshes.get(cache.data[BAKE_KEY]["mesh"])
 
 
-def bake_deformation(scene, obj, frame_start=None, frame_end=None):
-    """Sample the evaluated (tessellated, deformed) world positions of ``obj`` from ``frame_start``
-    to ``frame_end`` (default: the scene's range, starting earlier by twice the current
-    light-travel time to the farthest vertex) at ``relativity.samples_per_frame`` sub-frames, for per-vertex retarded times of a
-    deforming mesh. Steps the scene through the frames (frame_set), so it runs outside handlers;
-    the scene's frame is restored. The samples live in a mesh datablock kept with the .blend
-    (fake user) and are removed with the effect. Returns the number of samples.
-    """
-    modifier, cache = _ensure_modifier(obj)
+def motion_bake(obj):
+    """``(first frame, samples per frame, matrices (K, 4, 4) float64)`` of the object's motion
+    bake, or None."""
+    cache = cache_object(obj)
+    if cache is None or cache.data is None or MOTION_BAKE_KEY not in cache.data:
+        return None
+    info = cache.data[MOTION_BAKE_KEY]
+    matrices = np.array(info["matrices"], dtype=np.float64).reshape(-1, 4, 4)
+    return float(info["first_frame"]), int(info["samples_per_frame"]), matrices
+
+
+def _bake_frames(scene, obj, frame_start, frame_end):
+    """Sample frames for a bake of ``obj``: ``frame_start`` to ``frame_end`` (default: the scene's
+    range, starting earlier by twice the current light-travel time to the farthest vertex) at
+    ``relativity.samples_per_frame`` per frame."""
     fps = scene.render.fps / scene.render.fps_base
     first = scene.frame_start if frame_start is None else frame_start
     last = scene.frame_end if frame_end is None else frame_end
@@ -418,20 +384,44 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     frames = first + np.arange(int(round((last - first) * per_frame)) + 1) / per_frame
     if len(frames) < 2:
         raise RelativityError(f"object {obj.name!r}: bake range needs at least two samples")
+    return frames, per_frame
+
+
+def _sample_frames(scene, frames, sample):
+    """Call ``sample(depsgraph)`` at each of ``frames`` (scene.frame_set, sub-frames included),
+    with the handlers held off; the scene's frame is restored."""
     saved_frame, saved_subframe = scene.frame_current, scene.frame_subframe
-    samples = []
     with _Computing():
         try:
             for frame in frames:
                 whole = int(np.floor(frame))
                 scene.frame_set(whole, subframe=float(frame - whole))
-                depsgraph = bpy.context.evaluated_depsgraph_get()
-                rest = _evaluated_rest_positions(obj, depsgraph)
-                if rest is None or (samples and len(rest) != len(samples[0])):
-                    raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
-                samples.append(_to_world(_matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest))
+                sample(bpy.context.evaluated_depsgraph_get())
         finally:
             scene.frame_set(saved_frame, subframe=saved_subframe)
+
+
+def bake_deformation(scene, obj, frame_start=None, frame_end=None):
+    """Sample the evaluated (tessellated, deformed) world positions of ``obj`` from ``frame_start``
+    to ``frame_end`` (default: the scene's range, starting earlier by twice the current
+    light-travel time to the farthest vertex) at ``relativity.samples_per_frame`` sub-frames, for
+    per-vertex retarded times of a deforming mesh. Steps the scene through the frames (frame_set),
+    so it runs outside handlers; the scene's frame is restored. The samples live in a mesh
+    datablock kept with the .blend (fake user) and are removed with the effect. Returns the number
+    of samples.
+    """
+    modifier, cache = _ensure_modifier(obj)
+    fps = scene.render.fps / scene.render.fps_base
+    frames, per_frame = _bake_frames(scene, obj, frame_start, frame_end)
+
+    def sample(depsgraph):
+        rest = _evaluated_rest_positions(obj, depsgraph)
+        if rest is None or (samples and len(rest) != len(samples[0])):
+            raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
+        samples.append(_to_world(_matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest))
+
+    samples = []
+    _sample_frames(scene, frames, sample)
     mesh = bake_mesh(obj)
     if mesh is None:
         mesh = bpy.data.meshes.new(f"{BAKE_PREFIX} {obj.name}")
@@ -447,6 +437,32 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     with _Computing():
         update_object(scene, obj)
     return len(samples)
+
+
+def bake_motion(scene, obj, frame_start=None, frame_end=None):
+    """Sample the world matrix of ``obj`` as Blender evaluates it (depsgraph: constraints, drivers,
+    NLA, parents of any type, simulations) from ``frame_start`` to ``frame_end`` (default as
+    :func:`bake_deformation`) at ``relativity.samples_per_frame`` sub-frames, for the rigid
+    ANIMATION path. Steps the scene through the frames, so it runs outside handlers; the scene's
+    frame is restored. The matrices (float64) are stored on the cache mesh, so they are saved with
+    the .blend and removed with the effect. Returns the number of samples.
+    """
+    modifier, cache = _ensure_modifier(obj)
+    frames, per_frame = _bake_frames(scene, obj, frame_start, frame_end)
+    # Only the transform is sampled: the modifier (tessellation, cache lookup) need not run.
+    shown = modifier.show_viewport
+    modifier.show_viewport = False
+    matrices = []
+    try:
+        _sample_frames(scene, frames, lambda depsgraph: matrices.append(
+            _matrix_array(obj.evaluated_get(depsgraph).matrix_world)))
+    finally:
+        modifier.show_viewport = shown
+    cache.data[MOTION_BAKE_KEY] = {"first_frame": float(frames[0]), "samples_per_frame": per_frame,
+                                   "matrices": np.ravel(matrices).tolist()}
+    with _Computing():
+        update_object(scene, obj)
+    return len(matrices)
 
 
 def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
@@ -676,14 +692,17 @@ def remove_apparent_geometry(scene, objects=None):
 # --- handlers --------------------------------------------------------------------------------
 
 
+def object_error(obj):
+    """The one-line error of the object's last handler update, or None."""
+    cache = cache_object(obj) if find_modifier(obj) is not None else None
+    if cache is not None and cache.data is not None and cache.data.get(ERROR_KEY):
+        return cache.data[ERROR_KEY]
+    return None
+
+
 def scene_errors(scene):
     """One-line errors of the last update of each object (empty when every cache is current)."""
-    errors = []
-    for obj in applied_objects(scene):
-        cache = cache_object(obj)
-        if cache is not None and cache.data is not None and cache.data.get(ERROR_KEY):
-            errors.append(cache.data[ERROR_KEY])
-    return errors
+    return [error for error in map(object_error, applied_objects(scene)) if error is not None]
 
 
 def _update_scene_reporting(scene, depsgraph, only_changed):
@@ -720,6 +739,14 @@ def _depsgraph_update_post(scene, depsgraph=None):
     _update_scene_reporting(scene, depsgraph, only_changed=True)
 
 
+def _poll_mesh(cls, context):
+    obj = context.active_object
+    if obj is None or obj.type != "MESH" or context.scene is None or not hasattr(context.scene, "relativity"):
+        cls.poll_message_set("Select a mesh object")
+        return False
+    return True
+
+
 class RELATIVITY_OT_bake_deformation(bpy.types.Operator):
     """Sample the active object's deformed vertex positions over the scene's frame range, so each
     vertex can be shown at its own retarded time"""
@@ -730,11 +757,7 @@ class RELATIVITY_OT_bake_deformation(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        if obj is None or obj.type != "MESH" or context.scene is None or not hasattr(context.scene, "relativity"):
-            cls.poll_message_set("Select a mesh object")
-            return False
-        return True
+        return _poll_mesh(cls, context)
 
     def execute(self, context):
         scene, obj = context.scene, context.active_object
@@ -749,7 +772,37 @@ class RELATIVITY_OT_bake_deformation(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (RELATIVITY_OT_bake_deformation,)
+class RELATIVITY_OT_bake_motion(bpy.types.Operator):
+    """Sample the active object's world transform over the scene's frame range as Blender evaluates
+    it (constraints, drivers, NLA, parents), so its motion can be shown at each vertex's retarded
+    time"""
+
+    bl_idname = "relativity.bake_motion"
+    bl_label = "Bake Motion"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        if not _poll_mesh(cls, context):
+            return False
+        if context.active_object.relativity.use_deformation:
+            cls.poll_message_set("A deforming object bakes its vertex positions: use Bake Deformation")
+            return False
+        return True
+
+    def execute(self, context):
+        scene, obj = context.scene, context.active_object
+        obj.relativity.motion = "ANIMATION"
+        try:
+            count = bake_motion(scene, obj)
+        except RelativityError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Baked {count} transforms of {obj.name!r}")
+        return {"FINISHED"}
+
+
+classes = (RELATIVITY_OT_bake_deformation, RELATIVITY_OT_bake_motion)
 
 
 _HANDLERS = (

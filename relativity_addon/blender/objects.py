@@ -13,7 +13,8 @@ MOTION_ITEMS = (
     ("STATIC", "Static", "At rest in the scene (still seen moving when the observer moves)"),
     ("CONSTANT", "Constant Velocity", "Uniform motion with the velocity below (world axes, fraction of c); "
      "the object is where Blender draws it at the current frame"),
-    ("ANIMATION", "Animation", "The object's own keyframed transform, evaluated at each vertex's retarded time"),
+    ("ANIMATION", "Animation", "The object's animated transform at each vertex's retarded time: its keyframes "
+     "under its parents (deltas included), or its baked motion (Bake Motion) when constraints, drivers or NLA move it"),
 )
 
 
@@ -67,7 +68,8 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
     )
     samples_per_frame: IntProperty(
         name="Samples per Frame",
-        description="Animation samples per frame used to interpolate the motion at retarded times",
+        description="Animation samples per frame used to interpolate the motion at retarded times "
+        "(keyframes, and the next motion or deformation bake)",
         default=8,
         min=1,
         max=256,

@@ -82,7 +82,34 @@ def object_warnings(scene, obj):
         warnings.append(
             f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
         )
+    geometry = ops.geometry_module()
+    error = geometry.object_error(obj) if geometry is not None else None
+    bake = bake_status(scene, obj)
+    if error is not None:  # the last update failed: the viewport shows an older state
+        warnings.append(error)
+    elif bake is not None and bake[1] is None and bake[2] is not None:
+        warnings.append(bake[2])
     return warnings
+
+
+def bake_status(scene, obj):
+    """For an ANIMATION mesh: (bake operator, what is baked or None, why a bake is needed or None);
+    None for other objects. A needed bake that is missing is an object warning."""
+    geometry = ops.geometry_module()
+    settings = getattr(obj, "relativity", None)
+    if geometry is None or settings is None or obj.type != "MESH" or settings.motion != "ANIMATION":
+        return None
+    if settings.use_deformation:
+        baked = "Deformation baked" if geometry.bake_mesh(obj) is not None else None
+        return "relativity.bake_deformation", baked, "Deforming mesh: press Bake Deformation"
+    bake = geometry.motion_bake(obj)
+    if bake is not None:
+        first, per_frame, matrices = bake
+        last = first + (len(matrices) - 1) / per_frame
+        return "relativity.bake_motion", f"Motion baked: frames {first:g} to {last:g}", None
+    problem = animation.keyframe_motion_problem(obj, scene)
+    needed = f"{problem}: keyframes are not its motion, press Bake Motion" if problem else None
+    return "relativity.bake_motion", None, needed
 
 
 class RELATIVITY_PT_observer(Panel):
@@ -183,6 +210,12 @@ class RELATIVITY_PT_object(Panel):
             for prop in settings.bl_rna.properties:
                 if prop.identifier not in {"rna_type", "name"}:
                     layout.prop(settings, prop.identifier)
+        bake = bake_status(context.scene, obj)
+        if bake is not None:
+            operator, baked, _ = bake
+            if baked is not None:
+                layout.label(text=baked, icon="CHECKMARK")
+            layout.operator(operator, icon="REC")
         for warning in object_warnings(context.scene, obj):
             layout.label(text=warning, icon="ERROR")
 

@@ -40,3 +40,109 @@ def evaluated_points(bpy, obj, attribute=None):
 
 
 tangent_plane_axis_ratio = ch.tangent_plane_axis_ratio  # the camera tests' measure
+
+
+def retarded_residuals(x_a, x_e, x_o):
+    """For apparent positions ``x_a`` seen from ``(t_o, x_o)`` and the true positions ``x_e`` at
+    each point's retarded time ``t_e = t_o - |x_o - x_a| / c`` (so ``c (t_o - t_e) = |x_o - x_a|``):
+    the light-cone residual ``||x_o - x_e| - c (t_o - t_e)| / (c (t_o - t_e))`` and the position
+    mismatch ``|x_a - x_e| / (c (t_o - t_e))`` per point."""
+    light_path = np.linalg.norm(x_a - x_o, axis=1)
+    residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - light_path) / light_path
+    mismatch = np.linalg.norm(x_a - x_e, axis=1) / light_path
+    return residual, mismatch
+
+
+def world_lines_by_frame_set(bpy, scene, obj, local_points, times, fps):
+    """Blender's own evaluation of ``obj`` (constraints, drivers, parents) at each time (seconds):
+    ``scene.frame_set`` at the (sub-)frame, ``matrix_world`` applied to the matching local point.
+    Restores the scene's frame."""
+    saved = scene.frame_current, scene.frame_subframe
+    points = np.empty((len(times), 3))
+    for i, t in enumerate(times):
+        frame = t * fps
+        whole = int(np.floor(frame))
+        scene.frame_set(whole, subframe=float(frame - whole))
+        matrix = np.array(obj.matrix_world)
+        points[i] = matrix[:3, :3] @ local_points[i] + matrix[:3, 3]
+    scene.frame_set(saved[0], subframe=saved[1])
+    return points
+
+
+def evaluated_attribute(bpy, obj, name):
+    """A vector point attribute of the evaluated mesh, ``(N, 3)``."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        data = mesh.attributes[name].data
+        values = np.empty(len(data) * 3)
+        data.foreach_get("vector", values)
+    finally:
+        obj_eval.to_mesh_clear()
+    return values.reshape(-1, 3)
+
+
+def file_fingerprint(bpy):
+    """What the effect and its bakes may touch, as one string: every object (transform, parent,
+    modifiers, constraints, ID properties), every mesh (vertices, attributes, ID properties), the
+    node groups, and the scene frame."""
+    def idprops(owner):
+        return repr(sorted((key, repr(owner[key])) for key in owner.keys()))
+
+    objects = [(o.name, tuple(map(tuple, o.matrix_world)), o.parent.name if o.parent else "", repr(o.data),
+                [(m.name, m.type, m.show_viewport) for m in o.modifiers], [c.name for c in o.constraints], idprops(o))
+               for o in bpy.data.objects]
+    meshes = []
+    for mesh in bpy.data.meshes:
+        co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        meshes.append((mesh.name, co.tobytes().hex(), sorted(a.name for a in mesh.attributes), idprops(mesh)))
+    scene = bpy.context.scene
+    return repr((objects, meshes, sorted(g.name for g in bpy.data.node_groups),
+                 scene.frame_current, scene.frame_subframe))
+
+
+class _RecordingLayout:
+    """Stand-in for ``UILayout`` (no UI in background Blender): records labels and operators,
+    accepts any other layout call."""
+
+    def __init__(self, log):
+        self.log = log
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: _RecordingLayout(self.log)
+
+    def label(self, text="", icon="NONE", **kwargs):
+        self.log.append(("label", text, icon))
+
+    def operator(self, idname, text="", icon="NONE", **kwargs):
+        self.log.append(("operator", idname))
+        return _RecordingLayout(self.log)
+
+
+def draw_object_panel(bpy, scene, obj):
+    """What ``RELATIVITY_PT_object`` draws for ``obj``: [("label", text, icon) | ("operator", idname)]."""
+    panel_class = bpy.types.RELATIVITY_PT_object
+    context = type("Context", (), {"scene": scene, "object": obj})()
+    assert panel_class.poll(context)
+    log = []
+    panel_class.draw(type("PanelShim", (), {"layout": _RecordingLayout(log)})(), context)
+    return log
+
+
+def keyframe_linear(obj, path, index, points):
+    """Keys ``(frame, value)`` on ``obj.<path>[index]`` with linear interpolation and extrapolation.
+    Returns the F-curve."""
+    from bpy_extras import anim_utils
+
+    for frame, value in points:
+        getattr(obj, path)[index] = value
+        obj.keyframe_insert(path, index=index, frame=frame)
+    bag = anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data)
+    fcurve = next(f for f in bag.fcurves if f.data_path == path and f.array_index == index)
+    for point in fcurve.keyframe_points:
+        point.interpolation = "LINEAR"
+    fcurve.extrapolation = "LINEAR"
+    fcurve.update()
+    return fcurve
