@@ -219,6 +219,14 @@ def _format_seconds(seconds):
 
 def _render_frame(bpy, scene, frame, path, relativistic):
     scene.frame_set(frame)
+    if relativistic:
+        # The frame-change handler records a failed apparent-geometry update on the object
+        # instead of raising; rendering then would show the previous frame's shapes.
+        from .blender import geometry
+
+        errors = geometry.scene_errors(scene)
+        if errors:
+            raise BatchError(f"frame {frame}: {errors[0]}")
     scene.render.filepath = path
     if os.path.exists(path):
         os.remove(path)

@@ -224,3 +224,28 @@ def test_seed_samples_resolution_reference_and_searchlight_change_pixels(plain_b
     reference = render("reference", "--samples=4", "--reference")
     assert not np.allclose(wh.centroid(wh.luminance(reference)), wh.centroid(wh.luminance(render("moving", "--samples=4"))), atol=2.0)
     assert np.isfinite(base).all()
+
+
+def test_frame_whose_geometry_update_fails_is_not_rendered(relativity_addon, factory_blender, tmp_path):
+    """An object keyframed faster than light from frame 3 on (c = 100 units/s; linear keys: 0.1
+    then 5 units a frame, 0.024 c then 1.2 c; light takes 1.2 frames from the sphere): frames
+    whose light left before the fast part render; the batch stops at the first frame whose
+    apparent geometry cannot be computed, naming it, instead of rendering stale shapes."""
+    bpy = factory_blender
+    scene, _, sphere = wh.new_scene(bpy)
+    scene.frame_start, scene.frame_end = 1, 6
+    sphere.relativity.motion = "ANIMATION"
+    x, y, z = sphere.location
+    wh.keyframe_camera_path(sphere, [(1, (x, y, z)), (3, (x + 0.2, y, z)), (6, (x + 15.2, y, z))])
+    blend = wh.save_blend(bpy, tmp_path / "fast_object.blend")
+    out = tmp_path / "fast_object.png"
+    result = wh.run_render_script(blend, "--method=geometry", "--beta=0,0,0", "--speed-of-light=100",
+                                  "--frames=1-6", "--samples=1", f"--out={out}")
+    wh.assert_fails_with(result, "frame ")
+    line = wh.error_lines(result)[0]
+    print(line)
+    assert sphere.name in line
+    failed_frame = int(re.search(r"frame (\d+)", line).group(1))
+    assert 3 <= failed_frame <= 5
+    rendered = sorted(path.name for path in tmp_path.glob("fast_object*.png"))
+    assert rendered == [f"fast_object_{frame:04d}.png" for frame in range(1, failed_frame)]
