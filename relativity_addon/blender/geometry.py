@@ -389,16 +389,21 @@ def _bake_frames(scene, obj, frame_start, frame_end):
 
 def _sample_frames(scene, frames, sample):
     """Call ``sample(depsgraph)`` at each of ``frames`` (scene.frame_set, sub-frames included),
-    with the handlers held off; the scene's frame is restored."""
+    with the handlers held off and Blender's progress indicator showing; the scene's frame is
+    restored."""
     saved_frame, saved_subframe = scene.frame_current, scene.frame_subframe
+    window_manager = bpy.context.window_manager
+    window_manager.progress_begin(0, len(frames))
     with _Computing():
         try:
-            for frame in frames:
+            for done, frame in enumerate(frames):
                 whole = int(np.floor(frame))
                 scene.frame_set(whole, subframe=float(frame - whole))
                 sample(bpy.context.evaluated_depsgraph_get())
+                window_manager.progress_update(done + 1)
         finally:
             scene.frame_set(saved_frame, subframe=saved_subframe)
+            window_manager.progress_end()
 
 
 def bake_deformation(scene, obj, frame_start=None, frame_end=None):
