@@ -752,39 +752,50 @@ def _poll_mesh(cls, context):
     return True
 
 
-class RELATIVITY_OT_bake_deformation(bpy.types.Operator):
+class _BakeOperator:
+    """Shared execute of the bake operators: set the object's motion, bake, report."""
+
+    bl_options = {"REGISTER", "UNDO"}
+    use_deformation = False
+    baked = "samples"
+
+    def execute(self, context):
+        scene, obj = context.scene, context.active_object
+        if self.use_deformation:
+            obj.relativity.use_deformation = True
+        obj.relativity.motion = "ANIMATION"
+        try:
+            count = self.bake(scene, obj)
+        except RelativityError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Baked {count} {self.baked} of {obj.name!r}")
+        return {"FINISHED"}
+
+
+class RELATIVITY_OT_bake_deformation(_BakeOperator, bpy.types.Operator):
     """Sample the active object's deformed vertex positions over the scene's frame range, so each
     vertex can be shown at its own retarded time"""
 
     bl_idname = "relativity.bake_deformation"
     bl_label = "Bake Deformation"
-    bl_options = {"REGISTER", "UNDO"}
+    use_deformation = True
+    bake = staticmethod(bake_deformation)
 
     @classmethod
     def poll(cls, context):
         return _poll_mesh(cls, context)
 
-    def execute(self, context):
-        scene, obj = context.scene, context.active_object
-        obj.relativity.use_deformation = True
-        obj.relativity.motion = "ANIMATION"
-        try:
-            count = bake_deformation(scene, obj)
-        except RelativityError as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"Baked {count} samples of {obj.name!r}")
-        return {"FINISHED"}
 
-
-class RELATIVITY_OT_bake_motion(bpy.types.Operator):
+class RELATIVITY_OT_bake_motion(_BakeOperator, bpy.types.Operator):
     """Sample the active object's world transform over the scene's frame range as Blender evaluates
     it (constraints, drivers, NLA, parents), so its motion can be shown at each vertex's retarded
     time"""
 
     bl_idname = "relativity.bake_motion"
     bl_label = "Bake Motion"
-    bl_options = {"REGISTER", "UNDO"}
+    baked = "transforms"
+    bake = staticmethod(bake_motion)
 
     @classmethod
     def poll(cls, context):
@@ -794,17 +805,6 @@ class RELATIVITY_OT_bake_motion(bpy.types.Operator):
             cls.poll_message_set("A deforming object bakes its vertex positions: use Bake Deformation")
             return False
         return True
-
-    def execute(self, context):
-        scene, obj = context.scene, context.active_object
-        obj.relativity.motion = "ANIMATION"
-        try:
-            count = bake_motion(scene, obj)
-        except RelativityError as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"Baked {count} transforms of {obj.name!r}")
-        return {"FINISHED"}
 
 
 classes = (RELATIVITY_OT_bake_deformation, RELATIVITY_OT_bake_motion)

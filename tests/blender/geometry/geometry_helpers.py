@@ -69,6 +69,14 @@ def world_lines_by_frame_set(bpy, scene, obj, local_points, times, fps):
     return points
 
 
+def slow_light_scene(bpy, c, fps):
+    """64x48 Cycles scene with a camera at the origin, light at ``c`` units/s, ``fps`` frames/s."""
+    scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
+    scene.relativity.speed_of_light = c
+    scene.render.fps, scene.render.fps_base = fps, 1.0
+    return scene, camera_object
+
+
 def evaluated_attribute(bpy, obj, name):
     """A vector point attribute of the evaluated mesh, ``(N, 3)``."""
     depsgraph = bpy.context.evaluated_depsgraph_get()

@@ -23,10 +23,7 @@ FRAME = 30
 
 
 def _scene(bpy):
-    scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
-    scene.relativity.speed_of_light = C
-    scene.render.fps, scene.render.fps_base = FPS, 1.0
-    return scene, camera_object
+    return gh.slow_light_scene(bpy, C, FPS)
 
 
 def _empty(bpy, scene, name):

@@ -19,10 +19,7 @@ FPS = 24
 
 
 def _scene(bpy):
-    scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
-    scene.relativity.speed_of_light = C
-    scene.render.fps, scene.render.fps_base = FPS, 1.0
-    return scene, camera_object
+    return gh.slow_light_scene(bpy, C, FPS)
 
 
 def _keyframe(obj, path, index, points, interpolation):
@@ -69,7 +66,7 @@ def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
     geometry = gh.geometry_module()
     geometry.apply_apparent_geometry(scene)
     x_a, beta_seen = gh.evaluated_points(bpy, wheel, "relativity_beta")
-    rest = _ev_attribute(bpy, wheel, "relativity_rest")
+    rest = gh.evaluated_attribute(bpy, wheel, "relativity_rest")
 
     x_o = np.array(camera_object.matrix_world.translation)
     t_o = 30 / FPS
@@ -94,19 +91,6 @@ def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
     assert abs(np.linalg.norm(beta_seen[:96], axis=1).mean() - 0.9) < 1e-3
 
 
-def _ev_attribute(bpy, obj, name):
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    obj_eval = obj.evaluated_get(depsgraph)
-    mesh = obj_eval.to_mesh()
-    try:
-        data = mesh.attributes[name].data
-        values = np.empty(len(data) * 3)
-        data.foreach_get("vector", values)
-    finally:
-        obj_eval.to_mesh_clear()
-    return values.reshape(-1, 3)
-
-
 def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     bpy = factory_blender
     scene, camera_object = _scene(bpy)
@@ -122,7 +106,7 @@ def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     geometry = gh.geometry_module()
     geometry.apply_apparent_geometry(scene)
     x_a, _ = gh.evaluated_points(bpy, box)
-    rest = _ev_attribute(bpy, box, "relativity_rest")
+    rest = gh.evaluated_attribute(bpy, box, "relativity_rest")
     x_o = np.array(camera_object.matrix_world.translation)
     tau = np.linalg.norm(x_a - x_o, axis=1) / C
     t_e = frame / FPS - tau
@@ -185,7 +169,7 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
     for i, t in enumerate(t_e):
         whole = math.floor(t * FPS)
         scene.frame_set(whole, subframe=t * FPS - whole)
-        x_e[i] = _ev_attribute(bpy, blob, "relativity_rest")[i] + np.array(blob.location)
+        x_e[i] = gh.evaluated_attribute(bpy, blob, "relativity_rest")[i] + np.array(blob.location)
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
     print(f"deforming: max position mismatch {mismatch.max():.2e}, retarded frames "
           f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
@@ -201,5 +185,5 @@ def _ev_points_at(bpy, scene, obj, times):
     for i, t in enumerate(times):
         whole = math.floor(t * FPS)
         scene.frame_set(whole, subframe=t * FPS - whole)
-        out[i] = _ev_attribute(bpy, obj, "relativity_rest")[i] + np.array(obj.location)
+        out[i] = gh.evaluated_attribute(bpy, obj, "relativity_rest")[i] + np.array(obj.location)
     return out
