@@ -231,8 +231,8 @@ def run_render_script(blend, out, *options, check=True, timeout=300):
     return result
 
 
-def read_exr(bpy, path):
-    """Linear float RGB of an image file as an array [row (top first), column, channel]."""
+def read_image(bpy, path):
+    """RGBA float32 pixels [row (top first), column, channel] of a PNG or EXR file."""
     image = bpy.data.images.load(str(path), check_existing=False)
     try:
         width, height = image.size
@@ -240,7 +240,12 @@ def read_exr(bpy, path):
         image.pixels.foreach_get(pixels)
     finally:
         bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1, :, :3].astype(float)
+    return pixels.reshape(height, width, 4)[::-1]
+
+
+def read_exr(bpy, path):
+    """Linear float RGB of an image file as an array [row (top first), column, channel]."""
+    return read_image(bpy, path)[:, :, :3].astype(float)
 
 
 def render_image(bpy, blend, out, *options):
@@ -255,33 +260,33 @@ def luminance(rgb):
     return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
 
 
-def centroid(intensity, center, half_window):
-    """Intensity-weighted centroid in pixel coordinates within a square window."""
+def _window(intensity, center, half_window):
+    """The square patch of ``intensity`` around ``center`` (clipped to the image), its pixel-centre
+    coordinates ``xs, ys`` and its total."""
     height, width = intensity.shape
     cx, cy = int(round(center[0])), int(round(center[1]))
     x0, x1 = max(cx - half_window, 0), min(cx + half_window + 1, width)
     y0, y1 = max(cy - half_window, 0), min(cy + half_window + 1, height)
     patch = intensity[y0:y1, x0:x1]
-    total = patch.sum()
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    return patch, xs + 0.5, ys + 0.5, patch.sum()
+
+
+def centroid(intensity, center, half_window):
+    """Intensity-weighted centroid in pixel coordinates within a square window."""
+    patch, xs, ys, total = _window(intensity, center, half_window)
     if total <= 0.0:
         return None, 0.0
-    ys, xs = np.mgrid[y0:y1, x0:x1]
-    return np.array([((xs + 0.5) * patch).sum() / total, ((ys + 0.5) * patch).sum() / total]), total
+    return np.array([(xs * patch).sum() / total, (ys * patch).sum() / total]), total
 
 
 def rms_radius(intensity, center, half_window):
     """RMS distance (pixels) of the intensity from ``center``, within a square window around it:
     the square root of the intensity-weighted second moment, a size measure of a spot."""
-    height, width = intensity.shape
-    cx, cy = int(round(center[0])), int(round(center[1]))
-    x0, x1 = max(cx - half_window, 0), min(cx + half_window + 1, width)
-    y0, y1 = max(cy - half_window, 0), min(cy + half_window + 1, height)
-    patch = intensity[y0:y1, x0:x1]
-    total = patch.sum()
+    patch, xs, ys, total = _window(intensity, center, half_window)
     if total <= 0.0:
         return float("nan")
-    ys, xs = np.mgrid[y0:y1, x0:x1]
-    squared = (xs + 0.5 - center[0]) ** 2 + (ys + 0.5 - center[1]) ** 2
+    squared = (xs - center[0]) ** 2 + (ys - center[1]) ** 2
     return math.sqrt((squared * patch).sum() / total)
 
 

@@ -92,16 +92,7 @@ def assert_fails_with(result, reason):
     assert "Traceback" not in result.stderr + result.stdout
 
 
-def read_image(bpy, path):
-    """RGBA float pixels [row (top first), column, channel] of a PNG or EXR file."""
-    image = bpy.data.images.load(str(path), check_existing=False)
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, dtype=np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1]
+read_image = ch.read_image
 
 
 def luminance(rgba):
