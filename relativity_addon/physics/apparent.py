@@ -175,6 +175,14 @@ def lorentz_contraction_matrix(beta):
     return np.eye(3) - (1.0 - 1.0 / gamma) * np.outer(bhat, bhat)
 
 
+def _uniform_grid(times):
+    """``(start, step, intervals)`` of increasing, uniformly spaced sample ``times``."""
+    steps = np.diff(times)
+    if np.any(steps <= 0.0) or np.ptp(steps) > 1e-9 * max(abs(times[-1]), abs(steps[0]), 1.0):
+        raise ValueError("sample times must be increasing and uniformly spaced")
+    return float(times[0]), float(steps[0]), times.size - 1
+
+
 class SampledRigidMotion:
     """A rigid motion ``x(t) = A(t) p + b(t)`` sampled on a uniform time grid.
 
@@ -194,12 +202,7 @@ class SampledRigidMotion:
         matrices = finite_array(matrices, "matrices")
         if times.ndim != 1 or times.size < 2 or matrices.shape != (times.size, 4, 4):
             raise ValueError("need at least 2 sample times and one 4x4 matrix per time")
-        steps = np.diff(times)
-        if np.any(steps <= 0.0) or np.ptp(steps) > 1e-9 * max(abs(times[-1]), abs(steps[0]), 1.0):
-            raise ValueError("sample times must be increasing and uniformly spaced")
-        self.start = float(times[0])
-        self.step = float(steps[0])
-        self.intervals = times.size - 1
+        self.start, self.step, self.intervals = _uniform_grid(times)
         affine = matrices[:, :3, :]  # (K, 3, 4)
         # Pad one sample each side (linear extrapolation) so every interval has 4 neighbours.
         padded = np.concatenate([2 * affine[:1] - affine[1:2], affine, 2 * affine[-1:] - affine[-2:-1]])
@@ -312,12 +315,7 @@ class SampledPointMotion:
         if times.ndim != 1 or times.size < 2 or positions.ndim != 3 or positions.shape[0] != times.size \
                 or positions.shape[2] != 3:
             raise ValueError("need at least 2 sample times and positions of shape (times, points, 3)")
-        steps = np.diff(times)
-        if np.any(steps <= 0.0) or np.ptp(steps) > 1e-9 * max(abs(times[-1]), abs(steps[0]), 1.0):
-            raise ValueError("sample times must be increasing and uniformly spaced")
-        self.start = float(times[0])
-        self.step = float(steps[0])
-        self.intervals = times.size - 1
+        self.start, self.step, self.intervals = _uniform_grid(times)
         self._samples = np.concatenate(
             [2 * positions[:1] - positions[1:2], positions, 2 * positions[-1:] - positions[-2:-1]])
 
