@@ -57,24 +57,23 @@ def _shipped_table(load, log10_range):
     return pixels
 
 
+def _ensure_lut(name, table, log10_range, height):
+    image = bpy.data.images.get(name)
+    if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
+        return image
+    return _packed_float_image(name, LUT_SIZE, height, _shipped_table(table, log10_range))
+
+
 def ensure_doppler_matrix_lut():
     """The packed ``N x 3`` Doppler matrix table (``spectral.doppler_matrix_lut``)."""
 
-    image = bpy.data.images.get(DOPPLER_LUT_NAME)
-    if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
-        return image
-    pixels = _shipped_table(lut_data.doppler_matrix_lut, DOPPLER_LOG10_RANGE)
-    return _packed_float_image(DOPPLER_LUT_NAME, LUT_SIZE, 3, pixels)
+    return _ensure_lut(DOPPLER_LUT_NAME, lut_data.doppler_matrix_lut, DOPPLER_LOG10_RANGE, 3)
 
 
 def ensure_blackbody_lut():
     """The packed ``N x 1`` blackbody table (``spectral.blackbody_rgb_lut``)."""
 
-    image = bpy.data.images.get(BLACKBODY_LUT_NAME)
-    if image is not None and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
-        return image
-    pixels = _shipped_table(lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE)
-    return _packed_float_image(BLACKBODY_LUT_NAME, LUT_SIZE, 1, pixels)
+    return _ensure_lut(BLACKBODY_LUT_NAME, lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 
 
 def texture_u_scale_offset(log10_range, size=LUT_SIZE):
