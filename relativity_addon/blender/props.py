@@ -161,7 +161,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
     use_chang_searchlight: BoolProperty(
         name="Chang Searchlight (Wrong)",
         description="Comparison only: scale radiance by a single power of D as Chang et al. (1996) "
-        "did, which Weiskopf et al. (1999) show is wrong by D^3. Materials only",
+        "did, which Weiskopf et al. (1999) show is wrong by D^3",
         default=False,
         update=_settings_changed,
     )
