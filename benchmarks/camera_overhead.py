@@ -64,7 +64,7 @@ def main():
     import bpy
 
     import relativity_addon
-    from relativity_addon.blender import camera
+    from relativity_addon.blender import effect
 
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
@@ -74,10 +74,10 @@ def main():
 
     def render(beta, name):
         if beta is None:
-            camera.remove_relativistic_camera(scene)
+            effect.remove(scene)
         else:
             scene.relativity.beta = beta
-            camera.apply_relativistic_camera(scene)
+            effect.apply(scene)
         return timed_render(bpy, scene, os.path.join(out, name))
 
     for label, beta in cases:  # warm-up: shader compilation, kernel loading, caches

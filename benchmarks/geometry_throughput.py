@@ -6,7 +6,7 @@
 1. Physics core (``physics/apparent.py``), numpy only: apparent positions of N vertices for
    constant velocity (closed form) and for a keyframed rigid motion (rotation + translation
    sampled on a sub-frame grid, per-vertex retarded times by the bracketed secant solver).
-2. The add-on's full update (``geometry.update_object``): read the tessellated rest positions
+2. The add-on's full update (``geometry.update_object`` with ``snapshot.read``): read the tessellated rest positions
    from the evaluated mesh, compute, write the cache mesh; N-vertex grid, constant velocity and
    keyframed rotation.
 3. Render time of a small lit scene with the mesh path applied (observer at 0.8c) against the
@@ -80,7 +80,9 @@ def core_throughput(count, repeats):
     return count / uniform, count / keyframed, count / general
 
 
-def addon_throughput(bpy, geometry, count, repeats):
+def addon_throughput(bpy, count, repeats):
+    from relativity_addon.blender import effect, geometry, snapshot
+
     side = int(math.ceil(math.sqrt(count)))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -95,16 +97,17 @@ def addon_throughput(bpy, geometry, count, repeats):
     grid.relativity.tessellation = 0
     grid.relativity.motion = "CONSTANT"
     grid.relativity.beta = (0.9, 0.0, 0.0)
-    geometry.apply_apparent_geometry(scene)
+    scene.relativity.method = "GEOMETRY"
+    effect.apply(scene)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    uniform = best_time(lambda: geometry.update_object(scene, grid, depsgraph), repeats)
+    uniform = best_time(lambda: geometry.update_object(scene, grid, snapshot.read(scene, depsgraph), depsgraph), repeats)
     grid.keyframe_insert("rotation_euler", index=2, frame=0)
     grid.rotation_euler.z = 5.0 * 24 / scene.render.fps  # 5 rad/s: rim at 0.71 c
     grid.keyframe_insert("rotation_euler", index=2, frame=24)
     grid.relativity.motion = "ANIMATION"
     scene.frame_set(12)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    keyframed = best_time(lambda: geometry.update_object(scene, grid, depsgraph), repeats)
+    keyframed = best_time(lambda: geometry.update_object(scene, grid, snapshot.read(scene, depsgraph), depsgraph), repeats)
     return vertices, vertices / uniform, vertices / keyframed
 
 
@@ -118,7 +121,9 @@ def build_render_scene(bpy, resolution, samples):
     return scene
 
 
-def render_overhead(bpy, geometry, resolution, samples, repeats):
+def render_overhead(bpy, resolution, samples, repeats):
+    from relativity_addon.blender import effect
+
     scene = build_render_scene(bpy, resolution, samples)
     path = os.path.join(tempfile.mkdtemp(prefix="relativity-bench-"), "frame.png")
     scene.render.filepath = path
@@ -130,14 +135,15 @@ def render_overhead(bpy, geometry, resolution, samples, repeats):
 
     plain, mesh, ratios = [], [], []
     for _ in range(repeats):
-        geometry.remove_apparent_geometry(scene)
+        effect.remove(scene)
         scene.relativity.beta = (0.0, 0.0, 0.0)
         plain.append(render())
         scene.relativity.beta = (0.0, 0.8, 0.0)
         for obj in scene.objects:
             if obj.type == "MESH":
                 obj.relativity.tessellation = 3  # the 20-unit floor needs it to bend
-        geometry.apply_apparent_geometry(scene)
+        scene.relativity.method = "GEOMETRY"
+        effect.apply(scene)
         mesh.append(render())
         ratios.append(mesh[-1] / plain[-1])
     return statistics.median(plain), statistics.median(mesh), statistics.median(ratios)
@@ -160,9 +166,8 @@ def main():
     from relativity_addon import batch
 
     batch.enable_addon()
-    from relativity_addon.blender import geometry
 
-    grid_vertices, addon_uniform, addon_keyframed = addon_throughput(bpy, geometry, options.vertices, options.repeats)
+    grid_vertices, addon_uniform, addon_keyframed = addon_throughput(bpy, options.vertices, options.repeats)
     print_throughput_table([
         ("physics core, constant velocity", options.vertices, core_uniform, None),
         ("physics core, keyframed rigid motion", options.vertices, core_keyframed, KEYFRAMED_TARGET),
@@ -171,7 +176,7 @@ def main():
     ])
 
     batch.enable_addon()
-    plain, mesh, ratio = render_overhead(bpy, geometry, resolution, options.samples, options.repeats)
+    plain, mesh, ratio = render_overhead(bpy, resolution, options.samples, options.repeats)
     print(f"render {resolution[0]}x{resolution[1]}, {options.samples} samples: plain {plain:.2f} s, "
           f"mesh path at 0.8c {mesh:.2f} s, ratio {ratio:.2f} (median of {options.repeats} alternating rounds)")
 

@@ -66,13 +66,13 @@ def fly_camera(scene, camera_object, speed, lens_mm=55.0):
     Aberration shrinks the view ahead (by about 1/D), so a longer lens (``lens_mm``) frames the
     objects at a useful size while the floor still shows its bend at the image edges.
     """
-    from relativity_addon.blender import camera as relativistic_camera
+    from relativity_addon.blender import effect
 
     camera_object.data.lens = lens_mm
     bpy.context.view_layer.update()  # matrix_world of a just-built camera is stale until then
     forward = camera_object.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))
     scene.relativity.beta = tuple(speed * forward.normalized())
-    relativistic_camera.apply_relativistic_camera(scene)
+    effect.apply(scene)
     # Doppler factor straight ahead: D = gamma (1 + beta) (PHYSICS.md, observer moving).
     doppler_ahead = math.sqrt((1.0 + speed) / (1.0 - speed))
     scene.view_settings.exposure = -4.0 * math.log2(doppler_ahead)

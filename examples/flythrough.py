@@ -115,10 +115,10 @@ def build(out_dir, frames, beta_max, c, resolution, samples, searchlight=True):
     settings.speed_of_light = c
     settings.velocity_source = "CAMERA_ANIMATION"
     settings.method = "CAMERA"
-    from relativity_addon.blender import ops
+    from relativity_addon.blender import effect
 
     scene.frame_set(1)
-    ops.apply_effect(scene)
+    effect.apply(scene)
     blend = out_dir / "flythrough.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend), check_existing=False)
     return blend

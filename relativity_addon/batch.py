@@ -10,6 +10,9 @@ import math
 import os
 import sys
 
+from .errors import RelativityError
+from .physics.shutter import ShutterModel
+
 ADDON_PACKAGE = "relativity_addon"
 
 
@@ -64,14 +67,7 @@ def _frame_range(text):
     return first, last
 
 
-SHUTTER_CHOICES = (
-    "pinhole",
-    "aperture_plane",
-    "detector_plane",
-    "focus_surface",
-    "fixed_point_surface",
-    "arbitrary_plane",
-)
+SHUTTER_CHOICES = tuple(model.name.lower() for model in ShutterModel)
 
 
 def build_parser(with_blend_file):
@@ -259,7 +255,7 @@ def run(argv, log=print):
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}")
     enable_addon()
-    from .blender import camera, ops
+    from .blender import effect
 
     scene = bpy.context.scene
     frames = _frames(scene, options)
@@ -277,14 +273,14 @@ def run(argv, log=print):
     relativistic = not options.reference
     try:
         if options.reference:
-            camera.remove_relativistic_camera(scene)
+            effect.remove(scene)
             if scene.camera is None:
                 raise BatchError("scene has no active camera")
         else:
             _apply_options(scene, options)
             scene.frame_set(frames[0])
-            ops.apply_effect(scene, frame_range=(frames[0], frames[-1]))
-    except camera.RelativityError as error:
+            effect.apply(scene, frame_range=(frames[0], frames[-1]))
+    except RelativityError as error:
         raise BatchError(str(error)) from None
 
     several = len(frames) > 1

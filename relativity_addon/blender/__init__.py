@@ -1,5 +1,9 @@
 """Blender glue: property groups, node-tree builders, handlers, operators and panels.
 
+Layers (docs/architecture.md): settings (props, objects) -> snapshot -> effect -> the render
+paths (camera + osl; geometry + modifier + world_lines + bakes) and colour (colour, materials,
+compositing, luts), on shared leaves (names, nodes, compat, busy, animation).
+
 Each module listed in ``_MODULES`` may define ``classes`` (registered in order, unregistered in
 reverse) and ``register()`` / ``unregister()`` hooks for anything else it installs (properties
 on ID types, handlers, preset paths). Modules are registered in list order and unregistered in
@@ -9,15 +13,13 @@ reverse, so a module may rely on everything listed before it.
 import importlib
 
 _MODULES = (
-    "props",
-    "camera",
-    "compositing",
-    "objects",
-    "geometry",
-    "animation",
-    "presets",
-    "ops",
-    "panel",
+    "props",  # Scene.relativity
+    "objects",  # Object.relativity
+    "presets",  # preset menus and the shipped presets folder
+    "ops",  # Set Up, Remove, Check Camera Speed
+    "bakes",  # Bake Motion, Bake Deformation
+    "panel",  # the N-panel
+    "handlers",  # the handler table (effect.sync)
 )
 
 

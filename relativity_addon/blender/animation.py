@@ -1,37 +1,29 @@
-"""Motion from keyframes: the observer velocity from the camera's animation, and world matrices of any
-object at many (sub-)frames.
+"""Motion from keyframes: world matrices of any object at many (sub-)frames, and the observer
+velocity from the camera's animation.
+
+:func:`world_matrices` evaluates the keyframes of an object and its object-parent chain (F-curves
+at fractional frames, deltas included) in float64, never with ``frame_set``, so the result depends
+on the frame alone: a frame rendered by itself in a fresh process gets the same motion as in a
+sequence (farm-safe). Constraints, drivers, NLA and simulations are not evaluated:
+:func:`keyframe_motion_problem` says when keyframes alone are not the motion (such objects need a
+motion bake, and such a camera cannot give the velocity).
 
 With ``scene.relativity.velocity_source == 'CAMERA_ANIMATION'`` the observer velocity is the time
-derivative of the camera's world position, in scene time ``t = frame / fps`` (PHYSICS.md, units),
-divided by the scene's speed of light:
+derivative of the camera's world position in scene time ``t = frame / fps``, divided by c
+(docs/physics.md, units):
 
     beta(f) = (x(f + h) - x(f - h)) / (2 h / fps) / c        (central difference, h = STEP_FRAMES)
 
-The position is evaluated from the keyframes of the camera and its parents directly (F-curves at
-fractional frames), never with ``frame_set``, so the result depends on the frame alone: a frame
-rendered by itself in a fresh process gets the same velocity as in a sequence (farm-safe).
-Constraints and drivers are not evaluated; a camera that depends on them is refused with a clear
-message rather than given a wrong velocity.
-
-:func:`world_matrices` is that evaluation, vectorised over many (sub-)frames in float64: the
-apparent-geometry path samples keyframed objects with it at their retarded times, and
-:func:`keyframe_motion_problem` says when keyframes alone are not the motion (constraints,
-transform drivers, NLA, simulation, non-object parents: those objects need a baked motion).
-
-Persistent ``frame_change_pre`` and ``render_pre`` handlers write the velocity into
-``scene.relativity.beta`` (which re-syncs the relativistic camera through its update callback).
-``check_animation_speed`` is run by the operator and the batch script before rendering: it reports
-the first frame where the camera would move at or above c.
+``snapshot.read`` takes it at every frame; :func:`check_animation_speed` is run before rendering a
+range and names the first frame where the camera would move at or above c.
 """
 
 import math
 
-import bpy
 import numpy as np
-from bpy.app.handlers import persistent
 from mathutils import Matrix
 
-from .camera import RelativityError
+from ..errors import RelativityError
 
 # Half-width of the central difference, in frames. Small enough to be the instantaneous velocity
 # of smooth keyframe curves, large enough for float32 key values.
@@ -174,11 +166,6 @@ def world_matrices(obj, frames):
     return world_matrices(parent, frames) @ parent_inverse @ matrices
 
 
-def basis_matrix_at(obj, frame):
-    """The object's ``matrix_basis`` at ``frame`` from its keyframes (deltas included)."""
-    return Matrix(basis_matrices(obj, [frame])[0].tolist())
-
-
 def world_matrix_at(obj, frame):
     """``matrix_world`` at ``frame`` from keyframes alone (object parents; no constraints)."""
     return Matrix(world_matrices(obj, [frame])[0].tolist())
@@ -228,20 +215,16 @@ def _animated_camera(scene):
     return camera_object
 
 
-def camera_beta_at(scene, frame, camera_object=None):
+def camera_beta_at(scene, frame, camera_object=None, c=None):
     """Observer velocity (world axes, fraction of c) of the camera at ``frame`` (float allowed)."""
     camera_object = camera_object or _animated_camera(scene)
-    c = scene.relativity.speed_of_light
+    check_supported(camera_object, scene)
+    c = scene.relativity.speed_of_light if c is None else c
     if not (math.isfinite(c) and c > 0.0):
         raise RelativityError("speed of light must be a positive finite number")
-    before = world_matrix_at(camera_object, frame - STEP_FRAMES).translation
-    after = world_matrix_at(camera_object, frame + STEP_FRAMES).translation
+    before, after = world_matrices(camera_object, [frame - STEP_FRAMES, frame + STEP_FRAMES])[:, :3, 3]
     dt = 2.0 * STEP_FRAMES / frames_per_second(scene)
-    return tuple((a - b) / dt / c for a, b in zip(after, before))
-
-
-def current_frame(scene):
-    return scene.frame_current + scene.frame_subframe
+    return tuple(float(x) for x in (after - before) / dt / c)
 
 
 def check_animation_speed(scene, frame_start=None, frame_end=None):
@@ -267,51 +250,3 @@ def check_animation_speed(scene, frame_start=None, frame_end=None):
             )
         highest = max(highest, speed)
     return highest
-
-
-def sync_velocity_from_animation(scene):
-    """Write the camera's velocity at the current frame into ``scene.relativity.beta``."""
-    settings = scene.relativity
-    if settings.velocity_source != "CAMERA_ANIMATION":
-        return False
-    beta = camera_beta_at(scene, current_frame(scene))
-    if tuple(settings.beta) != tuple(float(b) for b in beta):
-        settings.beta = beta
-    return True
-
-
-def sync_velocity_if_animated(scene):
-    """Update-callback and handler entry point: never raises."""
-    try:
-        return sync_velocity_from_animation(scene)
-    except RelativityError as error:
-        print(f"Relativity: {error}")
-        return False
-
-
-@persistent
-def _frame_change_pre(scene, _depsgraph=None):
-    sync_velocity_if_animated(scene)
-
-
-@persistent
-def _render_pre(scene, _depsgraph=None):
-    sync_velocity_if_animated(scene)
-
-
-_HANDLERS = (("frame_change_pre", _frame_change_pre), ("render_pre", _render_pre))
-
-
-def register():
-    for name, handler in _HANDLERS:
-        handlers = getattr(bpy.app.handlers, name)
-        if handler not in handlers:
-            # Before the camera's render_pre re-sync, so the camera sees this frame's velocity.
-            handlers.insert(0, handler)
-
-
-def unregister():
-    for name, handler in _HANDLERS:
-        handlers = getattr(bpy.app.handlers, name)
-        if handler in handlers:
-            handlers.remove(handler)

@@ -1,30 +1,24 @@
-"""Attach, update, validate and remove the relativistic OSL camera.
+"""The exact camera: attach, write, invalidate and remove the relativistic OSL camera.
 
 The shader (``relativity_addon/shaders/relativistic_camera.osl``) is stored in the .blend as a
 text datablock and compiled by Cycles into the camera's bytecode; every parameter it needs is
-written to ``camera.data.cycles_custom``. A render therefore needs nothing outside the file.
-What ``apply_relativistic_camera`` changes on the camera is recorded in ID properties of the
-camera data, so ``remove_relativistic_camera`` restores it exactly (and undo covers both).
+written to ``camera.data.cycles_custom`` from a ``snapshot.Snapshot``. A render therefore needs
+nothing outside the file. What :func:`apply` changes on the camera is recorded in ID properties
+of the camera data, so :func:`remove` restores it exactly (and undo covers both).
 
 Coordinate conventions: Cycles' camera shaders use +Z forward, +Y up, +X right. Blender's
 camera object looks down its local -Z with +Y up and +X right, so a vector in the camera's
 local axes maps to shader coordinates as (x, y, -z).
 """
 
-import math
 import os
 
 import bpy
-from bpy.app.handlers import persistent
 
-from . import osl
+from ..errors import RelativityError
+from . import names, osl
 
-SHADER_TEXT_NAME = "relativistic_camera.osl"
-SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", SHADER_TEXT_NAME)
-
-# ID property on the camera data: present while the relativistic camera is applied; holds what
-# was there before.
-SAVED_STATE_KEY = "relativity_saved_state"
+SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.SHADER_TEXT)
 
 # Shader parameters that must exist after compilation; their absence means an empty shader.
 REQUIRED_PARAMETERS = (
@@ -46,10 +40,6 @@ REQUIRED_PARAMETERS = (
 )
 
 
-class RelativityError(Exception):
-    """A user-facing problem that prevents a physically correct render (one-line message)."""
-
-
 def shader_source():
     with open(SHADER_PATH, encoding="utf-8") as handle:
         return handle.read()
@@ -58,9 +48,9 @@ def shader_source():
 def ensure_shader_text():
     """The text datablock holding the camera shader, created or refreshed from the package."""
     source = shader_source()
-    text = bpy.data.texts.get(SHADER_TEXT_NAME)
+    text = bpy.data.texts.get(names.SHADER_TEXT)
     if text is None:
-        text = bpy.data.texts.new(SHADER_TEXT_NAME)
+        text = bpy.data.texts.new(names.SHADER_TEXT)
     if text.as_string().rstrip("\n") != source.rstrip("\n"):
         text.clear()
         text.write(source)
@@ -68,70 +58,7 @@ def ensure_shader_text():
 
 
 def is_applied(camera_data):
-    return camera_data is not None and SAVED_STATE_KEY in camera_data
-
-
-def _finite(values):
-    return all(math.isfinite(value) for value in values)
-
-
-def validate_scene(scene, require_perspective=True):
-    """Raise RelativityError unless the scene can be rendered with correct physics."""
-    settings = scene.relativity
-    beta = tuple(settings.beta)
-    if not _finite(beta):
-        raise RelativityError("observer velocity beta is not a finite vector")
-    speed = math.sqrt(sum(b * b for b in beta))
-    if speed >= 1.0:
-        raise RelativityError(f"observer speed |beta| = {speed:.6g} must be below 1 (the speed of light)")
-    c = settings.speed_of_light
-    if not (math.isfinite(c) and c > 0.0):
-        raise RelativityError("speed of light must be a positive finite number")
-    if not math.isfinite(settings.shutter_time):
-        raise RelativityError("shutter time must be finite")
-    if settings.method != "CAMERA":
-        raise RelativityError(f"render method {settings.method!r} is not implemented yet; use 'CAMERA'")
-    if scene.render.engine != "CYCLES":
-        raise RelativityError(
-            f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}"
-        )
-    camera_object = scene.camera
-    if camera_object is None or camera_object.type != "CAMERA":
-        raise RelativityError(f"scene {scene.name!r} has no active camera")
-    if settings.shutter_model == "ARBITRARY_PLANE":
-        normal = tuple(settings.shutter_plane_normal)
-        if not _finite(normal) or sum(n * n for n in normal) == 0.0:
-            raise RelativityError("arbitrary shutter plane needs a non-zero normal")
-    if require_perspective and not is_applied(camera_object.data):
-        if camera_object.data.type != "PERSP":
-            raise RelativityError(
-                f"camera {camera_object.name!r} is {camera_object.data.type}, "
-                "the relativistic camera replaces a perspective camera only"
-            )
-    return camera_object
-
-
-def camera_world_matrix(scene, camera_object):
-    """The camera's world matrix at the scene's current (sub-)frame.
-
-    During Blender's own animation render the original camera object is not re-evaluated, so
-    its ``matrix_world`` is that of the frame the file was saved at; a farm worker would then
-    render a turning camera wrongly. Keyframed transforms (with object parents) are therefore
-    evaluated from the F-curves at the frame itself; only a camera moved by constraints, drivers
-    or NLA falls back to ``matrix_world``.
-    """
-    from . import animation
-
-    try:
-        animation.check_supported(camera_object)
-        return animation.world_matrix_at(camera_object, scene.frame_current + scene.frame_subframe)
-    except RelativityError:
-        return camera_object.matrix_world
-
-
-def _world_to_camera_rotation(scene, camera_object):
-    """Rotation taking world vectors to the camera's local axes (scale and shear removed)."""
-    return camera_world_matrix(scene, camera_object).to_quaternion().to_matrix().transposed()
+    return camera_data is not None and names.CAMERA_SAVED_STATE_KEY in camera_data
 
 
 def _local_to_shader(vector):
@@ -162,14 +89,8 @@ def camera_frame_window(scene, camera_data):
     )
 
 
-def shader_parameters(scene, camera_object):
-    """Values for ``cycles_custom``, from the scene settings and the camera's world rotation."""
-    from mathutils import Vector
-
-    settings = scene.relativity
-    camera_data = camera_object.data
-    rotation = _world_to_camera_rotation(scene, camera_object)
-    beta_local = rotation @ Vector(settings.beta)
+def shader_parameters(scene, camera_data, snap):
+    """Values for ``cycles_custom`` from the snapshot and the camera's lens and sensor."""
     left, right, bottom, top = camera_frame_window(scene, camera_data)
     unit_scale = scene.unit_settings.scale_length or 1.0
     return {
@@ -178,27 +99,30 @@ def shader_parameters(scene, camera_object):
         "frame_bottom": bottom,
         "frame_top": top,
         "lens_focal_length": camera_data.lens * 1e-3 / unit_scale,
-        "beta": _local_to_shader(beta_local),
-        "speed_of_light": settings.speed_of_light,
-        "shutter_model": list(_shutter_models()).index(settings.shutter_model),
-        "shutter_time": settings.shutter_time,
-        "shutter_plane_point": _local_to_shader(settings.shutter_plane_point),
-        "shutter_plane_normal": _local_to_shader(settings.shutter_plane_normal),
-        "use_lorentz_window": bool(settings.use_lorentz_window),
-        "use_geometry": bool(settings.use_geometry),
-        "use_searchlight": bool(settings.use_searchlight),
+        "beta": _local_to_shader(snap.beta_camera),
+        "speed_of_light": snap.speed_of_light,
+        "shutter_model": snap.shutter_code,
+        "shutter_time": snap.shutter_time,
+        "shutter_plane_point": _local_to_shader(snap.shutter_plane_point),
+        "shutter_plane_normal": _local_to_shader(snap.shutter_plane_normal),
+        "use_lorentz_window": snap.use_lorentz_window,
+        "use_geometry": snap.use_geometry,
+        "use_searchlight": snap.use_searchlight,
         "settings_valid": True,
     }
 
 
-def _shutter_models():
-    from .props import SHUTTER_MODELS
-
-    return SHUTTER_MODELS
+def _same(current, value):
+    if hasattr(current, "__len__") and hasattr(value, "__len__"):
+        return len(current) == len(value) and all(a == b for a, b in zip(current, value))
+    return current == value
 
 
 def _write_parameters(camera_data, values):
+    """Write shader parameters, only those that changed (a write tags the camera for a depsgraph
+    update, whose handler syncs again)."""
     custom = camera_data.cycles_custom
+    changed = False
     for name, value in values.items():
         current = custom.get(name)
         if isinstance(value, tuple):
@@ -209,8 +133,12 @@ def _write_parameters(camera_data, values):
             value = int(value)
         elif isinstance(value, (int, float)) and isinstance(current, float):
             value = float(value)
+        if current is not None and _same(current, value):
+            continue
         custom[name] = value
-    camera_data.update_tag()
+        changed = True
+    if changed:
+        camera_data.update_tag()
 
 
 def _missing_parameters(camera_data):
@@ -236,7 +164,7 @@ def compile_shader(camera_data):
 
 def _save_state(camera_data):
     custom = camera_data.cycles_custom
-    camera_data[SAVED_STATE_KEY] = {
+    camera_data[names.CAMERA_SAVED_STATE_KEY] = {
         "type": camera_data.type,
         "custom_mode": camera_data.custom_mode,
         "custom_shader": camera_data.custom_shader.name if camera_data.custom_shader else "",
@@ -247,14 +175,17 @@ def _save_state(camera_data):
     }
 
 
-def apply_relativistic_camera(scene):
-    """Turn the scene camera into the relativistic OSL camera and sync it. Returns the camera.
-
-    Raises RelativityError (one-line message) if the scene cannot be rendered correctly.
-    """
-    camera_object = validate_scene(scene)
+def apply(scene, snap):
+    """Turn the snapshot's camera into the relativistic OSL camera and write its parameters.
+    Returns the camera object; RelativityError (one line), with the camera restored, on failure."""
+    camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
     if not is_applied(camera_data):
+        if camera_data.type != "PERSP":
+            raise RelativityError(
+                f"camera {camera_object.name!r} is {camera_data.type}, "
+                "the relativistic camera replaces a perspective camera only"
+            )
         try:
             osl.ensure_oslquery_importable()
         except osl.OSLUnavailableError as error:
@@ -265,64 +196,47 @@ def apply_relativistic_camera(scene):
         camera_data.custom_mode = "INTERNAL"
         camera_data.custom_shader = text
     try:
-        if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
-            compile_shader(camera_data)
-        _write_parameters(camera_data, shader_parameters(scene, camera_object))
+        write(scene, snap)
     except RelativityError:
-        if SAVED_STATE_KEY in camera_data:
-            remove_relativistic_camera(scene)
-        raise
-    from . import compositing  # Doppler colour stage (materials + compositor), undone on remove
-
-    try:
-        compositing.apply_camera_colour(scene)
-    except RelativityError:
-        remove_relativistic_camera(scene)
+        remove(camera_object)
         raise
     return camera_object
 
 
-def sync_relativistic_camera(scene):
-    """Re-write the shader parameters from the scene state; mark the shader invalid on error."""
-    camera_object = scene.camera
-    if camera_object is None or camera_object.type != "CAMERA" or not is_applied(camera_object.data):
-        return False
+def write(scene, snap):
+    """Write the snapshot into the applied camera (compiling the shader if it is missing)."""
+    camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
-    try:
-        validate_scene(scene)
-        if camera_data.type != "CUSTOM":
-            raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
-        if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
-            ensure_shader_text()
-            compile_shader(camera_data)
-        _write_parameters(camera_data, shader_parameters(scene, camera_object))
-    except RelativityError:
-        if "settings_valid" in camera_data.cycles_custom:
-            _write_parameters(camera_data, {"settings_valid": False})
-        raise
-    return True
+    if not is_applied(camera_data):
+        raise RelativityError(f"camera {camera_object.name!r} is not the relativistic camera")
+    if camera_data.type != "CUSTOM":
+        raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
+    if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
+        ensure_shader_text()
+        compile_shader(camera_data)
+    _write_parameters(camera_data, shader_parameters(scene, camera_data, snap))
 
 
-def sync_if_applied(scene):
-    """Property-update entry point: never raises; an invalid state renders black, not wrong."""
-    try:
-        sync_relativistic_camera(scene)
-    except RelativityError as error:
-        print(f"Relativity: {error}")
+def invalidate(camera_object):
+    """Mark the camera's parameters invalid: the shader renders black, never a wrong image."""
+    if camera_object is None or camera_object.type != "CAMERA" or not is_applied(camera_object.data):
+        return
+    if camera_object.data.cycles_custom.get("settings_valid", False):
+        _write_parameters(camera_object.data, {"settings_valid": False})
 
 
-def remove_relativistic_camera(scene, camera_object=None):
-    """Restore the camera exactly as it was before ``apply_relativistic_camera``."""
-    camera_object = camera_object or scene.camera
+def applied_cameras():
+    return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
+
+
+def remove(camera_object):
+    """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False
     camera_data = camera_object.data
     if not is_applied(camera_data):
         return False
-    from . import compositing
-
-    compositing.remove_camera_colour(scene)
-    saved = camera_data[SAVED_STATE_KEY].to_dict()
+    saved = camera_data[names.CAMERA_SAVED_STATE_KEY].to_dict()
     custom = camera_data.cycles_custom
     for key in list(custom.keys()):
         del custom[key]
@@ -334,28 +248,9 @@ def remove_relativistic_camera(scene, camera_object=None):
     camera_data.custom_bytecode = saved["custom_bytecode"]
     camera_data.custom_bytecode_hash = saved["custom_bytecode_hash"]
     camera_data.type = saved["type"]
-    del camera_data[SAVED_STATE_KEY]
-    text = bpy.data.texts.get(SHADER_TEXT_NAME)
+    del camera_data[names.CAMERA_SAVED_STATE_KEY]
+    text = bpy.data.texts.get(names.SHADER_TEXT)
     if text is not None and not any(cam.custom_shader == text for cam in bpy.data.cameras):
         bpy.data.texts.remove(text)
     camera_data.update_tag()
     return True
-
-
-@persistent
-def _render_pre(scene, _depsgraph=None):
-    """Re-sync before every render from the scene state alone (frame order does not matter)."""
-    try:
-        sync_relativistic_camera(scene)
-    except RelativityError as error:
-        print(f"Relativity: not rendering relativistic physics: {error}")
-
-
-def register():
-    if _render_pre not in bpy.app.handlers.render_pre:
-        bpy.app.handlers.render_pre.append(_render_pre)
-
-
-def unregister():
-    if _render_pre in bpy.app.handlers.render_pre:
-        bpy.app.handlers.render_pre.remove(_render_pre)

@@ -25,14 +25,13 @@ created if the scene has none); :func:`remove_colour_stage` restores the composi
 
 import bpy
 
-from . import luts, materials
-from .materials import Group, Menu, Node, fmath, group_node, vmath
+from . import luts, materials, names
+from .nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
 
-COMPOSITOR_GROUP = "Relativity Doppler Compositor"
-COMPOSITOR_GAMUT_MAP = "Relativity Gamut Map (Compositor)"
-SCENE_TREE_NAME = "Relativity Compositing"
-SAVED_KEY = "relativity_compositor_saved"
-GROUP_VERSION = 3
+COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
+COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
+SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
+SAVED_KEY = names.COMPOSITOR_SAVED_KEY
 VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
 
 
@@ -87,20 +86,14 @@ def compositor_group():
 
 def ensure_compositor_group():
     luts.ensure_doppler_matrix_lut()
-    gamut = bpy.data.node_groups.get(COMPOSITOR_GAMUT_MAP)
-    if gamut is None or gamut.get(materials.GROUPS_VERSION_KEY) != GROUP_VERSION:
-        gamut = materials.build_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"))
-        gamut[materials.GROUPS_VERSION_KEY] = GROUP_VERSION
-    tree = bpy.data.node_groups.get(COMPOSITOR_GROUP)
-    if tree is None or tree.get(materials.GROUPS_VERSION_KEY) != GROUP_VERSION:
-        tree = materials.build_group(compositor_group())
-        tree[materials.GROUPS_VERSION_KEY] = GROUP_VERSION
-    return tree
+    version = (names.GROUP_VERSION_KEY, names.COMPOSITOR_GROUPS_VERSION)
+    ensure_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"), *version)
+    return ensure_group(compositor_group(), *version)
 
 
-def colour_stage_values(scene):
-    """Values of the compositor group's flag inputs, from ``scene.relativity``."""
-    values = materials.settings_values(scene, camera_path=True)
+def colour_stage_values(snap):
+    """Values of the compositor group's flag inputs, from the snapshot."""
+    values = materials.settings_values(snap)
     return {name: values[name] for name in VALUE_NAMES}
 
 
@@ -112,11 +105,11 @@ def _inserted_nodes(scene):
     return tree, [tree.nodes[name] for name in names if name in tree.nodes]
 
 
-def sync_colour_stage(scene):
+def write_colour_stage(scene, snap):
     """Write the effect flags into the inserted group nodes (only where they changed).
 
     ``D`` itself comes from the AOV, computed by Cycles for every frame. The flags are written
-    whenever the scene changes (depsgraph_update_post), not only before a render: Blender's
+    at every sync (a setting's update callback and depsgraph_update_post), not only before a render: Blender's
     animation render shows its compositor what a render_pre or frame_change_pre handler wrote
     one frame late (measured with 5.0.1). They are plain values, not drivers, so the file
     renders the same without the add-on.
@@ -124,7 +117,7 @@ def sync_colour_stage(scene):
     _tree, nodes = _inserted_nodes(scene)
     if not nodes:
         return False
-    values = colour_stage_values(scene)
+    values = colour_stage_values(snap)
     for node in nodes:
         for name, value in values.items():
             if node.inputs[name].default_value != value:
@@ -136,8 +129,8 @@ def is_applied(scene):
     return SAVED_KEY in scene
 
 
-def apply_colour_stage(scene):
-    """Insert the Doppler colour group after the scene's Render Layers nodes and sync it."""
+def apply_colour_stage(scene, snap):
+    """Insert the Doppler colour group after the scene's Render Layers nodes and write its flags."""
     group = ensure_compositor_group()
     if not is_applied(scene):
         saved = {
@@ -182,7 +175,7 @@ def apply_colour_stage(scene):
             saved["inserted"].append({"group_node": node.name, "layers": layers.name, "targets": targets})
         scene.render.use_compositing = True
         scene[SAVED_KEY] = saved
-    sync_colour_stage(scene)
+    write_colour_stage(scene, snap)
 
 
 def remove_colour_stage(scene):
@@ -216,102 +209,3 @@ def remove_colour_stage(scene):
     scene.render.use_compositing = saved["use_compositing"]
     del scene[SAVED_KEY]
     return True
-
-
-# --- the exact camera's colour stage as a whole -------------------------------------------------
-
-
-def apply_camera_colour(scene):
-    """Called by ``camera.apply_relativistic_camera``: materials (blackbodies) + compositor.
-
-    Raises ``camera.RelativityError`` (one line) after undoing any partial change.
-    """
-    from .camera import RelativityError
-
-    try:
-        materials.apply_doppler_colour(scene, camera_path=True)
-        apply_colour_stage(scene)
-    except (ImportError, ValueError, KeyError, RuntimeError) as error:
-        remove_camera_colour(scene)
-        message = str(error).strip().splitlines()
-        raise RelativityError(
-            f"Doppler colour stage could not be set up: {type(error).__name__}: {message[-1] if message else ''}"
-        ) from error
-
-
-def remove_camera_colour(scene):
-    """Called by ``camera.remove_relativistic_camera``: undo :func:`apply_camera_colour`."""
-    remove_colour_stage(scene)
-    materials.remove_doppler_colour(scene)
-    if not any(is_applied(other) for other in bpy.data.scenes):
-        remove_unused_data()
-
-
-def remove_unused_data():
-    """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
-    if any(materials.is_attached(material) for material in bpy.data.materials):
-        return False
-    names = (COMPOSITOR_GROUP, COMPOSITOR_GAMUT_MAP) + tuple(
-        builder().name for builder in reversed(materials.GROUP_BUILDERS)
-    )
-    for name in names:
-        tree = bpy.data.node_groups.get(name)
-        if tree is not None:
-            bpy.data.node_groups.remove(tree)
-    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME):
-        image = bpy.data.images.get(name)
-        if image is not None:
-            bpy.data.images.remove(image)
-    return True
-
-
-def sync_camera_colour(scene, attach_new_materials=False):
-    """Re-write the settings; before a render also attach materials added since applying."""
-    if not is_applied(scene):
-        return
-    if attach_new_materials:
-        for material, temperature in materials.scene_materials(scene):
-            materials.attach(material, temperature)  # no-op for attached ones
-        materials.attach_world(scene.world)
-    materials.sync_settings(scene, camera_path=True)
-    sync_colour_stage(scene)
-
-
-@bpy.app.handlers.persistent
-def _sync_handler(scene, _depsgraph=None):
-    try:
-        sync_camera_colour(scene)
-    except Exception as error:  # noqa: BLE001 - a handler must never stop the render
-        print(f"Relativity: Doppler colour stage not synced: {error}")
-
-
-@bpy.app.handlers.persistent
-def _render_pre(scene, _depsgraph=None):
-    try:
-        sync_camera_colour(scene, attach_new_materials=True)
-    except Exception as error:  # noqa: BLE001 - a handler must never stop the render
-        print(f"Relativity: Doppler colour stage not synced: {error}")
-
-
-# The materials' observer velocity must follow each frame (Cycles reads shader values written
-# in render_pre and frame_change_pre, appended after the handlers that write the velocity);
-# the compositor's flags must be in place before the render starts (depsgraph_update_post).
-_HANDLERS = (
-    ("render_pre", _render_pre),
-    ("frame_change_pre", _sync_handler),
-    ("depsgraph_update_post", _sync_handler),
-)
-
-
-def register():
-    for name, handler in _HANDLERS:
-        handlers = getattr(bpy.app.handlers, name)
-        if handler not in handlers:
-            handlers.append(handler)
-
-
-def unregister():
-    for name, handler in _HANDLERS:
-        handlers = getattr(bpy.app.handlers, name)
-        if handler in handlers:
-            handlers.remove(handler)

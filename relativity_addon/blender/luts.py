@@ -12,13 +12,14 @@ import bpy
 import numpy as np
 
 from .. import lut_data
+from . import names
 
-DOPPLER_LUT_NAME = "Relativity Doppler Matrix LUT"
-BLACKBODY_LUT_NAME = "Relativity Blackbody LUT"
+DOPPLER_LUT_NAME = names.DOPPLER_LUT_IMAGE
+BLACKBODY_LUT_NAME = names.BLACKBODY_LUT_IMAGE
 LUT_SIZE = 2048
 # ID property on a LUT image: the layout version, so an outdated table is rebuilt.
-LAYOUT_KEY = "relativity_lut_layout"
-LAYOUT_VERSION = 1
+LAYOUT_KEY = names.LUT_LAYOUT_KEY
+LAYOUT_VERSION = names.LUT_LAYOUT_VERSION
 
 # Grid ranges as the shaders need them: u = (log10 x - low) / (high - low) * (N - 1)/N + 0.5/N.
 DOPPLER_LOG10_RANGE = (-2.0, 2.0)

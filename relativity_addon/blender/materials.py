@@ -4,7 +4,7 @@ Where the Doppler factor is computed in the shader: the group ``Relativity Doppl
 (:data:`DOPPLER_FACTOR`), from the geometry's Incoming vector ``k`` (the direction the photon
 propagates, toward the viewer) and two velocities in fractions of c:
 
-    D = gamma_o (1 - beta_o . k) / (gamma_s (1 - beta_s . k))          (PHYSICS.md)
+    D = gamma_o (1 - beta_o . k) / (gamma_s (1 - beta_s . k))          (docs/physics.md)
 
 ``beta_s`` is the point attribute ``relativity_beta`` (the apparent-geometry modifier writes the
 emitter's velocity relative to the observer; 0 where absent), ``beta_o`` the observer velocity
@@ -14,137 +14,37 @@ the observer frame).
 Colour (``docs/spectral-model.md``): ordinary colours go through the packed Doppler matrix table,
 ``rgb_obs = exp(a(D)) gamut_map(N(D) rgb)``; colours that come from Blender's Blackbody node are
 seen as a blackbody at ``D T`` with luminance ratio ``Y(D T) / Y(T)`` from the packed blackbody
-table. Every group is declared once as data (:class:`Group`) and built by :func:`build_group`.
+table. Every group is declared once as data (``nodes.Group``) and built by ``nodes.build_group``.
 
 Settings reach the shaders through one shared group, ``Relativity Settings``, whose constant
-nodes :func:`sync_settings` rewrites from ``scene.relativity`` (before every render too), so
+nodes :func:`write_settings` rewrites from the snapshot at every sync (``effect.sync``), so
 materials never need to be touched again after :func:`attach`.
 """
 
 import math
-from dataclasses import dataclass, field
 
 import bpy
 
-from . import luts
+from . import luts, names
+from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
-BETA_ATTRIBUTE = "relativity_beta"
-DONE_AOV = "relativity_colour_done"
-# ID property on a material while the effect is attached: what was inserted where.
-ATTACHED_KEY = "relativity_doppler_nodes"
-NODE_PREFIX = "Relativity Doppler"
+BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
+DONE_AOV = names.COLOUR_DONE_AOV
+ATTACHED_KEY = names.MATERIAL_ATTACHED_KEY
+NODE_PREFIX = names.MATERIAL_NODE_PREFIX
 EXP_LIMIT = 80.0  # float32 exp overflows past ~88: clamp the log brightness before exp
-
-
-class Menu(str):
-    """A menu socket value (a string that is not a reference)."""
-
-
-@dataclass
-class Node:
-    """One node: ``inputs`` maps socket (name or index) to a constant or a reference.
-
-    A reference is ``"node"`` (first output), ``"node.Output Name"``, ``"node.2"`` (output index)
-    or ``"group.Input Name"`` (the group's own input).
-    """
-
-    kind: str
-    inputs: dict = field(default_factory=dict)
-    props: dict = field(default_factory=dict)
-
-
-@dataclass
-class Group:
-    name: str
-    tree_type: str
-    inputs: tuple  # (name, socket type, default or None)
-    outputs: tuple  # (name, socket type, reference)
-    nodes: dict
-
-
-def fmath(operation, a, b=0.0, c=0.0, clamp=False):
-    return Node("ShaderNodeMath", {0: a, 1: b, 2: c}, {"operation": operation, "use_clamp": clamp})
-
-
-def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
-    inputs = {0: a, 1: b}
-    if scale is not None:
-        inputs["Scale"] = scale
-    return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
-
-
-def group_node(group_name, inputs=None, kind="ShaderNodeGroup"):
-    return Node(kind, inputs or {}, {"node_tree": group_name})
-
-
-def _socket(sockets, key):
-    if isinstance(key, int):
-        return sockets[key]
-    if key.isdigit():
-        return sockets[int(key)]
-    for socket in sockets:  # enabled socket of that name first (Math/Mix have hidden twins)
-        if socket.name == key and socket.enabled:
-            return socket
-    return sockets[key]
-
-
-def build_group(spec):
-    """Create or rebuild the node group described by ``spec`` (a :class:`Group`)."""
-    tree = bpy.data.node_groups.get(spec.name)
-    if tree is None or tree.bl_idname != spec.tree_type:
-        tree = bpy.data.node_groups.new(spec.name, spec.tree_type)
-    tree.nodes.clear()
-    tree.interface.clear()
-    for name, socket_type, default in spec.inputs:
-        socket = tree.interface.new_socket(name, in_out="INPUT", socket_type=socket_type)
-        if default is not None:
-            socket.default_value = default
-    for name, socket_type, _reference in spec.outputs:
-        tree.interface.new_socket(name, in_out="OUTPUT", socket_type=socket_type)
-    group_in = tree.nodes.new("NodeGroupInput")
-    group_out = tree.nodes.new("NodeGroupOutput")
-    built = {}
-    for index, (name, node_spec) in enumerate(spec.nodes.items()):
-        node = tree.nodes.new(node_spec.kind)
-        node.name = node.label = name
-        node.location = (200.0 * (index % 8), -200.0 * (index // 8))
-        for prop, value in node_spec.props.items():
-            if prop == "node_tree":
-                value = bpy.data.node_groups[value]
-            elif prop == "image":
-                value = bpy.data.images[value]
-            setattr(node, prop, value)
-        built[name] = node
-
-    def resolve(reference):
-        node_name, _, socket_key = reference.partition(".")
-        if node_name == "group":
-            return _socket(group_in.outputs, socket_key)
-        return _socket(built[node_name].outputs, socket_key or 0)
-
-    for name, node_spec in spec.nodes.items():
-        for key, value in node_spec.inputs.items():
-            target = _socket(built[name].inputs, key)
-            if isinstance(value, str) and not isinstance(value, Menu):
-                tree.links.new(resolve(value), target)
-            else:
-                target.default_value = value
-    for name, _socket_type, reference in spec.outputs:
-        if isinstance(reference, str):
-            tree.links.new(resolve(reference), _socket(group_out.inputs, name))
-    return tree
 
 
 # --- the groups -----------------------------------------------------------------------------
 
-SETTINGS = "Relativity Settings"
-DOPPLER_FACTOR = "Relativity Doppler Factor"
-GAMUT_MAP = "Relativity Gamut Map"
-DOPPLER_MATRIX = "Relativity Doppler Matrix"
-BLACKBODY_SHIFT = "Relativity Blackbody Shift"
-DOPPLER_EMISSION = "Relativity Doppler Colour"
-DOPPLER_AOV = "Relativity Doppler AOV"
-LOG_DOPPLER_AOV = "relativity_log_doppler"
+SETTINGS = names.SETTINGS_GROUP
+DOPPLER_FACTOR = names.DOPPLER_FACTOR_GROUP
+GAMUT_MAP = names.GAMUT_MAP_GROUP
+DOPPLER_MATRIX = names.DOPPLER_MATRIX_GROUP
+BLACKBODY_SHIFT = names.BLACKBODY_SHIFT_GROUP
+DOPPLER_EMISSION = names.DOPPLER_COLOUR_GROUP
+DOPPLER_AOV = names.DOPPLER_AOV_GROUP
+LOG_DOPPLER_AOV = names.LOG_DOPPLER_AOV
 
 LN10 = math.log(10.0)
 E = math.e
@@ -153,7 +53,7 @@ LUMINANCE_WEIGHTS = (0.2126729, 0.7151522, 0.0721750)
 
 
 def settings_group():
-    """Constants written by :func:`sync_settings` (one place for every material)."""
+    """Constants written by :func:`write_settings` (one place for every material)."""
     values = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Camera Path")
     nodes = {name: Node("ShaderNodeValue") for name in values}
     nodes["Observer Beta"] = Node("ShaderNodeCombineXYZ", {0: 0.0, 1: 0.0, 2: 0.0})
@@ -358,10 +258,6 @@ GROUP_BUILDERS = (
 )
 
 
-GROUPS_VERSION_KEY = "relativity_group_version"
-GROUPS_VERSION = 2
-
-
 def ensure_node_groups():
     """Pack the LUTs and build any missing or outdated group, dependencies first.
 
@@ -371,45 +267,33 @@ def ensure_node_groups():
     luts.ensure_doppler_matrix_lut()
     luts.ensure_blackbody_lut()
     for builder in GROUP_BUILDERS:
-        spec = builder()
-        tree = bpy.data.node_groups.get(spec.name)
-        if tree is None or tree.get(GROUPS_VERSION_KEY) != GROUPS_VERSION:
-            tree = build_group(spec)
-            tree[GROUPS_VERSION_KEY] = GROUPS_VERSION
+        ensure_group(builder(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
     return bpy.data.node_groups[DOPPLER_EMISSION]
 
 
 # --- settings -------------------------------------------------------------------------------
 
 
-def settings_values(scene, camera_path):
-    """Constants for ``Relativity Settings`` from ``scene.relativity``."""
-    settings = scene.relativity
-    use_doppler = bool(settings.use_doppler)
-    use_searchlight = bool(settings.use_searchlight)
-    chang = bool(getattr(settings, "use_chang_searchlight", False))
-    spectral = use_searchlight and use_doppler and not chang
-    if not use_searchlight or spectral:
-        power = 0.0
-    else:
-        power = 1.0 if chang else 4.0
-    camera_power = 4.0 if (camera_path and use_searchlight) else 0.0
+def settings_values(snap):
+    """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot``."""
+    colour = snap.colour
     return {
-        "Use Doppler": 1.0 if use_doppler else 0.0,
-        "Spectral Searchlight": 1.0 if spectral else 0.0,
-        "Power of D": power,
-        "Camera Power": camera_power,
-        "Camera Path": 1.0 if camera_path else 0.0,
-        "Observer Beta": tuple(settings.beta) if camera_path else (0.0, 0.0, 0.0),
+        "Use Doppler": 1.0 if colour.use_doppler else 0.0,
+        "Spectral Searchlight": 1.0 if colour.spectral_searchlight else 0.0,
+        "Power of D": colour.power_of_d,
+        "Camera Power": colour.camera_power,
+        "Camera Path": 1.0 if colour.camera_path else 0.0,
+        # the mesh path's meshes already live in the observer frame
+        "Observer Beta": tuple(snap.beta) if colour.camera_path else (0.0, 0.0, 0.0),
     }
 
 
-def sync_settings(scene, camera_path):
+def write_settings(snap):
     """Write the settings (Cycles reads shader values written in render_pre for every frame)."""
     tree = bpy.data.node_groups.get(SETTINGS)
     if tree is None:
         return False
-    for name, value in settings_values(scene, camera_path).items():
+    for name, value in settings_values(snap).items():
         node = tree.nodes[name]
         sockets = node.inputs[:3] if name == "Observer Beta" else node.outputs[:1]
         components = value if name == "Observer Beta" else (value,)
@@ -531,14 +415,14 @@ def scene_materials(scene):
     return list(found.items())
 
 
-def apply_doppler_colour(scene, camera_path=False):
-    """Attach the Doppler colour group to every material of ``scene`` and sync its settings."""
+def attach_scene(scene, camera_path):
+    """Attach the Doppler colour group to every material of ``scene`` (no-op for attached ones);
+    on the exact camera's path the world writes the Doppler AOV too."""
     ensure_node_groups()
     for material, temperature in scene_materials(scene):
         attach(material, temperature)
     if camera_path:
         attach_world(scene.world)
-    sync_settings(scene, camera_path)
 
 
 def attach_world(world):
@@ -563,7 +447,7 @@ def detach_world(world):
     return True
 
 
-def remove_doppler_colour(scene):
+def detach_all():
     """Detach from every material and world (the groups and LUTs stay in the file, unused)."""
     for material in bpy.data.materials:
         detach(material)

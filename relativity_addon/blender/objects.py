@@ -1,12 +1,13 @@
 """Per-object settings of the apparent-geometry path: ``bpy.types.Object.relativity``.
 
-Saved with the .blend and animatable. Changing a setting recomputes the object's apparent
-positions for the current frame at once (see ``geometry.py``), so the viewport follows.
+Saved with the .blend and animatable. Changing a setting syncs the effect at once
+(``effect.sync``: the object's apparent positions for the current frame), so the viewport follows.
 """
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
+from . import effect
 from .props import velocity_property
 
 MOTION_ITEMS = (
@@ -19,12 +20,9 @@ MOTION_ITEMS = (
 
 
 def _settings_changed(self, context):
-    from . import geometry
-
-    obj = self.id_data
-    scene = context.scene if context is not None and context.scene is not None else None
+    scene = getattr(context, "scene", None)
     if scene is not None:
-        geometry.update_object_if_applied(scene, obj)
+        effect.sync(scene)
 
 
 class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):

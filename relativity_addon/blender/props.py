@@ -1,7 +1,7 @@
 """Scene settings of the relativity add-on: ``bpy.types.Scene.relativity``.
 
 Everything lives in the scene (saved with the .blend, animatable, undoable). Changing a setting
-re-syncs the relativistic camera if it is applied (see ``camera.py``).
+calls ``effect.setting_changed``, which brings whichever render path is applied up to date.
 """
 
 import bpy
@@ -13,24 +13,26 @@ from bpy.props import (
     PointerProperty,
 )
 
+from ..physics.shutter import ShutterModel
+from . import effect
+
 METHOD_ITEMS = (
     ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),
     ("GEOMETRY", "Apparent Geometry", "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
 )
 
-# Order matters: the enum index is the shader's `shutter_model` integer.
-SHUTTER_MODEL_ITEMS = (
-    ("PINHOLE", "Pinhole", "Every ray passes the aperture centre at the shutter time (no depth of field)"),
-    ("APERTURE_PLANE", "Aperture Plane", "Every ray passes its lens point at the shutter time"),
-    ("DETECTOR_PLANE", "Detector Plane", "Every ray reaches the detector at the shutter time (ideal lens)"),
-    ("FOCUS_SURFACE", "Focus Surface", "Every ray passes the focus plane at the shutter time"),
-    (
-        "FIXED_POINT_SURFACE",
-        "Fixed-Point Surface",
-        "Each focus-plane point opens when it is a spatial fixed point of the boost (Gray eq. 4)",
+_SHUTTER_DESCRIPTIONS = {
+    "PINHOLE": ("Pinhole", "Every ray passes the aperture centre at the shutter time (no depth of field)"),
+    "APERTURE_PLANE": ("Aperture Plane", "Every ray passes its lens point at the shutter time"),
+    "DETECTOR_PLANE": ("Detector Plane", "Every ray reaches the detector at the shutter time (ideal lens)"),
+    "FOCUS_SURFACE": ("Focus Surface", "Every ray passes the focus plane at the shutter time"),
+    "FIXED_POINT_SURFACE": (
+        "Fixed-Point Surface", "Each focus-plane point opens when it is a spatial fixed point of the boost (Gray eq. 4)"
     ),
-    ("ARBITRARY_PLANE", "Arbitrary Plane", "Every ray crosses a given plane at the shutter time (Gray eq. B5)"),
-)
+    "ARBITRARY_PLANE": ("Arbitrary Plane", "Every ray crosses a given plane at the shutter time (Gray eq. B5)"),
+}
+# In the physics core's order, which is the shader's ``shutter_model`` integer code.
+SHUTTER_MODEL_ITEMS = tuple((model.name, *_SHUTTER_DESCRIPTIONS[model.name]) for model in ShutterModel)
 SHUTTER_MODELS = tuple(item[0] for item in SHUTTER_MODEL_ITEMS)
 
 
@@ -39,8 +41,8 @@ VELOCITY_SOURCE_ITEMS = (
     (
         "CAMERA_ANIMATION",
         "Camera Animation",
-        "The observer velocity follows the active camera's keyframed motion at each frame "
-        "(see animation.py); the Velocity setting is overwritten before every frame and render",
+        "The observer velocity follows the active camera's keyframed motion at each frame; "
+        "the Velocity setting is not used",
     ),
 )
 
@@ -60,16 +62,7 @@ def velocity_property(what, update):
 
 
 def _settings_changed(self, context):
-    from . import camera
-
-    scene = self.id_data
-    camera.sync_if_applied(scene)
-
-
-def _velocity_source_changed(self, context):
-    from . import animation
-
-    animation.sync_velocity_if_animated(self.id_data)
+    effect.setting_changed(self.id_data)
 
 
 def _speed(self):
@@ -90,7 +83,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         name="Velocity From",
         items=VELOCITY_SOURCE_ITEMS,
         default="MANUAL",
-        update=_velocity_source_changed,
+        update=_settings_changed,
     )
     speed: FloatProperty(
         name="Speed (c)",

@@ -11,10 +11,10 @@ import camera_helpers as ch
 def addon(factory_blender):
     """The add-on registered from this source tree (in-process, for glue-level tests)."""
     import relativity_addon
-    from relativity_addon.blender import camera
+    from relativity_addon.blender import effect
 
     relativity_addon.register()
-    yield camera
+    yield effect
     relativity_addon.unregister()
 
 
@@ -29,11 +29,11 @@ def test_apply_then_remove_restores_camera(addon, factory_blender):
     scene, camera_object = _scene(bpy)
     data = camera_object.data
     scene.relativity.beta = (0.3, 0.0, -0.4)
-    addon.apply_relativistic_camera(scene)
+    addon.apply(scene)
     assert data.type == "CUSTOM" and data.custom_mode == "INTERNAL"
-    assert data.custom_shader.name == addon.SHADER_TEXT_NAME
+    assert data.custom_shader.name == addon.camera.names.SHADER_TEXT
     assert data.custom_bytecode
-    assert set(addon.REQUIRED_PARAMETERS) <= set(data.cycles_custom.keys())
+    assert set(addon.camera.REQUIRED_PARAMETERS) <= set(data.cycles_custom.keys())
     # World beta (0.3, 0, -0.4) with an unrotated camera: shader axes are (x, y, -z).
     assert tuple(data.cycles_custom["beta"]) == pytest.approx((0.3, 0.0, 0.4))
 
@@ -48,12 +48,12 @@ def test_apply_then_remove_restores_camera(addon, factory_blender):
     scene.relativity.beta = (0.0, 0.5, 0.0)
     assert data.cycles_custom["settings_valid"]
 
-    assert addon.remove_relativistic_camera(scene)
+    assert addon.remove(scene)
     assert data.type == "PERSP"
     assert data.custom_shader is None
-    assert addon.SAVED_STATE_KEY not in data
+    assert addon.camera.names.CAMERA_SAVED_STATE_KEY not in data
     assert len(data.cycles_custom.keys()) == 0
-    assert addon.SHADER_TEXT_NAME not in bpy.data.texts
+    assert addon.camera.names.SHADER_TEXT not in bpy.data.texts
 
 
 @pytest.mark.parametrize(
@@ -64,7 +64,7 @@ def test_bad_velocity_is_refused(addon, factory_blender, beta, message):
     scene, camera_object = _scene(factory_blender)
     scene.relativity.beta = beta
     with pytest.raises(addon.RelativityError, match=message):
-        addon.apply_relativistic_camera(scene)
+        addon.apply(scene)
     assert camera_object.data.type == "PERSP"
 
 
@@ -72,15 +72,12 @@ def test_wrong_engine_camera_type_and_method_are_refused(addon, factory_blender)
     scene, camera_object = _scene(factory_blender)
     scene.render.engine = "BLENDER_WORKBENCH"
     with pytest.raises(addon.RelativityError, match="Cycles"):
-        addon.apply_relativistic_camera(scene)
+        addon.apply(scene)
     scene.render.engine = "CYCLES"
     camera_object.data.type = "ORTHO"
     with pytest.raises(addon.RelativityError, match="perspective"):
-        addon.apply_relativistic_camera(scene)
+        addon.apply(scene)
     camera_object.data.type = "PERSP"
-    scene.relativity.method = "GEOMETRY"
-    with pytest.raises(addon.RelativityError, match="not implemented"):
-        addon.apply_relativistic_camera(scene)
 
 
 @pytest.mark.parametrize(
@@ -95,12 +92,12 @@ def test_wrong_engine_camera_type_and_method_are_refused(addon, factory_blender)
 )
 def test_compile_failure_or_empty_shader_is_detected(addon, factory_blender, monkeypatch, source):
     scene, camera_object = _scene(factory_blender)
-    monkeypatch.setattr(addon, "shader_source", lambda: source)
+    monkeypatch.setattr(addon.camera, "shader_source", lambda: source)
     with pytest.raises(addon.RelativityError, match="compile|empty shader"):
-        addon.apply_relativistic_camera(scene)
+        addon.apply(scene)
     # The failed attempt leaves the camera as it was.
     assert camera_object.data.type == "PERSP"
-    assert addon.SAVED_STATE_KEY not in camera_object.data
+    assert addon.camera.names.CAMERA_SAVED_STATE_KEY not in camera_object.data
 
 
 def test_render_script_fails_with_one_line_reasons(factory_blender, tmp_path):

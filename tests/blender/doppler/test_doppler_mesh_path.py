@@ -22,7 +22,13 @@ def _setup(bpy, addon, **settings):
 
 
 def _apply(addon, scene):
-    dh.addon_module(addon, "materials").apply_doppler_colour(scene)
+    """The mesh path's colour stage alone (emitters carry a hand-written ``relativity_beta``):
+    what ``effect.apply`` and ``effect.sync`` do for method GEOMETRY, without the modifier.
+    tests/blender/workflow/test_settings_reach_render.py covers the whole path from the panel."""
+    scene.relativity.method = "GEOMETRY"
+    materials = dh.addon_module(addon, "materials")
+    materials.attach_scene(scene, camera_path=False)
+    materials.write_settings(dh.addon_module(addon, "snapshot").read(scene))
 
 
 def _region(image, rows, cols):
@@ -75,7 +81,7 @@ def test_searchlight_ratio_is_d4_and_chang_is_d1(relativity_addon, factory_blend
 
     # Chang et al.'s single power of D, as a labelled comparison option.
     scene.relativity.use_chang_searchlight = True
-    dh.addon_module(relativity_addon, "materials").sync_settings(scene, camera_path=False)
+    _apply(relativity_addon, scene)
     image = dh.render(bpy, scene, tmp_path / "chang.exr")
     measured = image[bright][..., 1].mean() / image[dim][..., 1].mean()
     expected = d[bright].mean() / d[dim].mean()

@@ -55,12 +55,12 @@ def _scene_with_user_compositor(bpy):
 
 def test_apply_then_remove_restores_everything(relativity_addon, factory_blender):
     bpy = factory_blender
-    camera_module = dh.addon_module(relativity_addon, "camera")
+    effect = dh.addon_module(relativity_addon, "effect")
     scene, _camera = _scene_with_user_compositor(bpy)
     before = _signature(bpy, scene)
 
     scene.relativity.beta = (0.0, 0.0, -0.5)
-    camera_module.apply_relativistic_camera(scene)
+    effect.apply(scene)
     applied = _signature(bpy, scene)
     assert applied != before
     user_tree = bpy.data.node_groups["User Compositing"]
@@ -68,22 +68,22 @@ def test_apply_then_remove_restores_everything(relativity_addon, factory_blender
     assert any(n.bl_idname == "CompositorNodeGroup" for n in user_tree.nodes)
     assert scene.render.use_compositing
     # Applying twice changes nothing more.
-    camera_module.apply_relativistic_camera(scene)
+    effect.apply(scene)
     assert _signature(bpy, scene) == applied
 
-    camera_module.remove_relativistic_camera(scene)
+    effect.remove(scene)
     after = _signature(bpy, scene)
     assert after == before
 
 
 def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, factory_blender, tmp_path):
     bpy = factory_blender
-    camera_module = dh.addon_module(relativity_addon, "camera")
+    effect = dh.addon_module(relativity_addon, "effect")
     scene, camera = dh.emitter_scene(bpy, samples=4)
     dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.3, 0.6, 0.2), beta=None)
     dh.add_emitter_plane(bpy, scene, "Sun", (-0.5, 0.5), (-0.5, 0.5), beta=None, temperature=5762.0, depth=4.0)
     scene.relativity.beta = (0.2, 0.0, -0.5)
-    camera_module.apply_relativistic_camera(scene)
+    effect.apply(scene)
     reference = dh.render(bpy, scene, tmp_path / "with_addon.exr")
     blend = ch.save_blend(bpy, tmp_path / "packed.blend")
 
@@ -123,19 +123,19 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
         "from relativity_addon import batch\n"
         "batch.enable_addon()\n"
         "from relativity_addon import lut_data\n"
-        "from relativity_addon.blender import camera\n"
+        "from relativity_addon.blender import effect\n"
         "scene = bpy.context.scene\n"
         "scene.relativity.beta = (0.0, 0.0, -0.5)\n"
-        "camera.apply_relativistic_camera(scene)  # works without colour-science\n"
+        "effect.apply(scene)  # works without colour-science\n"
         "print('APPLIED:' + scene.camera.data.type)\n"
-        "camera.remove_relativistic_camera(scene)\n"
+        "effect.remove(scene)\n"
         "lut_data.LUT_PATH = '/nonexistent/spectral_luts.npz'\n"
         "lut_data._tables.cache_clear()\n"
         "for image in [i for i in bpy.data.images if i.name.startswith('Relativity')]:\n"
         "    bpy.data.images.remove(image)\n"
         "try:\n"
-        "    camera.apply_relativistic_camera(scene)\n"
-        "except camera.RelativityError as error:\n"
+        "    effect.apply(scene)\n"
+        "except effect.RelativityError as error:\n"
         "    print('ERROR:' + str(error))\n"
         f"bpy.ops.wm.save_as_mainfile(filepath={str(tmp_path / 'after.blend')!r})\n"
     )
@@ -157,10 +157,10 @@ def test_material_added_after_apply_is_shifted_at_render(relativity_addon, facto
     from relativity_addon.physics import spectral
 
     bpy = factory_blender
-    camera_module = dh.addon_module(relativity_addon, "camera")
+    effect = dh.addon_module(relativity_addon, "effect")
     scene, camera = dh.emitter_scene(bpy, samples=4)
     scene.relativity.beta = (0.0, 0.0, -0.5)
-    camera_module.apply_relativistic_camera(scene)
+    effect.apply(scene)
     colour = (0.3, 0.6, 0.2)
     dh.add_emitter_plane(bpy, scene, "Late", (-400.0, 400.0), (-400.0, 400.0), colour, beta=None)
     image = dh.render(bpy, scene, tmp_path / "late.exr")

@@ -27,7 +27,8 @@ def _scene(bpy, addon):
     plane = dh.add_emitter_plane(bpy, scene, "Star", (-2.0, -0.8), (-1.2, -0.2), beta=None, temperature=5762.0)
     plane.relativity.motion = "CONSTANT"
     plane.relativity.beta = (-0.5, 0.0, 0.0)
-    dh.addon_module(addon, "geometry").apply_apparent_geometry(scene)
+    scene.relativity.method = "GEOMETRY"
+    dh.addon_module(addon, "effect").apply(scene)
     return scene
 
 

@@ -17,6 +17,21 @@ def geometry_module():
     return importlib.import_module(f"{ADDON_MODULE}.blender.geometry")
 
 
+def addon_module(name):
+    return importlib.import_module(f"{ADDON_MODULE}.blender.{name}")
+
+
+def apply_geometry(scene, objects=None):
+    """Set the scene up for Apparent Geometry as the Set Up button does (``effect.apply``)."""
+    scene.relativity.method = "GEOMETRY"
+    return addon_module("effect").apply(scene, objects=objects)
+
+
+def remove_effect(scene):
+    """What the Remove button does; returns the number of things removed."""
+    return addon_module("effect").remove(scene)
+
+
 def evaluated_points(bpy, obj, attribute=None):
     """World positions of the evaluated mesh (depsgraph), and optionally a vector attribute."""
     depsgraph = bpy.context.evaluated_depsgraph_get()

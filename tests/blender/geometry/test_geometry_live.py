@@ -25,7 +25,7 @@ def test_frames_are_independent_of_history(relativity_addon, factory_blender):
     obj.relativity.motion = "ANIMATION"
     scene.relativity.beta = (0.0, 0.3, 0.0)
     scene.frame_set(12)
-    gh.geometry_module().apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     alone, _ = gh.evaluated_points(bpy, obj)
     for frame in (1, 20, 5, 12):
         scene.frame_set(frame)
@@ -40,7 +40,7 @@ def test_velocity_changes_update_at_once(relativity_addon, factory_blender):
     bpy = factory_blender
     scene, camera_object, obj = _scene(bpy)
     obj.relativity.motion = "CONSTANT"
-    gh.geometry_module().apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     at_rest, _ = gh.evaluated_points(bpy, obj)
     obj.relativity.beta = (0.6, 0.0, 0.0)  # update callback
     moving, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
@@ -63,8 +63,8 @@ def test_superluminal_object_velocity_is_a_one_line_error(relativity_addon, fact
     obj.relativity.motion = "CONSTANT"
     obj.relativity.beta = (1.2, 0.0, 0.0)
     with pytest.raises(geometry.RelativityError, match="below 1"):
-        geometry.apply_apparent_geometry(scene)
-    assert geometry.find_modifier(obj) is None  # nothing changed
+        gh.apply_geometry(scene)
+    assert gh.addon_module("modifier").find_modifier(obj) is None  # nothing changed
     blend = ch.save_blend(bpy, tmp_path / "fast.blend")
     result = ch.run_render_script(blend, tmp_path / "fast.png", "--method=geometry", check=False)
     assert result.returncode == 1
@@ -106,7 +106,7 @@ def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blen
     bpy.context.view_layer.objects.active = obj
     geometry = gh.geometry_module()
     with pytest.raises(geometry.RelativityError, match="at least two samples"):
-        geometry.bake_deformation(scene, obj, 1, 1)
+        gh.addon_module("bakes").bake_deformation(scene, obj, 1, 1)
     scene.camera = None
     with pytest.raises(RuntimeError, match="no active camera"):
         bpy.ops.relativity.bake_deformation()
@@ -114,7 +114,7 @@ def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blen
     scene.frame_start, scene.frame_end = 1, 3
     obj.relativity.samples_per_frame = 2
     assert bpy.ops.relativity.bake_deformation() == {"FINISHED"}
-    assert geometry.bake_mesh(obj) is not None
+    assert gh.addon_module("modifier").bake_mesh(obj) is not None
     assert geometry.scene_errors(scene) == []
 
 
@@ -124,16 +124,16 @@ def test_duplicated_object_gets_its_own_cache(relativity_addon, factory_blender)
     scene, camera_object, obj = _scene(bpy)
     obj.relativity.motion = "CONSTANT"
     obj.relativity.beta = (0.5, 0.0, 0.0)
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     twin = obj.copy()  # what Shift+D does: the modifier (and its cache pointer) is copied
     twin.location = (1.5, 1.0, -6.0)
     scene.collection.objects.link(twin)
     twin.relativity.beta = (0.0, 0.0, 0.0)  # update callback
-    assert geometry.cache_object(twin) != geometry.cache_object(obj)
+    assert gh.addon_module("modifier").cache_object(twin) != gh.addon_module("modifier").cache_object(obj)
     first, _ = gh.evaluated_points(bpy, obj)
     second, beta = gh.evaluated_points(bpy, twin, "relativity_beta")
     assert np.allclose(beta, 0.0)
     assert not np.allclose(first, second)
-    geometry.remove_apparent_geometry(scene)
+    gh.remove_effect(scene)
     assert not any(o.name.startswith("RelativityCache") for o in bpy.data.objects)
     assert not any(m.name.startswith("RelativityCache") for m in bpy.data.meshes)

@@ -56,7 +56,7 @@ def _measure(bpy, scene, camera_object, obj, with_beta=False, remove=True):
     x_a, beta_seen = gh.evaluated_points(bpy, obj, "relativity_beta")
     rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
     if remove:
-        gh.geometry_module().remove_apparent_geometry(scene)
+        gh.remove_effect(scene)
     x_o = np.array(camera_object.matrix_world.translation)
     t_o = FRAME / FPS
     t_e = t_o - np.linalg.norm(x_a - x_o, axis=1) / C
@@ -93,7 +93,7 @@ def test_spinning_wheel_on_a_moving_turning_car(relativity_addon, factory_blende
     wheel.relativity.tessellation = 0
     wheel.relativity.samples_per_frame = 32
     scene.frame_set(FRAME)
-    gh.geometry_module().apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
 
     residual, mismatch, t_e, x_e, beta_seen, beta_true = _measure(bpy, scene, camera_object, wheel, with_beta=True)
     assert residual.max() < 1e-6
@@ -120,7 +120,7 @@ def test_delta_transforms_count(relativity_addon, factory_blender):
     box.relativity.tessellation = 1
     box.relativity.samples_per_frame = 16
     scene.frame_set(FRAME)
-    gh.geometry_module().apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     residual, mismatch, t_e, x_e = _measure(bpy, scene, camera_object, box)
     assert residual.max() < 1e-6
     assert mismatch.max() < 1e-6
@@ -187,7 +187,7 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     box.relativity.samples_per_frame = 16
     scene.relativity.method = "GEOMETRY"
     scene.frame_set(FRAME)
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     assert geometry.scene_errors(scene) == []
 
     # The constraint arrives: the handler's update refuses it and the error reporting names the fix.
@@ -199,19 +199,19 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     log = gh.draw_object_panel(bpy, scene, box)
     assert ("operator", "relativity.bake_motion") in log and hasattr(bpy.ops.relativity, "bake_motion")
     assert any(entry[0] == "label" and entry[2] == "ERROR" and "Bake Motion" in entry[1] for entry in log)
-    geometry.remove_apparent_geometry(scene)
+    gh.remove_effect(scene)
     with pytest.raises(geometry.RelativityError, match=r"'Box'.*constraints.*Bake Motion"):
-        geometry.apply_apparent_geometry(scene)
-    assert geometry.find_modifier(box) is None
+        gh.apply_geometry(scene)
+    assert gh.addon_module("modifier").find_modifier(box) is None
 
     # The operator bakes the scene's range, started earlier by the light-travel time.
     scene.frame_start, scene.frame_end = 20, FRAME
     bpy.context.view_layer.objects.active = box
     assert bpy.ops.relativity.bake_motion() == {"FINISHED"}
     assert (scene.frame_current, scene.frame_subframe) == (FRAME, 0.0)
-    first, per_frame, matrices = geometry.motion_bake(box)
+    first, per_frame, matrices = gh.addon_module("modifier").motion_bake(box)
     assert per_frame == 16 and first < 20 - 2 * 4.0 / C * FPS and first + (len(matrices) - 1) / 16 == FRAME
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     assert geometry.scene_errors(scene) == []
     log = gh.draw_object_panel(bpy, scene, box)
     assert any(entry[0] == "label" and entry[1].startswith("Motion baked") for entry in log)
@@ -248,9 +248,9 @@ def test_non_object_parent_needs_a_bake(relativity_addon, factory_blender):
     with pytest.raises(animation.RelativityError, match="vertex parent"):
         animation.world_matrices(box, [FRAME])
     with pytest.raises(geometry.RelativityError, match=r"'Box' has a vertex parent.*Bake Motion"):
-        geometry.apply_apparent_geometry(scene, [box])
-    assert geometry.bake_motion(scene, box, 0, FRAME) == FRAME * 4 + 1
-    geometry.apply_apparent_geometry(scene, [box])
+        gh.apply_geometry(scene, [box])
+    assert gh.addon_module("bakes").bake_motion(scene, box, 0, FRAME) == FRAME * 4 + 1
+    gh.apply_geometry(scene, [box])
     assert geometry.scene_errors(scene) == []
 
 
@@ -294,20 +294,20 @@ def test_remove_takes_the_motion_bake_and_restores_the_file(relativity_addon, fa
     scene.frame_set(FRAME)
     before = gh.file_fingerprint(bpy)
 
-    geometry.bake_motion(scene, box, 0, FRAME)
-    geometry.apply_apparent_geometry(scene)
+    gh.addon_module("bakes").bake_motion(scene, box, 0, FRAME)
+    gh.apply_geometry(scene)
     assert gh.file_fingerprint(bpy) != before
     points, _ = gh.evaluated_points(bpy, box)
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"))
     bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "baked.blend"))
     scene, box = bpy.context.scene, bpy.data.objects["Box"]
-    assert geometry.motion_bake(box) is not None
+    assert gh.addon_module("modifier").motion_bake(box) is not None
     scene.frame_set(FRAME)
     reloaded, _ = gh.evaluated_points(bpy, box)
     assert np.allclose(reloaded, points, atol=1e-6)
     assert geometry.scene_errors(scene) == []
 
-    assert geometry.remove_apparent_geometry(scene) == [box]
+    assert gh.remove_effect(scene) == 1
     assert gh.file_fingerprint(bpy) == before
-    assert not any(geometry.MOTION_BAKE_KEY in mesh for mesh in bpy.data.meshes)
+    assert not any(gh.addon_module("names").MOTION_BAKE_KEY in mesh for mesh in bpy.data.meshes)
     assert not any(o.name.startswith("RelativityCache") for o in bpy.data.objects)

@@ -60,7 +60,7 @@ def test_remove_restores_mesh_and_stack_exactly(relativity_addon, factory_blende
     before_hash = _state_hash(bpy, obj)
     rest_world, _ = gh.evaluated_points(bpy, obj)
 
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     assert [m.name for m in obj.modifiers][0] == "Bevel"
     deformed, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
     assert len(deformed) > len(rest_world)  # tessellated
@@ -69,11 +69,11 @@ def test_remove_restores_mesh_and_stack_exactly(relativity_addon, factory_blende
     for name, values in _mesh_arrays(obj.data).items():  # the original mesh is never written
         assert np.array_equal(values, before_arrays[name])
 
-    assert geometry.remove_apparent_geometry(scene) == [obj]
+    assert gh.remove_effect(scene) == 1
     assert _state_hash(bpy, obj) == before_hash
     after_world, _ = gh.evaluated_points(bpy, obj)
     assert np.array_equal(after_world, rest_world)
-    assert geometry.remove_apparent_geometry(scene) == []
+    assert gh.remove_effect(scene) == 0
 
 
 def test_undo_redo_of_apply_and_remove(relativity_addon, factory_blender):
@@ -82,11 +82,11 @@ def test_undo_redo_of_apply_and_remove(relativity_addon, factory_blender):
     scene, obj = _scene_with_mesh(bpy)
     bpy.ops.ed.undo_push(message="scene built")
     before_hash = _state_hash(bpy, obj)
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     bpy.ops.ed.undo_push(message="apply")
     applied_hash = _state_hash(bpy, obj)
     applied_points, _ = gh.evaluated_points(bpy, obj)
-    geometry.remove_apparent_geometry(scene)
+    gh.remove_effect(scene)
     bpy.ops.ed.undo_push(message="remove")
     assert _state_hash(bpy, bpy.data.objects["Ball"]) == before_hash
 

@@ -64,7 +64,7 @@ def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
     wheel.relativity.samples_per_frame = 32
     scene.frame_set(30)
     geometry = gh.geometry_module()
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     x_a, beta_seen = gh.evaluated_points(bpy, wheel, "relativity_beta")
     rest = gh.evaluated_attribute(bpy, wheel, "relativity_rest")
 
@@ -104,7 +104,7 @@ def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     frame = 36
     scene.frame_set(frame)
     geometry = gh.geometry_module()
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     x_a, _ = gh.evaluated_points(bpy, box)
     rest = gh.evaluated_attribute(bpy, box, "relativity_rest")
     x_o = np.array(camera_object.matrix_world.translation)
@@ -153,12 +153,12 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
     frame = 20
     scene.frame_set(frame)
     with pytest.raises(geometry.RelativityError, match="not baked"):
-        geometry.apply_apparent_geometry(scene)
-    assert geometry.find_modifier(blob) is None  # nothing applied
+        gh.apply_geometry(scene)
+    assert gh.addon_module("modifier").find_modifier(blob) is None  # nothing applied
     blob.relativity.use_deformation = False
-    geometry.apply_apparent_geometry(scene)
+    gh.apply_geometry(scene)
     blob.relativity.use_deformation = True
-    assert geometry.bake_deformation(scene, blob, 0, 24) == 24 * 16 + 1
+    assert gh.addon_module("bakes").bake_deformation(scene, blob, 0, 24) == 24 * 16 + 1
     assert scene.frame_current == frame
     x_a, _ = gh.evaluated_points(bpy, blob)
     x_o = np.array(camera_object.matrix_world.translation)
@@ -176,7 +176,7 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
     assert mismatch.max() < 1e-6
     speeds = np.linalg.norm(x_e - _ev_points_at(bpy, scene, blob, t_e - 1e-3), axis=1) / 1e-3
     assert speeds.max() > 0.1 * C  # the deformation is fast enough to matter
-    geometry.remove_apparent_geometry(scene)
+    gh.remove_effect(scene)
     assert not any(mesh.name.startswith("RelativityBake") for mesh in bpy.data.meshes)
 
 

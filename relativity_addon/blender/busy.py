@@ -1,0 +1,22 @@
+"""Re-entrancy guard: evaluating the depsgraph inside the add-on's own update fires the
+depsgraph handlers again, and a nested evaluation from a handler crashes Blender. Code that
+evaluates the depsgraph or steps frames runs inside :func:`computing`; handlers return at once
+while :func:`is_computing`."""
+
+from contextlib import contextmanager
+
+_depth = 0
+
+
+@contextmanager
+def computing():
+    global _depth
+    _depth += 1
+    try:
+        yield
+    finally:
+        _depth -= 1
+
+
+def is_computing():
+    return _depth > 0

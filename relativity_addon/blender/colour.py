@@ -1,0 +1,66 @@
+"""Searchlight and Doppler colour, as a whole: the colour module of the render paths.
+
+Both paths attach the Doppler colour group to every material (``materials``), which reads
+``D`` per shading point and scales and shifts the colour; the exact camera adds the world's
+Doppler AOV and the compositor stage (``compositing``), which shifts ordinary colours per pixel
+after the render. What the groups compute comes from a ``snapshot.Snapshot`` through one settings
+group (materials) and the compositor group's flag inputs.
+"""
+
+import bpy
+
+from ..errors import RelativityError
+from . import compositing, luts, materials
+from .compositing import is_applied as compositor_applied
+
+
+def apply(scene, snap):
+    """Searchlight and Doppler colour for the snapshot's render path: the materials (and, for the
+    exact camera, the world and the compositor stage). RelativityError (one line) after undoing
+    any partial change."""
+    try:
+        materials.attach_scene(scene, camera_path=snap.colour.camera_path)
+        if snap.colour.camera_path:
+            compositing.apply_colour_stage(scene, snap)
+        write(scene, snap)
+    except (ImportError, ValueError, KeyError, RuntimeError) as error:
+        remove(scene)
+        message = str(error).strip().splitlines()
+        raise RelativityError(
+            f"Doppler colour could not be set up: {type(error).__name__}: {message[-1] if message else ''}"
+        ) from error
+
+
+def write(scene, snap, attach_new_materials=False):
+    """Write the snapshot's colour factors; before a render also attach materials added since."""
+    if attach_new_materials:
+        materials.attach_scene(scene, camera_path=snap.colour.camera_path)
+    materials.write_settings(snap)
+    compositing.write_colour_stage(scene, snap)
+
+
+def remove(scene):
+    """Undo :func:`apply`: the compositor stage, every material and world, and the add-on's node
+    groups and lookup tables once no scene uses them."""
+    compositing.remove_colour_stage(scene)
+    materials.detach_all()
+    if not any(compositor_applied(other) for other in bpy.data.scenes):
+        remove_unused_data()
+
+
+def remove_unused_data():
+    """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
+    if any(materials.is_attached(material) for material in bpy.data.materials):
+        return False
+    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP) + tuple(
+        builder().name for builder in reversed(materials.GROUP_BUILDERS)
+    )
+    for name in group_names:
+        tree = bpy.data.node_groups.get(name)
+        if tree is not None:
+            bpy.data.node_groups.remove(tree)
+    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME):
+        image = bpy.data.images.get(name)
+        if image is not None:
+            bpy.data.images.remove(image)
+    return True

@@ -1,0 +1,201 @@
+"""Apply, sync and remove the relativistic effect: the only module that knows both render paths.
+
+One data path from a setting to the render::
+
+    scene.relativity, Object.relativity, the camera    (settings: props.py, objects.py)
+          |  snapshot.read (every check, once)
+          v
+    Snapshot  ->  camera.write       exact camera: OSL parameters          (method CAMERA)
+              ->  geometry.update    apparent geometry: cache meshes       (method GEOMETRY)
+              ->  colour.write       materials' settings group, compositor flags (both)
+
+:func:`sync` runs that path; every handler (``handlers.py``) and every property update callback
+calls it, so a setting changed in the panel reaches the next render on either path. The camera,
+geometry and colour modules import nothing from each other. :func:`sync` never raises: what
+stops a correct render is kept as the scene's warnings (shown in the panel), and the exact camera
+is marked invalid (it renders black, never a wrong image).
+"""
+
+from ..errors import RelativityError
+from . import animation, busy, camera, colour, geometry, modifier, snapshot
+
+# Scene name -> warnings of its last sync; mesh name -> (inputs, warnings) as of the last sync.
+_scene_warnings = {}
+_object_warnings = {}
+
+
+def applied_method(scene):
+    """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None."""
+    camera_object = scene.camera
+    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_applied(camera_object.data):
+        return "CAMERA"
+    if modifier.applied_objects(scene):
+        return "GEOMETRY"
+    return None
+
+
+def is_applied(scene):
+    return applied_method(scene) is not None or bool(camera.applied_cameras())
+
+
+def apply(scene, frame_range=None, objects=None):
+    """Apply the scene's method: check the observer (and the camera's speed over ``frame_range``,
+    first and last frame, default the scene's range, when the velocity comes from its animation),
+    then the render path and the colour stage. Returns the camera object (exact camera) or the
+    list of objects (apparent geometry); ``objects`` limits the apparent geometry to those.
+    Raises RelativityError (one line) and leaves the scene as it was."""
+    snap = snapshot.read(scene)
+    if snap.velocity_source == "CAMERA_ANIMATION":
+        animation.check_animation_speed(scene, *(frame_range or (None, None)))
+    if applied_method(scene) not in (None, snap.method):
+        remove(scene)
+    if snap.method == "CAMERA":
+        result = camera.apply(scene, snap)
+        undo = (lambda: camera.remove(result))  # noqa: E731
+    else:
+        result = geometry.apply(scene, snap, objects)
+        undo = (lambda: geometry.remove(scene, result))  # noqa: E731
+    try:
+        colour.apply(scene, snap)
+    except RelativityError:
+        undo()
+        raise
+    _record(scene, snap)
+    return result
+
+
+def remove(scene):
+    """Remove everything the add-on added (every relativistic camera, the apparent geometry, the
+    colour stage); the settings stay, they are the user's. Returns the number of things removed."""
+    removed = len(geometry.remove(scene))
+    for camera_object in camera.applied_cameras():
+        removed += bool(camera.remove(camera_object))
+    colour.remove(scene)
+    _scene_warnings.pop(scene.name, None)
+    return removed
+
+
+def sync(scene, depsgraph=None, *, update_geometry=True, only_changed=True, attach_new_materials=False):
+    """Bring the applied render path up to date with the scene at its current frame.
+
+    ``update_geometry=False`` skips the apparent geometry (it needs the frame's evaluated meshes,
+    which exist only after a frame change); ``only_changed`` recomputes only objects whose inputs
+    changed; ``attach_new_materials`` attaches the Doppler colour to materials added since Set Up.
+    Never raises."""
+    if busy.is_computing():
+        return None
+    method = applied_method(scene)
+    try:
+        snap = snapshot.read(scene, depsgraph)
+    except RelativityError as error:
+        if method == "CAMERA":
+            camera.invalidate(scene.camera)
+        _scene_warnings[scene.name] = [str(error)]
+        return None
+    if method != snap.method and method is not None:
+        # applied with the other method (the setting changed where no callback ran): refuse
+        if method == "CAMERA":
+            camera.invalidate(scene.camera)
+        _scene_warnings[scene.name] = [f"Set up again: the scene is set up for {method.title()}"]
+        return None
+    try:
+        if method == "CAMERA":
+            camera.write(scene, snap)
+        elif method == "GEOMETRY" and update_geometry:
+            geometry.update(scene, snap, depsgraph, only_changed)
+        if method is not None:
+            colour.write(scene, snap, attach_new_materials)
+    except RelativityError as error:
+        if method == "CAMERA":
+            camera.invalidate(scene.camera)
+        _scene_warnings[scene.name] = [str(error)]
+        return None
+    _record(scene, snap)
+    return snap
+
+
+def setting_changed(scene):
+    """Update callback of every scene setting: switch the render path if the method changed
+    (re-applying it), else sync. Never raises."""
+    method = applied_method(scene)
+    if method is not None and method != scene.relativity.method:
+        try:
+            apply(scene)
+        except RelativityError as error:
+            print(f"Relativity: {error}")
+            _scene_warnings[scene.name] = [str(error)]
+        return
+    sync(scene)
+
+
+# --- warnings, computed when the effect syncs -------------------------------------------------
+
+
+def _record(scene, snap):
+    warnings = []
+    if scene.render.engine == "CYCLES" and getattr(scene.cycles, "device", "CPU") == "GPU":
+        warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
+    if snap.method == "CAMERA":
+        camera_object = scene.objects.get(snap.camera)
+        if camera_object is not None and camera_object.data.type != "PERSP" and not camera.is_applied(camera_object.data):
+            warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
+    warnings += geometry.scene_errors(scene)
+    _scene_warnings[scene.name] = warnings
+    if snap.method == "GEOMETRY":
+        for obj in scene.objects:
+            if obj.type == "MESH" and obj.relativity.enabled:
+                _object_warnings[obj.name] = _mesh_warnings(obj, snap)
+
+
+def _mesh_warnings(obj, snap):
+    """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change."""
+    inputs = (tuple(map(tuple, obj.matrix_world)), obj.data.name, len(obj.data.edges),
+              tuple(snap.camera_position), obj.relativity.tessellation)
+    known = _object_warnings.get(obj.name)
+    if known is not None and known[0] == inputs:
+        return known
+    coarse = geometry.coarse_mesh_warning(obj, snap.camera_position)
+    return inputs, [coarse] if coarse else []
+
+
+def scene_warnings(scene):
+    """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
+    sync; checked now if it has not synced since the file was opened)."""
+    if scene.name not in _scene_warnings:
+        try:
+            _record(scene, snapshot.read(scene))
+        except RelativityError as error:
+            _scene_warnings[scene.name] = [str(error)]
+    return list(_scene_warnings[scene.name])
+
+
+def object_warnings(scene, obj):
+    """Warnings for the active object on the apparent-geometry path: its last update error, a bake
+    it needs, a mesh too coarse to curve (as of the last sync)."""
+    if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
+        return []
+    warnings = list(_object_warnings.get(obj.name, ((), []))[1])
+    error = modifier.object_error(obj)
+    status = bake_status(scene, obj)
+    if error is not None:  # the last update failed: the viewport shows an older state
+        warnings.append(error)
+    elif status is not None and status[1] is None and status[2] is not None:
+        warnings.append(status[2])
+    return warnings
+
+
+def bake_status(scene, obj):
+    """For an ANIMATION mesh: (bake operator, what is baked or None, why a bake is needed or None);
+    None for other objects."""
+    settings = obj.relativity
+    if obj.type != "MESH" or settings.motion != "ANIMATION":
+        return None
+    if settings.use_deformation:
+        baked = "Deformation baked" if modifier.bake_mesh(obj) is not None else None
+        return "relativity.bake_deformation", baked, "Deforming mesh: press Bake Deformation"
+    baked = modifier.motion_bake_range(obj)
+    if baked is not None:
+        return "relativity.bake_motion", f"Motion baked: frames {baked[0]:g} to {baked[1]:g}", None
+    problem = animation.keyframe_motion_problem(obj, scene)
+    needed = f"{problem}: keyframes are not its motion, press Bake Motion" if problem else None
+    return "relativity.bake_motion", None, needed

@@ -1,0 +1,65 @@
+"""The add-on's handlers, in one table: each brings the effect up to date through ``effect.sync``.
+
+Order within a frame change: ``frame_change_pre`` writes the camera's parameters and the colour
+factors for the new frame (Cycles reads shader values written there, also in an animation
+render); ``frame_change_post`` updates the apparent geometry, which needs the new frame's
+evaluated meshes. ``depsgraph_update_post`` follows every edit (only what changed is
+recomputed; writes happen only where a value changed, so its own writes end the loop), and
+``render_pre`` runs before every render, attaching the Doppler colour to materials added since
+Set Up. A handler never raises: a problem becomes the scene's warning and, for the exact camera,
+a black (never a wrong) image.
+"""
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import effect
+
+
+def _sync(scene, **options):
+    try:
+        effect.sync(scene, **options)
+    except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
+        print(f"Relativity: not synced: {type(error).__name__}: {error}")
+
+
+@persistent
+def frame_change_pre(scene, _depsgraph=None):
+    _sync(scene, update_geometry=False)
+
+
+@persistent
+def frame_change_post(scene, depsgraph=None):
+    _sync(scene, depsgraph=depsgraph, only_changed=False)
+
+
+@persistent
+def depsgraph_update_post(scene, depsgraph=None):
+    _sync(scene, depsgraph=depsgraph, only_changed=True)
+
+
+@persistent
+def render_pre(scene, _depsgraph=None):
+    _sync(scene, update_geometry=False, attach_new_materials=True)
+
+
+HANDLERS = (
+    ("frame_change_pre", frame_change_pre),
+    ("frame_change_post", frame_change_post),
+    ("depsgraph_update_post", depsgraph_update_post),
+    ("render_pre", render_pre),
+)
+
+
+def register():
+    for name, handler in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler not in handlers:
+            handlers.append(handler)
+
+
+def unregister():
+    for name, handler in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler in handlers:
+            handlers.remove(handler)

@@ -1,0 +1,53 @@
+"""Every name the add-on stores in a .blend: datablocks, node groups, attributes, AOVs,
+ID-property keys and version stamps.
+
+They are read back from files saved by earlier versions, so a value here never changes; a
+new layout gets a new version stamp instead.
+"""
+
+# --- exact camera ---------------------------------------------------------------------------
+SHADER_TEXT = "relativistic_camera.osl"  # text datablock holding the OSL camera shader
+CAMERA_SAVED_STATE_KEY = "relativity_saved_state"  # on camera data while the OSL camera is applied
+
+# --- apparent geometry ----------------------------------------------------------------------
+GEOMETRY_GROUP = "Relativity Apparent Geometry"  # geometry-nodes group
+GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
+GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
+GEOMETRY_GROUP_VERSION = 1
+REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
+BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
+CACHE_PREFIX = "RelativityCache"  # cache mesh objects (not linked into any scene)
+SIGNATURE_KEY = "relativity_signature"  # on the cache mesh: inputs of the last update
+ERROR_KEY = "relativity_error"  # on the cache mesh: why the last handler update failed
+OWNER_KEY = "relativity_owner"  # on the cache mesh: the name of the object it serves
+BAKE_PREFIX = "RelativityBake"  # deformation bake meshes
+BAKE_KEY = "relativity_bake"  # on the cache mesh: name of the bake mesh and its time grid
+MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world matrices
+
+# --- Doppler colour: materials --------------------------------------------------------------
+MATERIAL_ATTACHED_KEY = "relativity_doppler_nodes"  # on materials and worlds: inserted nodes
+MATERIAL_NODE_PREFIX = "Relativity Doppler"
+SETTINGS_GROUP = "Relativity Settings"
+DOPPLER_FACTOR_GROUP = "Relativity Doppler Factor"
+GAMUT_MAP_GROUP = "Relativity Gamut Map"
+DOPPLER_MATRIX_GROUP = "Relativity Doppler Matrix"
+BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
+DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
+DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
+SHADER_GROUPS_VERSION = 2
+GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
+
+# --- Doppler colour: compositor (exact camera) ----------------------------------------------
+COMPOSITOR_GROUP = "Relativity Doppler Compositor"
+COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
+COMPOSITOR_GROUPS_VERSION = 3
+COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
+COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
+LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit
+COLOUR_DONE_AOV = "relativity_colour_done"  # 1 where a material already shifted the colour
+
+# --- lookup tables --------------------------------------------------------------------------
+DOPPLER_LUT_IMAGE = "Relativity Doppler Matrix LUT"
+BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
+LUT_LAYOUT_KEY = "relativity_lut_layout"
+LUT_LAYOUT_VERSION = 1

@@ -1,0 +1,149 @@
+"""One declarative builder for every node group the add-on makes: geometry nodes, shader nodes
+and compositor nodes alike.
+
+A group is data (:class:`Group`): its interface and a dict of :class:`Node` by name, each with
+its input values, where a string is a link. :func:`build_group` creates or rebuilds the tree;
+:func:`ensure_group` rebuilds it only when its version stamp is outdated (rebuilding an
+interface drops the links of every node that uses the group).
+"""
+
+from dataclasses import dataclass, field
+
+import bpy
+
+
+class Literal(str):
+    """A string input value (an attribute name, a menu item), not a reference to a socket."""
+
+
+Menu = Literal
+
+
+@dataclass
+class Node:
+    """One node: ``inputs`` maps socket (name or index) to a constant or a reference.
+
+    A reference is ``"node"`` (first output), ``"node.Output Name"``, ``"node.2"`` (output index)
+    or ``"group.Input Name"`` (the group's own input). ``props`` are node attributes; the values
+    of ``node_tree`` and ``image`` name a node group and an image.
+    """
+
+    kind: str
+    inputs: dict = field(default_factory=dict)
+    props: dict = field(default_factory=dict)
+
+
+@dataclass
+class Group:
+    """``inputs``: (name, socket type, default or None, or a dict of socket attributes);
+    ``outputs``: (name, socket type, reference or None)."""
+
+    name: str
+    tree_type: str
+    inputs: tuple
+    outputs: tuple
+    nodes: dict
+
+
+def fmath(operation, a, b=0.0, c=0.0, clamp=False):
+    return Node("ShaderNodeMath", {0: a, 1: b, 2: c}, {"operation": operation, "use_clamp": clamp})
+
+
+def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
+    inputs = {0: a, 1: b}
+    if scale is not None:
+        inputs["Scale"] = scale
+    return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
+
+
+def group_node(group_name, inputs=None, kind="ShaderNodeGroup"):
+    return Node(kind, inputs or {}, {"node_tree": group_name})
+
+
+def _socket(sockets, key):
+    if isinstance(key, int):
+        return sockets[key]
+    if key.isdigit():
+        return sockets[int(key)]
+    for socket in sockets:  # the available socket of that name first (Math/Mix have hidden twins)
+        if socket.name == key and socket.enabled and not getattr(socket, "is_unavailable", False):
+            return socket
+    return sockets[key]
+
+
+def _new_interface_socket(tree, name, in_out, socket_type, default):
+    socket = tree.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+    attributes = default if isinstance(default, dict) else {"default_value": default}
+    for attribute, value in attributes.items():
+        if value is not None:
+            setattr(socket, attribute, value)
+
+
+def build_group(spec):
+    """Create or rebuild the node group described by ``spec`` (a :class:`Group`)."""
+    tree = bpy.data.node_groups.get(spec.name)
+    if tree is None or tree.bl_idname != spec.tree_type:
+        tree = bpy.data.node_groups.new(spec.name, spec.tree_type)
+    tree.nodes.clear()
+    tree.interface.clear()
+    for name, socket_type, default in spec.inputs:
+        _new_interface_socket(tree, name, "INPUT", socket_type, default)
+    for name, socket_type, _reference in spec.outputs:
+        _new_interface_socket(tree, name, "OUTPUT", socket_type, None)
+    group_in = tree.nodes.new("NodeGroupInput")
+    group_out = tree.nodes.new("NodeGroupOutput")
+    built = {}
+    for index, (name, node_spec) in enumerate(spec.nodes.items()):
+        node = tree.nodes.new(node_spec.kind)
+        node.name = node.label = name
+        node.location = (200.0 * (index % 8), -200.0 * (index // 8))
+        for prop, value in node_spec.props.items():
+            if prop == "node_tree":
+                value = bpy.data.node_groups[value]
+            elif prop == "image":
+                value = bpy.data.images[value]
+            setattr(node, prop, value)
+        built[name] = node
+
+    def resolve(reference):
+        node_name, _, socket_key = reference.partition(".")
+        if node_name == "group":
+            return _socket(group_in.outputs, socket_key)
+        return _socket(built[node_name].outputs, socket_key or 0)
+
+    for name, node_spec in spec.nodes.items():
+        for key, value in node_spec.inputs.items():
+            target = _socket(built[name].inputs, key)
+            if isinstance(value, str) and not isinstance(value, Literal):
+                tree.links.new(resolve(value), target)
+            else:
+                target.default_value = value
+    for name, _socket_type, reference in spec.outputs:
+        if isinstance(reference, str):
+            tree.links.new(resolve(reference), _socket(group_out.inputs, name))
+    return tree
+
+
+def ensure_group(spec, version_key, version):
+    """The group of ``spec``, built if missing or stamped with another version."""
+    tree = bpy.data.node_groups.get(spec.name)
+    if tree is None or tree.get(version_key) != version:
+        tree = build_group(spec)
+        tree[version_key] = version
+    return tree
+
+
+def interface_identifier(group, name, in_out="INPUT"):
+    """The identifier (``Socket_N``) of the group's interface socket ``name``."""
+    for item in group.interface.items_tree:
+        if item.item_type == "SOCKET" and item.in_out == in_out and item.name == name:
+            return item.identifier
+    raise KeyError(name)
+
+
+def remove_unused_groups(names):
+    """Delete the named node groups that nothing uses any more."""
+    for name in names:
+        tree = bpy.data.node_groups.get(name)
+        if tree is not None and tree.users == 0:
+            bpy.data.node_groups.remove(tree)

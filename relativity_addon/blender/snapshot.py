@@ -1,0 +1,210 @@
+"""One frozen, validated snapshot of everything a relativistic render needs, read once from the
+scene and its camera at the current (sub-)frame.
+
+Every check of the observer's state lives here: the speed of light, the observer velocity (the
+setting, or the camera's keyframed motion), the active camera, the shutter and the render engine.
+The camera, geometry and colour modules write their part of the render from a :class:`Snapshot`
+and never read ``scene.relativity`` themselves, so one setting reaches every render path by one
+route (``effect.sync``).
+
+Units and frames (docs/physics.md): scene time ``t = frame / fps`` in seconds, positions in scene
+units, velocities as fractions of c in world axes; ``beta_camera`` is the same velocity in the
+camera's local axes (Blender convention: the camera looks down its local -Z).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import RelativityError
+from ..physics.shutter import ShutterModel
+from . import animation
+
+Vector3 = tuple[float, float, float]
+
+SHUTTER_MODELS = tuple(model.name for model in ShutterModel)  # order = the OSL shader's integer codes
+
+
+@dataclass(frozen=True)
+class ColourFactors:
+    """How the materials and the compositor scale and shift colour (docs/spectral-model.md)."""
+
+    use_doppler: bool
+    spectral_searchlight: bool  # exact visible brightness from the spectrum (Doppler and searchlight on)
+    power_of_d: float  # brightness D^p where the spectrum does not give it (4, Chang's 1, or 0)
+    camera_power: float  # the D^4 the exact camera's shader already applied (0 on the mesh path)
+    camera_path: bool
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    scene: str
+    frame: float  # frame + sub-frame
+    fps: float
+    speed_of_light: float  # scene units per second
+    beta: Vector3  # observer velocity, world axes, fraction of c
+    velocity_source: str  # MANUAL or CAMERA_ANIMATION
+    method: str  # CAMERA or GEOMETRY
+    engine: str
+    camera: str  # camera object name
+    camera_matrix: tuple  # its 4x4 world matrix at the frame (rows)
+    shutter_model: str  # a ShutterModel name
+    shutter_time: float  # camera-frame seconds
+    shutter_plane_point: Vector3  # camera local axes
+    shutter_plane_normal: Vector3
+    use_lorentz_window: bool
+    use_geometry: bool
+    use_doppler: bool
+    use_searchlight: bool
+    use_chang_searchlight: bool
+
+    @property
+    def time(self) -> float:
+        """The observer's scene time ``t_o`` in seconds."""
+        return self.frame / self.fps
+
+    @property
+    def speed(self) -> float:
+        return math.sqrt(sum(b * b for b in self.beta))
+
+    @property
+    def gamma(self) -> float:
+        return 1.0 / math.sqrt(1.0 - self.speed**2)
+
+    @property
+    def camera_position(self) -> np.ndarray:
+        return np.array([row[3] for row in self.camera_matrix[:3]], dtype=np.float64)
+
+    @property
+    def world_to_camera(self) -> np.ndarray:
+        """Rotation ``(3, 3)`` taking world vectors to camera axes (scale and shear removed)."""
+        linear = np.array([row[:3] for row in self.camera_matrix[:3]], dtype=np.float64)
+        u, _, vt = np.linalg.svd(linear)  # nearest rotation (polar decomposition)
+        return (u @ vt).T
+
+    @property
+    def beta_camera(self) -> np.ndarray:
+        return self.world_to_camera @ np.array(self.beta)
+
+    @property
+    def shutter_code(self) -> int:
+        return SHUTTER_MODELS.index(self.shutter_model)
+
+    @property
+    def colour(self) -> ColourFactors:
+        spectral = self.use_searchlight and self.use_doppler and not self.use_chang_searchlight
+        if not self.use_searchlight or spectral:
+            power = 0.0
+        else:
+            power = 1.0 if self.use_chang_searchlight else 4.0
+        camera_path = self.method == "CAMERA"
+        return ColourFactors(
+            use_doppler=self.use_doppler,
+            spectral_searchlight=spectral,
+            power_of_d=power,
+            camera_power=4.0 if (camera_path and self.use_searchlight) else 0.0,
+            camera_path=camera_path,
+        )
+
+
+def _finite(values):
+    return all(math.isfinite(value) for value in values)
+
+
+def current_frame(scene):
+    return scene.frame_current + scene.frame_subframe
+
+
+def check_velocity(beta, what):
+    """``beta`` as a float tuple; RelativityError unless finite and below the speed of light."""
+    beta = tuple(float(b) for b in beta)
+    if not _finite(beta):
+        raise RelativityError(f"{what} is not a finite vector")
+    speed = math.sqrt(sum(b * b for b in beta))
+    if speed >= 1.0:
+        raise RelativityError(f"{what}: speed |beta| = {speed:.6g} must be below 1 (the speed of light)")
+    return beta
+
+
+def check_speed_of_light(c):
+    c = float(c)
+    if not (math.isfinite(c) and c > 0.0):
+        raise RelativityError("speed of light must be a positive finite number")
+    return c
+
+
+def active_camera(scene):
+    camera = scene.camera
+    if camera is None or camera.type != "CAMERA":
+        raise RelativityError(f"scene {scene.name!r} has no active camera")
+    return camera
+
+
+def camera_matrix(scene, camera, frame, depsgraph=None):
+    """The camera's world matrix at ``frame`` as float64 ``(4, 4)``.
+
+    Blender's animation render does not re-evaluate the original camera object, so its
+    ``matrix_world`` is that of the frame the file was saved at; a farm worker would render a
+    turning camera wrongly. Keyframed transforms (with object parents) are evaluated from the
+    F-curves at the frame itself; only a camera moved by constraints, drivers or NLA uses
+    Blender's evaluation (the depsgraph's, when given).
+    """
+    if animation.keyframe_motion_problem(camera, scene) is None:
+        return animation.world_matrices(camera, [frame])[0]
+    evaluated = camera.evaluated_get(depsgraph) if depsgraph is not None else camera
+    return np.array(evaluated.matrix_world, dtype=np.float64)
+
+
+def observer_velocity(scene, camera, frame, c):
+    """The observer velocity at ``frame``: the setting, or the camera's keyframed motion."""
+    settings = scene.relativity
+    if settings.velocity_source == "CAMERA_ANIMATION":
+        beta = animation.camera_beta_at(scene, frame, camera, c)
+        speed = math.sqrt(sum(b * b for b in beta))
+        if not math.isfinite(speed) or speed >= 1.0:
+            raise RelativityError(
+                f"camera {camera.name!r} moves at {speed:.4g} c at frame {frame:g}: "
+                "its animation must stay below the speed of light (slow it down or raise c)")
+        return tuple(float(b) for b in beta)
+    return check_velocity(settings.beta, "observer velocity beta")
+
+
+def read(scene, depsgraph=None) -> Snapshot:
+    """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
+    cannot be rendered with correct physics."""
+    settings = scene.relativity
+    c = check_speed_of_light(settings.speed_of_light)
+    camera = active_camera(scene)
+    frame = current_frame(scene)
+    beta = observer_velocity(scene, camera, frame, c)
+    if not math.isfinite(settings.shutter_time):
+        raise RelativityError("shutter time must be finite")
+    normal = tuple(settings.shutter_plane_normal)
+    if settings.shutter_model == "ARBITRARY_PLANE" and (not _finite(normal) or sum(n * n for n in normal) == 0.0):
+        raise RelativityError("arbitrary shutter plane needs a non-zero normal")
+    if not _finite(settings.shutter_plane_point):
+        raise RelativityError("the shutter plane point must be finite")
+    if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
+        raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
+    return Snapshot(
+        scene=scene.name,
+        frame=frame,
+        fps=animation.frames_per_second(scene),
+        speed_of_light=c,
+        beta=beta,
+        velocity_source=settings.velocity_source,
+        method=settings.method,
+        engine=scene.render.engine,
+        camera=camera.name,
+        camera_matrix=tuple(map(tuple, camera_matrix(scene, camera, frame, depsgraph).tolist())),
+        shutter_model=settings.shutter_model,
+        shutter_time=float(settings.shutter_time),
+        shutter_plane_point=tuple(float(v) for v in settings.shutter_plane_point),
+        shutter_plane_normal=tuple(float(v) for v in normal),
+        use_lorentz_window=bool(settings.use_lorentz_window),
+        use_geometry=bool(settings.use_geometry),
+        use_doppler=bool(settings.use_doppler),
+        use_searchlight=bool(settings.use_searchlight),
+        use_chang_searchlight=bool(settings.use_chang_searchlight),
+    )

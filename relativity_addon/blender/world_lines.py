@@ -1,0 +1,136 @@
+"""Where each vertex of a moving object is seen: its apparent world position and velocity for
+the observer event of a snapshot, by the object's motion source (``Object.relativity.motion``).
+
+- STATIC and CONSTANT: the mesh is the object's rest-frame shape; with a constant velocity it is
+  Lorentz-contracted along ``beta`` about the object origin, and the retarded times have a closed
+  form (``physics.apparent.apparent_positions_uniform``).
+- ANIMATION, rigid: world matrices on a sub-frame grid around the retarded times, from the
+  object's keyframes under its object-parent chain (``animation.world_matrices``, float64, no
+  ``frame_set``) or from its motion bake (``bakes.bake_motion``) when constraints, drivers or NLA
+  move it; per-vertex retarded times by the core's sampled solver.
+- ANIMATION with ``use_deformation``: per-vertex positions from the deformation bake.
+
+Every function raises RelativityError (one line) for a motion it cannot show correctly.
+"""
+
+import math
+
+import numpy as np
+
+from ..errors import RelativityError
+from ..physics import apparent
+from . import animation, modifier, names
+from .snapshot import check_velocity
+
+
+def matrix_array(matrix):
+    return np.array([list(row) for row in matrix], dtype=np.float64)
+
+
+def to_world(matrix, points):
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def apparent_world_positions(scene, obj, obj_eval, rest, snap):
+    """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
+    points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all)."""
+    t_o, x_o, beta_o, c = snap.time, snap.camera_position, np.array(snap.beta), snap.speed_of_light
+    matrix_now = matrix_array(obj_eval.matrix_world)
+    motion = obj.relativity.motion
+    if motion == "ANIMATION" and obj.relativity.use_deformation:
+        world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
+    elif motion == "ANIMATION":
+        world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
+    else:
+        beta_u = np.zeros(3)
+        if motion == "CONSTANT":
+            beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
+        # The mesh is the object's rest-frame shape: in the scene it is contracted along its motion
+        # about the object's origin (folded into the object matrix: one affine map per vertex).
+        contracted = apparent.lorentz_contraction_matrix(beta_u) @ matrix_now[:3, :3]
+        # Built as coordinate rows (3, N), the layout the closed form works on: no copy there.
+        world_now = (contracted @ rest.T + matrix_now[:3, 3:]).T
+        world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
+        beta_seen = beta_seen[:1]  # one velocity for every vertex
+    return world, beta_seen
+
+
+def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None):
+    """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
+    world matrices when it has a motion bake, else from its keyframes under its parent chain
+    (:func:`animation.world_matrices`). An object whose keyframes are not its motion
+    (constraints, transform drivers, NLA, ...) and that has no bake raises RelativityError."""
+    fps = animation.frames_per_second(scene)
+    obj_eval = obj if obj_eval is None else obj_eval
+    bake = modifier.motion_bake(obj)
+    if bake is not None:
+        return _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c)
+    problem = animation.keyframe_motion_problem(obj, scene)
+    if problem is not None:
+        raise RelativityError(
+            f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
+            "bake its motion (Bake Motion in the Relativity panel)")
+    samples_per_frame = int(obj.relativity.samples_per_frame)
+    step = 1.0 / (samples_per_frame * fps)
+    world_now = to_world(matrix_array(obj_eval.matrix_world), rest_local)
+    reach = float(np.max(np.linalg.norm(world_now - world_now.mean(0), axis=1))) if len(world_now) else 0.0
+    centre_tau = float(np.linalg.norm(x_o - world_now.mean(0))) / c if len(world_now) else 0.0
+    low, high = t_o - centre_tau - 2.0 * reach / c - 2 * step, t_o - centre_tau + 2.0 * reach / c + 2 * step
+    for _ in range(max_tries):
+        low_index, high_index = math.floor(low / step) - 2, math.ceil(high / step) + 2
+        if high_index - low_index > 200000:
+            raise RelativityError(f"object {obj.name!r}: light-travel times span too many animation samples")
+        times = np.arange(low_index, high_index + 1) * step
+        motion = apparent.SampledRigidMotion(times, animation.world_matrices(obj, times * fps), rest_local)
+        result = apparent.apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
+        t_e = t_o - result[1]
+        if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
+            return result
+        margin = 4 * step
+        low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)
+    raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
+
+
+def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c):
+    first_frame, per_frame, matrices = bake
+    frame_now = t_o * fps
+    index = (frame_now - first_frame) * per_frame
+    if abs(index - round(index)) < 1e-6 and 0 <= round(index) < len(matrices):
+        # The bake holds this very frame: if the object is elsewhere now, the bake is stale.
+        now = matrix_array(obj_eval.matrix_world)
+        if np.max(np.abs(matrices[round(index)] - now)) > 1e-5 * (1.0 + np.max(np.abs(now))):
+            raise RelativityError(
+                f"object {obj.name!r} moves differently from its motion bake at frame {frame_now:g}: "
+                "bake its motion again")
+    start, step = first_frame / fps, 1.0 / (per_frame * fps)
+    times = start + step * np.arange(len(matrices))
+    result = apparent.apparent_positions_sampled(apparent.SampledRigidMotion(times, matrices, rest_local),
+                                                 t_o, x_o, c, beta_o)
+    t_e = t_o - result[1]
+    if t_e.size and (t_e.min() < times[0] or t_e.max() > times[-1]):
+        raise RelativityError(
+            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"baked motion {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+    return result
+
+
+def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
+    """Apparent positions of a deforming object from its baked samples (per-vertex retarded times)."""
+    mesh = modifier.bake_mesh(obj)
+    if mesh is None:
+        raise RelativityError(f"object {obj.name!r} is deforming but not baked: run bake_deformation first")
+    info = modifier.cache_data(obj)[names.BAKE_KEY]
+    if info["points"] != count:
+        raise RelativityError(f"object {obj.name!r}: the mesh changed since the deformation bake; bake again")
+    positions = np.empty((info["samples"], count * 3), dtype=np.float32)
+    for i in range(info["samples"]):
+        mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
+    times = info["start"] + info["step"] * np.arange(info["samples"])
+    motion = apparent.SampledPointMotion(times, positions.reshape(info["samples"], count, 3).astype(np.float64))
+    result = apparent.apparent_positions(motion.positions, t_o, x_o, c, count, beta_o, velocity=motion.velocities)
+    t_e = t_o - result[1]
+    if t_e.min() < times[0] or t_e.max() > times[-1]:
+        raise RelativityError(
+            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"baked range {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+    return result
