@@ -491,9 +491,3 @@ def apparent_positions(world_line, observer_time, observer_position, c, count,
     beta_seen = velocity_seen_by_observer(point_beta, observer_beta)
     return apparent, tau, np.broadcast_to(beta_seen, (count, 3))
 
-
-def retarded_times_from_apparent(observer_time, observer_position, apparent, c):
-    """For an observer at rest in S: ``t_e = t_o - |x_o - x_apparent| / c`` (checking aid)."""
-    c = speed_of_light(c)
-    distance = np.linalg.norm(vector_array(apparent, "apparent") - vector_array(observer_position, "observer_position"), axis=-1)
-    return np.asarray(observer_time, dtype=np.float64) - distance / c
