@@ -1,10 +1,11 @@
-"""Rotation and object matrices (physics/transforms.py) against scipy's rotations, hand-built
-single-axis matrices and the defining properties of rotations (mathutils needs bpy: not used)."""
+"""Rotation and object matrices (physics/transforms.py) against hand-built single-axis matrices,
+Rodrigues' formula, quaternion rotation by Hamilton products, scipy's rotations (where scipy is
+installed: the Blender 5.2 environment does not pull it in) and the defining properties of
+rotations. mathutils needs bpy, so it is not used here."""
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from scipy.spatial.transform import Rotation
 
 from relativity_addon.physics import transforms
 
@@ -18,6 +19,23 @@ def _hand_built(axis, angle):
         "Y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
         "Z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]),
     }[axis]
+
+
+def _scipy_rotation():
+    return pytest.importorskip("scipy.spatial.transform").Rotation
+
+
+def _hamilton(p, q):
+    """Quaternion products p q of rows (w, x, y, z)."""
+    pw, pv, qw, qv = p[:, :1], p[:, 1:], q[:, :1], q[:, 1:]
+    return np.concatenate([pw * qw - np.sum(pv * qv, axis=1, keepdims=True),
+                           pw * qv + qw * pv + np.cross(pv, qv)], axis=1)
+
+
+def _rodrigues(axis, angle):
+    """R v = v cos + (k x v) sin + k (k.v)(1 - cos) for a unit axis k, as a matrix."""
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
 
 
 def _assert_rotations(matrices):
@@ -42,14 +60,20 @@ def test_euler_matrices_apply_the_first_letter_first(order):
     angles = RNG.uniform(-4, 4, (30, 3))
     matrices = transforms.euler_matrices(angles, order)
     _assert_rotations(matrices)
-    # scipy's lower-case (extrinsic) sequence applies the first letter first about fixed axes.
-    columns = ["XYZ".index(letter) for letter in order]
-    expected = Rotation.from_euler(order.lower(), angles[:, columns]).as_matrix()
-    assert_allclose(matrices, expected, atol=1e-13)
-    # The same written out: R = R_last @ R_middle @ R_first with hand-built matrices.
-    for k in range(3):
+    # R = R_last @ R_middle @ R_first with hand-built matrices.
+    for k in range(len(angles)):
         first, middle, last = (_hand_built(letter, angles[k, "XYZ".index(letter)]) for letter in order)
         assert_allclose(matrices[k], last @ middle @ first, atol=1e-13)
+
+
+@pytest.mark.parametrize("order", transforms.EULER_ORDERS)
+def test_euler_matrices_match_scipy_extrinsic_sequences(order):
+    rotation = _scipy_rotation()
+    angles = RNG.uniform(-4, 4, (30, 3))
+    # scipy's lower-case (extrinsic) sequence applies the first letter first about fixed axes.
+    columns = ["XYZ".index(letter) for letter in order]
+    expected = rotation.from_euler(order.lower(), angles[:, columns]).as_matrix()
+    assert_allclose(transforms.euler_matrices(angles, order), expected, atol=1e-13)
 
 
 def test_euler_xyz_is_rz_ry_rx():
@@ -60,14 +84,24 @@ def test_euler_xyz_is_rz_ry_rx():
         transforms.euler_matrices([ax, ay, az], "XYX")
 
 
-def test_quaternion_matrices_match_scipy_and_ignore_length():
+def test_quaternion_matrices_rotate_as_hamilton_products_and_ignore_length():
     q = RNG.normal(size=(40, 4))  # (w, x, y, z), not normalised
     matrices = transforms.quaternion_matrices(q)
     _assert_rotations(matrices)
-    expected = Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()  # scipy: scalar last
-    assert_allclose(matrices, expected, atol=1e-13)
+    unit = q / np.linalg.norm(q, axis=1, keepdims=True)
+    conjugate = unit * [1.0, -1.0, -1.0, -1.0]
+    vectors = RNG.normal(size=(40, 3))
+    rotated = _hamilton(_hamilton(unit, np.column_stack([np.zeros(40), vectors])), conjugate)  # q v q*
+    assert_allclose(np.einsum("kij,kj->ki", matrices, vectors), rotated[:, 1:], atol=1e-13)
     assert_allclose(transforms.quaternion_matrices(3.5 * q), matrices, atol=1e-14)
     assert_allclose(transforms.quaternion_matrices(-q), matrices, atol=1e-14)  # q and -q: same rotation
+
+
+def test_quaternion_matrices_match_scipy():
+    rotation = _scipy_rotation()
+    q = RNG.normal(size=(40, 4))
+    expected = rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()  # scipy: scalar last
+    assert_allclose(transforms.quaternion_matrices(q), expected, atol=1e-13)
 
 
 def test_zero_quaternion_is_a_half_turn_about_x_as_blender_normalises_it():
@@ -82,9 +116,20 @@ def test_axis_angle_matrices_match_rotation_vectors():
     matrices = transforms.axis_angle_matrices(np.column_stack([angles, axes]))
     _assert_rotations(matrices)
     unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
-    assert_allclose(matrices, Rotation.from_rotvec(angles[:, None] * unit).as_matrix(), atol=1e-13)
+    assert_allclose(matrices, [_rodrigues(k, a) for k, a in zip(unit, angles)], atol=1e-13)
+    # Composing two turns about the same axis adds the angles.
+    half = transforms.axis_angle_matrices(np.column_stack([0.5 * angles, axes]))
+    assert_allclose(half @ half, matrices, atol=1e-13)
     # Rotation about an axis leaves the axis fixed.
     assert_allclose(np.einsum("kij,kj->ki", matrices, unit), unit, atol=1e-13)
+
+
+def test_axis_angle_matrices_match_scipy_rotation_vectors():
+    rotation = _scipy_rotation()
+    angles, axes = RNG.uniform(-7, 7, 40), RNG.normal(size=(40, 3))
+    unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
+    assert_allclose(transforms.axis_angle_matrices(np.column_stack([angles, axes])),
+                    rotation.from_rotvec(angles[:, None] * unit).as_matrix(), atol=1e-13)
 
 
 def test_zero_axis_is_no_rotation():
