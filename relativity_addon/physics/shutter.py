@@ -17,15 +17,31 @@ from .lorentz import _aberrate, _boost
 from .validation import finite_array, speed_of_light, unit_vectors, vector_array, velocity_array
 
 
-class ShutterModel(enum.Enum):
-    """Where the camera's instantaneous shutter sits (Gray et al. section 3, appendix B)."""
+class ShutterModel(enum.IntEnum):
+    """Where the camera's instantaneous shutter sits (Gray et al. section 3, appendix B).
 
-    PINHOLE = "PINHOLE"  # every ray passes the aperture centre at t_S
-    APERTURE_PLANE = "APERTURE_PLANE"  # every ray passes its lens point at t_S
-    DETECTOR_PLANE = "DETECTOR_PLANE"  # every ray reaches the detector at t_S
-    FOCUS_SURFACE = "FOCUS_SURFACE"  # every ray passes the focus surface at t_S
-    FIXED_POINT_SURFACE = "FIXED_POINT_SURFACE"  # each focus point P at its fixed-point time (eq. 4)
-    ARBITRARY_PLANE = "ARBITRARY_PLANE"  # every ray crosses a given plane at t_S (appendix B)
+    The integer values are the codes of the OSL camera's ``shutter_model`` parameter
+    (``SHUTTER_*`` in ``shaders/relativistic_camera.osl``) and the order of the add-on's
+    ``shutter_model`` enum property; the names are that property's identifiers.
+    ``ShutterModel("PINHOLE")`` (by name) works as well as ``ShutterModel(0)``.
+    """
+
+    PINHOLE = 0  # every ray passes the aperture centre at t_S
+    APERTURE_PLANE = 1  # every ray passes its lens point at t_S
+    DETECTOR_PLANE = 2  # every ray reaches the detector at t_S
+    FOCUS_SURFACE = 3  # every ray passes the focus surface at t_S
+    FIXED_POINT_SURFACE = 4  # each focus point P at its fixed-point time (eq. 4)
+    ARBITRARY_PLANE = 5  # every ray crosses a given plane at t_S (appendix B)
+
+    @classmethod
+    def _missing_(cls, value: object) -> "ShutterModel | None":
+        if isinstance(value, str) and value in cls.__members__:
+            return cls.__members__[value]
+        return None
+
+
+# The models' names in code order: the identifiers of the add-on's shutter_model property.
+SHUTTER_MODEL_NAMES: tuple[str, ...] = tuple(model.name for model in ShutterModel)
 
 
 def _dot(a, b):
