@@ -1,5 +1,5 @@
 """Apparent positions of moving points: where a (possibly moving) observer sees them
-(PHYSICS.md, "Light-travel time (retarded positions)").
+(docs/physics.md, "Light-travel time (retarded positions)").
 
 Every world line is given in the scene frame S. The observer event is ``(t_o, x_o)`` in S and the
 observer moves with ``observer_beta`` (fraction of c, world axes) through S. A point is seen as it
@@ -23,7 +23,7 @@ def boost_emission_events(tau, emission_positions, observer_position, observer_b
     """Emission events ``(t_o - tau, x_e)`` seen from the observer event ``(t_o, x_o)``.
 
     Boosts the relative event ``(-tau, x_e - x_o)`` into the frame moving with ``observer_beta``
-    (PHYSICS.md, "Lorentz boost") and returns ``x_o + x'`` (shape ``(N, 3)``), the position at
+    (docs/physics.md, "Lorentz boost") and returns ``x_o + x'`` (shape ``(N, 3)``), the position at
     which a renderer at rest at ``x_o`` must draw the point. ``tau`` is kept small-and-relative
     so that the real ``c`` does not round it away.
     """

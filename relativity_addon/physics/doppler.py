@@ -1,4 +1,4 @@
-"""Doppler factor and apparent distance (PHYSICS.md, "Aberration and Doppler factor").
+"""Doppler factor and apparent distance (docs/physics.md, "Aberration and Doppler factor").
 
 ``D = nu_received / nu_emitted``: ``D > 1`` is a blueshift. ``k`` is always the photon's
 propagation direction (from the source toward the observer), a unit vector; it is normalised here.

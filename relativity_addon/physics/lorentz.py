@@ -1,4 +1,4 @@
-"""Lorentz boosts of events, photon directions and velocities (PHYSICS.md, "Lorentz boost").
+"""Lorentz boosts of events, photon directions and velocities (docs/physics.md, "Lorentz boost").
 
 Convention throughout: frame S' moves with velocity ``beta * c`` relative to frame S, axes
 parallel. Arrays broadcast: times have shape ``(...)``, positions, directions and velocities

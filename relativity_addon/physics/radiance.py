@@ -1,7 +1,7 @@
 """Transformation of radiance between frames: the searchlight effect.
 
 Weiskopf, Kraus, Ruder 1999, eqs. 13-15 and 18-19, written for ``D = nu_received / nu_emitted``
-(PHYSICS.md, "Radiance"). Blackbody colours and RGB spectra live in :mod:`.spectral`.
+(docs/physics.md, "Radiance"). Blackbody colours and RGB spectra live in :mod:`.spectral`.
 """
 
 import numpy as np
@@ -41,7 +41,7 @@ def transform_spectral_radiance(emitted_spectral_radiance, wavelength, doppler):
 
     ``emitted_spectral_radiance`` is a callable of wavelength (same units as ``wavelength``),
     defined wherever ``lambda * D`` falls: a spectrum known only in the visible must be extended
-    by the caller first (PHYSICS.md).
+    by the caller first (docs/physics.md).
     """
     wavelength = positive_array(wavelength, "wavelength")
     doppler = _doppler(doppler)

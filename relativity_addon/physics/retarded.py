@@ -1,4 +1,4 @@
-"""Light-travel time: when was an emitter where the observer now sees it? (PHYSICS.md,
+"""Light-travel time: when was an emitter where the observer now sees it? (docs/physics.md,
 "Light-travel time").
 
 An observer at event ``(t_o, x_o)`` sees a point of world line ``x_e(t)`` as it was at the

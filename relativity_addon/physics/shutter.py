@@ -4,7 +4,7 @@ All positions are in the camera frame, with the aperture centre at the origin; `
 camera's velocity in the scene frame expressed in camera coordinates. A photo ray ends at detector
 point ``D``, passes lens point ``L`` coming from the object point ``P`` conjugate to ``D``; its
 forward (propagation) direction is ``d = (L - P) / |L - P|``. The shutter model fixes the camera
-time ``t_L`` at which the ray passes ``L`` (PHYSICS.md, "Relativistic camera"); Gray eqs. (1)
+time ``t_L`` at which the ray passes ``L`` (docs/physics.md, "Relativistic camera"); Gray eqs. (1)
 and (2) then carry the ray into the scene frame, where the scene is at rest and timing no longer
 matters.
 """
@@ -107,7 +107,7 @@ def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_
 
     For the arbitrary plane, the ray crosses the plane at ``S = L - a d`` with
     ``(S - P0)·n = 0``, so ``a = (L - P0)·n / (d·n)`` and ``t_L = t_S + a / c``. Gray et al.'s
-    eq. (B5) (and PHYSICS.md's table) print ``(P0 - L)·n``, which is the same expression when
+    eq. (B5) (and docs/physics.md's table) print ``(P0 - L)·n``, which is the same expression when
     ``d`` is the backward (tracing) direction; with the forward ``d`` used here the sign of the
     numerator is ``L - P0`` (a shutter plane in front of the lens is crossed *before* ``L``).
     """

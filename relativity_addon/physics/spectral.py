@@ -1,6 +1,6 @@
 """Spectral Doppler and searchlight colour: blackbodies and up-sampled Rec.709 colours.
 
-Convention (``shared/PHYSICS.md``): the Doppler factor is ``D = nu_received / nu_emitted``,
+Convention (``docs/physics.md``): the Doppler factor is ``D = nu_received / nu_emitted``,
 ``D > 1`` is a blueshift. Spectral radiance per unit wavelength transforms as
 
     L_obs(lambda) = D^5 L_emit(lambda D)            (Weiskopf et al. 1999, eq. 14)
