@@ -244,7 +244,7 @@ class SampledRigidMotion:
         velocities = np.empty((3, count))
         accelerations = np.empty((3, count)) if with_acceleration else None
         edges = np.concatenate([[0], np.flatnonzero(keys[1:] != keys[:-1]) + 1, [count]]) if count else [0]
-        for a, b in zip(edges[:-1], edges[1:]):
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
             interval = int(keys[a])
             y = self._linear[interval] @ rows[:, a:b]
             y += self._offset[interval]

@@ -34,9 +34,8 @@ from __future__ import annotations
 
 import functools
 
-import numpy as np
-
 import colour
+import numpy as np
 from colour.colorimetry import planck_law
 
 __all__ = [

@@ -214,7 +214,8 @@ def test_sampled_point_motion_deforming_points_on_light_cone():
     samples = p[None] + 0.5 * acc[None] * (times ** 2)[:, None, None]
     motion = apparent.SampledPointMotion(times, samples)
     t_o, x_o = 0.2, np.zeros(3)
-    seen, tau, beta_seen = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(p), velocity=motion.velocities)
+    seen, tau, beta_seen = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(p),
+                                                       velocity=motion.velocities)
     truth = exact(t_o - tau, np.arange(len(p)))
     # Quadratic motion is reproduced exactly by Catmull-Rom: agreement at rounding level.
     assert np.max(np.linalg.norm(seen - truth, axis=1) / (c * tau)) < 1e-9

@@ -116,7 +116,7 @@ def test_axis_angle_matrices_match_rotation_vectors():
     matrices = transforms.axis_angle_matrices(np.column_stack([angles, axes]))
     _assert_rotations(matrices)
     unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
-    assert_allclose(matrices, [_rodrigues(k, a) for k, a in zip(unit, angles)], atol=1e-13)
+    assert_allclose(matrices, [_rodrigues(k, a) for k, a in zip(unit, angles, strict=True)], atol=1e-13)
     # Composing two turns about the same axis adds the angles.
     half = transforms.axis_angle_matrices(np.column_stack([0.5 * angles, axes]))
     assert_allclose(half @ half, matrices, atol=1e-13)
