@@ -15,29 +15,29 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-import numpy.typing as npt
 
 from .apparent import SampledRigidMotion, apparent_positions_sampled
+from .arrays import ArrayLike, FloatArray
 from .validation import finite_array, positive_array, speed_of_light, vector_array
 
 # Most sample times one window may hold: 200000 matrices of 4x4 float64 are 25 MB.
 MAX_SAMPLES = 200_000
 
-FloatArray = npt.NDArray[np.float64]
-MatrixFunction = Callable[[FloatArray], npt.ArrayLike]
+# world_matrices_at_times(t): object-to-world matrices (K, 4, 4) at scene times t (K,), seconds.
+MatrixFunction = Callable[[FloatArray], ArrayLike]
 
 
 def apparent_positions_from_matrix_function(
     world_matrices_at_times: MatrixFunction,
     step: float,
-    rest_local: npt.ArrayLike,
+    rest_local: ArrayLike,
     t_o: float,
-    x_o: npt.ArrayLike,
-    beta_o: npt.ArrayLike,
+    x_o: ArrayLike,
+    beta_o: ArrayLike,
     c: float,
     max_tries: int = 4,
     *,
-    world_matrix_now: npt.ArrayLike | None = None,
+    world_matrix_now: ArrayLike | None = None,
     max_samples: int = MAX_SAMPLES,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of points ``rest_local`` (``(N, 3)``, object space) of a rigid body whose

@@ -13,6 +13,7 @@ import enum
 
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray
 from .lorentz import _aberrate, _boost
 from .validation import finite_array, speed_of_light, unit_vectors, vector_array, velocity_array
 
@@ -48,7 +49,7 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def fixed_point_time(position, beta, c):
+def fixed_point_time(position: ArrayLike, beta: ArrayLike, c: float) -> FloatArray:
     """Gray et al. eq. (4): the camera time at which ``position`` is a spatial fixed point of
     eq. (1), i.e. maps to itself in the scene frame.
 
@@ -62,7 +63,7 @@ def fixed_point_time(position, beta, c):
     return -gamma * _dot(beta, x) / ((gamma + 1.0) * c)
 
 
-def fixed_point_plane(shutter_time, beta, c):
+def fixed_point_plane(shutter_time: float, beta: ArrayLike, c: float) -> tuple[FloatArray, FloatArray]:
     """Gray et al. eq. (6): the plane of spatial fixed points of eq. (1) at camera time ``t_S``,
 
         -beta·x = ((gamma + 1) / gamma) c t_S,
@@ -84,8 +85,10 @@ def fixed_point_plane(shutter_time, beta, c):
     return point, beta / np.sqrt(speed_squared)
 
 
-def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_point=None, beta=None,
-              plane_point=None, plane_normal=None, ideal_lens=True):
+def lens_time(model: ShutterModel | int | str, lens_point: ArrayLike, object_point: ArrayLike, *, c: float,
+              shutter_time: ArrayLike = 0.0, detector_point: ArrayLike | None = None, beta: ArrayLike | None = None,
+              plane_point: ArrayLike | None = None, plane_normal: ArrayLike | None = None, ideal_lens: bool = True
+              ) -> FloatArray:
     """Camera time ``t_L`` at which a photo ray passes its lens point, for a shutter model.
 
     | model               | t_L                                                   |
@@ -144,7 +147,8 @@ def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_
     return t_s + a / c
 
 
-def photo_ray_in_scene(lens_point, object_point, lens_time, beta, c):
+def photo_ray_in_scene(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float
+                       ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A camera-frame photo ray carried into the scene frame (Gray et al. eqs. 1 and 2).
 
     The event of the ray at ``L`` at camera time ``t_L`` maps by eq. (1); the forward direction
@@ -160,7 +164,8 @@ def photo_ray_in_scene(lens_point, object_point, lens_time, beta, c):
     return scene_time, scene_origin, _aberrate(d, -beta)
 
 
-def lorentz_window_ray(lens_point, object_point, lens_time, beta, c, window_point, window_normal):
+def lorentz_window_ray(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float,
+                       window_point: ArrayLike, window_normal: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A photo ray through a Lorentz-transformation window, carried into the scene frame.
 
     The window (Gray et al. section 4) changes a ray's direction exactly as the change of frame

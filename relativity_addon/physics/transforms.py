@@ -14,16 +14,14 @@ conventions as Blender:
 """
 
 import numpy as np
-import numpy.typing as npt
 
+from .arrays import ArrayLike, FloatArray
 from .validation import finite_array
 
 EULER_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 
-FloatArray = npt.NDArray[np.float64]
 
-
-def _rows(values: npt.ArrayLike, width: int, name: str) -> FloatArray:
+def _rows(values: ArrayLike, width: int, name: str) -> FloatArray:
     """``values`` as finite float64 rows ``(K, width)``; a single row ``(width,)`` becomes ``(1, width)``."""
     array = finite_array(values, name)
     if array.ndim == 1:
@@ -33,7 +31,7 @@ def _rows(values: npt.ArrayLike, width: int, name: str) -> FloatArray:
     return array
 
 
-def axis_rotation_matrices(axis: int, angles: npt.ArrayLike) -> FloatArray:
+def axis_rotation_matrices(axis: int, angles: ArrayLike) -> FloatArray:
     """Right-handed rotations by ``angles`` (radians, shape ``(K,)``) about coordinate axis
     ``axis`` (0 = X, 1 = Y, 2 = Z), shape ``(K, 3, 3)``: e.g. about Z,
     ``[[cos, -sin, 0], [sin, cos, 0], [0, 0, 1]]`` (a positive angle turns X towards Y)."""
@@ -50,7 +48,7 @@ def axis_rotation_matrices(axis: int, angles: npt.ArrayLike) -> FloatArray:
     return m
 
 
-def euler_matrices(angles: npt.ArrayLike, order: str = "XYZ") -> FloatArray:
+def euler_matrices(angles: ArrayLike, order: str = "XYZ") -> FloatArray:
     """Rotation matrices ``(K, 3, 3)`` of Euler angles ``(K, 3)`` (radians about X, Y, Z, in that
     column order whatever ``order`` is) in Blender's rotation mode ``order``: the first letter is
     applied first, so ``"XYZ"`` gives ``R = Rz @ Ry @ Rx``."""
@@ -64,7 +62,7 @@ def euler_matrices(angles: npt.ArrayLike, order: str = "XYZ") -> FloatArray:
     return np.ascontiguousarray(rotation)
 
 
-def quaternion_matrices(q: npt.ArrayLike) -> FloatArray:
+def quaternion_matrices(q: ArrayLike) -> FloatArray:
     """Rotation matrices ``(K, 3, 3)`` of quaternions ``(K, 4)`` as ``(w, x, y, z)``, normalised
     first as Blender does: a zero quaternion becomes ``(0, 1, 0, 0)``."""
     q = _rows(q, 4, "quaternions")
@@ -78,7 +76,7 @@ def quaternion_matrices(q: npt.ArrayLike) -> FloatArray:
     ], axis=1)
 
 
-def axis_angle_matrices(values: npt.ArrayLike) -> FloatArray:
+def axis_angle_matrices(values: ArrayLike) -> FloatArray:
     """Rotation matrices ``(K, 3, 3)`` of axis-angle rows ``(K, 4)`` = ``(angle, axis x, y, z)``
     (Blender's ``rotation_axis_angle``; the axis need not be normalised). A zero axis is no
     rotation, whatever the angle."""
@@ -89,7 +87,7 @@ def axis_angle_matrices(values: npt.ArrayLike) -> FloatArray:
     return quaternion_matrices(np.concatenate([np.cos(half), np.sin(half) * axis], axis=1))
 
 
-def compose_basis_matrices(location: npt.ArrayLike, rotation: npt.ArrayLike, scale: npt.ArrayLike) -> FloatArray:
+def compose_basis_matrices(location: ArrayLike, rotation: ArrayLike, scale: ArrayLike) -> FloatArray:
     """Object matrices ``(K, 4, 4)`` float64 from ``location`` ``(K, 3)``, ``rotation`` matrices
     ``(K, 3, 3)`` and ``scale`` ``(K, 3)``: ``M = T(location) @ R @ diag(scale)`` (Blender's
     ``BKE_object_to_mat4``, the object's ``matrix_basis``).
