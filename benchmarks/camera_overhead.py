@@ -80,7 +80,7 @@ def main():
             effect.apply(scene)
         return timed_render(bpy, scene, os.path.join(out, name))
 
-    for label, beta in cases:  # warm-up: shader compilation, kernel loading, caches
+    for _, beta in cases:  # warm-up: shader compilation, kernel loading, caches
         render(beta, "warmup.png")
     times = {label: [] for label, _ in cases}
     for round_index in range(options.repeats):
@@ -89,7 +89,7 @@ def main():
     base = times["perspective"]
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
     for label, _ in cases:
-        ratios = [seconds / reference for seconds, reference in zip(times[label], base)]
+        ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
         print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
               f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
 

@@ -5,8 +5,10 @@
 
 1. Physics core (``physics/apparent.py``), numpy only: apparent positions of N vertices for
    constant velocity (closed form) and for a keyframed rigid motion (rotation + translation
-   sampled on a sub-frame grid, per-vertex retarded times by the bracketed secant solver).
-2. The add-on's full update (``geometry.update_object`` with ``snapshot.read``): read the tessellated rest positions
+   sampled on a sub-frame grid, per-vertex retarded times by ``apparent_positions_sampled``'s Halley
+   iteration).
+2. The add-on's full update (``snapshot.read`` and ``geometry.update_object``): read the tessellated rest
+   positions
    from the evaluated mesh, compute, write the cache mesh; N-vertex grid, constant velocity and
    keyframed rotation.
 3. Render time of a small lit scene with the mesh path applied (observer at 0.8c) against the
@@ -29,7 +31,6 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 import numpy as np  # noqa: E402
-
 
 # Issue 4, vertices per second for 1M vertices a frame: keyframed motion in both the physics core
 # and the add-on update; constant velocity for the add-on's whole update.

@@ -33,6 +33,7 @@ sys.path[:0] = [str(REPO_ROOT), str(EXAMPLES_DIR)]
 
 import addon_utils  # noqa: E402  (ships with bpy, importable once bpy is)
 from mathutils import Vector  # noqa: E402
+
 from scenes import build_demo_scene  # noqa: E402
 
 

@@ -1,5 +1,5 @@
 """Apparent positions of moving points: where a (possibly moving) observer sees them
-(PHYSICS.md, "Light-travel time (retarded positions)").
+(docs/physics.md, "Light-travel time (retarded positions)").
 
 Every world line is given in the scene frame S. The observer event is ``(t_o, x_o)`` in S and the
 observer moves with ``observer_beta`` (fraction of c, world axes) through S. A point is seen as it
@@ -12,18 +12,22 @@ Functions return world-axis positions and the point velocity relative to the obs
 (fraction of c, observer frame), which the Doppler shaders need: ``D = 1 / (gamma (1 - beta·k))``.
 """
 
+from typing import Any
+
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray, WorldLine
 from .lorentz import _boost, compose_velocities
 from .retarded import light_travel_time, light_travel_time_uniform
 from .validation import finite_array, speed_of_light, vector_array, velocity_array
 
 
-def boost_emission_events(tau, emission_positions, observer_position, observer_beta, c):
+def boost_emission_events(tau: ArrayLike, emission_positions: ArrayLike, observer_position: ArrayLike,
+                          observer_beta: ArrayLike, c: float) -> FloatArray:
     """Emission events ``(t_o - tau, x_e)`` seen from the observer event ``(t_o, x_o)``.
 
     Boosts the relative event ``(-tau, x_e - x_o)`` into the frame moving with ``observer_beta``
-    (PHYSICS.md, "Lorentz boost") and returns ``x_o + x'`` (shape ``(N, 3)``), the position at
+    (docs/physics.md, "Lorentz boost") and returns ``x_o + x'`` (shape ``(N, 3)``), the position at
     which a renderer at rest at ``x_o`` must draw the point. ``tau`` is kept small-and-relative
     so that the real ``c`` does not round it away.
     """
@@ -37,7 +41,7 @@ def boost_emission_events(tau, emission_positions, observer_position, observer_b
     return boosted + x_o
 
 
-def velocity_seen_by_observer(point_beta, observer_beta):
+def velocity_seen_by_observer(point_beta: ArrayLike, observer_beta: ArrayLike) -> FloatArray:
     """Velocity (fraction of c) of points moving with ``point_beta`` in S, measured in the frame
     of an observer moving with ``observer_beta`` in S: S moves with ``-observer_beta`` there."""
     point_beta = velocity_array(point_beta, "point_beta")
@@ -47,8 +51,9 @@ def velocity_seen_by_observer(point_beta, observer_beta):
     return compose_velocities(-observer_beta, point_beta)
 
 
-def apparent_positions_uniform(observer_time, observer_position, positions_now, point_beta, c,
-                               observer_beta=(0.0, 0.0, 0.0)):
+def apparent_positions_uniform(observer_time: float, observer_position: ArrayLike, positions_now: ArrayLike,
+                               point_beta: ArrayLike, c: float, observer_beta: ArrayLike = (0.0, 0.0, 0.0)
+                               ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of points in uniform motion ``x_e(t) = p + u (t - t_o)``.
 
     ``positions_now`` (``p``, shape ``(N, 3)``) are the points' positions in S at the observer's
@@ -149,7 +154,7 @@ def _row_dot(rows, vector):
     return rows[0] * vector[0] + rows[1] * vector[1] + rows[2] * vector[2]
 
 
-def lorentz_contract(points, centre, beta):
+def lorentz_contract(points: ArrayLike, centre: ArrayLike, beta: ArrayLike) -> FloatArray:
     """Rest-frame shape -> its shape in a frame where it moves with ``beta``: the component of
     ``points - centre`` along ``beta`` shrinks by ``1 / gamma`` (simultaneity in that frame)."""
     points = vector_array(points, "points")
@@ -164,7 +169,7 @@ def lorentz_contract(points, centre, beta):
     return points - ((1.0 - 1.0 / gamma) * along)[:, None] * bhat
 
 
-def lorentz_contraction_matrix(beta):
+def lorentz_contraction_matrix(beta: ArrayLike) -> FloatArray:
     """The linear map of :func:`lorentz_contract` (about the origin): ``I - (1 - 1/gamma) bhat bhat^T``."""
     beta = velocity_array(beta, "beta")
     speed_squared = float(np.dot(beta, beta))
@@ -197,7 +202,7 @@ class SampledRigidMotion:
     in-place row operations instead of a gather of a 3x4 matrix per point.
     """
 
-    def __init__(self, times, matrices, local_points):
+    def __init__(self, times: ArrayLike, matrices: ArrayLike, local_points: ArrayLike) -> None:
         times = finite_array(times, "times")
         matrices = finite_array(matrices, "matrices")
         if times.ndim != 1 or times.size < 2 or matrices.shape != (times.size, 4, 4):
@@ -244,7 +249,7 @@ class SampledRigidMotion:
         velocities = np.empty((3, count))
         accelerations = np.empty((3, count)) if with_acceleration else None
         edges = np.concatenate([[0], np.flatnonzero(keys[1:] != keys[:-1]) + 1, [count]]) if count else [0]
-        for a, b in zip(edges[:-1], edges[1:]):
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
             interval = int(keys[a])
             y = self._linear[interval] @ rows[:, a:b]
             y += self._offset[interval]
@@ -279,7 +284,7 @@ class SampledRigidMotion:
             return positions, velocities, accelerations
         return positions, velocities
 
-    def positions_and_velocities(self, t, index):
+    def positions_and_velocities(self, t: ArrayLike, index: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """World positions and velocities (scene units per second), each ``(M, 3)``, of points
         ``index`` at times ``t``."""
         index = np.asarray(index)
@@ -293,11 +298,11 @@ class SampledRigidMotion:
         result_velocities[order] = velocities.T
         return result_positions, result_velocities
 
-    def positions(self, t, index):
+    def positions(self, t: ArrayLike, index: ArrayLike) -> FloatArray:
         """World positions of points ``index`` at times ``t`` (a ``world_line`` for the solver)."""
         return self.positions_and_velocities(t, index)[0]
 
-    def velocities(self, t, index):
+    def velocities(self, t: ArrayLike, index: ArrayLike) -> FloatArray:
         """World velocities (scene units per second) of points ``index`` at times ``t``."""
         return self.positions_and_velocities(t, index)[1]
 
@@ -309,7 +314,7 @@ class SampledPointMotion:
     :class:`SampledRigidMotion`. Use with :func:`apparent_positions` (``positions`` is its
     ``world_line``, ``velocities`` its ``velocity``)."""
 
-    def __init__(self, times, positions):
+    def __init__(self, times: ArrayLike, positions: ArrayLike) -> None:
         times = finite_array(times, "times")
         positions = finite_array(positions, "positions")
         if times.ndim != 1 or times.size < 2 or positions.ndim != 3 or positions.shape[0] != times.size \
@@ -319,7 +324,7 @@ class SampledPointMotion:
         self._samples = np.concatenate(
             [2 * positions[:1] - positions[1:2], positions, 2 * positions[-1:] - positions[-2:-1]])
 
-    def positions_and_velocities(self, t, index):
+    def positions_and_velocities(self, t: ArrayLike, index: ArrayLike) -> tuple[FloatArray, FloatArray]:
         index = np.asarray(index)
         s = (np.broadcast_to(np.asarray(t, dtype=np.float64), index.shape) - self.start) / self.step
         k = np.clip(np.floor(s), 0, self.intervals - 1).astype(np.int64)
@@ -333,10 +338,10 @@ class SampledPointMotion:
         position = ((c3 * g + c2) * g + c1) * g + p1 + (f[:, None] - g) * rate
         return position, rate / self.step
 
-    def positions(self, t, index):
+    def positions(self, t: ArrayLike, index: ArrayLike) -> FloatArray:
         return self.positions_and_velocities(t, index)[0]
 
-    def velocities(self, t, index):
+    def velocities(self, t: ArrayLike, index: ArrayLike) -> FloatArray:
         return self.positions_and_velocities(t, index)[1]
 
 
@@ -346,8 +351,9 @@ class SampledPointMotion:
 _BLOCK_SIZE = 1 << 14
 
 
-def apparent_positions_sampled(motion, observer_time, observer_position, c, observer_beta=(0.0, 0.0, 0.0),
-                               relative_tolerance=1e-10, max_iterations=30):
+def apparent_positions_sampled(motion: SampledRigidMotion, observer_time: float, observer_position: ArrayLike, c: float,
+                               observer_beta: ArrayLike = (0.0, 0.0, 0.0), relative_tolerance: float = 1e-10,
+                               max_iterations: int = 30) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of the points of a :class:`SampledRigidMotion` (per-point retarded times).
 
     Solves ``g(tau) = c tau - |x_o - x(t_o - tau)| = 0`` by Halley's method with the motion's own
@@ -468,8 +474,9 @@ def _retarded_emissions(motion, index, tau, t_o, x_o, c, relative_tolerance, max
     yield index, tau, position, rate
 
 
-def apparent_positions(world_line, observer_time, observer_position, c, count,
-                       observer_beta=(0.0, 0.0, 0.0), velocity=None, **solver_options):
+def apparent_positions(world_line: WorldLine, observer_time: float, observer_position: ArrayLike, c: float, count: int,
+                       observer_beta: ArrayLike = (0.0, 0.0, 0.0), velocity: WorldLine | None = None,
+                       **solver_options: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of ``count`` points on arbitrary sub-luminal world lines.
 
     ``world_line(t, index)`` returns positions ``(M, 3)`` (see :func:`retarded.light_travel_time`);
@@ -491,9 +498,3 @@ def apparent_positions(world_line, observer_time, observer_position, c, count,
     beta_seen = velocity_seen_by_observer(point_beta, observer_beta)
     return apparent, tau, np.broadcast_to(beta_seen, (count, 3))
 
-
-def retarded_times_from_apparent(observer_time, observer_position, apparent, c):
-    """For an observer at rest in S: ``t_e = t_o - |x_o - x_apparent| / c`` (checking aid)."""
-    c = speed_of_light(c)
-    distance = np.linalg.norm(vector_array(apparent, "apparent") - vector_array(observer_position, "observer_position"), axis=-1)
-    return np.asarray(observer_time, dtype=np.float64) - distance / c

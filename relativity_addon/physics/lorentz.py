@@ -1,4 +1,4 @@
-"""Lorentz boosts of events, photon directions and velocities (PHYSICS.md, "Lorentz boost").
+"""Lorentz boosts of events, photon directions and velocities (docs/physics.md, "Lorentz boost").
 
 Convention throughout: frame S' moves with velocity ``beta * c`` relative to frame S, axes
 parallel. Arrays broadcast: times have shape ``(...)``, positions, directions and velocities
@@ -8,6 +8,7 @@ the same number but stays finite at ``beta = 0``.
 
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray
 from .validation import finite_array, speed_of_light, unit_vectors, vector_array, velocity_array
 
 
@@ -15,7 +16,7 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def lorentz_factor(beta):
+def lorentz_factor(beta: ArrayLike) -> FloatArray:
     """gamma = 1 / sqrt(1 - beta·beta) for velocities ``beta`` (fractions of c), shape ``(...)``."""
     beta = velocity_array(beta)
     return 1.0 / np.sqrt(1.0 - _dot(beta, beta))
@@ -30,7 +31,7 @@ def _boost(t, x, beta, c):
     return t_boosted, x_boosted
 
 
-def boost_event(t, x, beta, c):
+def boost_event(t: ArrayLike, x: ArrayLike, beta: ArrayLike, c: float) -> tuple[FloatArray, FloatArray]:
     """Event ``(t, x)`` in S seen in S' (S' moves with ``beta`` in S).
 
     x' = x + (gamma - 1)(bhat·x) bhat - gamma beta c t,   c t' = gamma (c t - beta·x).
@@ -41,7 +42,8 @@ def boost_event(t, x, beta, c):
     return _boost(finite_array(t, "t"), vector_array(x, "x"), velocity_array(beta), c)
 
 
-def inverse_boost_event(t_prime, x_prime, beta, c):
+def inverse_boost_event(t_prime: ArrayLike, x_prime: ArrayLike, beta: ArrayLike, c: float
+                        ) -> tuple[FloatArray, FloatArray]:
     """Event ``(t', x')`` in S' seen in S: the boost with ``-beta``.
 
     This is Gray et al. eq. (1) when S' is the camera frame and ``beta`` the camera's velocity in
@@ -55,7 +57,7 @@ camera_to_scene_event = inverse_boost_event
 camera_to_scene_event.__doc__ = inverse_boost_event.__doc__
 
 
-def aberrate(k, beta):
+def aberrate(k: ArrayLike, beta: ArrayLike) -> FloatArray:
     """Unit photon propagation direction ``k`` in S seen in S' (S' moves with ``beta`` in S).
 
     k' = (k + (gamma - 1)(bhat·k) bhat - gamma beta) / (gamma (1 - beta·k)).
@@ -76,7 +78,7 @@ def _aberrate(k, beta):
     return k_prime / np.linalg.norm(k_prime, axis=-1, keepdims=True)
 
 
-def camera_to_scene_direction(d, beta):
+def camera_to_scene_direction(d: ArrayLike, beta: ArrayLike) -> FloatArray:
     """Gray et al. eq. (2): a ray's forward (propagation) direction ``d`` in the camera frame seen
     in the scene frame, for a camera moving with ``beta`` (in camera coordinates) through the scene.
 
@@ -86,7 +88,7 @@ def camera_to_scene_direction(d, beta):
     return _aberrate(unit_vectors(d, "d"), -velocity_array(beta))
 
 
-def compose_velocities(beta_frame, beta_in_frame):
+def compose_velocities(beta_frame: ArrayLike, beta_in_frame: ArrayLike) -> FloatArray:
     """Velocity in S of a body moving with ``beta_in_frame`` in S', where S' moves with
     ``beta_frame`` in S (relativistic velocity addition, the inverse boost of the body's 4-velocity).
 

@@ -1,4 +1,4 @@
-"""Light-travel time: when was an emitter where the observer now sees it? (PHYSICS.md,
+"""Light-travel time: when was an emitter where the observer now sees it? (docs/physics.md,
 "Light-travel time").
 
 An observer at event ``(t_o, x_o)`` sees a point of world line ``x_e(t)`` as it was at the
@@ -7,12 +7,16 @@ slower than light the solution is unique: ``g(t) = c (t_o - t) - |x_o - x_e(t)|`
 decreasing, with slope between ``-(c + |u|)`` and ``-(c - |u|)``.
 """
 
+from typing import Any
+
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray, WorldLine
 from .validation import finite_array, speed_of_light, vector_array, velocity_array
 
 
-def light_travel_time_uniform(observer_time, observer_position, emitter_position, emitter_beta, c):
+def light_travel_time_uniform(observer_time: ArrayLike, observer_position: ArrayLike, emitter_position: ArrayLike,
+                              emitter_beta: ArrayLike, c: float) -> FloatArray:
     """Closed-form light-travel time ``tau = t_o - t_e`` for uniform motion ``x_e(t) = p + u (t - t_o)``.
 
     ``emitter_position`` is ``p``, the emitter's position at the observer's time ``t_o`` (in the
@@ -37,14 +41,16 @@ def light_travel_time_uniform(observer_time, observer_position, emitter_position
         return np.where(a >= 0.0, (a + root) / b, q / np.where(root - a > 0.0, root - a, 1.0))
 
 
-def retarded_time_uniform(observer_time, observer_position, emitter_position, emitter_beta, c):
+def retarded_time_uniform(observer_time: ArrayLike, observer_position: ArrayLike, emitter_position: ArrayLike,
+                          emitter_beta: ArrayLike, c: float) -> FloatArray:
     """Retarded time ``t_e = t_o - tau`` for uniform motion (see :func:`light_travel_time_uniform`)."""
     tau = light_travel_time_uniform(observer_time, observer_position, emitter_position, emitter_beta, c)
     return np.asarray(observer_time, dtype=np.float64) - tau
 
 
-def light_travel_time(world_line, observer_time, observer_position, c, *, count=None,
-                      relative_tolerance=1e-13, max_iterations=100):
+def light_travel_time(world_line: WorldLine, observer_time: ArrayLike, observer_position: ArrayLike, c: float, *,
+                      count: int | None = None, relative_tolerance: float = 1e-13, max_iterations: int = 100
+                      ) -> FloatArray:
     """Light-travel times ``tau = t_o - t_e`` to ``count`` points on sub-luminal world lines.
 
     ``world_line(t, index)`` returns the positions, shape ``(M, 3)``, of the points numbered
@@ -110,7 +116,8 @@ def light_travel_time(world_line, observer_time, observer_position, c, *, count=
         "is the world line slower than light, and has light from it reached the observer?")
 
 
-def retarded_time(world_line, observer_time, observer_position, c, **options):
+def retarded_time(world_line: WorldLine, observer_time: ArrayLike, observer_position: ArrayLike, c: float,
+                  **options: Any) -> FloatArray:
     """Retarded times ``t_e = t_o - tau`` on arbitrary world lines (see :func:`light_travel_time`)."""
     tau = light_travel_time(world_line, observer_time, observer_position, c, **options)
     return np.asarray(observer_time, dtype=np.float64) - tau

@@ -4,7 +4,7 @@ All positions are in the camera frame, with the aperture centre at the origin; `
 camera's velocity in the scene frame expressed in camera coordinates. A photo ray ends at detector
 point ``D``, passes lens point ``L`` coming from the object point ``P`` conjugate to ``D``; its
 forward (propagation) direction is ``d = (L - P) / |L - P|``. The shutter model fixes the camera
-time ``t_L`` at which the ray passes ``L`` (PHYSICS.md, "Relativistic camera"); Gray eqs. (1)
+time ``t_L`` at which the ray passes ``L`` (docs/physics.md, "Relativistic camera"); Gray eqs. (1)
 and (2) then carry the ray into the scene frame, where the scene is at rest and timing no longer
 matters.
 """
@@ -13,26 +13,43 @@ import enum
 
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray
 from .lorentz import _aberrate, _boost
 from .validation import finite_array, speed_of_light, unit_vectors, vector_array, velocity_array
 
 
-class ShutterModel(enum.Enum):
-    """Where the camera's instantaneous shutter sits (Gray et al. section 3, appendix B)."""
+class ShutterModel(enum.IntEnum):
+    """Where the camera's instantaneous shutter sits (Gray et al. section 3, appendix B).
 
-    PINHOLE = "PINHOLE"  # every ray passes the aperture centre at t_S
-    APERTURE_PLANE = "APERTURE_PLANE"  # every ray passes its lens point at t_S
-    DETECTOR_PLANE = "DETECTOR_PLANE"  # every ray reaches the detector at t_S
-    FOCUS_SURFACE = "FOCUS_SURFACE"  # every ray passes the focus surface at t_S
-    FIXED_POINT_SURFACE = "FIXED_POINT_SURFACE"  # each focus point P at its fixed-point time (eq. 4)
-    ARBITRARY_PLANE = "ARBITRARY_PLANE"  # every ray crosses a given plane at t_S (appendix B)
+    The integer values are the codes of the OSL camera's ``shutter_model`` parameter
+    (``SHUTTER_*`` in ``shaders/relativistic_camera.osl``) and the order of the add-on's
+    ``shutter_model`` enum property; the names are that property's identifiers.
+    ``ShutterModel("PINHOLE")`` (by name) works as well as ``ShutterModel(0)``.
+    """
+
+    PINHOLE = 0  # every ray passes the aperture centre at t_S
+    APERTURE_PLANE = 1  # every ray passes its lens point at t_S
+    DETECTOR_PLANE = 2  # every ray reaches the detector at t_S
+    FOCUS_SURFACE = 3  # every ray passes the focus surface at t_S
+    FIXED_POINT_SURFACE = 4  # each focus point P at its fixed-point time (eq. 4)
+    ARBITRARY_PLANE = 5  # every ray crosses a given plane at t_S (appendix B)
+
+    @classmethod
+    def _missing_(cls, value: object) -> "ShutterModel | None":
+        if isinstance(value, str) and value in cls.__members__:
+            return cls.__members__[value]
+        return None
+
+
+# The models' names in code order: the identifiers of the add-on's shutter_model property.
+SHUTTER_MODEL_NAMES: tuple[str, ...] = tuple(model.name for model in ShutterModel)
 
 
 def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def fixed_point_time(position, beta, c):
+def fixed_point_time(position: ArrayLike, beta: ArrayLike, c: float) -> FloatArray:
     """Gray et al. eq. (4): the camera time at which ``position`` is a spatial fixed point of
     eq. (1), i.e. maps to itself in the scene frame.
 
@@ -46,7 +63,7 @@ def fixed_point_time(position, beta, c):
     return -gamma * _dot(beta, x) / ((gamma + 1.0) * c)
 
 
-def fixed_point_plane(shutter_time, beta, c):
+def fixed_point_plane(shutter_time: float, beta: ArrayLike, c: float) -> tuple[FloatArray, FloatArray]:
     """Gray et al. eq. (6): the plane of spatial fixed points of eq. (1) at camera time ``t_S``,
 
         -beta·x = ((gamma + 1) / gamma) c t_S,
@@ -68,8 +85,10 @@ def fixed_point_plane(shutter_time, beta, c):
     return point, beta / np.sqrt(speed_squared)
 
 
-def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_point=None, beta=None,
-              plane_point=None, plane_normal=None, ideal_lens=True):
+def lens_time(model: ShutterModel | int | str, lens_point: ArrayLike, object_point: ArrayLike, *, c: float,
+              shutter_time: ArrayLike = 0.0, detector_point: ArrayLike | None = None, beta: ArrayLike | None = None,
+              plane_point: ArrayLike | None = None, plane_normal: ArrayLike | None = None, ideal_lens: bool = True
+              ) -> FloatArray:
     """Camera time ``t_L`` at which a photo ray passes its lens point, for a shutter model.
 
     | model               | t_L                                                   |
@@ -91,7 +110,7 @@ def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_
 
     For the arbitrary plane, the ray crosses the plane at ``S = L - a d`` with
     ``(S - P0)·n = 0``, so ``a = (L - P0)·n / (d·n)`` and ``t_L = t_S + a / c``. Gray et al.'s
-    eq. (B5) (and PHYSICS.md's table) print ``(P0 - L)·n``, which is the same expression when
+    eq. (B5) (and docs/physics.md's table) print ``(P0 - L)·n``, which is the same expression when
     ``d`` is the backward (tracing) direction; with the forward ``d`` used here the sign of the
     numerator is ``L - P0`` (a shutter plane in front of the lens is crossed *before* ``L``).
     """
@@ -128,7 +147,8 @@ def lens_time(model, lens_point, object_point, *, c, shutter_time=0.0, detector_
     return t_s + a / c
 
 
-def photo_ray_in_scene(lens_point, object_point, lens_time, beta, c):
+def photo_ray_in_scene(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float
+                       ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A camera-frame photo ray carried into the scene frame (Gray et al. eqs. 1 and 2).
 
     The event of the ray at ``L`` at camera time ``t_L`` maps by eq. (1); the forward direction
@@ -144,7 +164,8 @@ def photo_ray_in_scene(lens_point, object_point, lens_time, beta, c):
     return scene_time, scene_origin, _aberrate(d, -beta)
 
 
-def lorentz_window_ray(lens_point, object_point, lens_time, beta, c, window_point, window_normal):
+def lorentz_window_ray(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float,
+                       window_point: ArrayLike, window_normal: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A photo ray through a Lorentz-transformation window, carried into the scene frame.
 
     The window (Gray et al. section 4) changes a ray's direction exactly as the change of frame

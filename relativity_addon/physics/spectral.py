@@ -1,6 +1,6 @@
 """Spectral Doppler and searchlight colour: blackbodies and up-sampled Rec.709 colours.
 
-Convention (``shared/PHYSICS.md``): the Doppler factor is ``D = nu_received / nu_emitted``,
+Convention (``docs/physics.md``): the Doppler factor is ``D = nu_received / nu_emitted``,
 ``D > 1`` is a blueshift. Spectral radiance per unit wavelength transforms as
 
     L_obs(lambda) = D^5 L_emit(lambda D)            (Weiskopf et al. 1999, eq. 14)
@@ -34,10 +34,11 @@ from __future__ import annotations
 
 import functools
 
-import numpy as np
-
 import colour
+import numpy as np
 from colour.colorimetry import planck_law
+
+from .arrays import ArrayLike, Float32Array, FloatArray, Spectrum
 
 __all__ = [
     "CMFS_NAME",
@@ -129,7 +130,7 @@ def _cmfs_visible() -> np.ndarray:
 # --- Colour space -------------------------------------------------------------------------------
 
 
-def XYZ_to_linear_rec709(XYZ) -> np.ndarray:
+def XYZ_to_linear_rec709(XYZ: ArrayLike) -> FloatArray:
     """Linear Rec.709 (Blender scene linear) RGB from CIE 1931 XYZ, shape (..., 3).
 
     colour-science's "ITU-R BT.709" colourspace, no chromatic adaptation (its white and ours are
@@ -145,7 +146,7 @@ def XYZ_to_linear_rec709(XYZ) -> np.ndarray:
     )
 
 
-def linear_rec709_to_XYZ(RGB) -> np.ndarray:
+def linear_rec709_to_XYZ(RGB: ArrayLike) -> FloatArray:
     """CIE 1931 XYZ from linear Rec.709 RGB, shape (..., 3); inverse of :func:`XYZ_to_linear_rec709`."""
 
     return colour.RGB_to_XYZ(
@@ -166,13 +167,13 @@ def _rec709_luminance_weights() -> np.ndarray:
     return weights
 
 
-def luminance_linear_rec709(RGB) -> np.ndarray:
+def luminance_linear_rec709(RGB: ArrayLike) -> FloatArray:
     """Relative luminance ``Y`` of linear Rec.709 RGB, shape (...)."""
 
     return np.asarray(RGB, dtype=np.float64) @ _rec709_luminance_weights()
 
 
-def gamut_map_linear_rec709(RGB) -> np.ndarray:
+def gamut_map_linear_rec709(RGB: ArrayLike) -> FloatArray:
     """Bring linear Rec.709 RGB into the gamut by desaturating toward grey at constant luminance.
 
     A strongly shifted spectrum (a blackbody below ~1900 K, white seen at ``D << 1``) is a real
@@ -219,7 +220,7 @@ def _planck_outer(wavelength_nm, temperature_K) -> np.ndarray:
     return np.reshape(radiance, (wavelength_m.size, temperature_K.size))
 
 
-def blackbody_spectral_radiance(wavelength_nm, temperature_K) -> np.ndarray:
+def blackbody_spectral_radiance(wavelength_nm: ArrayLike, temperature_K: ArrayLike) -> FloatArray:
     """Planck's law ``B_lambda(lambda, T)`` in W sr^-1 m^-2 per metre of wavelength.
 
     :func:`colour.colorimetry.planck_law` taking nanometres, with numpy broadcasting between
@@ -239,7 +240,8 @@ def blackbody_spectral_radiance(wavelength_nm, temperature_K) -> np.ndarray:
     return radiance
 
 
-def doppler_shifted_spectral_radiance(wavelength_nm, emitted_spectral_radiance, doppler_factor):
+def doppler_shifted_spectral_radiance(wavelength_nm: ArrayLike, emitted_spectral_radiance: Spectrum,
+                                      doppler_factor: ArrayLike) -> FloatArray:
     """Observed spectral radiance ``L_obs(lambda) = D^5 L_emit(lambda D)``.
 
     Weiskopf et al. (1999) eq. 14, written for ``D = nu_received / nu_emitted`` (their eq. 1 uses
@@ -252,7 +254,7 @@ def doppler_shifted_spectral_radiance(wavelength_nm, emitted_spectral_radiance, 
     return doppler_factor**5 * emitted_spectral_radiance(wavelength_nm * doppler_factor)
 
 
-def blackbody_XYZ(temperature_K) -> np.ndarray:
+def blackbody_XYZ(temperature_K: ArrayLike) -> FloatArray:
     """CIE 1931 XYZ of a blackbody at ``temperature_K``, shape (..., 3), in W sr^-1 m^-2.
 
     ``X = integral B_lambda(lambda, T) xbar(lambda) dlambda`` over 360-830 nm at 1 nm (the CMFs'
@@ -266,7 +268,7 @@ def blackbody_XYZ(temperature_K) -> np.ndarray:
     return XYZ.reshape(*temperature_K.shape, 3)
 
 
-def blackbody_linear_rgb(temperature_K, gamut_map: bool = False) -> np.ndarray:
+def blackbody_linear_rgb(temperature_K: ArrayLike, gamut_map: bool = False) -> FloatArray:
     """Linear Rec.709 RGB of a blackbody at ``temperature_K``, shape (..., 3), in W sr^-1 m^-2.
 
     Exact colorimetry by default: below about 1900 K the blue component is negative (and below
@@ -278,13 +280,13 @@ def blackbody_linear_rgb(temperature_K, gamut_map: bool = False) -> np.ndarray:
     return gamut_map_linear_rec709(rgb) if gamut_map else rgb
 
 
-def blackbody_luminance(temperature_K) -> np.ndarray:
+def blackbody_luminance(temperature_K: ArrayLike) -> FloatArray:
     """CIE ``Y`` of a blackbody at ``temperature_K`` in W sr^-1 m^-2 (CMF-weighted radiance)."""
 
     return blackbody_XYZ(temperature_K)[..., 1]
 
 
-def observed_blackbody_temperature(temperature_K, doppler_factor) -> np.ndarray:
+def observed_blackbody_temperature(temperature_K: ArrayLike, doppler_factor: ArrayLike) -> FloatArray:
     """Temperature ``D T`` of the blackbody an observer sees; the emitter is at ``T`` in its frame.
 
     Exact because ``D^5 B_lambda(lambda D, T) = B_lambda(lambda, D T)`` (Planck's law with
@@ -296,7 +298,7 @@ def observed_blackbody_temperature(temperature_K, doppler_factor) -> np.ndarray:
     return doppler_factor * temperature_K
 
 
-def blackbody_luminance_ratio(temperature_K, doppler_factor) -> np.ndarray:
+def blackbody_luminance_ratio(temperature_K: ArrayLike, doppler_factor: ArrayLike) -> FloatArray:
     """Observed over emitted visible luminance of a blackbody: ``Y(D T) / Y(T)``.
 
     This is the searchlight factor for what a camera records; it differs from the bolometric
@@ -332,13 +334,14 @@ def _log_blackbody_luminance(temperature_K) -> np.ndarray:
     return np.where(np.isneginf(peak[..., 0]), -np.inf, log_sum)
 
 
-def blackbody_lut_log10_t_grid(size: int = 2048, log10_t_range=BLACKBODY_LUT_LOG10_T_RANGE):
+def blackbody_lut_log10_t_grid(size: int = 2048, log10_t_range: tuple[float, float] = BLACKBODY_LUT_LOG10_T_RANGE
+                               ) -> FloatArray:
     """Evenly spaced ``log10 T`` grid (K) for :func:`blackbody_rgb_lut`."""
 
     return np.linspace(log10_t_range[0], log10_t_range[1], int(size))
 
 
-def blackbody_rgb_lut(log10_t_grid=None) -> np.ndarray:
+def blackbody_rgb_lut(log10_t_grid: ArrayLike | None = None) -> Float32Array:
     """Blackbody colour table for the shader, float32, flat, ``4 * N`` values.
 
     Layout: an ``N x 1`` RGBA float image (Blender ``Image.pixels`` order), pixel ``j`` for
@@ -374,7 +377,7 @@ def blackbody_rgb_lut(log10_t_grid=None) -> np.ndarray:
     return table.astype(np.float32).ravel()
 
 
-def sample_blackbody_rgb_lut(lut, log10_t_grid, temperature_K) -> np.ndarray:
+def sample_blackbody_rgb_lut(lut: ArrayLike, log10_t_grid: ArrayLike, temperature_K: ArrayLike) -> FloatArray:
     """Absolute gamut-mapped RGB at ``temperature_K`` read from :func:`blackbody_rgb_lut`.
 
     Reference for the shader: linear interpolation in ``log10 T``, clamped at the ends (an image
@@ -416,7 +419,7 @@ def basis_constrained_band_nm() -> tuple[float, float]:
     return float(lo), float(hi)
 
 
-def reflectance_basis_Mallett2019(wavelength_nm) -> np.ndarray:
+def reflectance_basis_Mallett2019(wavelength_nm: ArrayLike) -> FloatArray:
     """Mallett & Yuksel (2019) sRGB reflectance basis, extended to all wavelengths, shape (..., 3).
 
     ``reflectance(lambda) = sum_i w_i basis_i(lambda)``. Tabulated by colour-science at 5 nm;
@@ -436,7 +439,7 @@ def reflectance_basis_Mallett2019(wavelength_nm) -> np.ndarray:
     return np.stack([np.interp(clipped, table_nm, values[:, i]) for i in range(3)], axis=-1)
 
 
-def illuminant_white(wavelength_nm) -> np.ndarray:
+def illuminant_white(wavelength_nm: ArrayLike) -> FloatArray:
     """Relative spectral power of the white light of up-sampled colours, 1 at 560 nm, shape (...).
 
     A blackbody at ``WHITE_TEMPERATURE_K`` (6504 K, D65's correlated colour temperature). Not CIE
@@ -474,7 +477,7 @@ def _inverse_rest_frame_matrix() -> np.ndarray:
     return inverse
 
 
-def doppler_rgb_matrix(doppler_factor) -> np.ndarray:
+def doppler_rgb_matrix(doppler_factor: ArrayLike) -> FloatArray:
     """3x3 matrix ``M(D)``, shape (..., 3, 3): linear Rec.709 RGB emitted -> RGB observed at ``D``.
 
     The emitter's colour is up-sampled to a reflectance with the Mallett & Yuksel (2019) basis
@@ -498,7 +501,7 @@ def doppler_rgb_matrix(doppler_factor) -> np.ndarray:
     return _unnormalised_doppler_rgb_matrix(doppler_factor) @ _inverse_rest_frame_matrix()
 
 
-def doppler_shift_rgb(rgb, doppler_factor, gamut_map: bool = True) -> np.ndarray:
+def doppler_shift_rgb(rgb: ArrayLike, doppler_factor: ArrayLike, gamut_map: bool = True) -> FloatArray:
     """Linear Rec.709 RGB seen at Doppler factor ``D`` of an emitter of colour ``rgb``, (..., 3).
 
     ``M(D) rgb`` (see :func:`doppler_rgb_matrix`), then, by default, :func:`gamut_map_linear_rec709`
@@ -513,13 +516,14 @@ def doppler_shift_rgb(rgb, doppler_factor, gamut_map: bool = True) -> np.ndarray
     return gamut_map_linear_rec709(observed) if gamut_map else observed
 
 
-def doppler_lut_log10_d_grid(size: int = 2048, log10_d_range=DOPPLER_LUT_LOG10_D_RANGE):
+def doppler_lut_log10_d_grid(size: int = 2048, log10_d_range: tuple[float, float] = DOPPLER_LUT_LOG10_D_RANGE
+                             ) -> FloatArray:
     """Evenly spaced ``log10 D`` grid for :func:`doppler_matrix_lut` (default 0.01 to 100)."""
 
     return np.linspace(log10_d_range[0], log10_d_range[1], int(size))
 
 
-def doppler_matrix_lut(log10_d_grid=None) -> np.ndarray:
+def doppler_matrix_lut(log10_d_grid: ArrayLike | None = None) -> Float32Array:
     """Doppler matrix table for the shader, float32, flat, ``12 * N`` values.
 
     Layout: an ``N x 3`` (width x height) RGBA float image in Blender ``Image.pixels`` order
@@ -554,7 +558,7 @@ def doppler_matrix_lut(log10_d_grid=None) -> np.ndarray:
     return np.ascontiguousarray(np.swapaxes(pixels, 0, 1)).astype(np.float32).ravel()
 
 
-def sample_doppler_matrix_lut(lut, log10_d_grid, doppler_factor) -> np.ndarray:
+def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: ArrayLike, doppler_factor: ArrayLike) -> FloatArray:
     """``M(D)``, shape (..., 3, 3), read from :func:`doppler_matrix_lut` as the shader does it.
 
     Linear interpolation in ``log10 D`` of ``N`` and of ``a = ln Y(white)``, clamped at the ends.

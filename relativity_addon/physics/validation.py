@@ -6,8 +6,10 @@ argument, so no function of the core ever returns NaN or inf for NaN, inf or sup
 
 import numpy as np
 
+from .arrays import ArrayLike, FloatArray
 
-def finite_array(value, name):
+
+def finite_array(value: ArrayLike, name: str) -> FloatArray:
     """``value`` as a float64 array, or ``ValueError`` if any element is NaN or inf."""
     array = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(array)):
@@ -15,7 +17,7 @@ def finite_array(value, name):
     return array
 
 
-def vector_array(value, name):
+def vector_array(value: ArrayLike, name: str) -> FloatArray:
     """``value`` as a finite float64 array of 3-vectors (last axis of length 3)."""
     array = finite_array(value, name)
     if array.ndim == 0 or array.shape[-1] != 3:
@@ -23,7 +25,7 @@ def vector_array(value, name):
     return array
 
 
-def unit_vectors(value, name):
+def unit_vectors(value: ArrayLike, name: str) -> FloatArray:
     """Normalised 3-vectors; ``ValueError`` for zero-length (or denormal) vectors."""
     array = vector_array(value, name)
     norm = np.linalg.norm(array, axis=-1, keepdims=True)
@@ -32,7 +34,7 @@ def unit_vectors(value, name):
     return array / norm
 
 
-def velocity_array(beta, name="beta"):
+def velocity_array(beta: ArrayLike, name: str = "beta") -> FloatArray:
     """Velocities as fractions of c: finite 3-vectors with ``|beta| < 1``."""
     array = vector_array(beta, name)
     speed_squared = np.sum(array * array, axis=-1)
@@ -42,7 +44,7 @@ def velocity_array(beta, name="beta"):
     return array
 
 
-def positive_array(value, name):
+def positive_array(value: ArrayLike, name: str) -> FloatArray:
     """A finite array whose elements are all strictly positive."""
     array = finite_array(value, name)
     if np.any(array <= 0.0):
@@ -50,7 +52,7 @@ def positive_array(value, name):
     return array
 
 
-def speed_of_light(c):
+def speed_of_light(c: ArrayLike) -> float:
     """The speed of light in scene units per second: a positive finite scalar."""
     array = positive_array(c, "c")
     if array.ndim != 0:

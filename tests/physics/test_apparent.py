@@ -1,4 +1,4 @@
-"""Apparent positions (physics/apparent.py) against PHYSICS.md relations written out here."""
+"""Apparent positions (physics/apparent.py) against docs/physics.md relations written out here."""
 
 import math
 
@@ -17,7 +17,7 @@ def light_cone_residual(x_o, tau, x_e, c):
 
 
 def boost(t, x, beta, c):
-    """PHYSICS.md: x' = x + (gamma-1)(bhat.x) bhat - gamma beta c t, c t' = gamma (c t - beta.x)."""
+    """docs/physics.md: x' = x + (gamma-1)(bhat.x) bhat - gamma beta c t, c t' = gamma (c t - beta.x)."""
     beta = np.asarray(beta, float)
     b2 = beta @ beta
     g = 1.0 / math.sqrt(1.0 - b2)
@@ -37,7 +37,7 @@ def test_uniform_motion_lies_on_light_cone_and_matches_closed_form(c):
     x_e = p - (c * tau)[:, None] * u
     np.testing.assert_allclose(result, x_e, rtol=0, atol=1e-12 * 5)
     assert np.max(np.abs(light_cone_residual(x_o, tau, result, c))) < 1e-9
-    # Closed form of PHYSICS.md written out independently.
+    # Closed form of docs/physics.md written out independently.
     delta = x_o - p
     uu = u * c
     a = np.sum(delta * uu, 1)
@@ -214,7 +214,8 @@ def test_sampled_point_motion_deforming_points_on_light_cone():
     samples = p[None] + 0.5 * acc[None] * (times ** 2)[:, None, None]
     motion = apparent.SampledPointMotion(times, samples)
     t_o, x_o = 0.2, np.zeros(3)
-    seen, tau, beta_seen = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(p), velocity=motion.velocities)
+    seen, tau, beta_seen = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(p),
+                                                       velocity=motion.velocities)
     truth = exact(t_o - tau, np.arange(len(p)))
     # Quadratic motion is reproduced exactly by Catmull-Rom: agreement at rounding level.
     assert np.max(np.linalg.norm(seen - truth, axis=1) / (c * tau)) < 1e-9

@@ -4,7 +4,7 @@ composition of collinear boosts, and photon directions read off boosted light-li
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from relativity_addon.physics import retarded
-from strategies import velocities, vectors
+from strategies import vectors, velocities
 
 
 def light_cone_residual(tau, positions, observer_position, c):

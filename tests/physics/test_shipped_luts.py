@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
@@ -22,6 +23,46 @@ def test_a_changed_table_is_detected(tmp_path):
     fresh["doppler_matrix_lut"] = fresh["doppler_matrix_lut"] * np.float32(1.001)
     np.savez_compressed(tmp_path / "luts.npz", **fresh)
     assert build_luts.stale_tables(tmp_path / "luts.npz") == ["doppler_matrix_lut"]
+
+
+@pytest.fixture(scope="module")
+def fresh_tables():
+    return build_luts.compute_tables()
+
+
+def _stale_after(tmp_path, tables, name, change):
+    changed = dict(tables)
+    changed[name] = change(tables[name].copy())
+    np.savez_compressed(tmp_path / "luts.npz", **changed)
+    return build_luts.stale_tables(tmp_path / "luts.npz")
+
+
+def test_the_rounding_residual_of_gamut_mapped_zeros_is_tolerated(tmp_path, fresh_tables):
+    """numpy 1.26 and 2.x differ by 0 vs 1.1e-16 in components the gamut mapping drives to zero."""
+    def residual(table):
+        table[np.abs(table) < 1e-15] += np.float32(2.0 ** -53)
+        return table
+
+    assert _stale_after(tmp_path, fresh_tables, "blackbody_rgb_lut", residual) == []
+
+
+@pytest.mark.parametrize("change", ["one colour by 2e-6", "one zero to 1e-11", "one ln Y by 1e-4"])
+def test_a_small_change_to_the_blackbody_table_is_detected(tmp_path, fresh_tables, change):
+    rgba = fresh_tables["blackbody_rgb_lut"].reshape(-1, 4)
+    red = int(np.argmax(rgba[:, 0] > 0.5)) * 4  # a red component near 1
+    zero = int(np.flatnonzero(fresh_tables["blackbody_rgb_lut"] == 0.0)[0])
+    log_luminance = 4 * (len(rgba) // 2) + 3
+
+    def modify(table):
+        if change == "one colour by 2e-6":
+            table[red] *= np.float32(1.0 + 2e-6)
+        elif change == "one zero to 1e-11":
+            table[zero] = np.float32(1e-11)
+        else:
+            table[log_luminance] += np.float32(1e-4)
+        return table
+
+    assert _stale_after(tmp_path, fresh_tables, "blackbody_rgb_lut", modify) == ["blackbody_rgb_lut"]
 
 
 def test_reading_the_tables_needs_no_colour_science():

@@ -1,7 +1,7 @@
 """Tests of relativity_addon.physics.spectral against independent relations.
 
 Reference values come from colour-science directly (Planck's law, sd_blackbody, sd_to_XYZ, its
-SpectralDistribution interpolation) or from the physics (PHYSICS.md, Weiskopf et al. 1999), never
+SpectralDistribution interpolation) or from the physics (docs/physics.md, Weiskopf et al. 1999), never
 from numbers printed by the module under test.
 """
 

@@ -1,0 +1,100 @@
+"""Apparent positions of a rigid motion given as a function of time: choose the window of sample
+times that holds every point's retarded time, sample the motion there, solve
+(docs/physics.md, "Light-travel time (retarded positions)").
+
+The apparent-geometry path knows an animated object's world matrix at any time (from keyframes)
+but sampling a whole animation would be wasteful: light seen at ``t_o`` left each vertex at its
+own retarded time ``t_e = t_o - tau``, all of them within about ``2 reach / c`` of the object
+centre's light-travel time (``reach``: the largest distance of a vertex from the centroid). This
+module samples the motion on a uniform grid around that estimate, solves with
+:func:`apparent.apparent_positions_sampled`, and widens the window while some retarded time falls
+outside it (a point receding or approaching fast is seen much earlier or later than the estimate).
+"""
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from .apparent import SampledRigidMotion, apparent_positions_sampled
+from .arrays import ArrayLike, FloatArray
+from .validation import finite_array, positive_array, speed_of_light, vector_array
+
+# Most sample times one window may hold: 200000 matrices of 4x4 float64 are 25 MB.
+MAX_SAMPLES = 200_000
+
+# world_matrices_at_times(t): object-to-world matrices (K, 4, 4) at scene times t (K,), seconds.
+MatrixFunction = Callable[[FloatArray], ArrayLike]
+
+
+def apparent_positions_from_matrix_function(
+    world_matrices_at_times: MatrixFunction,
+    step: float,
+    rest_local: ArrayLike,
+    t_o: float,
+    x_o: ArrayLike,
+    beta_o: ArrayLike,
+    c: float,
+    max_tries: int = 4,
+    *,
+    world_matrix_now: ArrayLike | None = None,
+    max_samples: int = MAX_SAMPLES,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Apparent positions of points ``rest_local`` (``(N, 3)``, object space) of a rigid body whose
+    object-to-world matrices at scene times ``t`` (seconds, shape ``(K,)``) are
+    ``world_matrices_at_times(t)`` (shape ``(K, 4, 4)``), seen from the event ``(t_o, x_o)`` by an
+    observer moving with ``beta_o`` (fraction of c, world axes); ``c`` in scene units per second.
+
+    The motion is sampled at multiples of ``step`` (seconds; e.g. one animation sub-frame): first
+    around ``t_o - |x_o - centroid| / c`` (the centroid's travel time) widened by ``2 reach / c``
+    and two steps each side, ``reach`` being the largest distance of a point from the centroid at
+    ``t_o`` (``world_matrix_now``, default ``world_matrices_at_times([t_o])[0]``). Between samples
+    the motion is a Catmull-Rom cubic (:class:`apparent.SampledRigidMotion`). When a retarded time
+    falls outside the inner samples (not between the second and the second-last), the window is
+    stretched to hold all of them with four steps to spare, and solved again, up to ``max_tries``
+    windows in all.
+
+    Returns ``(apparent, tau, beta_seen)`` as :func:`apparent.apparent_positions_sampled`: world
+    positions ``(N, 3)``, light-travel times ``t_o - t_e`` ``(N,)`` and the points' velocities in
+    the observer frame ``(N, 3)``. Raises ``ValueError`` when a window would need more than
+    ``max_samples`` samples, when the retarded times do not settle inside the window after
+    ``max_tries`` windows, or for bad input (the motion not slower than light, NaN, ...).
+    """
+    c = speed_of_light(c)
+    step = float(positive_array(step, "step"))
+    t_o = float(finite_array(t_o, "t_o"))
+    x_o = vector_array(x_o, "x_o")
+    rest_local = vector_array(rest_local, "rest_local").reshape(-1, 3)
+    if max_tries < 1:
+        raise ValueError("max_tries must be at least 1")
+    if world_matrix_now is None:
+        world_matrix_now = np.asarray(world_matrices_at_times(np.array([t_o])), dtype=np.float64)[0]
+    matrix_now = finite_array(world_matrix_now, "world_matrix_now")
+    if matrix_now.shape != (4, 4):
+        raise ValueError(f"world matrices must be 4x4, got shape {matrix_now.shape}")
+    world_now = rest_local @ matrix_now[:3, :3].T + matrix_now[:3, 3]
+    if len(world_now):
+        centroid = world_now.mean(0)
+        reach = float(np.max(np.linalg.norm(world_now - centroid, axis=1)))
+        centre_tau = float(np.linalg.norm(x_o - centroid)) / c
+    else:
+        reach = centre_tau = 0.0
+    low = t_o - centre_tau - 2.0 * reach / c - 2 * step
+    high = t_o - centre_tau + 2.0 * reach / c + 2 * step
+    for _ in range(max_tries):
+        low_index, high_index = math.floor(low / step) - 2, math.ceil(high / step) + 2
+        if high_index - low_index > max_samples:
+            raise ValueError(
+                f"light-travel times span too many animation samples ({high_index - low_index + 1} > {max_samples}"
+                f" samples of {step:.4g} s, from {low:.4g} s to {high:.4g} s)")
+        times = np.arange(low_index, high_index + 1) * step
+        motion = SampledRigidMotion(times, world_matrices_at_times(times), rest_local)
+        result = apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
+        t_e = t_o - result[1]
+        if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
+            return result
+        margin = 4 * step
+        low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)
+    raise ValueError(
+        f"retarded times did not settle inside the sampled animation in {max_tries} windows "
+        f"(last retarded times {t_e.min():.4g}..{t_e.max():.4g} s, window {times[1]:.4g}..{times[-2]:.4g} s)")

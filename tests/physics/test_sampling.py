@@ -1,0 +1,109 @@
+"""The sample window around retarded times (physics/sampling.py): motions given as matrix
+functions of time against the closed form for uniform motion and the light-cone condition
+``|x_o - x_e(t_e)| = c (t_o - t_e)`` evaluated on the exact motion."""
+
+import numpy as np
+import pytest
+
+from relativity_addon.physics import apparent, sampling
+
+RNG = np.random.default_rng(21)
+
+
+def light_cone_residual(x_o, tau, x_e, c):
+    return (np.linalg.norm(x_o - x_e, axis=-1) - c * tau) / (c * tau)
+
+
+def uniform_motion(start, velocity, rotation_z=0.3):
+    """World matrices of a body turned by a fixed angle about Z, translated by start + v t."""
+    cos, sin = np.cos(rotation_z), np.sin(rotation_z)
+
+    def matrices(times):
+        m = np.zeros((len(times), 4, 4))
+        m[:, :3, :3] = [[cos, -sin, 0], [sin, cos, 0], [0, 0, 1]]
+        m[:, :3, 3] = start + np.multiply.outer(times, velocity)
+        m[:, 3, 3] = 1.0
+        return m
+    return matrices
+
+
+def accelerated_spinning_motion(acceleration, omega):
+    """x(t) = R_z(omega t) p + a t^2 / 2: accelerating and spinning."""
+    def matrices(times):
+        times = np.asarray(times, dtype=np.float64)
+        m = np.zeros(times.shape + (4, 4))
+        angle = omega * times
+        m[..., 0, 0], m[..., 0, 1] = np.cos(angle), -np.sin(angle)
+        m[..., 1, 0], m[..., 1, 1] = np.sin(angle), np.cos(angle)
+        m[..., 2, 2] = m[..., 3, 3] = 1.0
+        m[..., :3, 3] = 0.5 * np.multiply.outer(times ** 2, acceleration)
+        return m
+    return matrices
+
+
+@pytest.mark.parametrize("c", [2.0, 299792458.0])
+@pytest.mark.parametrize("observer_beta", [(0.0, 0.0, 0.0), (0.3, -0.5, 0.2)])
+def test_uniform_motion_reproduces_the_closed_form(c, observer_beta):
+    beta = np.array([0.2, 0.5, -0.4])
+    matrices = uniform_motion(np.array([1.0, 4.0, -2.0]), beta * c)
+    local = RNG.uniform(-1.0, 1.0, (300, 3))
+    t_o, x_o = 3.0, np.array([0.0, -2.0, 1.0])
+    seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
+        matrices, 1.0 / 96.0, local, t_o, x_o, observer_beta, c)
+    now = matrices(np.array([t_o]))[0]
+    positions_now = local @ now[:3, :3].T + now[:3, 3]
+    expected = apparent.apparent_positions_uniform(t_o, x_o, positions_now, beta, c, observer_beta)
+    # Catmull-Rom reproduces linear motion exactly: agreement at rounding level.
+    np.testing.assert_allclose(tau, expected[1], rtol=1e-9)
+    scale = np.linalg.norm(positions_now - x_o, axis=1)[:, None]
+    assert np.max(np.abs(seen - expected[0]) / scale) < 1e-9
+    np.testing.assert_allclose(beta_seen, expected[2], atol=1e-9)
+
+
+def test_accelerated_spinning_body_lies_on_the_light_cone():
+    c = 10.0
+    acceleration, omega = np.array([1.5, -0.5, 0.8]), 2.0
+    matrices = accelerated_spinning_motion(acceleration, omega)
+    local = RNG.uniform(-1.0, 1.0, (500, 3)) + np.array([0.0, 0.0, -5.0])
+    t_o, x_o = 2.0, np.array([1.0, 8.0, 0.0])
+    seen, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 1.0 / 240.0, local, t_o, x_o,
+                                                                    (0.0, 0.0, 0.0), c)
+    exact = matrices(t_o - tau)
+    emitted = np.einsum("nij,nj->ni", exact[:, :3, :3], local) + exact[:, :3, 3]
+    assert np.max(np.abs(light_cone_residual(x_o, tau, emitted, c))) < 1e-6
+    assert np.max(np.linalg.norm(seen - emitted, axis=1) / (c * tau)) < 1e-6  # observer at rest: x_e itself
+
+
+def test_window_widens_for_a_fast_receding_body_and_gives_up_after_max_tries():
+    """Receding at 0.9c from 10 units away (c = 1): seen at tau = 10 / 1.9, far from the first
+    estimate tau = 10 of the window."""
+    c = 1.0
+    matrices = uniform_motion(np.array([0.0, 10.0, 0.0]), np.array([0.0, 0.9, 0.0]), rotation_z=0.0)
+    local = np.zeros((50, 3))
+    local[:, 1] = RNG.uniform(-0.1, 0.1, 50)  # on the line of sight: c tau = 10 + y - 0.9 tau
+    _, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
+                                                                 (0.0, 0.0, 0.0), c)
+    np.testing.assert_allclose(tau, (10.0 + local[:, 1]) / 1.9, rtol=1e-9)
+    with pytest.raises(ValueError, match="did not settle"):
+        sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
+                                                         (0.0, 0.0, 0.0), c, max_tries=1)
+
+
+def test_too_many_samples_and_bad_input_raise():
+    matrices = uniform_motion(np.array([0.0, 0.0, -5.0]), np.zeros(3))
+    local = RNG.uniform(-1.0, 1.0, (10, 3))
+    with pytest.raises(ValueError, match="too many animation samples"):
+        sampling.apparent_positions_from_matrix_function(matrices, 1e-6, local, 0.0, np.zeros(3), np.zeros(3), 1.0)
+    with pytest.raises(ValueError, match="step"):
+        sampling.apparent_positions_from_matrix_function(matrices, 0.0, local, 0.0, np.zeros(3), np.zeros(3), 1.0)
+    with pytest.raises(ValueError, match="slower than light"):
+        sampling.apparent_positions_from_matrix_function(
+            uniform_motion(np.array([0.0, 0.0, -5.0]), np.array([2.0, 0.0, 0.0])), 0.01, local, 0.0, np.zeros(3),
+            np.zeros(3), 1.0)
+
+
+def test_no_points_give_empty_results():
+    matrices = uniform_motion(np.zeros(3), np.zeros(3))
+    seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
+        matrices, 0.1, np.zeros((0, 3)), 0.0, np.ones(3), np.zeros(3), 1.0)
+    assert seen.shape == (0, 3) and tau.shape == (0,) and beta_seen.shape == (0, 3)
