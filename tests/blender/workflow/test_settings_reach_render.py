@@ -12,14 +12,20 @@ and sample count, measured in ``test_identical_set_ups_render_identically``). An
 render must differ from the render before the change by far more than that, so that a setting
 which did nothing visible cannot pass.
 
-The scene: a camera moving at 0.68 c (sideways and forward), red and green emitting spheres, a
-blackbody emitter (``Object.relativity.temperature``), a blue sphere moving on its own at 0.5 c
-(apparent-geometry path), a diffuse floor lit by a point light (one quad: its tessellation shows in
-the curved edges). Its keyframed camera moves at (0.24, 0, -0.6) c for the speed of light of 10
-units/s used throughout, different from the manual velocity, so the velocity source shows too.
-"""
+The scene (F12 of the plain scene: red, green and blue spheres above a white one, a grey floor): a
+camera moving at 0.5 c (sideways and forward), red and green emitting spheres, a blackbody emitter
+(``Object.relativity.temperature``), a blue sphere moving on its own at 0.5 c (apparent-geometry
+path), a diffuse floor lit by a point light (one quad: its tessellation shows in its curved edges).
+Its keyframed camera moves at (0.2, 0, -0.4) c for the speed of light of 10 units/s used
+throughout, different from the manual velocity, so the velocity source shows too. Emitters are
+not sampled as lights and paths do not bounce, so a set-up renders exactly the same pixels every
+time (measured: 0 difference, also after rebuilding the scene); with light sampling, rebuilding
+the same scene changed the noise pattern by about 2% of the mean pixel value.
 
-import math
+Not a case: switching the velocity source back from Camera Animation to Manual. The animation
+overwrites the Velocity setting (by design, see props.py), so Manual then keeps the last animated
+velocity and there is no "fresh set-up with that setting" to compare with.
+"""
 
 import numpy as np
 import pytest
@@ -30,8 +36,9 @@ ch = wh.ch
 
 RESOLUTION = (48, 36)
 SAMPLES = 4
-# Mean absolute difference (linear RGB, pixel values about 0.1 to 2) allowed between two renders
-# of the same set-up, and the least a setting must change the image by to count as visible.
+# Mean absolute difference (linear RGB; mean pixel value about 0.5) allowed between two renders of
+# the same set-up (measured: exactly 0), and the least a setting must change the image by to count
+# as visible (the smallest change below measured 0.04, the object velocity).
 SAME = 1e-4
 VISIBLE = 1e-2
 
@@ -86,9 +93,8 @@ CASES = [
     case("CAMERA", "scene", "use_searchlight", False),
     case("CAMERA", "scene", "use_chang_searchlight", True),
     case("CAMERA", "scene", "velocity_source", "CAMERA_ANIMATION"),
-    case("CAMERA", "scene", "velocity_source", "MANUAL", base=FROM_ANIMATION),
     case("CAMERA", "Blackbody", "temperature", 9000.0),
-    case("CAMERA", "scene", "method", "GEOMETRY"),
+    case("CAMERA", "scene", "method", "GEOMETRY"),  # switching the method after Set Up
     # Apparent geometry: the scene settings that apply there, and every object setting.
     case("GEOMETRY", "scene", "speed_of_light", 15.0, base=FROM_ANIMATION),
     case("GEOMETRY", "scene", "beta", (0.4, -0.1, -0.5)),
@@ -96,7 +102,6 @@ CASES = [
     case("GEOMETRY", "scene", "use_searchlight", False),
     case("GEOMETRY", "scene", "use_chang_searchlight", True),
     case("GEOMETRY", "scene", "velocity_source", "CAMERA_ANIMATION"),
-    case("GEOMETRY", "scene", "velocity_source", "MANUAL", base=FROM_ANIMATION),
     case("GEOMETRY", "scene", "method", "CAMERA"),
     case("GEOMETRY", "Mover", "enabled", False),
     case("GEOMETRY", "Mover", "enabled", True, objects={"Mover": {"enabled": False}}),
@@ -155,7 +160,9 @@ def build_scene(bpy, method, scene_settings, object_settings):
     data = bpy.data.cameras.new("Camera")
     data.lens = 30.0
     data.clip_start, data.clip_end = 0.001, 1000.0
+    data.dof.use_dof = True  # the focus-surface shutter needs a focus distance; f/1000 stays sharp
     data.dof.focus_distance = 5.0
+    data.dof.aperture_fstop = 1000.0
     camera = bpy.data.objects.new("Camera", data)
     scene.collection.objects.link(camera)
     scene.camera = camera
@@ -271,4 +278,5 @@ def test_changed_setting_reaches_next_render(relativity_addon, factory_blender, 
     assert stale <= SAME, (
         f"after changing {name} to {value!r} in the panel, F12 renders {stale:.3g} (mean |difference|) away from "
         f"a fresh set-up with that setting (the change itself is {changed:.3g}; "
-        f"after vs before {difference(after, before):.3g})")
+        f"after vs before {difference(after, before):.3g}; mean pixel before {before.mean():.3g}, after "
+        f"{after.mean():.3g}, fresh {fresh.mean():.3g})")
