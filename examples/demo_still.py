@@ -74,7 +74,7 @@ def fly_camera(scene, camera_object, speed, lens_mm=55.0):
     forward = camera_object.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))
     scene.relativity.beta = tuple(speed * forward.normalized())
     effect.apply(scene)
-    # Doppler factor straight ahead: D = gamma (1 + beta) (PHYSICS.md, observer moving).
+    # Doppler factor straight ahead: D = gamma (1 + beta) (docs/physics.md, observer moving).
     doppler_ahead = math.sqrt((1.0 + speed) / (1.0 - speed))
     scene.view_settings.exposure = -4.0 * math.log2(doppler_ahead)
 

@@ -24,6 +24,7 @@ import numpy as np
 from mathutils import Matrix
 
 from ..errors import RelativityError
+from ..physics import transforms
 
 # Half-width of the central difference, in frames. Small enough to be the instantaneous velocity
 # of smooth keyframe curves, large enough for float32 key values.
@@ -77,46 +78,6 @@ def _channels(obj, curves, path, size, frames):
     return np.stack(columns, axis=1)
 
 
-def _axis_rotations(axis, angles):
-    c, s = np.cos(angles), np.sin(angles)
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    m = np.zeros((len(angles), 3, 3))
-    m[:, axis, axis] = 1.0
-    m[:, i, i], m[:, i, j], m[:, j, i], m[:, j, j] = c, -s, s, c
-    return m
-
-
-def _euler_matrices(angles, mode):
-    """Rotation matrices ``(K, 3, 3)`` of Euler angles in Blender's order ``mode`` ("XYZ": X
-    applied first, R = Rz Ry Rx)."""
-    rotation = np.broadcast_to(np.eye(3), (len(angles), 3, 3))
-    for axis_name in mode:
-        axis = "XYZ".index(axis_name)
-        rotation = _axis_rotations(axis, angles[:, axis]) @ rotation
-    return rotation
-
-
-def _quaternion_matrices(q):
-    """Rotation matrices of quaternions ``(K, 4)`` (w, x, y, z), normalised as Blender does: a
-    zero quaternion becomes (0, 1, 0, 0)."""
-    length = np.linalg.norm(q, axis=1, keepdims=True)
-    q = np.where(length > 0.0, q / np.where(length > 0.0, length, 1.0), [0.0, 1.0, 0.0, 0.0])
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], axis=1)
-
-
-def _axis_angle_matrices(values):
-    """Rotation matrices of (angle, axis x, y, z) rows; a zero axis is no rotation."""
-    axis_length = np.linalg.norm(values[:, 1:], axis=1, keepdims=True)
-    axis = values[:, 1:] / np.where(axis_length > 0.0, axis_length, 1.0)
-    half = 0.5 * np.where(axis_length[:, 0] > 0.0, values[:, 0], 0.0)[:, None]
-    return _quaternion_matrices(np.concatenate([np.cos(half), np.sin(half) * axis], axis=1))
-
-
 def basis_matrices(obj, frames):
     """The object's ``matrix_basis`` at each of ``frames`` (float, sub-frames allowed) from its
     keyframes, deltas included, as float64 ``(K, 4, 4)`` (mathutils is float32).
@@ -132,19 +93,18 @@ def basis_matrices(obj, frames):
 
     mode = obj.rotation_mode
     if mode == "QUATERNION":
-        rotation = _quaternion_matrices(channels("delta_rotation_quaternion", 4)) @ \
-            _quaternion_matrices(channels("rotation_quaternion", 4))
+        rotation = transforms.quaternion_matrices(channels("delta_rotation_quaternion", 4)) @ \
+            transforms.quaternion_matrices(channels("rotation_quaternion", 4))
     elif mode == "AXIS_ANGLE":
-        rotation = _axis_angle_matrices(channels("rotation_axis_angle", 4))
+        rotation = transforms.axis_angle_matrices(channels("rotation_axis_angle", 4))
     else:
-        rotation = _euler_matrices(channels("delta_rotation_euler", 3), mode) @ \
-            _euler_matrices(channels("rotation_euler", 3), mode)
-    scale = channels("scale", 3) * channels("delta_scale", 3)
-    matrices = np.zeros((len(frames), 4, 4))
-    matrices[:, :3, :3] = rotation * scale[:, None, :]
-    matrices[:, :3, 3] = channels("location", 3) + channels("delta_location", 3)
-    matrices[:, 3, 3] = 1.0
-    return matrices
+        rotation = transforms.euler_matrices(channels("delta_rotation_euler", 3), mode) @ \
+            transforms.euler_matrices(channels("rotation_euler", 3), mode)
+    return transforms.compose_basis_matrices(
+        channels("location", 3) + channels("delta_location", 3),
+        rotation,
+        channels("scale", 3) * channels("delta_scale", 3),
+    )
 
 
 def world_matrices(obj, frames):

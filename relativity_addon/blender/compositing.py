@@ -7,7 +7,7 @@ spectral Doppler matrix per pixel after the render, with no second render:
 - ``ln D`` per pixel comes from the ``relativity_log_doppler`` AOV, written by every material
   and the world at the first camera hit (``materials.doppler_aov_group``):
   ``D = gamma (1 - beta . k)`` with ``k`` the scene-frame photon direction (the Incoming vector)
-  and ``beta`` the observer velocity (PHYSICS.md). Computed by Cycles per sample, so it holds
+  and ``beta`` the observer velocity (docs/physics.md). Computed by Cycles per sample, so it holds
   for every shutter model, depth of field and the Lorentz window, and it follows the velocity
   frame by frame in animation renders.
 - ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),

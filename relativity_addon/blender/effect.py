@@ -128,6 +128,20 @@ def setting_changed(scene):
     sync(scene)
 
 
+def object_changed(scene, obj):
+    """Update callback of every object setting: a mesh switched on after Set Up gets the apparent
+    geometry, a changed blackbody temperature re-attaches its materials, then sync. Never raises."""
+    if applied_method(scene) == "GEOMETRY" and obj.type == "MESH" and obj.relativity.enabled \
+            and modifier.find_modifier(obj) is None:
+        try:
+            geometry.apply(scene, snapshot.read(scene), [obj])
+        except RelativityError as error:
+            print(f"Relativity: {error}")
+            _scene_warnings[scene.name] = [str(error)]
+            return
+    sync(scene, attach_new_materials=True)
+
+
 # --- warnings, computed when the effect syncs -------------------------------------------------
 
 

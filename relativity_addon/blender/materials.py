@@ -315,9 +315,9 @@ COLOUR_INPUTS = (
 
 def _targets(material):
     for node in list(material.node_tree.nodes):
-        for kind, names in COLOUR_INPUTS:
+        for kind, socket_names in COLOUR_INPUTS:
             if node.bl_idname == kind:
-                for name in names:
+                for name in socket_names:
                     socket = node.inputs.get(name)
                     if socket is not None:
                         yield node, socket
@@ -350,11 +350,11 @@ def attach(material, temperature=None):
             tree.links.new(source, node.inputs["Color"])
             if source.node.bl_idname == "ShaderNodeBlackbody":
                 node.inputs["Is Blackbody"].default_value = 1.0
-                temperature = source.node.inputs["Temperature"]
-                if temperature.is_linked:
-                    tree.links.new(temperature.links[0].from_socket, node.inputs["Temperature"])
+                temperature_socket = source.node.inputs["Temperature"]
+                if temperature_socket.is_linked:
+                    tree.links.new(temperature_socket.links[0].from_socket, node.inputs["Temperature"])
                 else:
-                    node.inputs["Temperature"].default_value = temperature.default_value
+                    node.inputs["Temperature"].default_value = temperature_socket.default_value
         else:
             node.inputs["Color"].default_value = socket.default_value
         is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
@@ -371,11 +371,14 @@ def attach(material, temperature=None):
                 "source_socket": source.identifier if source is not None else "",
             }
         )
+    object_temperature = float(temperature or 0.0)
     aov = tree.nodes.new("ShaderNodeGroup")
     aov.node_tree = bpy.data.node_groups[DOPPLER_AOV]
     aov.name = aov.label = f"{NODE_PREFIX} AOV"
     aov.hide = True
     records.append({"group_node": aov.name, "target": "", "socket": "", "source_node": "", "source_socket": ""})
+    for record in records:
+        record["object_temperature"] = object_temperature  # what attach_scene compares to re-attach
     material[ATTACHED_KEY] = records
     return True
 
@@ -415,11 +418,19 @@ def scene_materials(scene):
     return list(found.items())
 
 
+def attached_temperature(material):
+    """The object blackbody temperature ``material`` was attached with (0: none)."""
+    records = material[ATTACHED_KEY]
+    return float(records[0].get("object_temperature", 0.0)) if len(records) else 0.0
+
+
 def attach_scene(scene, camera_path):
     """Attach the Doppler colour group to every material of ``scene`` (no-op for attached ones);
     on the exact camera's path the world writes the Doppler AOV too."""
     ensure_node_groups()
     for material, temperature in scene_materials(scene):
+        if is_attached(material) and attached_temperature(material) != float(temperature or 0.0):
+            detach(material)  # its object's blackbody temperature changed since
         attach(material, temperature)
     if camera_path:
         attach_world(scene.world)

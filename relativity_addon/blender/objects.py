@@ -1,7 +1,7 @@
 """Per-object settings of the apparent-geometry path: ``bpy.types.Object.relativity``.
 
 Saved with the .blend and animatable. Changing a setting syncs the effect at once
-(``effect.sync``: the object's apparent positions for the current frame), so the viewport follows.
+(``effect.object_changed``: the object's apparent positions and colour for the current frame), so the viewport follows.
 """
 
 import bpy
@@ -22,7 +22,7 @@ MOTION_ITEMS = (
 def _settings_changed(self, context):
     scene = getattr(context, "scene", None)
     if scene is not None:
-        effect.sync(scene)
+        effect.object_changed(scene, self.id_data)
 
 
 class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):

@@ -23,7 +23,6 @@ from . import animation
 
 Vector3 = tuple[float, float, float]
 
-SHUTTER_MODELS = tuple(model.name for model in ShutterModel)  # order = the OSL shader's integer codes
 
 
 @dataclass(frozen=True)
@@ -89,7 +88,8 @@ class Snapshot:
 
     @property
     def shutter_code(self) -> int:
-        return SHUTTER_MODELS.index(self.shutter_model)
+        """The OSL shader's integer code of the shutter model (the physics core's enum value)."""
+        return int(ShutterModel[self.shutter_model])
 
     @property
     def colour(self) -> ColourFactors:

@@ -13,12 +13,10 @@ the observer event of a snapshot, by the object's motion source (``Object.relati
 Every function raises RelativityError (one line) for a motion it cannot show correctly.
 """
 
-import math
-
 import numpy as np
 
 from ..errors import RelativityError
-from ..physics import apparent
+from ..physics import apparent, sampling
 from . import animation, modifier, names
 from .snapshot import check_velocity
 
@@ -70,25 +68,13 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
         raise RelativityError(
             f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
             "bake its motion (Bake Motion in the Relativity panel)")
-    samples_per_frame = int(obj.relativity.samples_per_frame)
-    step = 1.0 / (samples_per_frame * fps)
-    world_now = to_world(matrix_array(obj_eval.matrix_world), rest_local)
-    reach = float(np.max(np.linalg.norm(world_now - world_now.mean(0), axis=1))) if len(world_now) else 0.0
-    centre_tau = float(np.linalg.norm(x_o - world_now.mean(0))) / c if len(world_now) else 0.0
-    low, high = t_o - centre_tau - 2.0 * reach / c - 2 * step, t_o - centre_tau + 2.0 * reach / c + 2 * step
-    for _ in range(max_tries):
-        low_index, high_index = math.floor(low / step) - 2, math.ceil(high / step) + 2
-        if high_index - low_index > 200000:
-            raise RelativityError(f"object {obj.name!r}: light-travel times span too many animation samples")
-        times = np.arange(low_index, high_index + 1) * step
-        motion = apparent.SampledRigidMotion(times, animation.world_matrices(obj, times * fps), rest_local)
-        result = apparent.apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
-        t_e = t_o - result[1]
-        if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
-            return result
-        margin = 4 * step
-        low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)
-    raise RelativityError(f"object {obj.name!r}: retarded times did not settle inside the sampled animation")
+    step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    try:
+        return sampling.apparent_positions_from_matrix_function(
+            lambda times: animation.world_matrices(obj, times * fps), step, rest_local, t_o, x_o, beta_o, c,
+            max_tries, world_matrix_now=matrix_array(obj_eval.matrix_world))
+    except ValueError as error:
+        raise RelativityError(f"object {obj.name!r}: {error}") from None
 
 
 def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c):

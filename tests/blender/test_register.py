@@ -10,6 +10,7 @@ which is what the checkbox in Preferences > Add-ons calls.
 import sys
 
 import bpy
+
 from blender_support import ADDON_MODULE, disable_addon, enable_addon
 
 # ID types the add-on may hang settings on; all must look the same after unregistering.

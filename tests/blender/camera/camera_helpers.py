@@ -1,6 +1,6 @@
 """Helpers for the relativistic-camera tests: scene builders, the batch render, pixel measures.
 
-The expected values are computed here from PHYSICS.md written out in numpy (aberration,
+The expected values are computed here from docs/physics.md written out in numpy (aberration,
 Doppler factor, pinhole projection), independently of the shader and of the add-on.
 
 Pixel convention: image arrays are indexed [row, column] with row 0 at the top; a pixel
@@ -19,7 +19,7 @@ REPO_ROOT = Path(__file__).resolve().parents[3]
 RENDER_SCRIPT = REPO_ROOT / "examples" / "render.py"
 
 
-# --- physics written out from PHYSICS.md -------------------------------------------------
+# --- physics written out from docs/physics.md -------------------------------------------------
 
 
 def gamma_of(beta):

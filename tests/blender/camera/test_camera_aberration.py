@@ -1,4 +1,4 @@
-"""Aberration: marker image positions match PHYSICS.md within 0.5 px (320x240, pinhole, t_S = 0).
+"""Aberration: marker image positions match docs/physics.md within 0.5 px (320x240, pinhole, t_S = 0).
 
 Static scene, pinhole shutter at t_S = 0: every photo ray passes the lens centre at the camera's
 event (t = 0, camera position), so each marker is seen along the aberrated direction of the

@@ -21,7 +21,6 @@ focus blur; its chief rays are the ones the spheres were placed for):
   except the central sphere (near the optical axis) and the one near the direction of beta.
 """
 
-import math
 
 import numpy as np
 
@@ -74,7 +73,7 @@ def _build_array(bpy, tmp_path, model, shutter_time):
     points, centres = sphere_centres(model, shutter_time)
     for index, centre in enumerate(centres):
         ch.add_sphere(bpy, scene, centre, SPHERE_RADIUS, material, name=f"S{index}", segments=24, rings=12)
-    blend = ch.save_blend(bpy, tmp_path / f"array_{model.value.lower()}.blend")
+    blend = ch.save_blend(bpy, tmp_path / f"array_{model.name.lower()}.blend")
     pixels = np.array([camera.project_direction(p) for p in points])
     return blend, pixels, camera
 
@@ -105,7 +104,7 @@ def _near_axis_and_beta(pixels, camera):
 
 def _check_pinhole_photo(camera, centres, pinhole_centres):
     """The moving pinhole (t_S = 0) sees each sphere where aberration of its cone of rays from
-    the camera event (t = 0, origin) puts it: PHYSICS.md aberration in camera_helpers."""
+    the camera event (t = 0, origin) puts it: docs/physics.md aberration in camera_helpers."""
     expected = np.array([ch.expected_sphere_centroid(camera, c, SPHERE_RADIUS, BETA_LOCAL) for c in centres])
     error = np.linalg.norm(pinhole_centres - expected, axis=1).max()
     assert error < 0.25, f"pinhole spot {error:.2f} px from the aberration formula"

@@ -1,6 +1,6 @@
 """Helpers for the Doppler colour tests: emitter scenes, in-process Cycles renders, references.
 
-Expected values come from PHYSICS.md written out in numpy (Doppler factor from the pixel's
+Expected values come from docs/physics.md written out in numpy (Doppler factor from the pixel's
 viewing direction) and from colour-science directly (Planck spectra through the CIE 1931
 observer), not from the add-on's node groups.
 """

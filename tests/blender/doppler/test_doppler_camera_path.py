@@ -4,7 +4,7 @@ Renders go through ``examples/render.py`` in a subprocess, as a user runs them (
 shader's D^4, the materials' blackbody shift and the compositor's Doppler matrix all come from
 the .blend). A static emitter fills the view; the observer moves. Expected Doppler factors per
 pixel: D = gamma (1 - beta . k), k the photon direction in the scene frame, equivalently
-D = 1 / (gamma (1 - beta . d')) with d' the pixel's camera-frame viewing direction (PHYSICS.md).
+D = 1 / (gamma (1 - beta . d')) with d' the pixel's camera-frame viewing direction (docs/physics.md).
 """
 
 import math

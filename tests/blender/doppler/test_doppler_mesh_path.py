@@ -3,7 +3,7 @@
 Real Cycles renders (CPU, 64x48). The camera looks down -Z from the origin; each emitter is a
 flat quad at z = -5 whose point attribute ``relativity_beta`` is its velocity relative to the
 observer. Expected Doppler factors are computed per pixel from the pixel's viewing direction
-(PHYSICS.md: D = 1 / (gamma_s (1 - beta_s . k))).
+(docs/physics.md: D = 1 / (gamma_s (1 - beta_s . k))).
 """
 
 import numpy as np

@@ -1,5 +1,5 @@
 """Helpers for the apparent-geometry tests: the camera tests' scene builders and pixel measures,
-plus evaluated-mesh readers. Expected values come from PHYSICS.md written out in the tests."""
+plus evaluated-mesh readers. Expected values come from docs/physics.md written out in the tests."""
 
 import importlib
 import sys
@@ -9,7 +9,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402
-
 from blender_support import ADDON_MODULE  # noqa: E402
 
 

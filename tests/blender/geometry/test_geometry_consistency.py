@@ -3,7 +3,6 @@ apparent-geometry mesh path (--method geometry) put marker spheres at the same p
 
 import numpy as np
 
-import geometry_helpers as gh
 from geometry_helpers import ch
 
 

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 import geometry_helpers as gh
-from geometry_helpers import ch
 
 C = 10.0
 FPS = 24

@@ -2,7 +2,7 @@
 
 A sphere keeps a circular outline in angle space, centred where aberration of its rest-frame
 view puts it; a cube shows its trailing face, rotated rather than contracted (the widths of
-trailing and front faces are in the ratio beta gamma). Expected values are PHYSICS.md relations
+trailing and front faces are in the ratio beta gamma). Expected values are docs/physics.md relations
 written out here (Lorentz boost of the observer event into the sphere's rest frame, aberration).
 """
 

@@ -1,7 +1,6 @@
 """The batch script as a pipeline uses it: frames, output names, progress, both invocation forms,
 every option reaching the scene, and one-line failures with exit code 1."""
 
-import math
 import re
 
 import numpy as np
@@ -53,7 +52,7 @@ def _pinhole_pixel(bpy, scene, camera, direction):
 
 
 def test_plain_blend_renders_relativistically_with_beta(factory_blender, tmp_path):
-    """A file never set up: --beta alone gives the aberrated image (PHYSICS.md), --reference the
+    """A file never set up: --beta alone gives the aberrated image (docs/physics.md), --reference the
     ordinary one; the sphere's centroid lands where the aberration formula puts it."""
     bpy = factory_blender
     scene, camera, sphere = wh.new_scene(bpy, resolution=(160, 120))

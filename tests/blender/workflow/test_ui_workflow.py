@@ -232,7 +232,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     load("paper_setups", "Gray_2020_beta_0.1_0_0.99_camera.py")
     right, up, view = rotation[:, 0], rotation[:, 1], -rotation[:, 2]
     np.testing.assert_allclose(tuple(settings.beta), 0.1 * right + 0.99 * view, atol=1e-6)
-    # Fig. 9: the shutter plane is the plane of spatial fixed points for t_S (PHYSICS.md eq. 6:
+    # Fig. 9: the shutter plane is the plane of spatial fixed points for t_S (docs/physics.md eq. 6:
     # -beta.x = ((gamma + 1) / gamma) c t_S), written in camera-local axes (beta.x is invariant).
     load("paper_setups", "Gray_2020_Fig_9_Lorentz_window.py")
     beta_local = rotation.T @ np.array(settings.beta)

@@ -1,6 +1,6 @@
 """Helpers for the workflow tests: small scenes, the batch script run as a user would, image reading.
 
-Physics expectations (aberration) are the camera tests' own, written out from PHYSICS.md in
+Physics expectations (aberration) are the camera tests' own, written out from docs/physics.md in
 tests/blender/camera/camera_helpers.py independently of the add-on; scenes are built with the
 same helpers.
 """
