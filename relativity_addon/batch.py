@@ -253,7 +253,7 @@ def run(argv, log=print):
         try:
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(options.blend_file))
         except RuntimeError as error:
-            raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}")
+            raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}") from None
     enable_addon()
     from .blender import effect
 
@@ -287,7 +287,7 @@ def run(argv, log=print):
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
     started = time.monotonic()
-    for done, (frame, path) in enumerate(zip(frames, paths), start=1):
+    for done, (frame, path) in enumerate(zip(frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
         _render_frame(bpy, scene, frame, path, relativistic)
         now = time.monotonic()

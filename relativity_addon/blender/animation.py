@@ -8,29 +8,15 @@ sequence (farm-safe). Constraints, drivers, NLA and simulations are not evaluate
 :func:`keyframe_motion_problem` says when keyframes alone are not the motion (such objects need a
 motion bake, and such a camera cannot give the velocity).
 
-With ``scene.relativity.velocity_source == 'CAMERA_ANIMATION'`` the observer velocity is the time
-derivative of the camera's world position in scene time ``t = frame / fps``, divided by c
-(docs/physics.md, units):
-
-    beta(f) = (x(f + h) - x(f - h)) / (2 h / fps) / c        (central difference, h = STEP_FRAMES)
-
-``snapshot.read`` takes it at every frame; :func:`check_animation_speed` is run before rendering a
-range and names the first frame where the camera would move at or above c.
+The observer velocity from the camera's animation (``snapshot.camera_beta_at``) differentiates
+these matrices.
 """
-
-import math
 
 import numpy as np
 from mathutils import Matrix
 
 from ..errors import RelativityError
 from ..physics import transforms
-
-# Half-width of the central difference, in frames. Small enough to be the instantaneous velocity
-# of smooth keyframe curves, large enough for float32 key values.
-STEP_FRAMES = 1.0 / 64.0
-# Sub-frame samples per frame used by ``check_animation_speed``.
-CHECK_SAMPLES_PER_FRAME = 4
 
 
 def frames_per_second(scene):
@@ -165,48 +151,3 @@ def check_supported(obj, scene=None):
             f"velocity from animation reads keyframes only, and {problem}; "
             "bake the camera motion to keyframes or set the velocity manually"
         )
-
-
-def _animated_camera(scene):
-    camera_object = scene.camera
-    if camera_object is None:
-        raise RelativityError(f"scene {scene.name!r} has no active camera")
-    check_supported(camera_object, scene)
-    return camera_object
-
-
-def camera_beta_at(scene, frame, camera_object=None, c=None):
-    """Observer velocity (world axes, fraction of c) of the camera at ``frame`` (float allowed)."""
-    camera_object = camera_object or _animated_camera(scene)
-    check_supported(camera_object, scene)
-    c = scene.relativity.speed_of_light if c is None else c
-    if not (math.isfinite(c) and c > 0.0):
-        raise RelativityError("speed of light must be a positive finite number")
-    before, after = world_matrices(camera_object, [frame - STEP_FRAMES, frame + STEP_FRAMES])[:, :3, 3]
-    dt = 2.0 * STEP_FRAMES / frames_per_second(scene)
-    return tuple(float(x) for x in (after - before) / dt / c)
-
-
-def check_animation_speed(scene, frame_start=None, frame_end=None):
-    """Raise RelativityError naming the first frame where the camera moves at or above c.
-
-    Samples every frame of [frame_start, frame_end] (default: the scene's frame range) and
-    CHECK_SAMPLES_PER_FRAME - 1 sub-frames between frames. Returns the highest speed found.
-    """
-    camera_object = _animated_camera(scene)
-    frame_start = scene.frame_start if frame_start is None else frame_start
-    frame_end = scene.frame_end if frame_end is None else frame_end
-    highest = 0.0
-    steps = max(int(round((frame_end - frame_start) * CHECK_SAMPLES_PER_FRAME)), 0)
-    for step in range(steps + 1):
-        frame = frame_start + step / CHECK_SAMPLES_PER_FRAME
-        beta = camera_beta_at(scene, frame, camera_object)
-        speed = math.sqrt(sum(b * b for b in beta))
-        if not math.isfinite(speed) or speed >= 1.0:
-            where = f"frame {int(frame)}" if frame == int(frame) else f"frame {math.floor(frame)} (sub-frame {frame:g})"
-            raise RelativityError(
-                f"camera {camera_object.name!r} moves at {speed:.4g} c at {where}: "
-                "its animation must stay below the speed of light (slow it down or raise c)"
-            )
-        highest = max(highest, speed)
-    return highest

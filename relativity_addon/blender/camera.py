@@ -114,7 +114,7 @@ def shader_parameters(scene, camera_data, snap):
 
 def _same(current, value):
     if hasattr(current, "__len__") and hasattr(value, "__len__"):
-        return len(current) == len(value) and all(a == b for a, b in zip(current, value))
+        return len(current) == len(value) and all(a == b for a, b in zip(current, value, strict=True))
     return current == value
 
 

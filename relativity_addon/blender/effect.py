@@ -46,7 +46,7 @@ def apply(scene, frame_range=None, objects=None):
     Raises RelativityError (one line) and leaves the scene as it was."""
     snap = snapshot.read(scene)
     if snap.velocity_source == "CAMERA_ANIMATION":
-        animation.check_animation_speed(scene, *(frame_range or (None, None)))
+        snapshot.check_animation_speed(scene, *(frame_range or (None, None)))
     if applied_method(scene) not in (None, snap.method):
         remove(scene)
     if snap.method == "CAMERA":
@@ -151,7 +151,8 @@ def _record(scene, snap):
         warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
     if snap.method == "CAMERA":
         camera_object = scene.objects.get(snap.camera)
-        if camera_object is not None and camera_object.data.type != "PERSP" and not camera.is_applied(camera_object.data):
+        if camera_object is not None and camera_object.data.type != "PERSP" \
+                and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
     warnings += geometry.scene_errors(scene)
     _scene_warnings[scene.name] = warnings

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from . import busy, modifier, names, snapshot, world_lines
-from .modifier import applied_objects, object_error  # noqa: F401  (part of this module's API)
+from .modifier import applied_objects, object_error
 
 # An edge longer than this fraction of its distance to the camera is too coarse for the
 # apparent-geometry path to curve (aberration bends straight lines; only vertices move).
@@ -94,13 +94,6 @@ def update_after_bake(scene, obj):
     with busy.computing():
         depsgraph = bpy.context.evaluated_depsgraph_get()
         update_object(scene, obj, snapshot.read(scene, depsgraph), depsgraph)
-
-
-def record_error(obj, message):
-    """Keep ``message`` as the object's last update error (shown in the panel)."""
-    data = modifier.cache_data(obj)
-    if data is not None:
-        data[names.ERROR_KEY] = message
 
 
 def scene_errors(scene):

@@ -297,7 +297,7 @@ def write_settings(snap):
         node = tree.nodes[name]
         sockets = node.inputs[:3] if name == "Observer Beta" else node.outputs[:1]
         components = value if name == "Observer Beta" else (value,)
-        for socket, component in zip(sockets, components):
+        for socket, component in zip(sockets, components, strict=True):
             if socket.default_value != component:  # also runs on depsgraph updates: no loops
                 socket.default_value = component
     return True

@@ -7,7 +7,7 @@ and report a ``RelativityError`` in one line instead of leaving a half-applied s
 from bpy.types import Operator
 
 from ..errors import RelativityError
-from . import animation, effect, snapshot
+from . import effect, snapshot
 
 
 def _poll_scene(cls, context):
@@ -91,7 +91,7 @@ class RELATIVITY_OT_check_animation(Operator):
     def execute(self, context):
         scene = context.scene
         try:
-            highest = animation.check_animation_speed(scene)
+            highest = snapshot.check_animation_speed(scene)
         except RelativityError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

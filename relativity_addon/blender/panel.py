@@ -152,4 +152,6 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
             layout.label(text=warning, icon="ERROR")
 
 
-classes = (RELATIVITY_PT_main, RELATIVITY_PT_observer, RELATIVITY_PT_shutter, RELATIVITY_PT_effects, RELATIVITY_PT_object)
+classes = (
+    RELATIVITY_PT_main, RELATIVITY_PT_observer, RELATIVITY_PT_shutter, RELATIVITY_PT_effects, RELATIVITY_PT_object,
+)

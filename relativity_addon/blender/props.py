@@ -18,7 +18,8 @@ from . import effect
 
 METHOD_ITEMS = (
     ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),
-    ("GEOMETRY", "Apparent Geometry", "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
+    ("GEOMETRY", "Apparent Geometry",
+     "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
 )
 
 _SHUTTER_DESCRIPTIONS = {

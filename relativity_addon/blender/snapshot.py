@@ -156,18 +156,58 @@ def camera_matrix(scene, camera, frame, depsgraph=None):
     return np.array(evaluated.matrix_world, dtype=np.float64)
 
 
-def observer_velocity(scene, camera, frame, c):
+# Half-width of the central difference, in frames. Small enough to be the instantaneous velocity
+# of smooth keyframe curves, large enough for float32 key values.
+STEP_FRAMES = 1.0 / 64.0
+# Sub-frame samples per frame checked by ``check_animation_speed``.
+CHECK_SAMPLES_PER_FRAME = 4
+
+
+def camera_beta_at(scene, frame, camera=None):
+    """The camera's velocity (world axes, fraction of c) at ``frame`` (float allowed), from its
+    keyframes: the time derivative of its world position in scene time ``t = frame / fps``, over c
+    (docs/physics.md, units), by a central difference of half-width STEP_FRAMES. A camera that its
+    keyframes do not move alone (constraints, drivers, NLA) is refused."""
+    camera = active_camera(scene) if camera is None else camera
+    animation.check_supported(camera, scene)
+    c = check_speed_of_light(scene.relativity.speed_of_light)
+    before, after = animation.world_matrices(camera, [frame - STEP_FRAMES, frame + STEP_FRAMES])[:, :3, 3]
+    dt = 2.0 * STEP_FRAMES / animation.frames_per_second(scene)
+    return tuple(float(x) for x in (after - before) / dt / c)
+
+
+def _checked_camera_speed(camera, beta, frame):
+    speed = math.sqrt(sum(b * b for b in beta))
+    if not math.isfinite(speed) or speed >= 1.0:
+        whole = math.floor(frame)
+        where = f"frame {whole}" if frame == whole else f"frame {whole} (sub-frame {frame:g})"
+        raise RelativityError(
+            f"camera {camera.name!r} moves at {speed:.4g} c at {where}: "
+            "its animation must stay below the speed of light (slow it down or raise c)")
+    return speed
+
+
+def check_animation_speed(scene, frame_start=None, frame_end=None):
+    """Raise RelativityError naming the first frame where the camera moves at or above c.
+
+    Samples every frame of [frame_start, frame_end] (default: the scene's frame range) and
+    CHECK_SAMPLES_PER_FRAME - 1 sub-frames between frames. Returns the highest speed found.
+    """
+    camera = active_camera(scene)
+    frame_start = scene.frame_start if frame_start is None else frame_start
+    frame_end = scene.frame_end if frame_end is None else frame_end
+    steps = max(int(round((frame_end - frame_start) * CHECK_SAMPLES_PER_FRAME)), 0)
+    frames = (frame_start + step / CHECK_SAMPLES_PER_FRAME for step in range(steps + 1))
+    return max((_checked_camera_speed(camera, camera_beta_at(scene, f, camera), f) for f in frames), default=0.0)
+
+
+def observer_velocity(scene, camera, frame):
     """The observer velocity at ``frame``: the setting, or the camera's keyframed motion."""
-    settings = scene.relativity
-    if settings.velocity_source == "CAMERA_ANIMATION":
-        beta = animation.camera_beta_at(scene, frame, camera, c)
-        speed = math.sqrt(sum(b * b for b in beta))
-        if not math.isfinite(speed) or speed >= 1.0:
-            raise RelativityError(
-                f"camera {camera.name!r} moves at {speed:.4g} c at frame {frame:g}: "
-                "its animation must stay below the speed of light (slow it down or raise c)")
-        return tuple(float(b) for b in beta)
-    return check_velocity(settings.beta, "observer velocity beta")
+    if scene.relativity.velocity_source == "CAMERA_ANIMATION":
+        beta = camera_beta_at(scene, frame, camera)
+        _checked_camera_speed(camera, beta, frame)
+        return beta
+    return check_velocity(scene.relativity.beta, "observer velocity beta")
 
 
 def read(scene, depsgraph=None) -> Snapshot:
@@ -177,7 +217,7 @@ def read(scene, depsgraph=None) -> Snapshot:
     c = check_speed_of_light(settings.speed_of_light)
     camera = active_camera(scene)
     frame = current_frame(scene)
-    beta = observer_velocity(scene, camera, frame, c)
+    beta = observer_velocity(scene, camera, frame)
     if not math.isfinite(settings.shutter_time):
         raise RelativityError("shutter time must be finite")
     normal = tuple(settings.shutter_plane_normal)

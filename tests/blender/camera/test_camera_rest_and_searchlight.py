@@ -84,7 +84,7 @@ def test_searchlight_ratio_is_doppler_fourth_power(factory_blender, tmp_path):
 
     ys, xs = np.mgrid[0:intensity.shape[0], 0:intensity.shape[1]]
     radiances = []
-    for pixel, doppler in emitters:
+    for pixel, _doppler in emitters:
         inside = np.hypot(xs + 0.5 - pixel[0], ys + 0.5 - pixel[1]) < 4.0
         radiances.append(intensity[inside].mean())
     measured = radiances[0] / radiances[1]
@@ -92,7 +92,7 @@ def test_searchlight_ratio_is_doppler_fourth_power(factory_blender, tmp_path):
     print(f"D = {emitters[0][1]:.4f}, {emitters[1][1]:.4f}; radiances {radiances}; "
           f"ratio measured {measured:.4f}, expected D^4 ratio {expected:.4f}")
     # Each emitter alone: radiance = D^4 times the emitted radiance (1).
-    for radiance, (_, doppler) in zip(radiances, emitters):
+    for radiance, (_, doppler) in zip(radiances, emitters, strict=True):
         assert radiance == pytest.approx(doppler ** 4, rel=0.02)
     assert measured == pytest.approx(expected, rel=0.02)
     assert abs(math.log(expected)) > 0.5, "test emitters must differ clearly in D"

@@ -19,8 +19,8 @@ def _signature(bpy, scene):
         if tree is None:
             return None
         nodes = sorted((node.name, node.bl_idname) for node in tree.nodes)
-        links = sorted((l.from_node.name, l.from_socket.identifier, l.to_node.name, l.to_socket.identifier)
-                       for l in tree.links)
+        links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+                       for link in tree.links)
         drivers = [] if tree.animation_data is None else sorted(f.data_path for f in tree.animation_data.drivers)
         return nodes, links, drivers, tree.animation_data is not None
 

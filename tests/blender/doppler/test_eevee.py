@@ -19,8 +19,8 @@ def _scene(bpy, addon):
     scene.relativity.speed_of_light = C
     # Placed where they are at the camera's time, so that light-travel time shows them in view.
     seen = np.array([-0.4, 0.3, -4.0])
-    ball = ch.add_sphere(bpy, scene, seen + [0.9 * np.linalg.norm(seen), 0.0, 0.0], 0.8, ch.emission_material(bpy, "Ball"),
-                         name="Ball", segments=48, rings=24)
+    ball = ch.add_sphere(bpy, scene, seen + [0.9 * np.linalg.norm(seen), 0.0, 0.0], 0.8,
+                         ch.emission_material(bpy, "Ball"), name="Ball", segments=48, rings=24)
     ball.active_material.node_tree.nodes["Emission"].inputs["Color"].default_value = (0.3, 0.6, 0.2, 1.0)
     ball.relativity.motion = "CONSTANT"
     ball.relativity.beta = (0.9, 0.0, 0.0)

@@ -165,7 +165,7 @@ def test_keyframe_matrices_match_blender(relativity_addon, factory_blender):
             chain.append(obj)
             bpy.context.view_layer.update()
         computed = animation.world_matrices(chain[-1], frames)
-        for matrix, frame in zip(computed, frames):
+        for matrix, frame in zip(computed, frames, strict=True):
             scene.frame_set(math.floor(frame), subframe=frame - math.floor(frame))
             expected = np.array(chain[-1].matrix_world)
             worst = max(worst, np.abs(matrix - expected).max() / np.abs(expected).max())
@@ -175,7 +175,6 @@ def test_keyframe_matrices_match_blender(relativity_addon, factory_blender):
 
 def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_blender):
     bpy = factory_blender
-    geometry = gh.geometry_module()
     scene, camera_object = _scene(bpy)
     target = _empty(bpy, scene, "Target")
     target.location = (-4.0, 0.5, -4.0)
@@ -187,19 +186,19 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     scene.relativity.method = "GEOMETRY"
     scene.frame_set(FRAME)
     gh.apply_geometry(scene)
-    assert geometry.scene_errors(scene) == []
+    assert gh.geometry_module().scene_errors(scene) == []
 
     # The constraint arrives: the handler's update refuses it and the error reporting names the fix.
     constraint = box.constraints.new("COPY_LOCATION")
     constraint.target = target
     bpy.context.view_layer.update()
-    errors = geometry.scene_errors(scene)
+    errors = gh.geometry_module().scene_errors(scene)
     assert len(errors) == 1 and "'Box'" in errors[0] and "constraints" in errors[0] and "Bake Motion" in errors[0]
     log = gh.draw_object_panel(bpy, scene, box)
     assert ("operator", "relativity.bake_motion") in log and hasattr(bpy.ops.relativity, "bake_motion")
     assert any(entry[0] == "label" and entry[2] == "ERROR" and "Bake Motion" in entry[1] for entry in log)
     gh.remove_effect(scene)
-    with pytest.raises(geometry.RelativityError, match=r"'Box'.*constraints.*Bake Motion"):
+    with pytest.raises(gh.geometry_module().RelativityError, match=r"'Box'.*constraints.*Bake Motion"):
         gh.apply_geometry(scene)
     assert gh.addon_module("modifier").find_modifier(box) is None
 
@@ -211,7 +210,7 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     first, per_frame, matrices = gh.addon_module("modifier").motion_bake(box)
     assert per_frame == 16 and first < 20 - 2 * 4.0 / C * FPS and first + (len(matrices) - 1) / 16 == FRAME
     gh.apply_geometry(scene)
-    assert geometry.scene_errors(scene) == []
+    assert gh.geometry_module().scene_errors(scene) == []
     log = gh.draw_object_panel(bpy, scene, box)
     assert any(entry[0] == "label" and entry[1].startswith("Motion baked") for entry in log)
     assert not any(entry[0] == "label" and entry[2] == "ERROR" for entry in log)
@@ -225,13 +224,12 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     # Edited motion after the bake is not rendered from the stale bake.
     gh.keyframe_linear(target, "location", 0, [(48, 8.0)])
     scene.frame_set(FRAME)
-    errors = geometry.scene_errors(scene)
+    errors = gh.geometry_module().scene_errors(scene)
     assert len(errors) == 1 and "motion bake" in errors[0] and "bake its motion again" in errors[0]
 
 
 def test_non_object_parent_needs_a_bake(relativity_addon, factory_blender):
     bpy = factory_blender
-    geometry = gh.geometry_module()
     animation = importlib.import_module(f"{relativity_addon}.blender.animation")
     scene, _ = _scene(bpy)
     anchor = _box(bpy, location=(0.0, 0.0, -6.0), size=2.0)
@@ -246,11 +244,11 @@ def test_non_object_parent_needs_a_bake(relativity_addon, factory_blender):
     scene.frame_set(FRAME)
     with pytest.raises(animation.RelativityError, match="vertex parent"):
         animation.world_matrices(box, [FRAME])
-    with pytest.raises(geometry.RelativityError, match=r"'Box' has a vertex parent.*Bake Motion"):
+    with pytest.raises(gh.geometry_module().RelativityError, match=r"'Box' has a vertex parent.*Bake Motion"):
         gh.apply_geometry(scene, [box])
     assert gh.addon_module("bakes").bake_motion(scene, box, 0, FRAME) == FRAME * 4 + 1
     gh.apply_geometry(scene, [box])
-    assert geometry.scene_errors(scene) == []
+    assert gh.geometry_module().scene_errors(scene) == []
 
 
 def test_what_keyframes_miss_is_named(relativity_addon, factory_blender):
@@ -281,7 +279,6 @@ def test_remove_takes_the_motion_bake_and_restores_the_file(relativity_addon, fa
     """The bake is saved with the .blend (a farm worker renders from the file alone) and leaves
     with the effect: the file is as before, bit for bit in what the effect may touch."""
     bpy = factory_blender
-    geometry = gh.geometry_module()
     scene, _ = _scene(bpy)
     target = _empty(bpy, scene, "Target")
     gh.keyframe_linear(target, "location", 0, [(0, -4.0), (48, 4.0)])
@@ -304,7 +301,7 @@ def test_remove_takes_the_motion_bake_and_restores_the_file(relativity_addon, fa
     scene.frame_set(FRAME)
     reloaded, _ = gh.evaluated_points(bpy, box)
     assert np.allclose(reloaded, points, atol=1e-6)
-    assert geometry.scene_errors(scene) == []
+    assert gh.geometry_module().scene_errors(scene) == []
 
     assert gh.remove_effect(scene) == 1
     assert gh.file_fingerprint(bpy) == before

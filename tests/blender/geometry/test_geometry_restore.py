@@ -54,7 +54,6 @@ def _scene_with_mesh(bpy):
 
 def test_remove_restores_mesh_and_stack_exactly(relativity_addon, factory_blender):
     bpy = factory_blender
-    geometry = gh.geometry_module()
     scene, obj = _scene_with_mesh(bpy)
     before_arrays = _mesh_arrays(obj.data)
     before_hash = _state_hash(bpy, obj)
@@ -78,7 +77,6 @@ def test_remove_restores_mesh_and_stack_exactly(relativity_addon, factory_blende
 
 def test_undo_redo_of_apply_and_remove(relativity_addon, factory_blender):
     bpy = factory_blender
-    geometry = gh.geometry_module()
     scene, obj = _scene_with_mesh(bpy)
     bpy.ops.ed.undo_push(message="scene built")
     before_hash = _state_hash(bpy, obj)

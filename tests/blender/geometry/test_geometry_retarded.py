@@ -62,7 +62,6 @@ def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
     wheel.relativity.tessellation = 0
     wheel.relativity.samples_per_frame = 32
     scene.frame_set(30)
-    geometry = gh.geometry_module()
     gh.apply_geometry(scene)
     x_a, beta_seen = gh.evaluated_points(bpy, wheel, "relativity_beta")
     rest = gh.evaluated_attribute(bpy, wheel, "relativity_rest")
@@ -102,7 +101,6 @@ def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     box.relativity.samples_per_frame = 16
     frame = 36
     scene.frame_set(frame)
-    geometry = gh.geometry_module()
     gh.apply_geometry(scene)
     x_a, _ = gh.evaluated_points(bpy, box)
     rest = gh.evaluated_attribute(bpy, box, "relativity_rest")
@@ -148,10 +146,9 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
     blob.relativity.use_deformation = True
     blob.relativity.tessellation = 0
     blob.relativity.samples_per_frame = 16
-    geometry = gh.geometry_module()
     frame = 20
     scene.frame_set(frame)
-    with pytest.raises(geometry.RelativityError, match="not baked"):
+    with pytest.raises(gh.geometry_module().RelativityError, match="not baked"):
         gh.apply_geometry(scene)
     assert gh.addon_module("modifier").find_modifier(blob) is None  # nothing applied
     blob.relativity.use_deformation = False

@@ -31,7 +31,7 @@ def test_frames_written_with_numbers_and_progress(plain_blend, tmp_path):
     assert not (tmp_path / "out" / "shot.png").exists()
     progress = [line for line in result.stdout.splitlines() if line.startswith("render.py: frame")]
     assert len(progress) == 3
-    for done, (line, frame) in enumerate(zip(progress, (2, 3, 4)), start=1):
+    for done, (line, frame) in enumerate(zip(progress, (2, 3, 4), strict=True), start=1):
         assert re.match(rf"render\.py: frame {frame} \({done}/3\) in [\d.]+ s, about [\d.]+ s left: ", line), line
     assert progress[-1].split("about ")[1].startswith("0.0 s left")
 
@@ -161,7 +161,8 @@ def test_animation_faster_than_light_is_refused_with_its_frame(factory_blender, 
     assert "1.2 c" in wh.error_lines(result)[0]
     assert not list(tmp_path.glob("fast*.png"))
     # The slow part alone renders; the fast part alone is refused at its first frame.
-    result = wh.run_render_script(blend, "--velocity-from-animation", light, "--frames=1-5", "--samples=1", f"--out={out}")
+    result = wh.run_render_script(blend, "--velocity-from-animation", light, "--frames=1-5", "--samples=1",
+                                  f"--out={out}")
     assert result.returncode == 0, result.stderr[-2000:]
     result = wh.run_render_script(blend, "--velocity-from-animation", light, "--frame=8", f"--out={out}")
     wh.assert_fails_with(result, "at frame 8")
@@ -191,7 +192,8 @@ def test_options_reach_the_scene(factory_blender):
         assert settings.speed_of_light == 7.0
         assert not (settings.use_doppler or settings.use_searchlight or settings.use_geometry)
         assert settings.use_lorentz_window
-        batch._apply_options(scene, parser.parse_args(["--out=x.png", "--velocity-from-animation", "--method=geometry"]))
+        options = parser.parse_args(["--out=x.png", "--velocity-from-animation", "--method=geometry"])
+        batch._apply_options(scene, options)
         assert settings.velocity_source == "CAMERA_ANIMATION" and settings.method == "GEOMETRY"
         assert batch.frame_output_path("/a/b.png", 7, several=False) == "/a/b.png"
         assert batch.frame_output_path("/a/b.png", 7, several=True) == "/a/b_0007.png"
@@ -221,7 +223,8 @@ def test_seed_samples_resolution_reference_and_searchlight_change_pixels(plain_b
     unlit = wh.luminance(render("unlit", "--samples=4", "--no-searchlight")).sum()
     assert lit > 1.5 * unlit
     reference = render("reference", "--samples=4", "--reference")
-    assert not np.allclose(wh.centroid(wh.luminance(reference)), wh.centroid(wh.luminance(render("moving", "--samples=4"))), atol=2.0)
+    moving = render("moving", "--samples=4")
+    assert not np.allclose(wh.centroid(wh.luminance(reference)), wh.centroid(wh.luminance(moving)), atol=2.0)
     assert np.isfinite(base).all()
 
 

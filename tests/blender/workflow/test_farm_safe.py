@@ -34,7 +34,8 @@ def _build_scene(bpy, method):
     scene.frame_start, scene.frame_end = FRAMES
     # Accelerating camera (linear keys): 0.2 c, then 0.5 c, then 0.8 c (c = 10, 24 fps).
     wh.keyframe_camera_path(
-        camera, [(0, (0, 0, 0)), (1, (0, 0, -1 / 12)), (2, (0, 0, -1 / 12 - 5 / 24)), (3, (0, 0, -1 / 12 - 5 / 24 - 1 / 3))]
+        camera,
+        [(0, (0, 0, 0)), (1, (0, 0, -1 / 12)), (2, (0, 0, -1 / 12 - 5 / 24)), (3, (0, 0, -1 / 12 - 5 / 24 - 1 / 3))],
     )
     settings = scene.relativity
     settings.speed_of_light = 10.0
@@ -64,7 +65,8 @@ def test_frame_alone_equals_frame_in_sequence(relativity_addon, factory_blender,
     for name, option in {"batch_sequence": "--frames=1-3", "batch_alone": "--frame=2"}.items():
         result = wh.run_render_script(blend, option, f"--out={tmp_path / name / 'b.exr'}", f"--method={method.lower()}")
         assert result.returncode == 0, result.stderr[-2000:]
-    images["batch_sequence"] = {f: wh.read_image(bpy, tmp_path / "batch_sequence" / f"b_{f:04d}.exr") for f in (1, 2, 3)}
+    sequence = tmp_path / "batch_sequence"
+    images["batch_sequence"] = {f: wh.read_image(bpy, sequence / f"b_{f:04d}.exr") for f in (1, 2, 3)}
     images["batch_alone"] = {2: wh.read_image(bpy, tmp_path / "batch_alone" / "b.exr")}
 
     reference = images["sequence"][2]

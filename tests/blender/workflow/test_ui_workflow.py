@@ -230,7 +230,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     # Gray et al.: (0.1, 0, 0.99) in Dr TIM (x right, y up, z into the page = viewing direction).
     # In the camera's own axes that is 0.1 * right + 0.99 * view, with view = local -Z.
     load("paper_setups", "Gray_2020_beta_0.1_0_0.99_camera.py")
-    right, up, view = rotation[:, 0], rotation[:, 1], -rotation[:, 2]
+    right, view = rotation[:, 0], -rotation[:, 2]
     np.testing.assert_allclose(tuple(settings.beta), 0.1 * right + 0.99 * view, atol=1e-6)
     # Fig. 9: the shutter plane is the plane of spatial fixed points for t_S (docs/physics.md eq. 6:
     # -beta.x = ((gamma + 1) / gamma) c t_S), written in camera-local axes (beta.x is invariant).
@@ -238,7 +238,8 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     beta_local = rotation.T @ np.array(settings.beta)
     gamma = 1.0 / math.sqrt(1.0 - beta_local @ beta_local)
     point = np.array(settings.shutter_plane_point)
-    assert -beta_local @ point == pytest.approx((gamma + 1) / gamma * settings.speed_of_light * settings.shutter_time, abs=2e-3)
+    expected = (gamma + 1) / gamma * settings.speed_of_light * settings.shutter_time
+    assert -beta_local @ point == pytest.approx(expected, abs=2e-3)
     normal = np.array(settings.shutter_plane_normal)
     np.testing.assert_allclose(normal / np.linalg.norm(normal), beta_local / np.linalg.norm(beta_local), atol=1e-6)
     assert settings.use_lorentz_window and settings.shutter_model == "ARBITRARY_PLANE"

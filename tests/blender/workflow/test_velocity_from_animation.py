@@ -16,7 +16,14 @@ def animation(relativity_addon, factory_blender):
     return importlib.import_module(f"{relativity_addon}.blender.animation")
 
 
-def test_linear_keys_give_slope_over_c(animation, factory_blender):
+@pytest.fixture
+def snapshot(relativity_addon, factory_blender):
+    import importlib
+
+    return importlib.import_module(f"{relativity_addon}.blender.snapshot")
+
+
+def test_linear_keys_give_slope_over_c(snapshot, factory_blender):
     bpy = factory_blender
     scene, camera, _ = wh.new_scene(bpy)
     scene.render.fps, scene.render.fps_base = 30, 1.001  # NTSC: 29.97 frames per second
@@ -27,9 +34,9 @@ def test_linear_keys_give_slope_over_c(animation, factory_blender):
     first = np.array([3.0, -4.0, 0.0]) / (10 / fps) / 25.0  # 0.5994 c along (3, -4, 0)/5
     second = np.array([0.0, 0.0, -2.0]) / (10 / fps) / 25.0
     for frame in (2.0, 5.5, 10.25):
-        np.testing.assert_allclose(animation.camera_beta_at(scene, frame), first, atol=1e-5)
-    np.testing.assert_allclose(animation.camera_beta_at(scene, 15.0), second, atol=1e-5)
-    assert animation.check_animation_speed(scene, 1, 21) == pytest.approx(np.linalg.norm(first), abs=1e-5)
+        np.testing.assert_allclose(snapshot.camera_beta_at(scene, frame), first, atol=1e-5)
+    np.testing.assert_allclose(snapshot.camera_beta_at(scene, 15.0), second, atol=1e-5)
+    assert snapshot.check_animation_speed(scene, 1, 21) == pytest.approx(np.linalg.norm(first), abs=1e-5)
 
     # The snapshot takes it at each frame, the frame-change handler writes it into the shader.
     settings.velocity_source = "CAMERA_ANIMATION"
@@ -41,8 +48,8 @@ def test_linear_keys_give_slope_over_c(animation, factory_blender):
     np.testing.assert_allclose(tuple(camera.data.cycles_custom["beta"]), second * [1, 1, -1], atol=1e-5)
 
     settings.speed_of_light = 0.5 * 25.0 * np.linalg.norm(second)  # second segment now at 2 c
-    with pytest.raises(animation.RelativityError, match=r"moves at 2 c at frame 12:"):
-        animation.check_animation_speed(scene, 12, 21)
+    with pytest.raises(snapshot.RelativityError, match=r"moves at 2 c at frame 12:"):
+        snapshot.check_animation_speed(scene, 12, 21)
     # From rest before frame 1: at frame 1 the central difference sees half the first segment's
     # 5 units / (10 / 29.97 s) = 14.99 units/s, i.e. 7.49 / 2.997 = 2.5 c: refused at frame 1.
     scene.frame_start, scene.frame_end = 1, 21
@@ -81,13 +88,13 @@ def test_keyframe_evaluation_matches_blender_world_matrices(animation, factory_b
         np.testing.assert_allclose(computed, expected, atol=1e-5)
 
 
-def test_constraints_are_refused_not_guessed(animation, factory_blender):
+def test_constraints_are_refused_not_guessed(snapshot, factory_blender):
     bpy = factory_blender
     scene, camera, _ = wh.new_scene(bpy)
     wh.keyframe_camera_path(camera, [(1, (0, 0, 0)), (5, (0, 0, -1))])
     camera.constraints.new("COPY_LOCATION")
-    with pytest.raises(animation.RelativityError, match="has constraints"):
-        animation.check_animation_speed(scene)
+    with pytest.raises(snapshot.RelativityError, match="has constraints"):
+        snapshot.check_animation_speed(scene)
     scene.relativity.velocity_source = "CAMERA_ANIMATION"
     with pytest.raises(RuntimeError, match="has constraints"):
         bpy.ops.relativity.setup_scene()
