@@ -1,7 +1,7 @@
 """The spectral lookup tables shipped with the add-on, read without colour-science.
 
 Blender bundles numpy but not colour-science (nor the scipy it needs), so the tables that the
-shaders sample are computed once from :mod:`relativity_addon.physics.spectral` by
+shaders sample are computed once by :mod:`relativity_addon.physics.spectral_luts` through
 ``tools/build_luts.py`` and shipped as ``data/spectral_luts.npz``;
 ``tests/physics/test_shipped_luts.py`` checks that the shipped file equals a fresh computation.
 Layouts: ``docs/spectral-model.md``.

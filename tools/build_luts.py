@@ -13,17 +13,17 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from relativity_addon import lut_data  # noqa: E402
-from relativity_addon.physics import spectral  # noqa: E402
+from relativity_addon.physics import spectral_luts  # noqa: E402
 
 
 def compute_tables():
-    d_grid = spectral.doppler_lut_log10_d_grid()
-    t_grid = spectral.blackbody_lut_log10_t_grid()
+    d_grid = spectral_luts.doppler_lut_log10_d_grid()
+    t_grid = spectral_luts.blackbody_lut_log10_t_grid()
     return {
         "doppler_log10_d_grid": d_grid,
-        "doppler_matrix_lut": spectral.doppler_matrix_lut(d_grid),
+        "doppler_matrix_lut": spectral_luts.doppler_matrix_lut(d_grid),
         "blackbody_log10_t_grid": t_grid,
-        "blackbody_rgb_lut": spectral.blackbody_rgb_lut(t_grid),
+        "blackbody_rgb_lut": spectral_luts.blackbody_rgb_lut(t_grid),
     }
 
 

@@ -1,6 +1,6 @@
 """Lookup-table images for the Doppler colour shaders, packed into the .blend.
 
-The tables are computed by ``physics/spectral.py`` (colour-science) once, at development time,
+The tables are computed by ``physics/spectral_luts.py`` (colour-science) once, at development time,
 and shipped with the add-on (``relativity_lut_data``, built by ``tools/build_luts.py``), because
 Blender bundles numpy but not colour-science; their layouts are described in
 ``docs/spectral-model.md``. They are stored as packed 32-bit float images with the
@@ -66,13 +66,13 @@ def _ensure_lut(name, table, log10_range, height):
 
 
 def ensure_doppler_matrix_lut():
-    """The packed ``N x 3`` Doppler matrix table (``spectral.doppler_matrix_lut``)."""
+    """The packed ``N x 3`` Doppler matrix table (``spectral_luts.doppler_matrix_lut``)."""
 
     return _ensure_lut(DOPPLER_LUT_NAME, lut_data.doppler_matrix_lut, DOPPLER_LOG10_RANGE, 3)
 
 
 def ensure_blackbody_lut():
-    """The packed ``N x 1`` blackbody table (``spectral.blackbody_rgb_lut``)."""
+    """The packed ``N x 1`` blackbody table (``spectral_luts.blackbody_rgb_lut``)."""
 
     return _ensure_lut(BLACKBODY_LUT_NAME, lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 

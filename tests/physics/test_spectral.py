@@ -329,67 +329,6 @@ def test_colours_keep_their_contrast_when_shifted_far():
     assert luminance[0] > 3 * luminance[1]
 
 
-# --- Lookup tables ------------------------------------------------------------------------------
-
-
-def test_doppler_matrix_lut_layout_and_nodes():
-    grid = spectral.doppler_lut_log10_d_grid(64)
-    lut = spectral.doppler_matrix_lut(grid)
-    assert lut.dtype == np.float32 and lut.shape == (64 * 3 * 4,)
-    assert np.all(np.isfinite(lut))
-    pixels = lut.reshape(3, 64, 4)  # (matrix row / image row, D / image column, RGBA)
-    matrices = spectral.doppler_rgb_matrix(10.0**grid)
-    white_luminance = spectral.luminance_linear_rec709(matrices.sum(-1))
-    np.testing.assert_allclose(pixels[..., 3], np.log(white_luminance)[None].repeat(3, 0), atol=1e-4)
-    np.testing.assert_allclose(
-        np.moveaxis(pixels[..., :3], 0, 1), matrices / white_luminance[:, None, None], atol=1e-6
-    )
-
-
-def test_doppler_matrix_lut_interpolation_error():
-    """Linear interpolation in log10 D of the default 2048-column table: worst at mid-cells."""
-
-    grid = spectral.doppler_lut_log10_d_grid()
-    lut = spectral.doppler_matrix_lut(grid)
-    midpoints = 10.0 ** (0.5 * (grid[1:] + grid[:-1]))
-    exact = spectral.doppler_rgb_matrix(midpoints)
-    sampled = spectral.sample_doppler_matrix_lut(lut, grid, midpoints)
-    white_luminance = spectral.luminance_linear_rec709(exact.sum(-1))
-    error = np.abs(sampled - exact).max(axis=(-1, -2)) / white_luminance
-    # Worst near D = 0.01, where the band sees the CIE table's truncated red end (1e-123 of white).
-    assert error.max() < 5e-3
-    assert error[midpoints > 0.1].max() < 1e-3
-
-
-def test_blackbody_lut_layout_units_and_float32_range():
-    grid = spectral.blackbody_lut_log10_t_grid(64)
-    lut = spectral.blackbody_rgb_lut(grid)
-    assert lut.dtype == np.float32 and lut.shape == (64 * 4,)
-    pixels = lut.reshape(64, 4)
-    assert np.all(np.isfinite(pixels)) and np.all(pixels[:, :3] >= 0)
-    np.testing.assert_allclose(spectral.luminance_linear_rec709(pixels[:, :3]), 1.0, rtol=1e-6)
-    for j in (20, 40, 63):  # Above ~1000 K, where colour's own sd_blackbody does not underflow.
-        Y = colour_blackbody_XYZ(10.0 ** grid[j])[1]
-        assert pixels[j, 3] == pytest.approx(np.log(Y), abs=1e-5)
-
-
-def test_blackbody_lut_interpolation_error():
-    grid = spectral.blackbody_lut_log10_t_grid()
-    lut = spectral.blackbody_rgb_lut(grid)
-    midpoints = 10.0 ** (0.5 * (grid[1:] + grid[:-1]))
-    exact = spectral.blackbody_linear_rgb(midpoints, gamut_map=True)
-    sampled = spectral.sample_blackbody_rgb_lut(lut, grid, midpoints)
-    error = np.abs(sampled - exact).max(-1) / spectral.blackbody_luminance(midpoints)
-    assert error.max() < 5e-3  # Worst near 100 K, where ln Y curves most in log T.
-    assert error[midpoints > 1000].max() < 1e-3
-    # The searchlight ratio from the alpha channel, as the shader computes it.
-    T, D = 5762.0, np.array([0.3, 0.7, 1.5, 4.0])
-    alpha = np.interp(np.log10([T, *(D * T)]), grid, lut.reshape(-1, 4)[:, 3].astype(float))
-    np.testing.assert_allclose(
-        np.exp(alpha[1:] - alpha[0]), spectral.blackbody_luminance_ratio(T, D), rtol=1e-4
-    )
-
-
 # --- Validation ---------------------------------------------------------------------------------
 
 BAD_POSITIVE = [0.0, -1.0, np.nan, np.inf, -np.inf, [1.0, np.nan], [2.0, 0.0]]
@@ -422,12 +361,6 @@ def test_bad_temperature_raises(bad):
             call()
 
 
-def test_bad_rgb_and_grids_raise():
+def test_bad_rgb_raises():
     with pytest.raises(ValueError, match="rgb"):
         spectral.doppler_shift_rgb([1.0, np.nan, 0.0], 2.0)
-    with pytest.raises(ValueError, match="log10_d_grid"):
-        spectral.doppler_matrix_lut([0.0, np.inf])
-    with pytest.raises(ValueError, match="log10_t_grid"):
-        spectral.blackbody_rgb_lut([3.0, np.nan])
-    with pytest.raises(ValueError, match="underflows"):
-        spectral.doppler_matrix_lut([-4.0, 0.0])
