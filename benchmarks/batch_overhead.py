@@ -1,7 +1,7 @@
 """Fixed cost per frame of the batch script against a plain render, each in a fresh process.
 
     python benchmarks/batch_overhead.py [--repeats 5] [--resolution 64x48] [--samples 1]
-        [--beta=0,0.48,-0.13] [--phases] [--as-environment]
+        [--beta=0,0.48,-0.13] [--grid VERTICES] [--phases] [--as-environment]
 
 A tiny frame (64x48, 1 sample) makes the render itself negligible, so what is left is the cost a
 user pays per invocation of ``examples/render.py FILE.blend --out X.png ...``: start Python and
@@ -35,6 +35,9 @@ sys.path.insert(0, sys.argv[1])
 import bpy
 from camera_overhead import build_scene
 build_scene(bpy, (64, 48), 1)
+side = int(int(sys.argv[3]) ** 0.5)
+if side > 1:  # a heavy mesh in view: the geometry method's per-frame update scales with it
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=3.0, location=(-0.5, 1.5, 1.5))
 bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2], check_existing=False)
 """
 
@@ -237,6 +240,8 @@ def main():
     parser.add_argument("--resolution", default="64x48")
     parser.add_argument("--samples", type=int, default=1)
     parser.add_argument("--beta", default="0,0.48,-0.13", help="observer velocity for the batch script")
+    parser.add_argument("--grid", type=int, default=0,
+                        help="add a grid of about this many vertices to the scene (before the add-on's tessellation)")
     parser.add_argument("--phases", action="store_true", help="also time each phase of the batch script")
     parser.add_argument("--as-environment", action="store_true",
                         help="keep PYTHONDONTWRITEBYTECODE if set (default: cache bytecode, as on a user's machine)")
@@ -250,7 +255,8 @@ def main():
         ENV.pop("PYTHONDONTWRITEBYTECODE", None)
         ENV["PYTHONPYCACHEPREFIX"] = os.path.join(work, "pycache")
     blend = os.path.join(work, "room.blend")
-    subprocess.run([sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend],
+    subprocess.run([sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend,
+                    str(options.grid)],
                    check=True, capture_output=True)
     out = os.path.join(work, "frame.png")
     common = ["--out", out, "--resolution", options.resolution, "--samples", str(options.samples),

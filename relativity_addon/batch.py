@@ -217,8 +217,13 @@ def _format_seconds(seconds):
     return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
 
 
-def _render_frame(bpy, scene, frame, path, relativistic):
-    scene.frame_set(frame)
+def _render_frame(bpy, scene, frame, path, relativistic, evaluated=False):
+    """Render ``frame`` to ``path``. ``evaluated``: the scene already stands at this frame with
+    the effect computed for it (applying the effect did that for the first frame); setting the
+    frame again would only repeat the frame-change handlers, which recompute every object's
+    apparent geometry."""
+    if not evaluated:
+        scene.frame_set(frame)
     if relativistic:
         # The frame-change handler records a failed apparent-geometry update on the object
         # instead of raising; rendering then would show the previous frame's shapes.
@@ -275,6 +280,7 @@ def run(argv, log=print):
     _output_format(scene, out_path)
 
     relativistic = not options.reference
+    evaluated_frame = None  # the frame the effect was just computed for
     try:
         if options.reference:
             camera.remove_relativistic_camera(scene)
@@ -284,6 +290,8 @@ def run(argv, log=print):
             _apply_options(scene, options)
             scene.frame_set(frames[0])
             ops.apply_effect(scene, frame_range=(frames[0], frames[-1]))
+            if scene.frame_current == frames[0] and scene.frame_subframe == 0.0:
+                evaluated_frame = frames[0]
     except camera.RelativityError as error:
         raise BatchError(str(error)) from None
 
@@ -293,7 +301,7 @@ def run(argv, log=print):
     started = time.monotonic()
     for done, (frame, path) in enumerate(zip(frames, paths), start=1):
         frame_started = time.monotonic()
-        _render_frame(bpy, scene, frame, path, relativistic)
+        _render_frame(bpy, scene, frame, path, relativistic, evaluated=done == 1 and frame == evaluated_frame)
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(
