@@ -75,12 +75,13 @@ def remove(scene):
     return removed
 
 
-def sync(scene, depsgraph=None, *, update_geometry=True, only_changed=True, attach_new_materials=False):
+def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False):
     """Bring the applied render path up to date with the scene at its current frame.
 
     ``update_geometry=False`` skips the apparent geometry (it needs the frame's evaluated meshes,
-    which exist only after a frame change); ``only_changed`` recomputes only objects whose inputs
-    changed; ``attach_new_materials`` attaches the Doppler colour to materials added since Set Up.
+    which exist only after a frame change); only objects whose inputs changed (the frame among
+    them) are recomputed; ``attach_new_materials`` attaches the Doppler colour to materials added
+    since Set Up.
     Never raises."""
     if busy.is_computing():
         return None
@@ -102,7 +103,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, only_changed=True, atta
         if method == "CAMERA":
             camera.write(scene, snap)
         elif method == "GEOMETRY" and update_geometry:
-            geometry.update(scene, snap, depsgraph, only_changed)
+            geometry.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
             colour.write(scene, snap, attach_new_materials)
     except RelativityError as error:

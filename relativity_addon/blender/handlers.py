@@ -3,9 +3,9 @@
 Order within a frame change: ``frame_change_pre`` writes the camera's parameters and the colour
 factors for the new frame (Cycles reads shader values written there, also in an animation
 render); ``frame_change_post`` updates the apparent geometry, which needs the new frame's
-evaluated meshes. ``depsgraph_update_post`` follows every edit (only what changed is
-recomputed; writes happen only where a value changed, so its own writes end the loop), and
-``render_pre`` runs before every render, attaching the Doppler colour to materials added since
+evaluated meshes. ``depsgraph_update_post`` follows every edit. Only objects whose inputs
+changed are recomputed (the frame is one of them), and values are written only where they
+changed, so the handlers' own writes end the loop. ``render_pre`` runs before every render, attaching the Doppler colour to materials added since
 Set Up. A handler never raises: a problem becomes the scene's warning and, for the exact camera,
 a black (never a wrong) image.
 """
@@ -30,12 +30,12 @@ def frame_change_pre(scene, _depsgraph=None):
 
 @persistent
 def frame_change_post(scene, depsgraph=None):
-    _sync(scene, depsgraph=depsgraph, only_changed=False)
+    _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
 def depsgraph_update_post(scene, depsgraph=None):
-    _sync(scene, depsgraph=depsgraph, only_changed=True)
+    _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
