@@ -37,7 +37,8 @@ from camera_overhead import build_scene
 build_scene(bpy, (64, 48), 1)
 side = int(int(sys.argv[3]) ** 0.5)
 if side > 1:  # a heavy mesh in view: the geometry method's per-frame update scales with it
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=3.0, location=(-0.5, 1.5, 1.5))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=3.0,
+                                    location=(-0.5, 1.5, 1.5))
 bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2], check_existing=False)
 """
 
@@ -115,7 +116,7 @@ batch.enable_addon()
 phase("enable the add-on (register)")
 addon_modules = sorted(set(sys.modules) - before_addon)
 
-from relativity_addon.blender import camera, compositing, geometry, materials, luts, ops
+from relativity_addon.blender import camera, compositing, effect, luts, materials, modifier
 timers = {}
 stack = []
 
@@ -139,7 +140,7 @@ wrap(luts, "ensure_doppler_matrix_lut", "  LUT images (load + pack)")
 wrap(luts, "ensure_blackbody_lut", "  LUT images (load + pack)")
 wrap(materials, "ensure_node_groups", "  node groups")
 wrap(compositing, "ensure_compositor_group", "  node groups")
-wrap(geometry, "build_node_group", "  node groups")
+wrap(modifier, "ensure_node_group", "  node groups")
 
 options = batch.build_parser(True).parse_args(
     [blend, "--out", out, "--method", method, "--beta=" + beta, "--samples", samples, "--resolution", resolution])
@@ -154,7 +155,7 @@ batch._apply_options(scene, options)
 scene.frame_set(scene.frame_current)
 stack.append(0.0)
 begun = time.perf_counter()
-ops.apply_effect(scene, frame_range=(scene.frame_current, scene.frame_current))
+effect.apply(scene, frame_range=(scene.frame_current, scene.frame_current))
 timers["  rest of applying"] = time.perf_counter() - begun - stack.pop()
 phase("apply the effect")
 apply_row = rows[-1]
@@ -223,10 +224,10 @@ def print_table(seconds, peaks):
     plain_s, plain_m = seconds["plain render"], peaks["plain render"]
     print(f"  {'command':30s}{'wall s':>8s}{'+s vs plain':>13s}{'ratio':>7s}{'peak MiB':>10s}{'+MiB':>7s}{'ratio':>7s}")
     for label in seconds:
-        extra_s = statistics.median(a - b for a, b in zip(seconds[label], plain_s))
-        ratio_s = statistics.median(a / b for a, b in zip(seconds[label], plain_s))
-        extra_m = statistics.median(a - b for a, b in zip(peaks[label], plain_m))
-        ratio_m = statistics.median(a / b for a, b in zip(peaks[label], plain_m))
+        extra_s = statistics.median(a - b for a, b in zip(seconds[label], plain_s, strict=True))
+        ratio_s = statistics.median(a / b for a, b in zip(seconds[label], plain_s, strict=True))
+        extra_m = statistics.median(a - b for a, b in zip(peaks[label], plain_m, strict=True))
+        ratio_m = statistics.median(a / b for a, b in zip(peaks[label], plain_m, strict=True))
         print(f"  {label:30s}{statistics.median(seconds[label]):8.2f}{extra_s:+13.2f}{ratio_s:7.2f}"
               f"{statistics.median(peaks[label]):10.0f}{extra_m:+7.0f}{ratio_m:7.2f}")
         if label != "plain render":

@@ -5,9 +5,9 @@ factors for the new frame (Cycles reads shader values written there, also in an 
 render); ``frame_change_post`` updates the apparent geometry, which needs the new frame's
 evaluated meshes. ``depsgraph_update_post`` follows every edit. Only objects whose inputs
 changed are recomputed (the frame is one of them), and values are written only where they
-changed, so the handlers' own writes end the loop. ``render_pre`` runs before every render, attaching the Doppler colour to materials added since
-Set Up. A handler never raises: a problem becomes the scene's warning and, for the exact camera,
-a black (never a wrong) image.
+changed, so the handlers' own writes end the loop. ``render_pre`` runs before every render,
+attaching the Doppler colour to materials added since Set Up. A handler never raises: a problem
+becomes the scene's warning and, for the exact camera, a black (never a wrong) image.
 """
 
 import bpy
