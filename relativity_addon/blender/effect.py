@@ -148,7 +148,7 @@ def object_changed(scene, obj):
 
 def _record(scene, snap):
     warnings = []
-    if scene.render.engine == "CYCLES" and getattr(scene.cycles, "device", "CPU") == "GPU":
+    if scene.render.engine == "CYCLES" and scene.cycles.device == "GPU":
         warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
     if snap.method == "CAMERA":
         camera_object = scene.objects.get(snap.camera)

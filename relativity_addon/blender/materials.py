@@ -410,9 +410,8 @@ def scene_materials(scene):
     """``(material, blackbody temperature or None)`` for every material used in ``scene``."""
     found = {}
     for obj in scene.objects:
-        object_settings = getattr(obj, "relativity", None)
-        temperature = getattr(object_settings, "temperature", 0.0) or None
-        for slot in getattr(obj, "material_slots", ()):
+        temperature = obj.relativity.temperature or None
+        for slot in obj.material_slots:
             if slot.material is not None:
                 found[slot.material] = found.get(slot.material) or temperature
     return list(found.items())

@@ -110,6 +110,7 @@ def ensure_modifier(obj):
     identifier = interface_identifier(group, "Tessellation")
     if compat.modifier_input(modifier, identifier) != int(obj.relativity.tessellation):
         compat.set_modifier_input(modifier, identifier, int(obj.relativity.tessellation))
+        obj.update_tag()  # a modifier input is no tagged property: re-evaluate before reading the rest
     enabled = bool(obj.relativity.enabled)
     if modifier.show_viewport != enabled or modifier.show_render != enabled:
         modifier.show_viewport = modifier.show_render = enabled
