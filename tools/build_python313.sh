@@ -25,7 +25,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
 apt-get source --download-only -qq python3.13
-tar xf python3.13_*.orig.tar.*
+tar xf python3.13_*.orig.tar.xz
 cd Python-3.13*/
 ./configure -q --prefix="$prefix" --with-ensurepip=install
 make -s -j"$(nproc)" >/dev/null
