@@ -31,6 +31,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 from mathutils import Matrix
 
+from . import compat
 from .camera import RelativityError
 
 # Half-width of the central difference, in frames. Small enough to be the instantaneous velocity
@@ -59,14 +60,9 @@ def _transform_fcurves(obj):
     animation_data = obj.animation_data
     if animation_data is None or animation_data.action is None:
         return {}
-    from bpy_extras import anim_utils
-
-    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
-    if channelbag is None:
-        return {}
     return {
         (fcurve.data_path, fcurve.array_index): fcurve
-        for fcurve in channelbag.fcurves
+        for fcurve in compat.action_fcurves(animation_data)
         if fcurve.data_path in TRANSFORM_PATHS and not fcurve.mute
         and (len(fcurve.keyframe_points) or len(fcurve.modifiers))
     }

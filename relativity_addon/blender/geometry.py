@@ -45,7 +45,7 @@ from bpy.app.handlers import persistent
 
 from ..physics import apparent
 from . import camera as camera_module
-from . import animation, compositing, materials
+from . import animation, compat, compositing, materials
 from .camera import RelativityError
 
 NODE_GROUP_NAME = "Relativity Apparent Geometry"
@@ -173,7 +173,7 @@ def cache_object(obj):
     modifier = find_modifier(obj)
     if modifier is None:
         return None
-    return modifier.get(_input_identifier(modifier.node_group, "Cache"))
+    return compat.modifier_input(modifier, _input_identifier(modifier.node_group, "Cache"))
 
 
 def _ensure_modifier(obj):
@@ -188,12 +188,12 @@ def _ensure_modifier(obj):
     if cache is None:
         mesh = bpy.data.meshes.new(f"{CACHE_PREFIX} {obj.name}")
         cache = bpy.data.objects.new(f"{CACHE_PREFIX} {obj.name}", mesh)
-        modifier[_input_identifier(group, "Cache")] = cache
+        compat.set_modifier_input(modifier, _input_identifier(group, "Cache"), cache)
     if cache.data.get(OWNER_KEY) != obj.name:
         cache.data[OWNER_KEY] = obj.name  # set on creation, and follows a rename
     identifier = _input_identifier(group, "Tessellation")
-    if modifier.get(identifier) != int(obj.relativity.tessellation):
-        modifier[identifier] = int(obj.relativity.tessellation)
+    if compat.modifier_input(modifier, identifier) != int(obj.relativity.tessellation):
+        compat.set_modifier_input(modifier, identifier, int(obj.relativity.tessellation))
     return modifier, cache
 
 

@@ -8,6 +8,8 @@ with Doppler colour and searchlight. Both images must show the same outline and 
 
 import numpy as np
 
+from relativity_addon.blender import compat
+
 import doppler_helpers as dh
 from doppler_helpers import ch
 
@@ -41,7 +43,7 @@ def test_eevee_shows_the_cycles_image(relativity_addon, factory_blender, tmp_pat
     bpy = factory_blender
     scene = _scene(bpy, relativity_addon)
     cycles = dh.render(bpy, scene, tmp_path / "cycles.exr")
-    scene.render.engine = "BLENDER_EEVEE"
+    scene.render.engine = compat.eevee_engine()
     scene.render.filter_size = 0.0  # one sample position per pixel, like Cycles' 1 px box filter
     eevee = dh.render(bpy, scene, tmp_path / "eevee.exr")
     assert np.all(np.isfinite(eevee)) and np.all(eevee >= 0)

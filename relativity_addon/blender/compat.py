@@ -1,0 +1,85 @@
+"""Every call that differs between the supported Blender lines (4.5 LTS and 5.2 LTS), in one place.
+
+Decided by feature detection (what the running Blender offers), not by version numbers, so a
+later release that keeps the newer API needs no change here. Each function is tested on both
+lines in ``tests/blender/test_compat.py`` (real ``bpy``).
+"""
+
+import bpy
+
+
+def _modifier_inputs(modifier):
+    """5.2+: a geometry-nodes modifier's inputs live in ``modifier.properties.inputs`` (RNA)."""
+    properties = getattr(modifier, "properties", None)
+    return getattr(properties, "inputs", None)
+
+
+def modifier_input(modifier, identifier):
+    """Value of a geometry-nodes modifier input (``identifier`` as in ``interface.items_tree``)."""
+    inputs = _modifier_inputs(modifier)
+    if inputs is not None:
+        return getattr(inputs, identifier).value
+    return modifier.get(identifier)  # 4.5: ID properties on the modifier
+
+
+def set_modifier_input(modifier, identifier, value):
+    inputs = _modifier_inputs(modifier)
+    if inputs is not None:
+        getattr(inputs, identifier).value = value
+    else:
+        modifier[identifier] = value
+
+
+def action_channelbag(animation_data):
+    """The channelbag (F-curves, groups) of the action slot assigned to ``animation_data``, or None.
+
+    4.5 lacks ``anim_utils.animdata_get_channelbag_for_assigned_slot``; the per-slot lookup
+    exists in 4.5 and 5.x alike."""
+    if animation_data is None or animation_data.action is None or animation_data.action_slot is None:
+        return None
+    from bpy_extras import anim_utils
+
+    return anim_utils.action_get_channelbag_for_slot(animation_data.action, animation_data.action_slot)
+
+
+def action_fcurves(animation_data):
+    """The F-curves of the action slot assigned to ``animation_data`` (empty if none)."""
+    channelbag = action_channelbag(animation_data)
+    return () if channelbag is None else channelbag.fcurves
+
+
+def _node_tree(owner):
+    # 5.x: materials and worlds always have a node tree (use_nodes is deprecated, do not touch it);
+    # 4.5: a new one has none until use_nodes is switched on.
+    if owner.node_tree is None:
+        owner.use_nodes = True
+    return owner.node_tree
+
+
+def world_node_tree(world):
+    """The world's shader node tree, creating Blender's default one (Background) where needed."""
+    return _node_tree(world)
+
+
+def material_node_tree(material):
+    """The material's shader node tree, creating Blender's default one (Principled) where needed."""
+    return _node_tree(material)
+
+
+def eevee_engine():
+    """Identifier of the EEVEE render engine ('BLENDER_EEVEE_NEXT' in 4.5, 'BLENDER_EEVEE' in 5.x)."""
+    engines = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
+    return "BLENDER_EEVEE" if "BLENDER_EEVEE" in engines else "BLENDER_EEVEE_NEXT"
+
+
+def has_compositor_node_groups():
+    """5.x: the scene's compositor is a node group (``scene.compositing_node_group``) ending in a
+    Group Output; 4.5 has the scene-owned ``scene.node_tree`` with a Composite node instead."""
+    return "compositing_node_group" in bpy.types.Scene.bl_rna.properties
+
+
+def compositor_tree(scene):
+    """The scene's compositor node tree or None (4.5: only while ``scene.use_nodes`` is on)."""
+    if has_compositor_node_groups():
+        return scene.compositing_node_group
+    return scene.node_tree if scene.use_nodes else None
