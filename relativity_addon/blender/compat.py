@@ -83,3 +83,65 @@ def compositor_tree(scene):
     if has_compositor_node_groups():
         return scene.compositing_node_group
     return scene.node_tree if scene.use_nodes else None
+
+
+def new_compositor_tree(scene, name):
+    """Give a scene with no compositor tree one that passes Render Layers to the output; return it.
+
+    5.x: a new node group ``name`` ending in a Group Output, assigned to the scene. 4.5: switches
+    ``scene.use_nodes`` on, which makes Blender's default scene-owned tree (Render Layers ->
+    Composite, and a Viewer) or re-enables the scene's existing one."""
+    if not has_compositor_node_groups():
+        scene.use_nodes = True
+        return scene.node_tree
+    tree = bpy.data.node_groups.new(name, "CompositorNodeTree")
+    tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    output = tree.nodes.new("NodeGroupOutput")
+    output.location = (400.0, 0.0)
+    tree.links.new(layers.outputs["Image"], output.inputs[0])
+    scene.compositing_node_group = tree
+    return tree
+
+
+def restore_compositor_tree(scene, name):
+    """Undo :func:`new_compositor_tree`: the tree named ``name`` ("" for none) is the scene's again
+    (4.5: the scene's own tree stays, ``use_nodes`` is restored)."""
+    if not has_compositor_node_groups():
+        scene.use_nodes = bool(name)
+        return
+    scene.compositing_node_group = bpy.data.node_groups.get(name) if name else None
+
+
+def map_uv_nearest():
+    """``(inputs, props)`` for a compositor Map UV node that reads the nearest texel.
+
+    5.x: the Interpolation menu socket; 4.5: the ``filter_type`` property (which offers only
+    nearest and anisotropic, no bilinear: callers interpolate themselves)."""
+    if "filter_type" in bpy.types.CompositorNodeMapUV.bl_rna.properties:
+        return {}, {"filter_type": "NEAREST"}
+    return {"Interpolation": "Nearest"}, {}
+
+
+def run_main(main):
+    """Run a script's ``main()`` and end the process with its exit status.
+
+    Blender 4.5's ``bpy`` wheel can deadlock in ``exit()``: a static destructor waits on its
+    delayed file-close thread (seen after rendering to a file, also after an error). There the
+    process flushes its output and leaves with ``os._exit``; 5.x exits normally."""
+    import os
+    import sys
+
+    try:
+        status = main()
+    except SystemExit as stop:  # argparse errors, explicit sys.exit
+        status = stop.code
+    if bpy.app.version >= (5, 0, 0):
+        sys.exit(status)
+    if not isinstance(status, int):
+        if status is not None:
+            print(status, file=sys.stderr)
+        status = 0 if status is None else 1
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)

@@ -87,3 +87,17 @@ def test_compositor_tree(factory_blender):
         scene.use_nodes = True
         tree = scene.node_tree
     assert compat.compositor_tree(scene) == tree
+
+
+def test_map_uv_nearest_settings_are_accepted(factory_blender):
+    bpy = factory_blender
+    tree = bpy.data.node_groups.new("Compat Compositing", "CompositorNodeTree")
+    node = tree.nodes.new("CompositorNodeMapUV")
+    inputs, props = compat.map_uv_nearest()
+    assert inputs or props
+    for name, value in inputs.items():
+        node.inputs[name].default_value = value
+        assert node.inputs[name].default_value == value
+    for name, value in props.items():
+        setattr(node, name, value)
+        assert getattr(node, name) == value
