@@ -60,7 +60,7 @@ setup() {  # setup X.Y: create .venv-X.Y and install requirements/blender-X.Y.tx
     local version=$1 venv=.venv-$1 requirements=requirements/blender-$1.txt want python
     if [ ! -x "$venv/bin/python" ]; then
         python=$(python_for "$version") || return 1
-        if ! works "$python" "$version"; then
+        if ! works "$python" "$(python_version "$version")"; then
             echo "error: Blender $version's bpy wheel needs CPython $(python_version "$version") with venv and ssl; none found (install python$(python_version "$version") or set PYTHON$(python_version "$version" | tr -d .))" >&2
             return 1
         fi

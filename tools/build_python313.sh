@@ -27,7 +27,10 @@ cd "$work"
 apt-get source --download-only -qq python3.13
 tar xf python3.13_*.orig.tar.xz
 cd Python-3.13*/
-./configure -q --prefix="$prefix" --with-ensurepip=install
-make -s -j"$(nproc)" >/dev/null
-make -s altinstall >/dev/null
+log=$work/build.log
+{ ./configure --prefix="$prefix" --with-ensurepip=install && make -j"$(nproc)" && make altinstall; } >"$log" 2>&1 || {
+    tail -n 40 "$log" >&2
+    echo "error: building CPython 3.13 failed (last lines above)" >&2
+    exit 1
+}
 "$prefix/bin/python3.13" -c "import ssl, venv, ensurepip, ctypes, lzma, bz2, zlib; import sys; print('built', sys.version)"
