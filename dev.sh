@@ -102,15 +102,16 @@ versions() {
 case "${1:-}" in
     demo)
         version=${BLENDER:-5.2}
-        versions >/dev/null
+        BLENDER=$version versions >/dev/null || exit 2
         setup "$version"
         ".venv-$version/bin/python" examples/demo_still.py --out out/demo.png
         ;;
     test)
         shift
+        chosen=$(versions) || exit 2
         failed=0
         summary=()
-        for version in $(versions); do
+        for version in $chosen; do
             echo "=== Blender $version ==="
             start=$SECONDS
             status=0
