@@ -17,7 +17,7 @@ import os
 import bpy
 from bpy.app.handlers import persistent
 
-from . import osl
+from . import compat, osl
 
 SHADER_TEXT_NAME = "relativistic_camera.osl"
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", SHADER_TEXT_NAME)
@@ -33,6 +33,7 @@ REQUIRED_PARAMETERS = (
     "frame_bottom",
     "frame_top",
     "lens_focal_length",
+    "aperture_scale",
     "beta",
     "speed_of_light",
     "shutter_model",
@@ -178,6 +179,7 @@ def shader_parameters(scene, camera_object):
         "frame_bottom": bottom,
         "frame_top": top,
         "lens_focal_length": camera_data.lens * 1e-3 / unit_scale,
+        "aperture_scale": compat.custom_camera_aperture_scale(camera_data.lens * 1e-3 / unit_scale),
         "beta": _local_to_shader(beta_local),
         "speed_of_light": settings.speed_of_light,
         "shutter_model": list(_shutter_models()).index(settings.shutter_model),

@@ -145,3 +145,20 @@ def run_main(main):
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(status)
+
+
+def custom_property_keys(owner):
+    """Names of the user's custom (ID) properties on ``owner``.
+
+    4.5 also lists there the storage of registered properties (``relativity``, ``cycles``, ...);
+    5.x keeps those apart."""
+    rna_properties = owner.bl_rna.properties
+    return [key for key in owner.keys() if key not in rna_properties]
+
+
+def custom_camera_aperture_scale(focal_length):
+    """Factor from Cycles' custom-camera ``cam:aperture_position`` to scene units.
+
+    5.x samples the aperture for a unit focal length (radius ``1 / (2 f-stop)``), 4.5 in scene
+    units (radius ``focal length / (2 f-stop)``). No API tells the two apart: decided by version."""
+    return focal_length if bpy.app.version >= (5, 0, 0) else 1.0

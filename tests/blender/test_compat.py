@@ -101,3 +101,10 @@ def test_map_uv_nearest_settings_are_accepted(factory_blender):
     for name, value in props.items():
         setattr(node, name, value)
         assert getattr(node, name) == value
+
+
+def test_custom_property_keys_are_the_users_only(relativity_addon, factory_blender):
+    scene = factory_blender.context.scene
+    scene.relativity.beta = (0.0, 0.5, 0.0)  # stored in an ID property on 4.5, apart on 5.x
+    scene["user_key"] = 1
+    assert compat.custom_property_keys(scene) == ["user_key"]

@@ -30,15 +30,15 @@ def _signature(bpy, scene):
         return nodes, links, drivers, tree.animation_data is not None
 
     return {
-        "materials": {m.name: (tree_signature(m.node_tree), sorted(m.keys())) for m in bpy.data.materials},
-        "worlds": {w.name: (tree_signature(w.node_tree), sorted(w.keys())) for w in bpy.data.worlds},
+        "materials": {m.name: (tree_signature(m.node_tree), sorted(compat.custom_property_keys(m)))
+                      for m in bpy.data.materials},
+        "worlds": {w.name: (tree_signature(w.node_tree), sorted(compat.custom_property_keys(w))) for w in bpy.data.worlds},
         "compositor": (compat.compositor_tree(scene).name if compat.compositor_tree(scene) else None,
                        tree_signature(compat.compositor_tree(scene)), scene.render.use_compositing),
         "aovs": {v.name: sorted(a.name for a in v.aovs) for v in scene.view_layers},
         "node_groups": sorted(g.name for g in bpy.data.node_groups),
         "images": sorted(i.name for i in bpy.data.images),
-        # (Blender 4.5 lists the storage of registered property groups, 'relativity' included, here)
-        "scene_keys": sorted(key for key in scene.keys() if key != "relativity"),
+        "scene_keys": sorted(compat.custom_property_keys(scene)),
     }
 
 

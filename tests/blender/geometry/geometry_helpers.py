@@ -98,7 +98,7 @@ def file_fingerprint(bpy):
     modifiers, constraints, ID properties), every mesh (vertices, attributes, ID properties), the
     node groups, and the scene frame."""
     def idprops(owner):
-        return repr(sorted((key, repr(owner[key])) for key in owner.keys()))
+        return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
     objects = [(o.name, tuple(map(tuple, o.matrix_world)), o.parent.name if o.parent else "", repr(o.data),
                 [(m.name, m.type, m.show_viewport) for m in o.modifiers], [c.name for c in o.constraints], idprops(o))

@@ -11,6 +11,8 @@ import os
 import numpy as np
 import pytest
 
+from relativity_addon.blender import compat
+
 import workflow_helpers as wh
 
 
@@ -66,7 +68,7 @@ def draw_panel(bpy, idname, scene, obj=None):
 def fingerprint(bpy):
     """Everything the add-on may touch, as one string (compared before apply and after remove)."""
     def idprops(owner):
-        return repr(sorted((key, repr(owner[key])) for key in owner.keys()))
+        return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
     cameras = []
     for data in bpy.data.cameras:
