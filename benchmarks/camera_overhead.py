@@ -94,4 +94,6 @@ def main():
               f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
 
 if __name__ == "__main__":
-    main()
+    from relativity_addon.blender import compat
+
+    compat.run_main(main)

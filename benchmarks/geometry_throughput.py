@@ -186,4 +186,6 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    from relativity_addon.blender import compat
+
+    compat.run_main(main)

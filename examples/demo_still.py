@@ -117,4 +117,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from relativity_addon.blender import compat
+
+    compat.run_main(main)

@@ -28,6 +28,7 @@ sys.path[:0] = [str(REPO_ROOT), str(EXAMPLES_DIR)]
 
 import scenes  # noqa: E402
 from relativity_addon import batch  # noqa: E402
+from relativity_addon.blender import compat  # noqa: E402
 
 EYE_HEIGHT = 1.6  # metres
 BLOCK_COLOURS = (scenes.RED, scenes.GREEN, scenes.BLUE, scenes.YELLOW, (0.7, 0.7, 0.7))
@@ -73,8 +74,6 @@ def keyframe_camera(scene, camera, frames, c, beta_max, searchlight):
     brightening straight ahead (D = sqrt((1 + beta) / (1 - beta))), partly, as a camera operator
     would: -0.75 log2(D^4) stops, keyframed so that every frame renders alone the same.
     """
-    from bpy_extras import anim_utils
-
     fps = scene.render.fps / scene.render.fps_base
     t_cruise = 0.6 * (frames - 1) / fps
     u_max = beta_max / math.sqrt(1.0 - beta_max * beta_max)
@@ -83,7 +82,7 @@ def keyframe_camera(scene, camera, frames, c, beta_max, searchlight):
     for frame, y in enumerate(positions, start=1):
         camera.location = (0.0, y, EYE_HEIGHT)
         camera.keyframe_insert("location", frame=frame)
-    for fcurve in anim_utils.animdata_get_channelbag_for_assigned_slot(camera.animation_data).fcurves:
+    for fcurve in compat.action_fcurves(camera.animation_data):
         for point in fcurve.keyframe_points:
             point.interpolation = "LINEAR"
     if searchlight:
@@ -164,4 +163,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    compat.run_main(main)

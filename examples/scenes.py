@@ -8,6 +8,8 @@ import bmesh
 import bpy
 from mathutils import Vector
 
+from relativity_addon.blender import compat
+
 # Colours are linear Rec.709 base colours.
 RED = (0.8, 0.06, 0.05)
 GREEN = (0.08, 0.6, 0.12)
@@ -34,7 +36,7 @@ def _mesh_from_bmesh(name, build):
 
 def principled_material(name, base_color, roughness=0.4):
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    compat.material_node_tree(material)
     bsdf = material.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*base_color, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
@@ -56,7 +58,7 @@ def checker_material(name, color1=(0.8, 0.8, 0.8), color2=(0.05, 0.05, 0.05), sc
 def emission_material(name, color, strength):
     """Emission only; ``strength`` in W/m^2 as Blender's Emission node defines it."""
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    compat.material_node_tree(material)
     nodes, links = material.node_tree.nodes, material.node_tree.links
     nodes.remove(nodes["Principled BSDF"])
     emission = nodes.new("ShaderNodeEmission")
@@ -116,7 +118,7 @@ def add_camera(scene, location, target, lens_mm=28.0):
 def set_world_color(scene, color, strength=1.0):
     world = scene.world or bpy.data.worlds.new("World")
     scene.world = world
-    world.use_nodes = True
+    compat.world_node_tree(world)
     background = world.node_tree.nodes["Background"]
     background.inputs["Color"].default_value = (*color, 1.0)
     background.inputs["Strength"].default_value = strength

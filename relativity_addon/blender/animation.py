@@ -17,6 +17,7 @@ from mathutils import Matrix
 
 from ..errors import RelativityError
 from ..physics import transforms
+from . import compat
 
 
 def frames_per_second(scene):
@@ -38,14 +39,9 @@ def _transform_fcurves(obj):
     animation_data = obj.animation_data
     if animation_data is None or animation_data.action is None:
         return {}
-    from bpy_extras import anim_utils
-
-    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(animation_data)
-    if channelbag is None:
-        return {}
     return {
         (fcurve.data_path, fcurve.array_index): fcurve
-        for fcurve in channelbag.fcurves
+        for fcurve in compat.action_fcurves(animation_data)
         if fcurve.data_path in TRANSFORM_PATHS and not fcurve.mute
         and (len(fcurve.keyframe_points) or len(fcurve.modifiers))
     }

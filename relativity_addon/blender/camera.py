@@ -16,7 +16,7 @@ import os
 import bpy
 
 from ..errors import RelativityError
-from . import names, osl
+from . import compat, names, osl
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.SHADER_TEXT)
 
@@ -27,6 +27,7 @@ REQUIRED_PARAMETERS = (
     "frame_bottom",
     "frame_top",
     "lens_focal_length",
+    "aperture_scale",
     "beta",
     "speed_of_light",
     "shutter_model",
@@ -99,6 +100,7 @@ def shader_parameters(scene, camera_data, snap):
         "frame_bottom": bottom,
         "frame_top": top,
         "lens_focal_length": camera_data.lens * 1e-3 / unit_scale,
+        "aperture_scale": compat.custom_camera_aperture_scale(camera_data.lens * 1e-3 / unit_scale),
         "beta": _local_to_shader(snap.beta_camera),
         "speed_of_light": snap.speed_of_light,
         "shutter_model": snap.shutter_code,

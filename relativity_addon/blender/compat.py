@@ -1,17 +1,164 @@
-"""Every call that differs between the supported Blender lines (4.5 LTS and 5.2 LTS)."""
+"""Every call that differs between the supported Blender lines (4.5 LTS and 5.2 LTS), in one place.
+
+Decided by feature detection (what the running Blender offers), not by version numbers, so a
+later release that keeps the newer API needs no change here. Each function is tested on both
+lines in ``tests/blender/test_compat.py`` (real ``bpy``).
+"""
+
+import bpy
+
+
+def _modifier_inputs(modifier):
+    """5.2+: a geometry-nodes modifier's inputs live in ``modifier.properties.inputs`` (RNA)."""
+    properties = getattr(modifier, "properties", None)
+    return getattr(properties, "inputs", None)
 
 
 def modifier_input(modifier, identifier):
-    """A geometry-nodes modifier's input value (ID properties up to 5.1, ``properties`` after)."""
-    properties = getattr(modifier, "properties", None)
-    if properties is not None and hasattr(properties, "inputs"):
-        return getattr(properties.inputs, identifier).value
-    return modifier.get(identifier)
+    """Value of a geometry-nodes modifier input (``identifier`` as in ``interface.items_tree``)."""
+    inputs = _modifier_inputs(modifier)
+    if inputs is not None:
+        return getattr(inputs, identifier).value
+    return modifier.get(identifier)  # 4.5: ID properties on the modifier
 
 
 def set_modifier_input(modifier, identifier, value):
-    properties = getattr(modifier, "properties", None)
-    if properties is not None and hasattr(properties, "inputs"):
-        getattr(properties.inputs, identifier).value = value
+    inputs = _modifier_inputs(modifier)
+    if inputs is not None:
+        getattr(inputs, identifier).value = value
     else:
         modifier[identifier] = value
+
+
+def action_channelbag(animation_data):
+    """The channelbag (F-curves, groups) of the action slot assigned to ``animation_data``, or None.
+
+    4.5 lacks ``anim_utils.animdata_get_channelbag_for_assigned_slot``; the per-slot lookup
+    exists in 4.5 and 5.x alike."""
+    if animation_data is None or animation_data.action is None or animation_data.action_slot is None:
+        return None
+    from bpy_extras import anim_utils
+
+    return anim_utils.action_get_channelbag_for_slot(animation_data.action, animation_data.action_slot)
+
+
+def action_fcurves(animation_data):
+    """The F-curves of the action slot assigned to ``animation_data`` (empty if none)."""
+    channelbag = action_channelbag(animation_data)
+    return () if channelbag is None else channelbag.fcurves
+
+
+def _node_tree(owner):
+    # 5.x: materials and worlds always have a node tree (use_nodes is deprecated, do not touch it);
+    # 4.5: a new one has none until use_nodes is switched on.
+    if owner.node_tree is None:
+        owner.use_nodes = True
+    return owner.node_tree
+
+
+def world_node_tree(world):
+    """The world's shader node tree, creating Blender's default one (Background) where needed."""
+    return _node_tree(world)
+
+
+def material_node_tree(material):
+    """The material's shader node tree, creating Blender's default one (Principled) where needed."""
+    return _node_tree(material)
+
+
+def eevee_engine():
+    """Identifier of the EEVEE render engine ('BLENDER_EEVEE_NEXT' in 4.5, 'BLENDER_EEVEE' in 5.x)."""
+    engines = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
+    return "BLENDER_EEVEE" if "BLENDER_EEVEE" in engines else "BLENDER_EEVEE_NEXT"
+
+
+def has_compositor_node_groups():
+    """5.x: the scene's compositor is a node group (``scene.compositing_node_group``) ending in a
+    Group Output; 4.5 has the scene-owned ``scene.node_tree`` with a Composite node instead."""
+    return "compositing_node_group" in bpy.types.Scene.bl_rna.properties
+
+
+def compositor_tree(scene):
+    """The scene's compositor node tree or None (4.5: only while ``scene.use_nodes`` is on)."""
+    if has_compositor_node_groups():
+        return scene.compositing_node_group
+    return scene.node_tree if scene.use_nodes else None
+
+
+def new_compositor_tree(scene, name):
+    """Give a scene with no compositor tree one that passes Render Layers to the output; return it.
+
+    5.x: a new node group ``name`` ending in a Group Output, assigned to the scene. 4.5: switches
+    ``scene.use_nodes`` on, which makes Blender's default scene-owned tree (Render Layers ->
+    Composite, and a Viewer) or re-enables the scene's existing one."""
+    if not has_compositor_node_groups():
+        scene.use_nodes = True
+        return scene.node_tree
+    tree = bpy.data.node_groups.new(name, "CompositorNodeTree")
+    tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    output = tree.nodes.new("NodeGroupOutput")
+    output.location = (400.0, 0.0)
+    tree.links.new(layers.outputs["Image"], output.inputs[0])
+    scene.compositing_node_group = tree
+    return tree
+
+
+def restore_compositor_tree(scene, name):
+    """Undo :func:`new_compositor_tree`: the tree named ``name`` ("" for none) is the scene's again
+    (4.5: the scene's own tree stays, ``use_nodes`` is restored)."""
+    if not has_compositor_node_groups():
+        scene.use_nodes = bool(name)
+        return
+    scene.compositing_node_group = bpy.data.node_groups.get(name) if name else None
+
+
+def map_uv_nearest():
+    """``(inputs, props)`` for a compositor Map UV node that reads the nearest texel.
+
+    5.x: the Interpolation menu socket; 4.5: the ``filter_type`` property (which offers only
+    nearest and anisotropic, no bilinear: callers interpolate themselves)."""
+    if "filter_type" in bpy.types.CompositorNodeMapUV.bl_rna.properties:
+        return {}, {"filter_type": "NEAREST"}
+    return {"Interpolation": "Nearest"}, {}
+
+
+def run_main(main):
+    """Run a script's ``main()`` and end the process with its exit status.
+
+    Blender 4.5's ``bpy`` wheel can deadlock in ``exit()``: a static destructor waits on its
+    delayed file-close thread (seen after rendering to a file, also after an error). There the
+    process flushes its output and leaves with ``os._exit``; 5.x exits normally."""
+    import os
+    import sys
+
+    try:
+        status = main()
+    except SystemExit as stop:  # argparse errors, explicit sys.exit
+        status = stop.code
+    if bpy.app.version >= (5, 0, 0):
+        sys.exit(status)
+    if not isinstance(status, int):
+        if status is not None:
+            print(status, file=sys.stderr)
+        status = 0 if status is None else 1
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)
+
+
+def custom_property_keys(owner):
+    """Names of the user's custom (ID) properties on ``owner``.
+
+    4.5 also lists there the storage of registered properties (``relativity``, ``cycles``, ...);
+    5.x keeps those apart."""
+    rna_properties = owner.bl_rna.properties
+    return [key for key in owner.keys() if key not in rna_properties]
+
+
+def custom_camera_aperture_scale(focal_length):
+    """Factor from Cycles' custom-camera ``cam:aperture_position`` to scene units.
+
+    5.x samples the aperture for a unit focal length (radius ``1 / (2 f-stop)``), 4.5 in scene
+    units (radius ``focal length / (2 f-stop)``). No API tells the two apart: decided by version."""
+    return focal_length if bpy.app.version >= (5, 0, 0) else 1.0

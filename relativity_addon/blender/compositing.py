@@ -13,8 +13,8 @@ spectral Doppler matrix per pixel after the render, with no second render:
 - ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),
   and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
   (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
-  with Map UV (bilinear, extend), ``E = a(D)`` with searchlight and Doppler, ``4 ln D`` without
-  Doppler (``1 ln D`` for Chang et al.'s comparison). All exponents are added before one
+  with Map UV (linear between the two nearest texels, clamped at the ends), ``E = a(D)`` with
+  searchlight and Doppler, ``4 ln D`` without Doppler (``1 ln D`` for Chang et al.'s comparison). All exponents are added before one
   ``exp`` so that nothing overflows float32.
 - Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
   written by ``materials``) keep their rendered colour.
@@ -25,7 +25,7 @@ created if the scene has none); :func:`remove_colour_stage` restores the composi
 
 import bpy
 
-from . import luts, materials, names
+from . import compat, luts, materials, names
 from .nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
 
 COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
@@ -41,25 +41,43 @@ def compositor_group():
     nodes.update({
         # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group)
         "ln_d": fmath("ADD", "group.Log Doppler", 0.0),
-        "u": fmath("MULTIPLY_ADD", "ln_d", scale / materials.LN10, offset),
+        # Linear interpolation between the two nearest texels, done here with two nearest-texel
+        # reads (Blender 4.5's Map UV has no bilinear mode nor an Extend border): x is the texel
+        # coordinate, clamped to the table (= Extend), i0 the left texel, at most size - 2.
+        "x_raw": fmath("MULTIPLY_ADD", "ln_d", scale * luts.LUT_SIZE / materials.LN10, offset * luts.LUT_SIZE - 0.5),
+        "x_low": fmath("MAXIMUM", "x_raw", 0.0),
+        "x": fmath("MINIMUM", "x_low", luts.LUT_SIZE - 1.0),
+        "i_floor": fmath("FLOOR", "x"),
+        "i0": fmath("MINIMUM", "i_floor", luts.LUT_SIZE - 2.0),
+        "frac": fmath("SUBTRACT", "x", "i0"),
+        "u0": fmath("MULTIPLY_ADD", "i0", 1.0 / luts.LUT_SIZE, 0.5 / luts.LUT_SIZE),
+        "u1": fmath("ADD", "u0", 1.0 / luts.LUT_SIZE),
         "lut": Node("CompositorNodeImage", props={"image": luts.DOPPLER_LUT_NAME}),
     })
+    map_inputs, map_props = compat.map_uv_nearest()
     for row in range(3):
-        nodes[f"uv{row}"] = Node("ShaderNodeCombineXYZ", {0: "u", 1: (row + 0.5) / 3.0, 2: 1.0})  # z: UV alpha
-        nodes[f"row{row}"] = Node("CompositorNodeMapUV", {
-            "Image": "lut.Image", "UV": f"uv{row}", "Interpolation": Menu("Bilinear"),
-            "Extension X": Menu("Extend"), "Extension Y": Menu("Extend"),
-        })
-        nodes[f"dot{row}"] = vmath("DOT_PRODUCT", f"row{row}", "group.Image")
+        for side in "01":
+            texel = f"row{row}_{side}"
+            # z: UV alpha
+            nodes[f"uv{texel}"] = Node("ShaderNodeCombineXYZ", {0: f"u{side}", 1: (row + 0.5) / 3.0, 2: 1.0})
+            nodes[texel] = Node("CompositorNodeMapUV", {
+                "Image": "lut.Image", "UV": f"uv{texel}", **{key: Menu(value) for key, value in map_inputs.items()},
+            }, map_props)
+            nodes[f"dot{texel}"] = vmath("DOT_PRODUCT", texel, "group.Image")
+        nodes[f"step{row}"] = fmath("SUBTRACT", f"dotrow{row}_1.Value", f"dotrow{row}_0.Value")
+        nodes[f"dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"step{row}", f"dotrow{row}_0.Value")
     nodes.update({
-        "row0_split": Node("CompositorNodeSeparateColor", {0: "row0"}),
+        "row0_split0": Node("CompositorNodeSeparateColor", {0: "row0_0"}),
+        "row0_split1": Node("CompositorNodeSeparateColor", {0: "row0_1"}),
+        "alpha_step": fmath("SUBTRACT", "row0_split1.Alpha", "row0_split0.Alpha"),
+        "alpha": fmath("MULTIPLY_ADD", "frac", "alpha_step", "row0_split0.Alpha"),
         "product": Node("ShaderNodeCombineXYZ", {0: "dot0.Value", 1: "dot1.Value", 2: "dot2.Value"}),
         "mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: "product"}, kind="CompositorNodeGroup"),
         "base": Node("ShaderNodeMix", {"Factor": "group.Use Doppler", 4: "group.Image", 5: "mapped"},
                      {"data_type": "VECTOR"}),
         "power": fmath("SUBTRACT", "group.Power of D", "group.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
-        "log_gain": fmath("MULTIPLY_ADD", "row0_split.Alpha", "group.Spectral Searchlight", "power_term"),
+        "log_gain": fmath("MULTIPLY_ADD", "alpha", "group.Spectral Searchlight", "power_term"),
         "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
         "gain": fmath("EXPONENT", "safe_log_gain"),
         "shifted": vmath("SCALE", "base.Result", scale="gain"),
@@ -98,7 +116,7 @@ def colour_stage_values(snap):
 
 
 def _inserted_nodes(scene):
-    tree = scene.compositing_node_group
+    tree = compat.compositor_tree(scene)
     if tree is None or not is_applied(scene):
         return tree, []
     names = [record["group_node"] for record in scene[SAVED_KEY]["inserted"]]
@@ -134,21 +152,15 @@ def apply_colour_stage(scene, snap):
     group = ensure_compositor_group()
     if not is_applied(scene):
         saved = {
-            "tree": scene.compositing_node_group.name if scene.compositing_node_group else "",
+            "tree": compat.compositor_tree(scene).name if compat.compositor_tree(scene) else "",
             "use_compositing": scene.render.use_compositing,
             "added_aovs": [],
             "inserted": [],
             "created_tree": "",
         }
-        tree = scene.compositing_node_group
+        tree = compat.compositor_tree(scene)
         if tree is None:
-            tree = bpy.data.node_groups.new(SCENE_TREE_NAME, "CompositorNodeTree")
-            tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
-            layers = tree.nodes.new("CompositorNodeRLayers")
-            output = tree.nodes.new("NodeGroupOutput")
-            output.location = (400.0, 0.0)
-            tree.links.new(layers.outputs["Image"], output.inputs[0])
-            scene.compositing_node_group = tree
+            tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
         for view_layer in scene.view_layers:
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV):
@@ -183,7 +195,7 @@ def remove_colour_stage(scene):
     if not is_applied(scene):
         return False
     saved = scene[SAVED_KEY].to_dict()
-    tree = scene.compositing_node_group
+    tree = compat.compositor_tree(scene)
     if tree is not None:
         for record in saved["inserted"]:
             node = tree.nodes.get(record["group_node"])
@@ -201,7 +213,7 @@ def remove_colour_stage(scene):
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:
             view_layer.aovs.remove(view_layer.aovs[aov_name])
-    scene.compositing_node_group = bpy.data.node_groups.get(saved["tree"]) if saved["tree"] else None
+    compat.restore_compositor_tree(scene, saved["tree"])
     if saved["created_tree"]:
         created = bpy.data.node_groups.get(saved["created_tree"])
         if created is not None and created.users == 0:

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from relativity_addon.blender import compat
+
 REPO_ROOT = Path(__file__).resolve().parents[3]
 RENDER_SCRIPT = REPO_ROOT / "examples" / "render.py"
 
@@ -136,7 +138,7 @@ def expected_sphere_centroid(camera, center, radius, beta, samples=720):
 
 def emission_material(bpy, name="Emitter", strength=1.0):
     material = bpy.data.materials.new(name)
-    tree = material.node_tree
+    tree = compat.material_node_tree(material)
     tree.nodes.clear()
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.inputs["Strength"].default_value = strength
@@ -161,7 +163,7 @@ def reset_cycles_scene(bpy, resolution, samples):
     scene.view_settings.view_transform = "Standard"
     world = bpy.data.worlds.new("Black")
     world.color = (0.0, 0.0, 0.0)
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    compat.world_node_tree(world).nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     return scene
 

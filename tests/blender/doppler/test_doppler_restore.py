@@ -11,6 +11,10 @@ import numpy as np
 
 import doppler_helpers as dh
 from doppler_helpers import ch
+from relativity_addon.blender import compat
+
+# End of a worker script: bpy 4.5 can hang in exit() (see compat.run_main), so leave with os._exit.
+EXIT_WORKER = "import os\nsys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"
 
 
 def _signature(bpy, scene):
@@ -25,14 +29,16 @@ def _signature(bpy, scene):
         return nodes, links, drivers, tree.animation_data is not None
 
     return {
-        "materials": {m.name: (tree_signature(m.node_tree), sorted(m.keys())) for m in bpy.data.materials},
-        "worlds": {w.name: (tree_signature(w.node_tree), sorted(w.keys())) for w in bpy.data.worlds},
-        "compositor": (scene.compositing_node_group.name if scene.compositing_node_group else None,
-                       tree_signature(scene.compositing_node_group), scene.render.use_compositing),
+        "materials": {m.name: (tree_signature(m.node_tree), sorted(compat.custom_property_keys(m)))
+                      for m in bpy.data.materials},
+        "worlds": {w.name: (tree_signature(w.node_tree), sorted(compat.custom_property_keys(w)))
+                   for w in bpy.data.worlds},
+        "compositor": (compat.compositor_tree(scene).name if compat.compositor_tree(scene) else None,
+                       tree_signature(compat.compositor_tree(scene)), scene.render.use_compositing),
         "aovs": {v.name: sorted(a.name for a in v.aovs) for v in scene.view_layers},
         "node_groups": sorted(g.name for g in bpy.data.node_groups),
         "images": sorted(i.name for i in bpy.data.images),
-        "scene_keys": sorted(scene.keys()),
+        "scene_keys": sorted(compat.custom_property_keys(scene)),
     }
 
 
@@ -41,14 +47,21 @@ def _scene_with_user_compositor(bpy):
     dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.3, 0.6, 0.2), beta=None)
     dh.add_emitter_plane(bpy, scene, "Sun", (-0.5, 0.5), (-0.5, 0.5), beta=None, temperature=5762.0, depth=4.0)
     # The user's own compositor: Render Layers -> Exposure -> output.
-    tree = bpy.data.node_groups.new("User Compositing", "CompositorNodeTree")
-    tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    if compat.has_compositor_node_groups():
+        tree = bpy.data.node_groups.new("User Compositing", "CompositorNodeTree")
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+        output = tree.nodes.new("NodeGroupOutput")
+        scene.compositing_node_group = tree
+    else:  # Blender 4.5: the scene's own tree, ending in a Composite node
+        scene.use_nodes = True
+        tree = scene.node_tree
+        tree.nodes.clear()
+        output = tree.nodes.new("CompositorNodeComposite")
+        bpy.data.images.remove(bpy.data.images["Viewer Node"])  # made for the default tree's Viewer
     layers = tree.nodes.new("CompositorNodeRLayers")
     exposure = tree.nodes.new("CompositorNodeExposure")
-    output = tree.nodes.new("NodeGroupOutput")
     tree.links.new(layers.outputs["Image"], exposure.inputs["Image"])
     tree.links.new(exposure.outputs["Image"], output.inputs[0])
-    scene.compositing_node_group = tree
     scene.render.use_compositing = False
     return scene, camera
 
@@ -63,8 +76,8 @@ def test_apply_then_remove_restores_everything(relativity_addon, factory_blender
     effect.apply(scene)
     applied = _signature(bpy, scene)
     assert applied != before
-    user_tree = bpy.data.node_groups["User Compositing"]
-    assert scene.compositing_node_group == user_tree  # the user's tree is kept, the stage inserted
+    user_tree = compat.compositor_tree(scene)
+    assert user_tree is not None and user_tree.name == before["compositor"][0]  # the user's tree, kept
     assert any(n.bl_idname == "CompositorNodeGroup" for n in user_tree.nodes)
     assert scene.render.use_compositing
     # Applying twice changes nothing more.
@@ -96,6 +109,7 @@ def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, fa
         "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
         f"scene.render.filepath = {str(tmp_path / 'plain.exr')!r}\n"
         "bpy.ops.render.render(write_still=True)\n"
+        + EXIT_WORKER
     )
     result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
@@ -138,6 +152,7 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
         "except effect.RelativityError as error:\n"
         "    print('ERROR:' + str(error))\n"
         f"bpy.ops.wm.save_as_mainfile(filepath={str(tmp_path / 'after.blend')!r})\n"
+        + EXIT_WORKER
     )
     result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]

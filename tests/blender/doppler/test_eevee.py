@@ -10,6 +10,7 @@ import numpy as np
 
 import doppler_helpers as dh
 from doppler_helpers import ch
+from relativity_addon.blender import compat
 
 C = 5.0
 
@@ -42,7 +43,7 @@ def test_eevee_shows_the_cycles_image(relativity_addon, factory_blender, tmp_pat
     bpy = factory_blender
     scene = _scene(bpy, relativity_addon)
     cycles = dh.render(bpy, scene, tmp_path / "cycles.exr")
-    scene.render.engine = "BLENDER_EEVEE"
+    scene.render.engine = compat.eevee_engine()
     scene.render.filter_size = 0.0  # one sample position per pixel, like Cycles' 1 px box filter
     eevee = dh.render(bpy, scene, tmp_path / "eevee.exr")
     assert np.all(np.isfinite(eevee)) and np.all(eevee >= 0)

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from relativity_addon.blender import compat
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402
 from blender_support import ADDON_MODULE  # noqa: E402
@@ -110,7 +112,7 @@ def file_fingerprint(bpy):
     modifiers, constraints, ID properties), every mesh (vertices, attributes, ID properties), the
     node groups, and the scene frame."""
     def idprops(owner):
-        return repr(sorted((key, repr(owner[key])) for key in owner.keys()))
+        return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
     objects = [(o.name, tuple(map(tuple, o.matrix_world)), o.parent.name if o.parent else "", repr(o.data),
                 [(m.name, m.type, m.show_viewport) for m in o.modifiers], [c.name for c in o.constraints], idprops(o))
@@ -156,13 +158,11 @@ def draw_object_panel(bpy, scene, obj):
 def keyframe_linear(obj, path, index, points):
     """Keys ``(frame, value)`` on ``obj.<path>[index]`` with linear interpolation and extrapolation.
     Returns the F-curve."""
-    from bpy_extras import anim_utils
-
     for frame, value in points:
         getattr(obj, path)[index] = value
         obj.keyframe_insert(path, index=index, frame=frame)
-    bag = anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data)
-    fcurve = next(f for f in bag.fcurves if f.data_path == path and f.array_index == index)
+    fcurve = next(f for f in compat.action_fcurves(obj.animation_data)
+                  if f.data_path == path and f.array_index == index)
     for point in fcurve.keyframe_points:
         point.interpolation = "LINEAR"
     fcurve.extrapolation = "LINEAR"

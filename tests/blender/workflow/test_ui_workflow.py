@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import workflow_helpers as wh
+from relativity_addon.blender import compat
 
 
 class RecordingLayout:
@@ -66,7 +67,7 @@ def draw_panel(bpy, idname, scene, obj=None):
 def fingerprint(bpy):
     """Everything the add-on may touch, as one string (compared before apply and after remove)."""
     def idprops(owner):
-        return repr(sorted((key, repr(owner[key])) for key in owner.keys()))
+        return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
     cameras = []
     for data in bpy.data.cameras:

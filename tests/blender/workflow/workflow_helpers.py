@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from relativity_addon.blender import compat
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402
 
@@ -50,10 +52,7 @@ def keyframe_camera_path(camera, frames_and_positions, interpolation="LINEAR"):
     for frame, position in frames_and_positions:
         camera.location = position
         camera.keyframe_insert("location", frame=frame)
-    from bpy_extras import anim_utils
-
-    channelbag = anim_utils.animdata_get_channelbag_for_assigned_slot(camera.animation_data)
-    for fcurve in channelbag.fcurves:
+    for fcurve in compat.action_fcurves(camera.animation_data):
         for point in fcurve.keyframe_points:
             point.interpolation = interpolation
 

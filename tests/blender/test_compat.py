@@ -1,0 +1,110 @@
+"""relativity_addon.blender.compat on the running Blender (each supported line runs this file)."""
+
+import pytest
+
+from relativity_addon.blender import compat
+
+
+def _nodes_modifier(bpy):
+    group = bpy.data.node_groups.new("Compat Group", "GeometryNodeTree")
+    group.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    cache = group.interface.new_socket("Cache", in_out="INPUT", socket_type="NodeSocketObject")
+    count = group.interface.new_socket("Count", in_out="INPUT", socket_type="NodeSocketInt")
+    group.links.new(group.nodes.new("NodeGroupInput").outputs[0], group.nodes.new("NodeGroupOutput").inputs[0])
+    obj = bpy.data.objects.new("Carrier", bpy.data.meshes.new("Carrier"))
+    bpy.context.scene.collection.objects.link(obj)
+    modifier = obj.modifiers.new("Compat", "NODES")
+    modifier.node_group = group
+    return modifier, cache.identifier, count.identifier
+
+
+def test_modifier_inputs_read_and_write(factory_blender):
+    bpy = factory_blender
+    modifier, cache_id, count_id = _nodes_modifier(bpy)
+    target = bpy.data.objects.new("Target", None)
+    assert compat.modifier_input(modifier, cache_id) is None
+    compat.set_modifier_input(modifier, cache_id, target)
+    compat.set_modifier_input(modifier, count_id, 7)
+    assert compat.modifier_input(modifier, cache_id) == target
+    assert compat.modifier_input(modifier, count_id) == 7
+    # Blender sees the value: the object is used by the modifier (one more user than before).
+    users = target.users
+    compat.set_modifier_input(modifier, cache_id, None)
+    assert target.users == users - 1
+    assert compat.modifier_input(modifier, cache_id) is None
+
+
+def test_action_fcurves_of_the_assigned_slot(factory_blender):
+    bpy = factory_blender
+    obj = bpy.data.objects.new("Moving", None)
+    bpy.context.scene.collection.objects.link(obj)
+    assert tuple(compat.action_fcurves(obj.animation_data)) == ()
+    obj.location = (0.0, 0.0, 0.0)
+    obj.keyframe_insert("location", frame=1)
+    obj.location = (3.0, 0.0, 0.0)
+    obj.keyframe_insert("location", frame=11)
+    curves = {(f.data_path, f.array_index): f for f in compat.action_fcurves(obj.animation_data)}
+    assert set(curves) == {("location", 0), ("location", 1), ("location", 2)}
+    assert curves["location", 0].evaluate(11) == pytest.approx(3.0)
+    assert compat.action_channelbag(obj.animation_data).fcurves[0] == curves["location", 0]
+    # Another object with its own action sees only its own curves.
+    other = bpy.data.objects.new("Other", None)
+    bpy.context.scene.collection.objects.link(other)
+    other.keyframe_insert("scale", frame=1)
+    assert {f.data_path for f in compat.action_fcurves(other.animation_data)} == {"scale"}
+
+
+def test_world_and_material_node_trees(factory_blender):
+    import warnings
+
+    bpy = factory_blender
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no deprecation warning (use_nodes is deprecated in 5.x)
+        world = bpy.data.worlds.new("World")
+        tree = compat.world_node_tree(world)
+        material = bpy.data.materials.new("Material")
+        material_tree = compat.material_node_tree(material)
+    assert tree is world.node_tree and "Background" in tree.nodes
+    assert material_tree is material.node_tree and "Material Output" in material_tree.nodes
+    assert compat.world_node_tree(world) is tree  # a second call keeps the tree
+
+
+def test_eevee_engine_is_accepted(factory_blender):
+    scene = factory_blender.context.scene
+    scene.render.engine = compat.eevee_engine()
+    assert scene.render.engine == compat.eevee_engine()
+
+
+def test_compositor_tree(factory_blender):
+    bpy = factory_blender
+    scene = bpy.context.scene
+    assert compat.compositor_tree(scene) is None
+    if compat.has_compositor_node_groups():
+        tree = bpy.data.node_groups.new("Compositing", "CompositorNodeTree")
+        scene.compositing_node_group = tree
+    else:
+        scene.use_nodes = True
+        tree = scene.node_tree
+    assert compat.compositor_tree(scene) == tree
+
+
+def test_map_uv_nearest_settings_are_accepted(factory_blender):
+    bpy = factory_blender
+    tree = bpy.data.node_groups.new("Compat Compositing", "CompositorNodeTree")
+    node = tree.nodes.new("CompositorNodeMapUV")
+    inputs, props = compat.map_uv_nearest()
+    assert inputs or props
+    for name, value in inputs.items():
+        node.inputs[name].default_value = value
+        assert node.inputs[name].default_value == value
+    for name, value in props.items():
+        setattr(node, name, value)
+        assert getattr(node, name) == value
+
+
+def test_custom_property_keys_are_the_users_only(relativity_addon, factory_blender):
+    scene = factory_blender.context.scene
+    scene.relativity.beta = (0.0, 0.5, 0.0)  # stored in an ID property on 4.5, apart on 5.x
+    scene["user_key"] = 1
+    assert compat.custom_property_keys(scene) == ["user_key"]
