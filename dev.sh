@@ -3,7 +3,7 @@
 # 5.2 LTS (bpy 5.2, CPython 3.13); each has its pins in requirements/blender-X.Y.txt and its own
 # virtual environment .venv-X.Y.
 #   ./dev.sh demo   set up .venv-5.2, render the demo still to out/demo.png
-#   ./dev.sh test   set up each venv and run the whole test suite on every supported version, one
+#   ./dev.sh test   run ruff, then set up each venv and run the whole suite on every supported version, one
 #                   after the other (extra arguments go to pytest); non-zero if any version fails
 # BLENDER=4.5 or BLENDER=5.2 picks one version (e.g. BLENDER=5.2 ./dev.sh test -k register).
 # PYTHON311 / PYTHON313 name the interpreters to use; without PYTHON313 a python3.13 is looked
@@ -88,6 +88,17 @@ run_tests() {  # run_tests X.Y [pytest arguments]
     return "$status"
 }
 
+lint() {  # ruff over the whole repository, in its own venv (requirements/lint.txt)
+    local venv=.venv-lint want
+    [ -x "$venv/bin/python" ] || "${PYTHON311:-python3.11}" -m venv "$venv" || return 1
+    want=$(sha256sum requirements/lint.txt | cut -d' ' -f1)
+    if [ ! -f "$venv/.requirements.sha256" ] || [ "$(cat "$venv/.requirements.sha256")" != "$want" ]; then
+        "$venv/bin/python" -m pip install --disable-pip-version-check -q -r requirements/lint.txt || return 1
+        echo "$want" > "$venv/.requirements.sha256"
+    fi
+    "$venv/bin/ruff" check .
+}
+
 versions() {
     local chosen=${BLENDER:-$SUPPORTED}
     for version in $chosen; do
@@ -111,6 +122,8 @@ case "${1:-}" in
         chosen=$(versions) || exit 2
         failed=0
         summary=()
+        echo "=== ruff ==="
+        if lint; then summary+=("ruff: clean"); else summary+=("ruff: FAILED"); failed=1; fi
         for version in $chosen; do
             echo "=== Blender $version ==="
             start=$SECONDS

@@ -85,6 +85,18 @@ def phase(label):
     rows.append((label, now - last[0], rss, hwm))
     last[0] = now
 
+def render_and_write(scene, subphases=None):
+    scene.render.filepath = out
+    bpy.ops.render.render(write_still=False)
+    phase("render (64x48)")
+    bpy.data.images["Render Result"].save_render(out)
+    phase("write the PNG")
+    for label, seconds, rss, hwm in rows:
+        print(f"PHASE\t{label}\t{seconds:.4f}\t{rss:.1f}\t{hwm:.1f}")
+        if subphases and label == "apply the effect":
+            for sub in sorted(subphases):
+                print(f"SUB\t{sub}\t{subphases[sub]:.4f}")
+
 phase("python start (to first line)")
 rows.clear()
 before = set(sys.modules)
@@ -100,13 +112,7 @@ if method == "plain":
     scene.render.resolution_x, scene.render.resolution_y = (int(v) for v in resolution.split("x"))
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
-    scene.render.filepath = out
-    bpy.ops.render.render(write_still=False)
-    phase("render (64x48)")
-    bpy.data.images["Render Result"].save_render(out)
-    phase("write the PNG")
-    for label, seconds, rss, hwm in rows:
-        print(f"PHASE\t{label}\t{seconds:.4f}\t{rss:.1f}\t{hwm:.1f}")
+    render_and_write(scene)
     print(f"EPOCHS\t{started_epoch}\t{time.time()}", flush=True)
     sys.exit(0)
 before_addon = set(sys.modules)
@@ -159,16 +165,7 @@ effect.apply(scene, frame_range=(scene.frame_current, scene.frame_current))
 timers["  rest of applying"] = time.perf_counter() - begun - stack.pop()
 phase("apply the effect")
 apply_row = rows[-1]
-scene.render.filepath = out
-bpy.ops.render.render(write_still=False)
-phase("render (64x48)")
-bpy.data.images["Render Result"].save_render(out)
-phase("write the PNG")
-for label, seconds, rss, hwm in rows:
-    print(f"PHASE\t{label}\t{seconds:.4f}\t{rss:.1f}\t{hwm:.1f}")
-    if label == "apply the effect":
-        for sub in sorted(timers):
-            print(f"SUB\t{sub}\t{timers[sub]:.4f}")
+render_and_write(scene, timers)
 print("MODULES\t" + " ".join(addon_modules))
 print(f"EPOCHS\t{started_epoch}\t{time.time()}", flush=True)
 """

@@ -14,8 +14,8 @@ spectral Doppler matrix per pixel after the render, with no second render:
   and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
   (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
   with Map UV (linear between the two nearest texels, clamped at the ends), ``E = a(D)`` with
-  searchlight and Doppler, ``4 ln D`` without Doppler (``1 ln D`` for Chang et al.'s comparison). All exponents are added before one
-  ``exp`` so that nothing overflows float32.
+  searchlight and Doppler, ``4 ln D`` without Doppler (``1 ln D`` for Chang et al.'s
+  comparison). All exponents are added before one ``exp`` so that nothing overflows float32.
 - Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
   written by ``materials``) keep their rendered colour.
 

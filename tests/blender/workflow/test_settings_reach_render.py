@@ -117,7 +117,7 @@ CASES = [
 
 def _diffuse_material(bpy, name, colour):
     material = bpy.data.materials.new(name)
-    tree = material.node_tree
+    tree = wh.compat.material_node_tree(material)
     tree.nodes.clear()
     diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (*colour, 1.0)
