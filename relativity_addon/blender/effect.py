@@ -19,8 +19,8 @@ is marked invalid (it renders black, never a wrong image).
 from ..errors import RelativityError
 from . import animation, busy, camera, colour, geometry, modifier, snapshot
 
-# Scene name -> warnings of its last sync; mesh name -> (inputs, warnings) as of the last sync.
-_scene_warnings = {}
+# Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
+_scene_status = {}
 _object_warnings = {}
 
 
@@ -71,7 +71,7 @@ def remove(scene):
     for camera_object in camera.applied_cameras():
         removed += bool(camera.remove(camera_object))
     colour.remove(scene)
-    _scene_warnings.pop(scene.name, None)
+    _scene_status.pop(scene.name, None)
     return removed
 
 
@@ -88,18 +88,9 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
     method = applied_method(scene)
     try:
         snap = snapshot.read(scene, depsgraph)
-    except RelativityError as error:
-        if method == "CAMERA":
-            camera.invalidate(scene.camera)
-        _scene_warnings[scene.name] = [str(error)]
-        return None
-    if method != snap.method and method is not None:
-        # applied with the other method (the setting changed where no callback ran): refuse
-        if method == "CAMERA":
-            camera.invalidate(scene.camera)
-        _scene_warnings[scene.name] = [f"Set up again: the scene is set up for {method.title()}"]
-        return None
-    try:
+        if method is not None and method != snap.method:
+            # applied with the other method (the setting changed where no callback ran)
+            raise RelativityError(f"Set up again: the scene is set up for {method.title()}")
         if method == "CAMERA":
             camera.write(scene, snap)
         elif method == "GEOMETRY" and update_geometry:
@@ -109,7 +100,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
     except RelativityError as error:
         if method == "CAMERA":
             camera.invalidate(scene.camera)
-        _scene_warnings[scene.name] = [str(error)]
+        _refused(scene, error)
         return None
     _record(scene, snap)
     return snap
@@ -123,8 +114,7 @@ def setting_changed(scene):
         try:
             apply(scene)
         except RelativityError as error:
-            print(f"Relativity: {error}")
-            _scene_warnings[scene.name] = [str(error)]
+            _refused(scene, error)
         return
     sync(scene)
 
@@ -137,13 +127,17 @@ def object_changed(scene, obj):
         try:
             geometry.apply(scene, snapshot.read(scene), [obj])
         except RelativityError as error:
-            print(f"Relativity: {error}")
-            _scene_warnings[scene.name] = [str(error)]
+            _refused(scene, error)
             return
     sync(scene, attach_new_materials=True)
 
 
 # --- warnings, computed when the effect syncs -------------------------------------------------
+
+
+def _refused(scene, error):
+    print(f"Relativity: {error}")
+    _scene_status[scene.name] = (None, [str(error)])
 
 
 def _record(scene, snap):
@@ -156,7 +150,7 @@ def _record(scene, snap):
                 and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
     warnings += geometry.scene_errors(scene)
-    _scene_warnings[scene.name] = warnings
+    _scene_status[scene.name] = (snap, warnings)
     if snap.method == "GEOMETRY":
         for obj in scene.objects:
             if obj.type == "MESH" and obj.relativity.enabled:
@@ -174,15 +168,26 @@ def _mesh_warnings(obj, snap):
     return inputs, [coarse] if coarse else []
 
 
-def scene_warnings(scene):
-    """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
-    sync; checked now if it has not synced since the file was opened)."""
-    if scene.name not in _scene_warnings:
+def _status(scene):
+    """(snapshot or None, warnings) of the scene's last sync; checked now if it has not synced
+    since the file was opened."""
+    if scene.name not in _scene_status:
         try:
             _record(scene, snapshot.read(scene))
         except RelativityError as error:
-            _scene_warnings[scene.name] = [str(error)]
-    return list(_scene_warnings[scene.name])
+            _scene_status[scene.name] = (None, [str(error)])
+    return _scene_status[scene.name]
+
+
+def last_snapshot(scene):
+    """The snapshot of the scene's last sync, or None if that sync was refused."""
+    return _status(scene)[0]
+
+
+def scene_warnings(scene):
+    """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
+    sync)."""
+    return list(_status(scene)[1])
 
 
 def object_warnings(scene, obj):

@@ -45,7 +45,7 @@ class RELATIVITY_OT_setup_scene(Operator):
         except RelativityError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        snap = snapshot.read(scene)
+        snap = effect.last_snapshot(scene)
         self.report({"INFO"}, f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}")
         return {"FINISHED"}
 

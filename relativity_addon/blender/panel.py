@@ -1,15 +1,14 @@
 """The N-panel: View3D > Sidebar > Relativity, with sub-panels as Blender's own panels have them.
 
 Nothing here computes: the warnings come from the effect's last sync (``effect.scene_warnings``,
-``effect.object_warnings``), and the speed shown is the snapshot's.
+``effect.object_warnings``), and so does the speed taken from the camera's animation.
 """
 
 import math
 
 from bpy.types import Panel
 
-from ..errors import RelativityError
-from . import effect, snapshot
+from . import effect
 
 
 def _split(layout):
@@ -65,11 +64,11 @@ class RELATIVITY_PT_observer(_RelativityPanel, Panel):
         column = layout.column()
         column.enabled = settings.velocity_source == "MANUAL"
         column.prop(settings, "beta")
-        try:
-            snap = snapshot.read(scene) if settings.velocity_source == "CAMERA_ANIMATION" else None
-            speed = snap.speed if snap is not None else settings.speed
-        except RelativityError:
-            speed = math.nan
+        if settings.velocity_source == "CAMERA_ANIMATION":  # as of the last sync: no F-curves in draw
+            snap = effect.last_snapshot(scene)
+            speed = snap.speed if snap is not None else math.nan
+        else:
+            speed = settings.speed
         box = layout.box()
         box.label(text=f"Speed: {speed:.6g} c")
         gamma = 1.0 / math.sqrt(1.0 - speed * speed) if speed < 1.0 else math.nan
