@@ -25,7 +25,7 @@ import math
 
 import bpy
 
-from . import luts, names
+from . import luts, names, spectral_nodes
 from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
@@ -59,7 +59,9 @@ def settings_group():
     nodes["Observer Beta"] = Node("ShaderNodeCombineXYZ", {0: 0.0, 1: 0.0, 2: 0.0})
     outputs = tuple((name, "NodeSocketFloat", name) for name in values)
     outputs += (("Observer Beta", "NodeSocketVector", "Observer Beta"),)
-    return Group(SETTINGS, "ShaderNodeTree", (), outputs, nodes)
+    spectral, spectral_outputs = spectral_nodes.settings_nodes()
+    nodes.update(spectral)
+    return Group(SETTINGS, "ShaderNodeTree", (), outputs + spectral_outputs, nodes)
 
 
 def doppler_factor_group():
@@ -185,8 +187,11 @@ def doppler_colour_group():
     off) and ``E`` the log brightness: the exact visible factor (``a``, or ``ln Y(DT)/Y(T)``)
     when Doppler and the searchlight are both on, else ``p ln D`` with ``p`` = 4 (searchlight
     without colour) or 1 (Chang et al.'s comparison), minus the ``D^4`` the exact camera applies.
-    On the exact-camera path ordinary colours pass unchanged (the compositor shifts them) and
-    blackbodies write the ``relativity_colour_done`` AOV so the compositor leaves them alone.
+    On the exact-camera path the scene is at rest, so only camera rays are shifted: ordinary
+    colours pass unchanged (the compositor shifts the pixel), blackbodies seen directly are shifted
+    here and write the ``relativity_colour_done`` AOV so the compositor leaves them alone, and the
+    light every other ray carries (a lamp lighting the floor) stays the scene-frame light.
+    In a spectral pass (``spectral_nodes``) every colour becomes its spectral values instead.
     """
     nodes = {
         "settings": group_node(SETTINGS),
@@ -214,9 +219,21 @@ def doppler_colour_group():
         "bb_log_safe": fmath("MINIMUM", "bb_log", EXP_LIMIT),
         "bb_gain": fmath("EXPONENT", "bb_log_safe"),
         "bb_out": vmath("SCALE", "bb_base.Result", scale="bb_gain"),
-        "out": Node("ShaderNodeMix", {"Factor": "group.Is Blackbody", 4: "rgb_out.Result", 5: "bb_out"},
+        # exact camera: the blackbody shift only for camera rays (1 - path (1 - camera ray))
+        "light_path": Node("ShaderNodeLightPath"),
+        "other_ray": fmath("SUBTRACT", 1.0, "light_path.Is Camera Ray"),
+        "unshifted": fmath("MULTIPLY", "settings.Camera Path", "other_ray"),
+        "shifted_ray": fmath("SUBTRACT", 1.0, "unshifted"),
+        "bb_select": fmath("MULTIPLY", "group.Is Blackbody", "shifted_ray"),
+        "fast": Node("ShaderNodeMix", {"Factor": "bb_select", 4: "rgb_out.Result", 5: "bb_out"},
+                     {"data_type": "VECTOR"}),
+        "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, {
+            "Color": "group.Color", "Temperature": "group.Temperature",
+            "Is Blackbody": "group.Is Blackbody", "Is Emission": "group.Is Emission"}),
+        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "fast.Result", 5: "spectral"},
                     {"data_type": "VECTOR"}),
-        "done": fmath("MULTIPLY", "group.Is Blackbody", "settings.Camera Path"),
+        "done_path": fmath("MULTIPLY", "group.Is Blackbody", "settings.Camera Path"),
+        "done": fmath("MULTIPLY", "done_path", "light_path.Is Camera Ray"),
         "aov": Node("ShaderNodeOutputAOV", {"Value": "done"}, {"aov_name": DONE_AOV}),
     }
     return Group(
@@ -226,6 +243,7 @@ def doppler_colour_group():
             ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
             ("Temperature", "NodeSocketFloat", 5762.0),
             ("Is Blackbody", "NodeSocketFloat", 0.0),
+            ("Is Emission", "NodeSocketFloat", 0.0),
         ),
         (("Color", "NodeSocketColor", "out.Result"),),
         nodes,
@@ -253,6 +271,7 @@ GROUP_BUILDERS = (
     gamut_map_group,
     doppler_matrix_group,
     blackbody_shift_group,
+    spectral_nodes.spectral_colour_group,
     doppler_colour_group,
     doppler_aov_group,
 )
@@ -274,10 +293,21 @@ def ensure_node_groups():
 # --- settings -------------------------------------------------------------------------------
 
 
+# Wavelengths (nm) of the spectral pass being rendered (spectral_render), None between passes.
+_spectral_pass = {"wavelengths": None}
+
+
+def set_spectral_pass(wavelengths_nm):
+    """Render the next passes at these three rest-frame wavelengths (None: the fast mode again);
+    takes effect at the next :func:`write_settings`."""
+    _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
+
+
 def settings_values(snap):
-    """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot``."""
+    """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot`` (and the spectral pass)."""
     colour = snap.colour
     return {
+        **spectral_nodes.pass_values(_spectral_pass["wavelengths"]),
         "Use Doppler": 1.0 if colour.use_doppler else 0.0,
         "Spectral Searchlight": 1.0 if colour.spectral_searchlight else 0.0,
         "Power of D": colour.power_of_d,
@@ -295,8 +325,9 @@ def write_settings(snap):
         return False
     for name, value in settings_values(snap).items():
         node = tree.nodes[name]
-        sockets = node.inputs[:3] if name == "Observer Beta" else node.outputs[:1]
-        components = value if name == "Observer Beta" else (value,)
+        vector = isinstance(value, tuple)
+        sockets = node.inputs[:3] if vector else node.outputs[:1]
+        components = value if vector else (value,)
         for socket, component in zip(sockets, components, strict=True):
             if socket.default_value != component:  # also runs on depsgraph updates: no loops
                 socket.default_value = component
@@ -358,6 +389,7 @@ def attach(material, temperature=None):
         else:
             node.inputs["Color"].default_value = socket.default_value
         is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
+        node.inputs["Is Emission"].default_value = 1.0 if is_emission else 0.0
         if temperature and is_emission and not node.inputs["Is Blackbody"].default_value:
             node.inputs["Is Blackbody"].default_value = 1.0
             node.inputs["Temperature"].default_value = temperature

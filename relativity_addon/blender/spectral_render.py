@@ -1,0 +1,169 @@
+"""Spectral mode of the exact camera: a few Cycles passes at rest-frame wavelengths, one picture.
+
+``physics/spectral_render.py`` has the model. Here, for the scene's current frame:
+
+1. a Doppler pass: the compositor stage outputs ``ln D`` of the first camera hit (the materials'
+   and world's AOV) at a few samples with no bounces, giving every pixel's ``D`` and the range of
+   ``D`` in the picture;
+2. ``passes`` colour passes: materials (``spectral_nodes``), the world and the lights get their
+   spectral values at three wavelengths of the band ``[380 D_min, 780 D_max]`` nm, and the
+   compositor stage passes the render through;
+3. per pixel, the CIE integral of ``D^5 L(lambda D)``.
+
+Everything the passes change (render settings, lights' colours, the stage's mode) is restored
+afterwards, also when a pass fails. Works from the operator (F12's sibling in the panel) and the
+batch script (``--spectral N``).
+"""
+
+import os
+import tempfile
+import time
+
+import bpy
+import numpy as np
+
+from ..errors import RelativityError
+from ..physics import spectral, spectral_render
+from . import compositing, effect, materials, names
+
+DOPPLER_PASS_SAMPLES = 16
+IMAGE_NAME = names.SPECTRAL_IMAGE
+
+
+def check(scene):
+    """RelativityError unless the scene is set up for a spectral render."""
+    if effect.applied_method(scene) != "CAMERA":
+        raise RelativityError("Spectral colour needs the Exact Camera: set it up first (Set Up Relativistic Render)")
+    settings = scene.relativity
+    if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
+        raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "
+                              "Searchlight on (and Chang's searchlight off)")
+
+
+def _light_spectrum(light, wavelengths):
+    """Spectral values of a lamp's colour (its temperature, if used, as a blackbody), >= 0."""
+    colour = np.array(light.color, dtype=np.float64)
+    if light.use_temperature:
+        tint = spectral_render.reflectance_matrix(wavelengths) @ colour
+        luminance = spectral.luminance_linear_rec709(np.array(light.temperature_color, dtype=np.float64))
+        values = tint * spectral_render.blackbody_samples(wavelengths, light.temperature, luminance)
+    else:
+        values = spectral_render.emission_matrix(wavelengths) @ colour
+    return np.maximum(values, 0.0)
+
+
+class _Saved:
+    """Everything the passes change, restored by :meth:`restore`."""
+
+    def __init__(self, scene):
+        render, cycles = scene.render, scene.cycles
+        settings = render.image_settings
+        self.scene = scene
+        self.render = {key: getattr(render, key) for key in ("filepath", "use_file_extension")}
+        self.image = {key: getattr(settings, key) for key in ("file_format", "color_depth", "color_mode")}
+        self.cycles = {key: getattr(cycles, key) for key in ("samples", "max_bounces", "use_denoising")}
+        self.lights = {light.name: (tuple(light.color), light.use_temperature) for light in _scene_lights(scene)}
+
+    def restore(self):
+        scene = self.scene
+        for key, value in self.render.items():
+            setattr(scene.render, key, value)
+        for key, value in self.image.items():
+            setattr(scene.render.image_settings, key, value)
+        for key, value in self.cycles.items():
+            setattr(scene.cycles, key, value)
+        for name, (colour, use_temperature) in self.lights.items():
+            light = bpy.data.lights.get(name)
+            if light is not None:
+                light.color, light.use_temperature = colour, use_temperature
+
+
+def _scene_lights(scene):
+    return list({obj.data for obj in scene.objects if obj.type == "LIGHT"})
+
+
+def _render_exr(scene, path):
+    scene.render.filepath = path
+    scene.render.use_file_extension = False
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "32"
+    settings.color_mode = "RGBA"
+    effect.sync(scene)  # the settings group and the compositor stage for this pass
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(path, check_existing=False)
+    try:
+        width, height = image.size
+        pixels = np.empty(width * height * 4, dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+    finally:
+        bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)  # bottom row first, as Blender stores images
+
+
+def render(scene, passes, progress=None):
+    """Render the scene's current frame in spectral mode: ``(pixels, info)``, pixels RGBA float32
+    (bottom row first, scene linear), info the Doppler range, wavelengths and time taken.
+    ``progress(done, total)`` is called after each pass. RelativityError (one line) on failure."""
+    check(scene)
+    if passes < 1:
+        raise RelativityError(f"Spectral passes must be at least 1, got {passes}")
+    started = time.monotonic()
+    saved = _Saved(scene)
+    total = passes + 1
+    try:
+        with tempfile.TemporaryDirectory(prefix="relativity_spectral_") as folder:
+            compositing.set_stage_mode("LOG_DOPPLER")
+            materials.set_spectral_pass(None)
+            scene.cycles.samples = min(saved.cycles["samples"], DOPPLER_PASS_SAMPLES)
+            scene.cycles.max_bounces = 0
+            scene.cycles.use_denoising = False
+            doppler_pass = _render_exr(scene, os.path.join(folder, "doppler.exr"))
+            log_doppler, alpha = doppler_pass[..., 0].astype(np.float64), doppler_pass[..., 3]
+            if not np.all(np.isfinite(log_doppler)):
+                raise RelativityError("the Doppler pass has pixels without a Doppler factor")
+            if progress:
+                progress(1, total)
+            saved.restore()
+            d_min, d_max = float(np.exp(log_doppler.min())), float(np.exp(log_doppler.max()))
+            wavelengths = spectral_render.sample_wavelengths(d_min, d_max, passes)
+            compositing.set_stage_mode("PASS_THROUGH")
+            samples = []
+            for index in range(passes):
+                trio = spectral_render.pass_wavelengths(wavelengths, index)
+                materials.set_spectral_pass(trio)
+                for name, (colour, use_temperature) in saved.lights.items():  # from the user's lamp each time
+                    light = bpy.data.lights[name]
+                    light.color, light.use_temperature = colour, use_temperature
+                    spectrum = _light_spectrum(light, trio)
+                    light.use_temperature, light.color = False, tuple(spectrum)
+                samples.append(_render_exr(scene, os.path.join(folder, f"pass{index}.exr"))[..., :3])
+                if progress:
+                    progress(index + 2, total)
+    except RuntimeError as error:
+        message = str(error).strip().splitlines()
+        raise RelativityError(f"Spectral render failed: {message[-1] if message else type(error).__name__}") from None
+    finally:
+        saved.restore()
+        materials.set_spectral_pass(None)
+        compositing.set_stage_mode("COLOUR")
+        effect.sync(scene)
+    stacked = np.concatenate(samples, axis=-1).astype(np.float64)  # (H, W, 3 passes)
+    rgb = spectral_render.reconstruct_rgb(stacked, log_doppler, wavelengths)
+    pixels = np.concatenate([rgb, alpha[..., None]], axis=-1).astype(np.float32)
+    info = {"doppler_range": (d_min, d_max), "wavelengths_nm": wavelengths, "seconds": time.monotonic() - started}
+    return pixels, info
+
+
+def store_image(pixels, name=IMAGE_NAME):
+    """Put the pixels into the float image ``name`` (made or resized as needed) and return it."""
+    height, width = pixels.shape[:2]
+    image = bpy.data.images.get(name)
+    if image is not None and (tuple(image.size) != (width, height) or not image.is_float):
+        bpy.data.images.remove(image)
+        image = None
+    if image is None:
+        image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, dtype=np.float32).ravel())
+    image.update()
+    return image
