@@ -155,3 +155,117 @@ def test_wall_under_blackbody_lamp_is_a_blackbody_at_d_t(relativity_addon, tmp_p
     print(f"fast (RGB) mode: Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, "
           f"Y / expected {fast[1] / expected[1]:.4f}")
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
+
+
+SUN_TEMPERATURE = 5762.0
+PATCHES = {  # name: (base colour, centre)
+    "White": ((1.0, 1.0, 1.0), (-1.0, 1.0)),
+    "Red": ((0.8, 0.15, 0.1), (1.0, 1.0)),
+    "Green": ((0.15, 0.6, 0.2), (-1.0, -1.0)),
+    "Blue": ((0.1, 0.2, 0.7), (1.0, -1.0)),
+}
+
+
+def _sun(bpy, scene, direction_z=-1.0, temperature=SUN_TEMPERATURE, strength=3.0):
+    """A sun lamp with its own temperature on, shining along ``direction_z`` (-1: toward -Z)."""
+    light = bpy.data.lights.new("Sun", "SUN")
+    light.energy = strength
+    light.use_temperature = True
+    light.temperature = temperature
+    sun = bpy.data.objects.new("Sun", light)
+    sun.rotation_euler = (0.0, 0.0, 0.0) if direction_z < 0 else (math.pi, 0.0, 0.0)
+    scene.collection.objects.link(sun)
+    return sun
+
+
+def _patch_windows(bpy, scene, camera, beta, half=2):
+    """Pixel window around each patch centre's apparent position (aberration, docs/physics.md)."""
+    model = ch.pinhole_model(bpy, scene, camera)
+    windows = {}
+    for name, (_colour, (x, y)) in PATCHES.items():
+        direction = ch.apparent_view_direction(np.array([x, y, -5.0]), np.zeros(3), np.asarray(beta, float))
+        px, py = model.project_direction(direction)
+        column, row = int(round(float(px) - 0.5)), int(round(float(py) - 0.5))
+        windows[name] = (slice(row - half, row + half), slice(column - half, column + half))
+    return windows
+
+
+@pytest.mark.parametrize("speed", [0.3, 0.6])
+def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed):
+    """Up-sampled RGB patches under a sun with its own temperature: spectral mode within Delta E 2
+    of the same spectra (reflectance basis times Planck) shifted and integrated here."""
+    bpy = __import__("bpy")
+    scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
+    for name, (colour, (x, y)) in PATCHES.items():
+        corners = [(x - 1, y - 1, -5), (x + 1, y - 1, -5), (x + 1, y + 1, -5), (x - 1, y + 1, -5)]
+        _quad(bpy, scene, name, corners, _diffuse(bpy, name, colour))
+    _sun(bpy, scene)
+    rest_windows = _patch_windows(bpy, scene, camera, (0.0, 0.0, 0.0))
+    rest = _render_f12(bpy, scene, tmp_path, "rest")
+    white_rest = _xyz(rest[rest_windows["White"]].reshape(-1, 3)).mean(axis=0)[1]
+    wavelengths, cmfs = _cmfs()
+    scale = white_rest / (_planck(wavelengths, SUN_TEMPERATURE) @ cmfs[:, 1])  # k: white reflects 1
+
+    beta = (0.0, 0.0, -speed)
+    _set_up(bpy, scene, beta)
+    doppler = _pixel_doppler(bpy, scene, camera, beta)
+    windows = _patch_windows(bpy, scene, camera, beta)
+    spectral, _info = _render_spectral(bpy, relativity_addon, scene)
+    fast = _render_f12(bpy, scene, tmp_path, "fast")
+    for name, (colour, _centre) in PATCHES.items():
+        window = windows[name]
+
+        def spectrum(mu, colour=colour):
+            return scale * _mallett_reflectance(colour, mu) * _planck(mu, SUN_TEMPERATURE)
+
+        expected = np.mean([_observed_xyz(spectrum, d) for d in doppler[window].ravel()], axis=0)
+        measured = _xyz(spectral[window].reshape(-1, 3)).mean(axis=0)
+        fast_xyz = _xyz(fast[window].reshape(-1, 3)).mean(axis=0)
+        delta_e = dh.delta_e_2000_normalised(measured, expected)
+        print(f"{speed}c {name}: D {doppler[window].mean():.3f}, spectral Delta E {delta_e:.2f}, "
+              f"Y/expected {measured[1] / expected[1]:.3f}; fast Delta E "
+              f"{dh.delta_e_2000_normalised(fast_xyz, expected):.2f}, Y/expected {fast_xyz[1] / expected[1]:.3f}")
+        assert delta_e < 2.0
+        assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+
+
+def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):
+    """A coloured reflector (behind the camera, invisible to it) lit by a sun lights a coloured
+    wall that the sun cannot reach: the wall's light is ``G rho_wall rho_reflector S`` for one
+    geometric factor ``G`` (measured at rest with both white), exactly two reflections
+    (max bounces 1)."""
+    bpy = __import__("bpy")
+    scene, camera = dh.emitter_scene(bpy, samples=64, resolution=RESOLUTION)
+    scene.cycles.max_bounces = 1
+    scene.cycles.diffuse_bounces = 1
+    wall = _quad(bpy, scene, "Wall", [(-3, -3, -5), (3, -3, -5), (3, 3, -5), (-3, 3, -5)],
+                 _diffuse(bpy, "WallColour", (1.0, 1.0, 1.0)))
+    reflector = _quad(bpy, scene, "Reflector", [(-20, -20, 2), (-20, 20, 2), (20, 20, 2), (20, -20, 2)],
+                      _diffuse(bpy, "ReflectorColour", (1.0, 1.0, 1.0)))
+    reflector.visible_camera = False
+    _sun(bpy, scene, direction_z=1.0, temperature=4000.0, strength=20.0)
+    white_rest = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)[1]
+    assert white_rest > 0.01, "the wall must be lit through the reflector"
+    wall_colour, reflector_colour = (0.2, 0.5, 0.8), (0.9, 0.6, 0.2)
+    wall.data.materials[0].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = (*wall_colour, 1.0)
+    reflector.data.materials[0].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = \
+        (*reflector_colour, 1.0)
+    wavelengths, cmfs = _cmfs()
+    scale = white_rest / (_planck(wavelengths, 4000.0) @ cmfs[:, 1])
+
+    def spectrum(mu):
+        return (scale * _mallett_reflectance(wall_colour, mu) * _mallett_reflectance(reflector_colour, mu)
+                * _planck(mu, 4000.0))
+
+    beta = (0.0, 0.0, -0.5)
+    _set_up(bpy, scene, beta)
+    doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
+    expected = np.mean([_observed_xyz(spectrum, d) for d in doppler], axis=0)
+    spectral, _info = _render_spectral(bpy, relativity_addon, scene)
+    measured = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
+    fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
+    delta_e = dh.delta_e_2000_normalised(measured, expected)
+    print(f"two bounces: spectral Delta E {delta_e:.2f}, Y/expected {measured[1] / expected[1]:.3f}; "
+          f"fast Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, Y/expected {fast[1] / expected[1]:.3f}")
+    assert delta_e < 2.0
+    assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
