@@ -31,3 +31,9 @@ def blackbody_rgb_lut():
     """``(log10_t_grid, pixels)``: the blackbody table as float32 RGBA image pixels."""
     tables = _tables()
     return tables["blackbody_log10_t_grid"], tables["blackbody_rgb_lut"]
+
+
+def spectral_mode_tables():
+    """The CIE functions, the RGB basis and the matrices of the spectral mode (see
+    ``physics.spectral_luts.spectral_mode_tables``), by name without the ``spectral_`` prefix."""
+    return {name[len("spectral_"):]: values for name, values in _tables().items() if name.startswith("spectral_")}

@@ -24,6 +24,7 @@ def compute_tables():
         "doppler_matrix_lut": spectral_luts.doppler_matrix_lut(d_grid),
         "blackbody_log10_t_grid": t_grid,
         "blackbody_rgb_lut": spectral_luts.blackbody_rgb_lut(t_grid),
+        **spectral_luts.spectral_mode_tables(),
     }
 
 

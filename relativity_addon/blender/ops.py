@@ -7,7 +7,7 @@ and report a ``RelativityError`` in one line instead of leaving a half-applied s
 from bpy.types import Operator
 
 from ..errors import RelativityError
-from . import effect, snapshot
+from . import effect, snapshot, spectral_render
 
 
 def _poll_scene(cls, context):
@@ -102,4 +102,48 @@ class RELATIVITY_OT_check_animation(Operator):
         return {"FINISHED"}
 
 
-classes = (RELATIVITY_OT_setup_scene, RELATIVITY_OT_remove_all, RELATIVITY_OT_check_animation)
+class RELATIVITY_OT_render_spectral(Operator):
+    """Render the current frame with spectral colour: exact for lamps, sun and sky at rest (one Doppler
+    pass and the chosen number of colour passes); the picture opens as an image"""
+
+    bl_idname = "relativity.render_spectral"
+    bl_label = "Render Spectral"
+    bl_options = {"REGISTER"}
+
+    @classmethod
+    def poll(cls, context):
+        if not _poll_scene(cls, context):
+            return False
+        try:
+            spectral_render.check(context.scene)
+        except RelativityError as error:
+            cls.poll_message_set(str(error))
+            return False
+        return True
+
+    def execute(self, context):
+        scene = context.scene
+        window_manager = context.window_manager
+        passes = scene.relativity.spectral_passes
+        window_manager.progress_begin(0, passes + 1)
+        try:
+            pixels, info = spectral_render.render(scene, passes, progress=lambda done, _total:
+                                                  window_manager.progress_update(done))
+        except RelativityError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            window_manager.progress_end()
+        image = spectral_render.store_image(pixels)
+        for area in context.screen.areas if context.screen else ():
+            if area.type == "IMAGE_EDITOR":
+                area.spaces.active.image = image
+                break
+        low, high = info["doppler_range"]
+        self.report({"INFO"}, f"Spectral render in image {image.name!r}: D {low:.3g} to {high:.3g}, "
+                    f"{passes} passes, {info['seconds']:.1f} s")
+        return {"FINISHED"}
+
+
+classes = (RELATIVITY_OT_setup_scene, RELATIVITY_OT_remove_all, RELATIVITY_OT_check_animation,
+           RELATIVITY_OT_render_spectral)

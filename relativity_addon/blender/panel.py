@@ -111,6 +111,10 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row = column.row()
         row.active = settings.use_searchlight
         row.prop(settings, "use_chang_searchlight")
+        if settings.method == "CAMERA":
+            column = layout.column(heading="Spectral")
+            column.prop(settings, "spectral_passes")
+            column.operator("relativity.render_spectral", icon="RENDER_STILL")
 
 
 class RELATIVITY_PT_object(_RelativityPanel, Panel):

@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 
 from ..errors import RelativityError
-from ..physics import spectral, spectral_render
+from ..physics import spectral_render
 from . import compositing, effect, materials, names
 
 DOPPLER_PASS_SAMPLES = 16
@@ -45,7 +45,7 @@ def _light_spectrum(light, wavelengths):
     colour = np.array(light.color, dtype=np.float64)
     if light.use_temperature:
         tint = spectral_render.reflectance_matrix(wavelengths) @ colour
-        luminance = spectral.luminance_linear_rec709(np.array(light.temperature_color, dtype=np.float64))
+        luminance = spectral_render.luminance(np.array(light.temperature_color, dtype=np.float64))
         values = tint * spectral_render.blackbody_samples(wavelengths, light.temperature, luminance)
     else:
         values = spectral_render.emission_matrix(wavelengths) @ colour

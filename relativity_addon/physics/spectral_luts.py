@@ -174,3 +174,28 @@ def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: ArrayLike, doppler_f
         axis=-2,
     )  # (..., 3, 4)
     return sampled[..., :3] * np.exp(sampled[..., :1, 3:4])
+
+
+def spectral_mode_tables() -> dict:
+    """What the spectral mode (:mod:`.spectral_render`) needs at render time, where Blender has no
+    colour-science: the CIE 1931 functions on the 1 nm grid, Mallett & Yuksel's basis table and its
+    constrained band, the rest-frame inverse matrix of the up-sampled colours and the Rec.709 matrices."""
+    from .spectral import (
+        _REC709,
+        WAVELENGTHS_VISIBLE_NM,
+        _basis_table,
+        _cmfs_visible,
+        _inverse_rest_frame_matrix,
+        basis_constrained_band_nm,
+    )
+
+    basis_nm, basis_values = _basis_table()
+    return {
+        "spectral_cmfs_nm": WAVELENGTHS_VISIBLE_NM.copy(),
+        "spectral_cmfs": np.array(_cmfs_visible()),
+        "spectral_basis_nm": basis_nm,
+        "spectral_basis": basis_values,
+        "spectral_basis_band_nm": np.array(basis_constrained_band_nm()),
+        "spectral_inverse_rest_matrix": np.array(_inverse_rest_frame_matrix()),
+        "spectral_xyz_to_rgb": np.array(_REC709.matrix_XYZ_to_RGB, dtype=np.float64),
+    }

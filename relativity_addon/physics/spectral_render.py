@@ -20,14 +20,18 @@ Mallett & Yuksel's basis with weights ``rgb`` (white reflects 1 at every wavelen
 ``Y B(mu, T) / Y_B(T)``. Units: radiance per nanometre, integrated over the CIE 1931 observer's
 1 nm grid, the fast mode's normalisation, so both modes agree for white light.
 
-Everything here is numpy and colour-science; no ``bpy``.
+Everything here is numpy on the tables the add-on ships (``lut_data.spectral_mode_tables``, made
+with colour-science by ``tools/build_luts.py``): it runs inside Blender, which has no
+colour-science. ``tests/physics/test_spectral_render.py`` checks it against :mod:`.spectral`.
 """
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from . import spectral
+from .. import lut_data
 from .arrays import ArrayLike, FloatArray
 
 __all__ = [
@@ -52,6 +56,73 @@ ANCHOR_TEMPERATURES_K = (1500.0, 3000.0, 6000.0, 12000.0)
 the samples leave room: at most ``K - 3`` of them count."""
 
 _NM = 1e-9
+PLANCK_C1, PLANCK_C2 = 3.741771e-16, 0.014388  # colour.colorimetry.planck_law's constants
+WHITE_TEMPERATURE_K = 6504.0  # the white light of up-sampled colours (spectral.illuminant_white)
+
+
+@functools.lru_cache(maxsize=1)
+def _tables():
+    return lut_data.spectral_mode_tables()
+
+
+def planck(wavelengths_nm: ArrayLike, temperature_k: float) -> FloatArray:
+    """Planck's law per metre of wavelength (as colour-science's ``planck_law``), 0 deep in the Wien tail."""
+    metres = np.asarray(wavelengths_nm, dtype=np.float64) * _NM
+    with np.errstate(over="ignore"):
+        return PLANCK_C1 / np.pi / metres**5 / np.expm1(PLANCK_C2 / (metres * temperature_k))
+
+
+def log_blackbody_luminance(temperature_k: ArrayLike) -> FloatArray:
+    """``ln Y_B(T)``, CIE ``Y`` of Planck's law over the 1 nm grid, in log space (no underflow)."""
+    tables = _tables()
+    metres = tables["cmfs_nm"] * _NM
+    x = PLANCK_C2 / (metres * np.asarray(temperature_k, dtype=np.float64)[..., None])
+    terms = np.log(PLANCK_C1 / np.pi / metres**5) - (x + np.log1p(-np.exp(-x))) + np.log(tables["cmfs"][:, 1] * _NM)
+    peak = np.max(terms, axis=-1, keepdims=True)
+    return peak[..., 0] + np.log(np.sum(np.exp(terms - peak), axis=-1))
+
+
+def blackbody_xyz(temperature_k: ArrayLike) -> FloatArray:
+    """CIE XYZ of Planck's law (per metre, summed on the 1 nm grid), shape (..., 3)."""
+    tables = _tables()
+    temperature_k = np.asarray(temperature_k, dtype=np.float64)
+    radiance = planck(tables["cmfs_nm"], temperature_k[..., None])
+    return radiance @ tables["cmfs"] * _NM
+
+
+def white(wavelengths_nm: ArrayLike) -> FloatArray:
+    """The 6504 K white of up-sampled colours, 1 at 560 nm."""
+    return planck(wavelengths_nm, WHITE_TEMPERATURE_K) / planck(560.0, WHITE_TEMPERATURE_K)
+
+
+def xyz_to_linear_rec709(xyz: ArrayLike) -> FloatArray:
+    return np.asarray(xyz, dtype=np.float64) @ _tables()["xyz_to_rgb"].T
+
+
+def luminance(rgb: ArrayLike) -> FloatArray:
+    """CIE ``Y`` of linear Rec.709 colours."""
+    return np.asarray(rgb, dtype=np.float64) @ np.linalg.inv(_tables()["xyz_to_rgb"])[1]
+
+
+def gamut_map(rgb: ArrayLike) -> FloatArray:
+    """:func:`.spectral.gamut_map_linear_rec709` in numpy alone (toward grey at constant Y)."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    grey = luminance(rgb)[..., None]
+    smallest = np.min(rgb, axis=-1, keepdims=True)
+    outside = smallest < 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mapped = np.where(outside, grey + (rgb - grey) * (grey / (grey - smallest)), rgb)
+    return np.maximum(np.where(grey > 0, mapped, 0.0), 0.0)
+
+
+def doppler_rgb_matrix(doppler: ArrayLike) -> FloatArray:
+    """:func:`.spectral.doppler_rgb_matrix` (the fast mode's exact matrix) from the shipped tables."""
+    tables = _tables()
+    doppler = np.asarray(doppler, dtype=np.float64)
+    emitted = tables["cmfs_nm"] * doppler[..., None]
+    spectra = reflectance_matrix(emitted) * (white(emitted) * doppler[..., None] ** 5)[..., None]
+    columns = np.einsum("wc,...wi->...ci", tables["cmfs"], spectra)
+    return tables["xyz_to_rgb"] @ columns @ tables["inverse_rest_matrix"]
 
 
 def sample_wavelengths(doppler_min: float, doppler_max: float, passes: int) -> FloatArray:
@@ -73,27 +144,28 @@ def pass_wavelengths(wavelengths: ArrayLike, index: int) -> FloatArray:
 def reflectance_matrix(wavelengths_nm: ArrayLike) -> FloatArray:
     """``(K, 3)``: reflectance at each wavelength of a surface of (linear Rec.709) colour ``rgb``
     is ``matrix @ rgb`` (Mallett & Yuksel 2019 basis, weights ``rgb``)."""
-    return spectral.reflectance_basis_Mallett2019(np.asarray(wavelengths_nm, dtype=np.float64))
+    tables = _tables()
+    clipped = np.clip(np.asarray(wavelengths_nm, dtype=np.float64), *tables["basis_band_nm"])
+    return np.stack([np.interp(clipped, tables["basis_nm"], tables["basis"][:, i]) for i in range(3)], axis=-1)
 
 
 def emission_matrix(wavelengths_nm: ArrayLike) -> FloatArray:
     """``(K, 3)``: spectral radiance per nm at each wavelength of an emitter of colour ``rgb`` is
     ``matrix @ rgb``; its CIE integral at rest is ``rgb`` (as in :func:`.spectral.doppler_rgb_matrix`)."""
     wavelengths_nm = np.asarray(wavelengths_nm, dtype=np.float64)
-    white = spectral.illuminant_white(wavelengths_nm)[..., None]
-    return white * reflectance_matrix(wavelengths_nm) @ spectral._inverse_rest_frame_matrix()
+    return white(wavelengths_nm)[..., None] * reflectance_matrix(wavelengths_nm) @ _tables()["inverse_rest_matrix"]
 
 
 def blackbody_samples(wavelengths_nm: ArrayLike, temperature_k: float, luminance: float = 1.0) -> FloatArray:
     """Spectral radiance per nm of a blackbody at ``temperature_k`` (K) with CIE luminance ``luminance``."""
     wavelengths_nm = np.asarray(wavelengths_nm, dtype=np.float64)
-    log_radiance = np.log(spectral.blackbody_spectral_radiance(wavelengths_nm, temperature_k))
-    log_y = spectral._log_blackbody_luminance(np.asarray(float(temperature_k)))
-    return luminance * np.exp(log_radiance - log_y) * _NM
+    with np.errstate(divide="ignore"):
+        log_radiance = np.log(planck(wavelengths_nm, float(temperature_k)))
+    return luminance * np.exp(log_radiance - log_blackbody_luminance(float(temperature_k))) * _NM
 
 
 def _cmfs():
-    return spectral.WAVELENGTHS_VISIBLE_NM, spectral._cmfs_visible()
+    return _tables()["cmfs_nm"], _tables()["cmfs"]
 
 
 def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exact_for_rgb: bool = True) -> FloatArray:
@@ -120,12 +192,12 @@ def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exac
     # blackbodies at ANCHOR_TEMPERATURES_K, V b_T = XYZ_B(D T) / (Y_B(T) D^4).
     doppler = np.exp(log_doppler)
     spectra = [emission_matrix(np.exp(log_mu))]  # (K, 3)
-    targets = [np.asarray(spectral._REC709.matrix_RGB_to_XYZ) @ spectral.doppler_rgb_matrix(doppler)]
+    targets = [np.linalg.inv(_tables()["xyz_to_rgb"]) @ doppler_rgb_matrix(doppler)]
     for temperature in ANCHOR_TEMPERATURES_K:
         samples = blackbody_samples(np.exp(log_mu), temperature)
         scale = 1.0 / np.linalg.norm(samples)
         spectra.append(samples[:, None] * scale)
-        observed = spectral.blackbody_XYZ(doppler * temperature) / spectral.blackbody_luminance(temperature)
+        observed = blackbody_xyz(doppler * temperature) * np.exp(-log_blackbody_luminance(temperature))
         targets.append(observed[..., None] * scale)
     constrained = np.concatenate(spectra, axis=1)  # (K, S)
     target = np.concatenate(targets, axis=-1) / doppler[:, None, None] ** 4  # (J, 3, S)
@@ -136,7 +208,7 @@ def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exac
 
 
 def reconstruct_rgb(samples: ArrayLike, log_doppler: ArrayLike, wavelengths_nm: ArrayLike, table_size: int = 512,
-                    gamut_map: bool = True) -> FloatArray:
+                    map_to_gamut: bool = True) -> FloatArray:
     """Linear Rec.709 colour of every pixel from its samples ``D^4 L_k``, shape ``(..., K)``, and its
     ``ln D``, shape ``(...)``: ``XYZ = sum_k V_k(D) D^4 L_k`` (:func:`reconstruction_table`, tabulated on
     ``table_size`` points of ``ln D`` over the pixels' range and interpolated linearly), then RGB,
@@ -157,5 +229,5 @@ def reconstruct_rgb(samples: ArrayLike, log_doppler: ArrayLike, wavelengths_nm: 
         for c in range(3):
             weight = np.interp(flat_log_d, grid, table[:, k, c]) if grid.size > 1 else table[0, k, c]
             xyz[:, c] += weight * flat_samples[:, k]
-    rgb = spectral.XYZ_to_linear_rec709(xyz).reshape(*log_doppler.shape, 3)
-    return spectral.gamut_map_linear_rec709(rgb) if gamut_map else rgb
+    rgb = xyz_to_linear_rec709(xyz).reshape(*log_doppler.shape, 3)
+    return gamut_map(rgb) if map_to_gamut else rgb
