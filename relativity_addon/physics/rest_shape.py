@@ -1,4 +1,5 @@
-"""The modelled mesh is an object's rest shape (docs/physics.md, "Rest shape of a moving object").
+"""The modelled mesh is an object's rest shape (docs/architecture.md, "Motion sources and the rest
+shape"; the contraction is the Lorentz boost of docs/physics.md read at equal scene times).
 
 At scene time ``t`` an object is, in the scene frame, its rest shape contracted along the velocity
 ``beta(t)`` of its origin, about the origin:

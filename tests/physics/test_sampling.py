@@ -2,7 +2,7 @@
 functions of time against the closed form for uniform motion and the light-cone condition
 ``|x_o - x_e(t_e)| = c (t_o - t_e)`` evaluated on the exact motion. The local points are the rest
 shape: in the scene the body is contracted about its origin along the origin's velocity
-(docs/physics.md, "Rest shape of a moving object"), written out here as ``contract``."""
+(docs/architecture.md, "Motion sources and the rest shape"), written out here as ``contract``."""
 
 import numpy as np
 import pytest

@@ -70,9 +70,9 @@ def retarded_residuals(x_a, x_e, x_o):
 
 
 def contract(relative, beta):
-    """docs/physics.md, rest shape of a moving object: offsets ``relative`` (``(N, 3)``) from the
-    origin of a body moving with ``beta`` (``(3,)`` or ``(N, 3)``) lose the factor 1/gamma of
-    their component along beta."""
+    """Lorentz contraction (docs/architecture.md, "Motion sources and the rest shape"): offsets
+    ``relative`` (``(N, 3)``) from the origin of a body moving with ``beta`` (``(3,)`` or
+    ``(N, 3)``) keep 1/gamma of their component along beta."""
     beta = np.broadcast_to(np.asarray(beta, float), np.shape(relative))
     speed = np.linalg.norm(beta, axis=-1, keepdims=True)
     bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
