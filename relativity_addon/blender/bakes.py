@@ -62,13 +62,14 @@ def _sample_frames(scene, frames, sample):
 
 
 def bake_deformation(scene, obj, frame_start=None, frame_end=None):
-    """Sample the evaluated (tessellated, deformed) world positions of ``obj`` from ``frame_start``
-    to ``frame_end`` (default: the scene's range, starting earlier by twice the current
-    light-travel time to the farthest vertex) at ``relativity.samples_per_frame`` sub-frames, for
-    per-vertex retarded times of a deforming mesh. Steps the scene through the frames (frame_set),
-    so it runs outside handlers; the scene's frame is restored. The samples live in a mesh
-    datablock kept with the .blend (fake user) and are removed with the effect. Returns the number
-    of samples.
+    """Sample the evaluated (tessellated, deformed) world positions of ``obj`` and its origin from
+    ``frame_start`` to ``frame_end`` (default: the scene's range, starting earlier by twice the
+    current light-travel time to the farthest vertex) at ``relativity.samples_per_frame``
+    sub-frames, for per-vertex retarded times of a deforming mesh (the origin's path gives the
+    velocity along which the baked shape is contracted, ``physics.rest_shape``). Steps the scene
+    through the frames (frame_set), so it runs outside handlers; the scene's frame is restored.
+    The samples live in a mesh datablock kept with the .blend (fake user) and are removed with the
+    effect. Returns the number of samples.
     """
     _, cache = modifier.ensure_modifier(obj)
     fps = animation.frames_per_second(scene)
@@ -78,9 +79,11 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
         rest = modifier.evaluated_rest_positions(obj, depsgraph)
         if rest is None or (samples and len(rest) != len(samples[0])):
             raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
-        samples.append(to_world(matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest))
+        matrix = matrix_array(obj.evaluated_get(depsgraph).matrix_world)
+        samples.append(to_world(matrix, rest))
+        origins.append(matrix[:3, 3])
 
-    samples = []
+    samples, origins = [], []
     _sample_frames(scene, frames, sample)
     mesh = modifier.bake_mesh(obj)
     if mesh is None:
@@ -93,7 +96,8 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
         attribute = mesh.attributes.new(f"sample_{i:05d}", "FLOAT_VECTOR", "POINT")
         attribute.data.foreach_set("vector", positions.astype(np.float32).ravel())
     cache.data[names.BAKE_KEY] = {"mesh": mesh.name, "start": float(frames[0] / fps), "step": 1.0 / (per_frame * fps),
-                            "samples": len(samples), "points": count}
+                            "samples": len(samples), "points": count,
+                            names.BAKE_ORIGINS_KEY: np.ravel(origins).tolist()}
     geometry.update_after_bake(scene, obj)
     return len(samples)
 

@@ -22,6 +22,7 @@ ERROR_KEY = "relativity_error"  # on the cache mesh: why the last handler update
 OWNER_KEY = "relativity_owner"  # on the cache mesh: the name of the object it serves
 BAKE_PREFIX = "RelativityBake"  # deformation bake meshes
 BAKE_KEY = "relativity_bake"  # on the cache mesh: name of the bake mesh and its time grid
+BAKE_ORIGINS_KEY = "origins"  # in the BAKE_KEY record: the object's origin at each sample (x, y, z, ...)
 MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world matrices
 
 # --- Doppler colour: materials --------------------------------------------------------------

@@ -7,8 +7,11 @@ the observer event of a snapshot, by the object's motion source (``Object.relati
 - ANIMATION, rigid: world matrices on a sub-frame grid around the retarded times, from the
   object's keyframes under its object-parent chain (``animation.world_matrices``, float64, no
   ``frame_set``) or from its motion bake (``bakes.bake_motion``) when constraints, drivers or NLA
-  move it; per-vertex retarded times by the core's sampled solver.
-- ANIMATION with ``use_deformation``: per-vertex positions from the deformation bake.
+  move it; per-vertex retarded times by the core's sampled solver. The mesh is the rest shape
+  here too: each sample is contracted along the velocity of the object's origin there
+  (``physics.rest_shape``), so a constant keyframed velocity gives the CONSTANT result.
+- ANIMATION with ``use_deformation``: per-vertex positions from the deformation bake, contracted
+  the same way about the object's origin along the origin's velocity (baked with them).
 
 Every function raises RelativityError (one line) for a motion it cannot show correctly.
 """
@@ -16,7 +19,7 @@ Every function raises RelativityError (one line) for a motion it cannot show cor
 import numpy as np
 
 from ..errors import RelativityError
-from ..physics import apparent, sampling
+from ..physics import apparent, rest_shape, sampling
 from . import animation, modifier, names
 from .snapshot import check_velocity
 
@@ -90,8 +93,7 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
                 "bake its motion again")
     start, step = first_frame / fps, 1.0 / (per_frame * fps)
     times = start + step * np.arange(len(matrices))
-    result = apparent.apparent_positions_sampled(apparent.SampledRigidMotion(times, matrices, rest_local),
-                                                 t_o, x_o, c, beta_o)
+    result = rest_shape.apparent_positions_rigid_rest_shape(times, matrices, rest_local, t_o, x_o, c, beta_o)
     t_e = t_o - result[1]
     if t_e.size and (t_e.min() < times[0] or t_e.max() > times[-1]):
         raise RelativityError(
@@ -108,12 +110,16 @@ def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
     info = modifier.cache_data(obj)[names.BAKE_KEY]
     if info["points"] != count:
         raise RelativityError(f"object {obj.name!r}: the mesh changed since the deformation bake; bake again")
+    if names.BAKE_ORIGINS_KEY not in info:
+        raise RelativityError(f"object {obj.name!r}: the deformation bake has no origin path (an earlier "
+                              "version made it); bake again")
     positions = np.empty((info["samples"], count * 3), dtype=np.float32)
     for i in range(info["samples"]):
         mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
     times = info["start"] + info["step"] * np.arange(info["samples"])
-    motion = apparent.SampledPointMotion(times, positions.reshape(info["samples"], count, 3).astype(np.float64))
-    result = apparent.apparent_positions(motion.positions, t_o, x_o, c, count, beta_o, velocity=motion.velocities)
+    origins = np.array(info[names.BAKE_ORIGINS_KEY], dtype=np.float64).reshape(-1, 3)
+    result = rest_shape.apparent_positions_deforming_rest_shape(
+        times, positions.reshape(info["samples"], count, 3).astype(np.float64), origins, t_o, x_o, c, beta_o)
     t_e = t_o - result[1]
     if t_e.min() < times[0] or t_e.max() > times[-1]:
         raise RelativityError(

@@ -18,6 +18,7 @@ import numpy as np
 
 from .apparent import SampledRigidMotion, apparent_positions_sampled
 from .arrays import ArrayLike, FloatArray
+from .rest_shape import check_samples_used, contracted_rigid_samples
 from .validation import finite_array, positive_array, speed_of_light, vector_array
 
 # Most sample times one window may hold: 200000 matrices of 4x4 float64 are 25 MB.
@@ -40,10 +41,12 @@ def apparent_positions_from_matrix_function(
     world_matrix_now: ArrayLike | None = None,
     max_samples: int = MAX_SAMPLES,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Apparent positions of points ``rest_local`` (``(N, 3)``, object space) of a rigid body whose
-    object-to-world matrices at scene times ``t`` (seconds, shape ``(K,)``) are
-    ``world_matrices_at_times(t)`` (shape ``(K, 4, 4)``), seen from the event ``(t_o, x_o)`` by an
-    observer moving with ``beta_o`` (fraction of c, world axes); ``c`` in scene units per second.
+    """Apparent positions of points ``rest_local`` (``(N, 3)``, object space, the body's rest shape)
+    of a rigid body whose object-to-world matrices at scene times ``t`` (seconds, shape ``(K,)``)
+    are ``world_matrices_at_times(t)`` (shape ``(K, 4, 4)``), seen from the event ``(t_o, x_o)`` by
+    an observer moving with ``beta_o`` (fraction of c, world axes); ``c`` in scene units per second.
+    The rest shape is Lorentz-contracted about the origin along the origin's velocity at each
+    sample (:func:`rest_shape.contracted_rigid_samples`), so at each point's retarded time.
 
     The motion is sampled at multiples of ``step`` (seconds; e.g. one animation sub-frame): first
     around ``t_o - |x_o - centroid| / c`` (the centroid's travel time) widened by ``2 reach / c``
@@ -58,7 +61,8 @@ def apparent_positions_from_matrix_function(
     positions ``(N, 3)``, light-travel times ``t_o - t_e`` ``(N,)`` and the points' velocities in
     the observer frame ``(N, 3)``. Raises ``ValueError`` when a window would need more than
     ``max_samples`` samples, when the retarded times do not settle inside the window after
-    ``max_tries`` windows, or for bad input (the motion not slower than light, NaN, ...).
+    ``max_tries`` windows, or for bad input (the motion, or the origin at a sample a retarded time
+    uses, not slower than light, NaN, ...).
     """
     c = speed_of_light(c)
     step = float(positive_array(step, "step"))
@@ -88,10 +92,11 @@ def apparent_positions_from_matrix_function(
                 f"light-travel times span too many animation samples ({high_index - low_index + 1} > {max_samples}"
                 f" samples of {step:.4g} s, from {low:.4g} s to {high:.4g} s)")
         times = np.arange(low_index, high_index + 1) * step
-        motion = SampledRigidMotion(times, world_matrices_at_times(times), rest_local)
-        result = apparent_positions_sampled(motion, t_o, x_o, c, beta_o)
+        matrices, superluminal = contracted_rigid_samples(world_matrices_at_times(times), step, c)
+        result = apparent_positions_sampled(SampledRigidMotion(times, matrices, rest_local), t_o, x_o, c, beta_o)
         t_e = t_o - result[1]
         if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
+            check_samples_used(t_e, times[0], step, superluminal)
             return result
         margin = 4 * step
         low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)

@@ -1,6 +1,8 @@
 """The sample window around retarded times (physics/sampling.py): motions given as matrix
 functions of time against the closed form for uniform motion and the light-cone condition
-``|x_o - x_e(t_e)| = c (t_o - t_e)`` evaluated on the exact motion."""
+``|x_o - x_e(t_e)| = c (t_o - t_e)`` evaluated on the exact motion. The local points are the rest
+shape: in the scene the body is contracted about its origin along the origin's velocity
+(docs/architecture.md, "Motion sources and the rest shape"), written out here as ``contract``."""
 
 import numpy as np
 import pytest
@@ -12,6 +14,16 @@ RNG = np.random.default_rng(21)
 
 def light_cone_residual(x_o, tau, x_e, c):
     return (np.linalg.norm(x_o - x_e, axis=-1) - c * tau) / (c * tau)
+
+
+def contract(relative, beta):
+    """Rest-frame offsets from the origin -> scene frame: the component along beta shrinks by 1/gamma.
+    ``beta`` is (3,) or one row per offset."""
+    beta = np.broadcast_to(np.asarray(beta, float), np.shape(relative))
+    speed = np.linalg.norm(beta, axis=-1, keepdims=True)
+    bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
+    along = np.sum(relative * bhat, axis=-1, keepdims=True)
+    return relative - (1.0 - np.sqrt(1.0 - speed ** 2)) * along * bhat
 
 
 def uniform_motion(start, velocity, rotation_z=0.3):
@@ -51,7 +63,7 @@ def test_uniform_motion_reproduces_the_closed_form(c, observer_beta):
     seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
         matrices, 1.0 / 96.0, local, t_o, x_o, observer_beta, c)
     now = matrices(np.array([t_o]))[0]
-    positions_now = local @ now[:3, :3].T + now[:3, 3]
+    positions_now = contract(local @ now[:3, :3].T, beta) + now[:3, 3]
     expected = apparent.apparent_positions_uniform(t_o, x_o, positions_now, beta, c, observer_beta)
     # Catmull-Rom reproduces linear motion exactly: agreement at rounding level.
     np.testing.assert_allclose(tau, expected[1], rtol=1e-9)
@@ -69,21 +81,23 @@ def test_accelerated_spinning_body_lies_on_the_light_cone():
     seen, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 1.0 / 240.0, local, t_o, x_o,
                                                                     (0.0, 0.0, 0.0), c)
     exact = matrices(t_o - tau)
-    emitted = np.einsum("nij,nj->ni", exact[:, :3, :3], local) + exact[:, :3, 3]
+    # Contracted along the origin's velocity a t_e at each point's own retarded time.
+    velocity = np.multiply.outer(t_o - tau, acceleration) / c
+    emitted = contract(np.einsum("nij,nj->ni", exact[:, :3, :3], local), velocity) + exact[:, :3, 3]
     assert np.max(np.abs(light_cone_residual(x_o, tau, emitted, c))) < 1e-6
     assert np.max(np.linalg.norm(seen - emitted, axis=1) / (c * tau)) < 1e-6  # observer at rest: x_e itself
 
 
 def test_window_widens_for_a_fast_receding_body_and_gives_up_after_max_tries():
-    """Receding at 0.9c from 10 units away (c = 1): seen at tau = 10 / 1.9, far from the first
-    estimate tau = 10 of the window."""
+    """Receding at 0.9c from 10 units away (c = 1): seen at tau = (10 + y / gamma) / 1.9 (the
+    rest offsets y contracted), far from the first estimate tau = 10 of the window."""
     c = 1.0
     matrices = uniform_motion(np.array([0.0, 10.0, 0.0]), np.array([0.0, 0.9, 0.0]), rotation_z=0.0)
     local = np.zeros((50, 3))
     local[:, 1] = RNG.uniform(-0.1, 0.1, 50)  # on the line of sight: c tau = 10 + y - 0.9 tau
     _, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
                                                                  (0.0, 0.0, 0.0), c)
-    np.testing.assert_allclose(tau, (10.0 + local[:, 1]) / 1.9, rtol=1e-9)
+    np.testing.assert_allclose(tau, (10.0 + local[:, 1] * np.sqrt(1.0 - 0.81)) / 1.9, rtol=1e-9)
     with pytest.raises(ValueError, match="did not settle"):
         sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
                                                          (0.0, 0.0, 0.0), c, max_tries=1)

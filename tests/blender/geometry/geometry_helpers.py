@@ -69,18 +69,41 @@ def retarded_residuals(x_a, x_e, x_o):
     return residual, mismatch
 
 
-def world_lines_by_frame_set(bpy, scene, obj, local_points, times, fps):
+def contract(relative, beta):
+    """Lorentz contraction (docs/architecture.md, "Motion sources and the rest shape"): offsets
+    ``relative`` (``(N, 3)``) from the origin of a body moving with ``beta`` (``(3,)`` or
+    ``(N, 3)``) keep 1/gamma of their component along beta."""
+    beta = np.broadcast_to(np.asarray(beta, float), np.shape(relative))
+    speed = np.linalg.norm(beta, axis=-1, keepdims=True)
+    bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
+    along = np.sum(relative * bhat, axis=-1, keepdims=True)
+    return relative - (1.0 - np.sqrt(1.0 - speed ** 2)) * along * bhat
+
+
+def _frame_set_time(scene, t, fps):
+    frame = t * fps
+    whole = int(np.floor(frame))
+    scene.frame_set(whole, subframe=float(frame - whole))
+
+
+def world_lines_by_frame_set(bpy, scene, obj, local_points, times, fps, c=None, velocity_step=0.01):
     """Blender's own evaluation of ``obj`` (constraints, drivers, parents) at each time (seconds):
     ``scene.frame_set`` at the (sub-)frame, ``matrix_world`` applied to the matching local point.
-    Restores the scene's frame."""
+    With ``c`` the local points are the rest shape (the add-on's convention): the offset from the
+    origin is contracted along the origin's velocity, the central difference of ``matrix_world``'s
+    translation over ``+-velocity_step`` seconds, divided by ``c``. Restores the scene's frame."""
     saved = scene.frame_current, scene.frame_subframe
     points = np.empty((len(times), 3))
     for i, t in enumerate(times):
-        frame = t * fps
-        whole = int(np.floor(frame))
-        scene.frame_set(whole, subframe=float(frame - whole))
+        beta = np.zeros(3)
+        if c is not None:
+            _frame_set_time(scene, t + velocity_step, fps)
+            ahead = np.array(obj.matrix_world.translation)
+            _frame_set_time(scene, t - velocity_step, fps)
+            beta = (ahead - np.array(obj.matrix_world.translation)) / (2.0 * velocity_step * c)
+        _frame_set_time(scene, t, fps)
         matrix = np.array(obj.matrix_world)
-        points[i] = matrix[:3, :3] @ local_points[i] + matrix[:3, 3]
+        points[i] = contract((matrix[:3, :3] @ local_points[i])[None], beta)[0] + matrix[:3, 3]
     scene.frame_set(saved[0], subframe=saved[1])
     return points
 

@@ -4,8 +4,9 @@ constraints and other parent types.
 
 Every check is on the evaluated mesh (depsgraph). For each vertex at apparent position x_a, seen by
 a camera at rest at (t_o, x_o): t_e = t_o - |x_o - x_a| / c, and Blender's own evaluation of the
-object at t_e (scene.frame_set at that sub-frame, matrix_world; independent of the add-on) must
-put the vertex at x_a: |x_o - x_e(t_e)| = c (t_o - t_e) to 1e-6 relative.
+object at t_e (scene.frame_set at that sub-frame, matrix_world; independent of the add-on), with
+the mesh as the rest shape contracted along the origin's velocity (docs/physics.md), must put the
+vertex at x_a: |x_o - x_e(t_e)| = c (t_o - t_e) to 1e-6 relative.
 """
 
 import importlib
@@ -60,15 +61,15 @@ def _measure(bpy, scene, camera_object, obj, with_beta=False, remove=True):
     x_o = np.array(camera_object.matrix_world.translation)
     t_o = FRAME / FPS
     t_e = t_o - np.linalg.norm(x_a - x_o, axis=1) / C
-    x_e = gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e, FPS)
+    x_e = gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e, FPS, c=C)
     residual, mismatch = gh.retarded_residuals(x_a, x_e, x_o)
     print(f"{obj.name}: max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
           f"retarded frames {t_e.min() * FPS:.3f}..{t_e.max() * FPS:.3f}")
     if not with_beta:
         return residual, mismatch, t_e, x_e
     dt = 2e-3
-    velocity = (gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e + dt, FPS)
-                - gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e - dt, FPS)) / (2 * dt)
+    velocity = (gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e + dt, FPS, c=C)
+                - gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e - dt, FPS, c=C)) / (2 * dt)
     return residual, mismatch, t_e, x_e, beta_seen, velocity / C
 
 
