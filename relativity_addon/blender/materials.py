@@ -25,7 +25,7 @@ import math
 
 import bpy
 
-from . import luts, names
+from . import luts, names, sources
 from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
@@ -310,6 +310,7 @@ COLOUR_INPUTS = (
     ("ShaderNodeEmission", ("Color",)),
     ("ShaderNodeBsdfPrincipled", ("Base Color", "Emission Color")),
     ("ShaderNodeBsdfDiffuse", ("Color",)),
+    ("ShaderNodeVolumePrincipled", ("Emission Color",)),
 )
 
 
@@ -321,6 +322,15 @@ def _targets(material):
                     socket = node.inputs.get(name)
                     if socket is not None:
                         yield node, socket
+
+
+def _mark_blackbody(tree, node, blackbody):
+    """Colour group ``node`` shifts its colour as a blackbody (``sources.Blackbody``)."""
+    node.inputs["Is Blackbody"].default_value = 1.0
+    if isinstance(blackbody.temperature, float):
+        node.inputs["Temperature"].default_value = blackbody.temperature
+    else:
+        tree.links.new(blackbody.temperature, node.inputs["Temperature"])
 
 
 def is_attached(material):
@@ -341,6 +351,7 @@ def attach(material, temperature=None):
     records = []
     for target_node, socket in list(_targets(material)):
         source = socket.links[0].from_socket if socket.is_linked else None
+        blackbody = sources.blackbody_source(socket)  # through reroutes, mixes, groups
         node = tree.nodes.new("ShaderNodeGroup")
         node.node_tree = group
         node.name = node.label = f"{NODE_PREFIX} {target_node.name} {socket.identifier}"
@@ -348,13 +359,8 @@ def attach(material, temperature=None):
         node.hide = True
         if source is not None:
             tree.links.new(source, node.inputs["Color"])
-            if source.node.bl_idname == "ShaderNodeBlackbody":
-                node.inputs["Is Blackbody"].default_value = 1.0
-                temperature_socket = source.node.inputs["Temperature"]
-                if temperature_socket.is_linked:
-                    tree.links.new(temperature_socket.links[0].from_socket, node.inputs["Temperature"])
-                else:
-                    node.inputs["Temperature"].default_value = temperature_socket.default_value
+            if blackbody is not None:
+                _mark_blackbody(tree, node, blackbody)
         else:
             node.inputs["Color"].default_value = socket.default_value
         is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
@@ -436,21 +442,42 @@ def attach_scene(scene, camera_path):
 
 
 def attach_world(world):
-    """The world writes the Doppler AOV too, so background pixels get their D."""
+    """The world writes the Doppler AOV too, so background pixels get their D; a Background
+    colour fed by a blackbody (``sources``) gets the colour group, like an emission."""
     if world is None or world.node_tree is None or ATTACHED_KEY in world:
         return False
-    node = world.node_tree.nodes.new("ShaderNodeGroup")
+    tree = world.node_tree
+    node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = bpy.data.node_groups[DOPPLER_AOV]
     node.name = node.label = f"{NODE_PREFIX} AOV"
     node.hide = True
-    world[ATTACHED_KEY] = node.name
+    records = [{"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}]
+    for background in [n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground"]:
+        socket = background.inputs["Color"]
+        blackbody = sources.blackbody_source(socket)
+        if blackbody is None:
+            continue  # ordinary colours: the compositor shifts them
+        source = socket.links[0].from_socket
+        group = tree.nodes.new("ShaderNodeGroup")
+        group.node_tree = bpy.data.node_groups[DOPPLER_EMISSION]
+        group.name = group.label = f"{NODE_PREFIX} {background.name} {socket.identifier}"
+        group.location = (background.location.x - 220.0, background.location.y)
+        group.hide = True
+        tree.links.new(source, group.inputs["Color"])
+        _mark_blackbody(tree, group, blackbody)
+        tree.links.new(group.outputs["Color"], socket)
+        records.append({"group_node": group.name, "target": background.name, "socket": socket.identifier,
+                        "source_node": source.node.name, "source_socket": source.identifier})
+    world[ATTACHED_KEY] = records
     return True
 
 
 def detach_world(world):
     if world is None or ATTACHED_KEY not in world:
         return False
-    node = world.node_tree.nodes.get(world[ATTACHED_KEY]) if world.node_tree else None
+    if not isinstance(world[ATTACHED_KEY], str):
+        return detach(world)  # the same records as a material's
+    node = world.node_tree.nodes.get(world[ATTACHED_KEY]) if world.node_tree else None  # older files: the AOV's name
     if node is not None:
         world.node_tree.nodes.remove(node)
     del world[ATTACHED_KEY]
