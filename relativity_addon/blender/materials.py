@@ -310,7 +310,6 @@ COLOUR_INPUTS = (
     ("ShaderNodeEmission", ("Color",)),
     ("ShaderNodeBsdfPrincipled", ("Base Color", "Emission Color")),
     ("ShaderNodeBsdfDiffuse", ("Color",)),
-    ("ShaderNodeVolumePrincipled", ("Emission Color",)),
 )
 
 

@@ -158,3 +158,23 @@ def test_blackbody_world_seen_at_dt_by_moving_observer(factory_blender, tmp_path
         assert delta_e < 2.0
         assert ratio == pytest.approx(expected_ratio, rel=0.03)
     assert d.max() / d.min() > 1.3
+
+
+def test_blackbody_world_attach_and_detach_restore_the_links(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, _ = dh.emitter_scene(bpy)
+    tree = scene.world.node_tree
+    background = tree.nodes["Background"]
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    tree.links.new(blackbody.outputs[0], background.inputs["Color"])
+    before = sorted(node.name for node in tree.nodes)
+    materials = dh.addon_module(relativity_addon, "materials")
+    materials.ensure_node_groups()
+    assert materials.attach_world(scene.world)
+    group = background.inputs["Color"].links[0].from_node
+    assert group.node_tree.name == "Relativity Doppler Colour"
+    assert group.inputs["Is Blackbody"].default_value == 1.0
+    assert group.inputs["Temperature"].default_value == pytest.approx(blackbody.inputs["Temperature"].default_value)
+    assert materials.detach_world(scene.world)
+    assert sorted(node.name for node in tree.nodes) == before
+    assert background.inputs["Color"].links[0].from_node == blackbody
