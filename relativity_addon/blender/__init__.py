@@ -2,7 +2,7 @@
 
 Layers (docs/architecture.md): settings (props, objects) -> snapshot -> effect -> the render
 paths (camera + osl; geometry + modifier + world_lines + bakes) and colour (colour, materials,
-compositing, luts), on shared leaves (names, nodes, compat, busy, animation).
+compositing, luts), on shared leaves (names, nodes, compat, busy, animation, sources).
 
 Each module listed in ``_MODULES`` may define ``classes`` (registered in order, unregistered in
 reverse) and ``register()`` / ``unregister()`` hooks for anything else it installs (properties

@@ -5,6 +5,8 @@ later release that keeps the newer API needs no change here. Each function is te
 lines in ``tests/blender/test_compat.py`` (real ``bpy``).
 """
 
+import warnings
+
 import bpy
 
 
@@ -64,6 +66,16 @@ def world_node_tree(world):
 def material_node_tree(material):
     """The material's shader node tree, creating Blender's default one (Principled) where needed."""
     return _node_tree(material)
+
+
+def light_node_tree(light):
+    """The node tree a light renders with, or None. 5.x: lights always have one and always use
+    it (``use_nodes`` is deprecated and stays on); 4.5: only while ``use_nodes`` is on."""
+    if light.node_tree is None:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return light.node_tree if getattr(light, "use_nodes", True) else None
 
 
 def eevee_engine():

@@ -25,7 +25,7 @@ import math
 
 import bpy
 
-from . import luts, names, spectral_nodes
+from . import luts, names, sources, spectral_nodes
 from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
@@ -336,24 +336,6 @@ def write_settings(snap):
 
 # --- attaching to materials -----------------------------------------------------------------
 
-# (node type, input names) whose colour is an emitted or reflected rest-frame colour.
-COLOUR_INPUTS = (
-    ("ShaderNodeEmission", ("Color",)),
-    ("ShaderNodeBsdfPrincipled", ("Base Color", "Emission Color")),
-    ("ShaderNodeBsdfDiffuse", ("Color",)),
-)
-
-
-def _targets(material):
-    for node in list(material.node_tree.nodes):
-        for kind, socket_names in COLOUR_INPUTS:
-            if node.bl_idname == kind:
-                for name in socket_names:
-                    socket = node.inputs.get(name)
-                    if socket is not None:
-                        yield node, socket
-
-
 def is_attached(material):
     return material is not None and ATTACHED_KEY in material
 
@@ -370,8 +352,9 @@ def attach(material, temperature=None):
     group = bpy.data.node_groups.get(DOPPLER_EMISSION) or ensure_node_groups()
     tree = material.node_tree
     records = []
-    for target_node, socket in list(_targets(material)):
+    for target_node, socket in list(sources.colour_targets(material)):
         source = socket.links[0].from_socket if socket.is_linked else None
+        blackbody = sources.blackbody_source(socket)  # through reroutes, mixes, groups
         node = tree.nodes.new("ShaderNodeGroup")
         node.node_tree = group
         node.name = node.label = f"{NODE_PREFIX} {target_node.name} {socket.identifier}"
@@ -379,13 +362,8 @@ def attach(material, temperature=None):
         node.hide = True
         if source is not None:
             tree.links.new(source, node.inputs["Color"])
-            if source.node.bl_idname == "ShaderNodeBlackbody":
-                node.inputs["Is Blackbody"].default_value = 1.0
-                temperature_socket = source.node.inputs["Temperature"]
-                if temperature_socket.is_linked:
-                    tree.links.new(temperature_socket.links[0].from_socket, node.inputs["Temperature"])
-                else:
-                    node.inputs["Temperature"].default_value = temperature_socket.default_value
+            if blackbody is not None:
+                sources.mark_blackbody(tree, node, blackbody)
         else:
             node.inputs["Color"].default_value = socket.default_value
         is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
@@ -468,21 +446,47 @@ def attach_scene(scene, camera_path):
 
 
 def attach_world(world):
-    """The world writes the Doppler AOV too, so background pixels get their D."""
+    """The world writes the Doppler AOV too, so background pixels get their D; a Background
+    colour fed by a blackbody (``sources``) gets the colour group, like an emission."""
     if world is None or world.node_tree is None or ATTACHED_KEY in world:
         return False
-    node = world.node_tree.nodes.new("ShaderNodeGroup")
+    tree = world.node_tree
+    node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = bpy.data.node_groups[DOPPLER_AOV]
     node.name = node.label = f"{NODE_PREFIX} AOV"
     node.hide = True
-    world[ATTACHED_KEY] = node.name
+    records = [{"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}]
+    for background in [n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground"]:
+        # every background colour: the fast mode shifts only blackbodies here (the compositor the
+        # rest), a spectral pass needs all of them as emitted spectra
+        socket = background.inputs["Color"]
+        source = socket.links[0].from_socket if socket.is_linked else None
+        group = tree.nodes.new("ShaderNodeGroup")
+        group.node_tree = bpy.data.node_groups[DOPPLER_EMISSION]
+        group.name = group.label = f"{NODE_PREFIX} {background.name} {socket.identifier}"
+        group.location, group.hide = (background.location.x - 220.0, background.location.y), True
+        if source is not None:
+            tree.links.new(source, group.inputs["Color"])
+        else:
+            group.inputs["Color"].default_value = socket.default_value
+        blackbody = sources.blackbody_source(socket)
+        if blackbody is not None:
+            sources.mark_blackbody(tree, group, blackbody)
+        group.inputs["Is Emission"].default_value = 1.0
+        tree.links.new(group.outputs["Color"], socket)
+        records.append({"group_node": group.name, "target": background.name, "socket": socket.identifier,
+                        "source_node": source.node.name if source else "", "source_socket": source.identifier
+                        if source else ""})
+    world[ATTACHED_KEY] = records
     return True
 
 
 def detach_world(world):
     if world is None or ATTACHED_KEY not in world:
         return False
-    node = world.node_tree.nodes.get(world[ATTACHED_KEY]) if world.node_tree else None
+    if not isinstance(world[ATTACHED_KEY], str):
+        return detach(world)  # the same records as a material's
+    node = world.node_tree.nodes.get(world[ATTACHED_KEY]) if world.node_tree else None  # older files: the AOV's name
     if node is not None:
         world.node_tree.nodes.remove(node)
     del world[ATTACHED_KEY]

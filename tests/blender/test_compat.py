@@ -108,3 +108,16 @@ def test_custom_property_keys_are_the_users_only(relativity_addon, factory_blend
     scene.relativity.beta = (0.0, 0.5, 0.0)  # stored in an ID property on 4.5, apart on 5.x
     scene["user_key"] = 1
     assert compat.custom_property_keys(scene) == ["user_key"]
+
+
+def test_light_node_tree(factory_blender):
+    bpy = factory_blender
+    light = bpy.data.lights.new("Lamp", "POINT")
+    if light.node_tree is None:  # 4.5: a tree only once use_nodes is switched on, used while it is
+        assert compat.light_node_tree(light) is None
+        light.use_nodes = True
+        assert compat.light_node_tree(light) == light.node_tree
+        light.use_nodes = False
+        assert compat.light_node_tree(light) is None
+    else:  # 5.x: always there and used
+        assert compat.light_node_tree(light) == light.node_tree
