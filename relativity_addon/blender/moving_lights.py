@@ -1,5 +1,5 @@
 """Moving lights: point and spot lights with constant velocity light each surface from their
-retarded position, with eq. 19's ``D^4`` beaming and shadows (docs/physics.md, "Moving lights").
+retarded position, with eq. 19's ``D^4`` beaming and shadows (docs/moving-lights.md).
 
 Cycles' own lights cannot move during the light's flight, so a moving light is drawn by the
 surfaces instead: every material of the scene gets the group ``Relativity Moving Lights``
@@ -10,7 +10,7 @@ hidden from renders while the effect is applied. Every change is recorded (the u
 ``hide_render`` on the light, the scene's Open Shading Language setting, each material's old
 surface link) and :func:`remove` restores it exactly.
 
-What is covered (docs/physics.md, "Moving lights"): point and spot lights with CONSTANT motion,
+What is covered (docs/moving-lights.md): point and spot lights with CONSTANT motion,
 surfaces at rest in the scene frame, diffuse reflection (the albedo is the Base Color / Color of
 the first Principled or Diffuse BSDF feeding the output), one shadow ray to a point source on
 the Apparent Geometry path. Behind the exact camera (an OSL camera) Cycles crashes in the
@@ -100,14 +100,28 @@ def ensure_group(light_names):
     return group
 
 
+def reception_event(snap):
+    """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame.
+
+    The exact camera's aperture centre at its shutter time ``t_S`` (camera frame), by Gray eq. (1):
+    ``t = t_o + gamma t_S``, ``x = x_cam + gamma beta c t_S``; the apparent-geometry path uses
+    ``(t_o, x_cam)`` (world_lines.py)."""
+    if snap.method != "CAMERA":
+        return 0.0, tuple(float(v) for v in snap.camera_position)
+    ct = snap.speed_of_light * snap.shutter_time * snap.gamma
+    return ct, tuple(float(x + b * ct) for x, b in zip(snap.camera_position, snap.beta, strict=True))
+
+
 def shader_parameters(light, snap):
-    """The script node's inputs for one light (world axes; intensity in W/sr per channel)."""
+    """The script node's inputs for one light (world axes; intensity in W/sr per channel): the
+    light's position at the reception event's time and that event's position."""
     cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
     smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0.0 and cos_half < 1.0 else 0.0
+    ct, camera_position = reception_event(snap)
     return {
-        "light_position": light.position,
+        "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
         "light_beta": light.beta,
-        "camera_position": tuple(float(v) for v in snap.camera_position),
+        "camera_position": camera_position,
         "intensity": light.intensity,
         "light_type": SUPPORTED_KINDS[light.kind],
         "spot_axis": light.axis,

@@ -1,5 +1,5 @@
 """Surfaces lit by a light in uniform motion: retarded light position, Doppler factor, irradiance
-(docs/physics.md, "Moving lights"; Weiskopf, Kraus, Ruder 1999, eq. 19).
+(docs/moving-lights.md; Weiskopf, Kraus, Ruder 1999, eq. 19).
 
 Frames and conventions: everything is in the scene frame, where the lit surface and the camera
 are at rest. The light moves with constant velocity ``beta c`` (world axes) and is at

@@ -1,7 +1,7 @@
 """A point light moving at 0.5c above a white diffuse floor, seen by a camera at rest (the exact
 camera at beta = 0; the shadow test on the Apparent Geometry path, since OSL shadow rays crash
 Cycles behind the exact camera's OSL camera): real Cycles renders against eq. 19 with retarded
-positions written out here in numpy (docs/physics.md, "Moving lights"), independently of the
+positions written out here in numpy (docs/moving-lights.md), independently of the
 add-on.
 
 The floor point x sends the camera its light at t_x = t_o - |x - x_cam| / c and was lit by the
@@ -36,13 +36,15 @@ ROWS = slice(58, 62)  # the four pixel rows around the image's centre line (floo
 # an occluder: a square at height 0.5 under the lamp's retarded positions
 OCCLUDER_CENTRE = np.array([-1.3, 0.4, 0.5])
 OCCLUDER_HALF = 0.2
+SPOT_SIZE = math.radians(80.0)  # full cone angle
+SPOT_BLEND = 0.3
 
 
 def _effect():
     return importlib.import_module(f"{ADDON_MODULE}.blender.effect")
 
 
-def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA"):
+def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA", kind="POINT"):
     scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=samples, location=tuple(CAMERA))
     camera.data.lens = 25.0  # the floor from x = -3.6 to 3.6 in view
     scene.cycles.pixel_filter_type = "BOX"
@@ -60,9 +62,12 @@ def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA"):
         tree = compat.material_node_tree(black)
         tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
         _quad(bpy, scene, "Occluder", tuple(OCCLUDER_CENTRE), OCCLUDER_HALF, black)
-    light = bpy.data.lights.new("Lamp", "POINT")
+    light = bpy.data.lights.new("Lamp", kind)
     light.energy = POWER
     light.shadow_soft_size = 0.0
+    if kind == "SPOT":  # pointing down (-Z)
+        light.spot_size = SPOT_SIZE
+        light.spot_blend = SPOT_BLEND
     lamp = bpy.data.objects.new("Lamp", light)
     lamp.location = tuple(LAMP)
     scene.collection.objects.link(lamp)
@@ -105,20 +110,20 @@ def _floor_points(bpy, scene, camera):
     return CAMERA + t[..., None] * view
 
 
-def _retarded_lamp(points, beta):
-    """The lamp's position when it emitted the light each floor point sends the camera at t_o,
-    by fixed-point iteration in scene time (t_o = 0)."""
-    t_x = -np.linalg.norm(points - CAMERA, axis=-1) / C
+def _retarded_lamp(points, beta, reception_time=0.0):
+    """The lamp's position when it emitted the light each floor point sends the camera at
+    ``reception_time`` (scene seconds after t_o = 0), by fixed-point iteration in scene time."""
+    t_x = reception_time - np.linalg.norm(points - CAMERA, axis=-1) / C
     t_e = t_x.copy()
     for _ in range(80):  # contracts by |beta| = 0.5 per step
         t_e = t_x - np.linalg.norm(points - (LAMP + beta * C * t_e[..., None]), axis=-1) / C
     return LAMP + beta * C * t_e[..., None]
 
 
-def _expected_radiance(points, beta, occluder=False):
+def _expected_radiance(points, beta, occluder=False, reception_time=0.0):
     """a / pi * D^4 cos(alpha) I / r^2 at floor points, zero where the occluder blocks the segment
     from the retarded lamp."""
-    source = _retarded_lamp(points, beta)
+    source = _retarded_lamp(points, beta, reception_time)
     ray = points - source
     r = np.linalg.norm(ray, axis=-1)
     n = ray / r[..., None]
@@ -218,12 +223,13 @@ def test_occluder_shadow_falls_where_the_retarded_position_says(relativity_addon
     assert np.abs(image[outside] - lit[outside]).max() < 0.05 * lit.max()
 
 
-@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
-def test_at_rest_matches_blenders_own_point_light(relativity_addon, factory_blender, tmp_path, method):
+@pytest.mark.parametrize("method, kind", [("CAMERA", "POINT"), ("GEOMETRY", "POINT"), ("CAMERA", "SPOT")])
+def test_at_rest_matches_blenders_own_light(relativity_addon, factory_blender, tmp_path, method, kind):
     """beta = 0: the moving-light shader's floor equals Blender's own point light (soft radius 0,
-    the lamp rendered by Cycles) within 3 % over the lit area: the absolute scale I = P / (4 pi)."""
+    the lamp rendered by Cycles) within 3 % over the lit area: the absolute scale I = P / (4 pi);
+    a spot light's cone and blend too."""
     bpy = factory_blender
-    scene, _camera, lamp = _floor_scene(bpy, beta=(0.0, 0.0, 0.0), method=method)
+    scene, _camera, lamp = _floor_scene(bpy, beta=(0.0, 0.0, 0.0), method=method, kind=kind)
     _effect().apply(scene)
     assert lamp.hide_render
     ours = _render(bpy, scene, tmp_path / "ours.exr")
@@ -234,6 +240,60 @@ def test_at_rest_matches_blenders_own_point_light(relativity_addon, factory_blen
     blender = _render(bpy, scene, tmp_path / "blender.exr")
     lit = blender[..., 1] > 0.1 * blender[..., 1].max()
     ratio = ours[lit].mean() / blender[lit].mean()
-    print(f"{method}: moving-light shader / Blender's lamp over {lit.sum()} lit px: {ratio:.4f}")
+    print(f"{method} {kind}: moving-light shader / Blender's lamp over {lit.sum()} lit px: {ratio:.4f}, "
+          f"largest difference {np.abs(ours[lit] - blender[lit]).max() / blender[lit].max():.2e} of the peak")
     assert ratio == pytest.approx(1.0, abs=0.03)
     assert np.abs(ours[lit] - blender[lit]).max() < 0.05 * blender[lit].max()
+
+
+def _spot_mask(n, beta):
+    """Blender's spot cone (smoothstep over the blend) on the photon direction in the lamp's own
+    frame: n' = (n + (gamma - 1)(bhat . n) bhat - gamma beta) / (gamma (1 - beta . n))."""
+    gamma = 1.0 / math.sqrt(1.0 - beta @ beta)
+    bhat = beta / np.linalg.norm(beta)
+    bn = n @ bhat
+    n_light = (n + (gamma - 1.0) * bn[..., None] * bhat - gamma * beta) / (gamma * (1.0 - n @ beta))[..., None]
+    cos_axis = -n_light[..., 2]  # the spot points down its local -Z
+    cos_half = math.cos(SPOT_SIZE / 2.0)
+    t = np.clip((cos_axis - cos_half) / ((1.0 - cos_half) * SPOT_BLEND), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def test_moving_spot_light_cone_is_aberrated(relativity_addon, factory_blender, tmp_path):
+    """A spot light at 0.5c pointing down: its cone is defined in its own frame, so on the floor
+    it is aberrated forward (and beamed): eq. 19 times the cone of the aberrated direction."""
+    bpy = factory_blender
+    scene, camera, _lamp = _floor_scene(bpy, kind="SPOT")
+    _effect().apply(scene)
+    image = _render(bpy, scene, tmp_path / "spot.exr")[..., 1]
+    points = _floor_points(bpy, scene, camera)
+    radiance, source, _ = _expected_radiance(points, BETA)
+    n = (points - source) / np.linalg.norm(points - source, axis=-1, keepdims=True)
+    expected = radiance * _spot_mask(n, BETA)
+    at_rest_cone = radiance * _spot_mask(n, np.array([1e-12, 0.0, 0.0]))
+    error = np.abs(image - expected)
+    inner = (slice(2, -2), slice(2, -2))  # a cone edge inside a pixel is averaged over it: judged by the mean
+    print(f"spot: peak {expected.max():.3f}; mean error {error[inner].mean() / expected.max():.4f}, "
+          f"max {error[inner].max() / expected.max():.4f} of the peak; lit px {np.sum(expected > 0)} "
+          f"(cone not aberrated: {np.sum(at_rest_cone > 0)})")
+    assert np.abs(image[ROWS].mean(0) - expected[ROWS].mean(0)).max() < 0.05 * expected.max()
+    assert error[inner].mean() < 0.005 * expected.max()
+    assert np.abs(image - at_rest_cone)[inner].mean() > 4.0 * error[inner].mean()
+
+
+def test_shutter_time_is_when_the_camera_receives_the_light(relativity_addon, factory_blender, tmp_path):
+    """The exact camera at rest with shutter time t_S receives the light at t_o + t_S: the pool of
+    light moves on with the lamp (here c t_S = 1.5, the lamp 0.75 further on)."""
+    bpy = factory_blender
+    scene, camera, _lamp = _floor_scene(bpy)
+    scene.relativity.shutter_time = 0.15
+    _effect().apply(scene)
+    image = _render(bpy, scene, tmp_path / "later.exr")[..., 1]
+    points = _floor_points(bpy, scene, camera)
+    expected, _, _ = _expected_radiance(points, BETA, reception_time=0.15)
+    at_t_o, _, _ = _expected_radiance(points, BETA)
+    measured, later, earlier = image[ROWS].mean(0), expected[ROWS].mean(0), at_t_o[ROWS].mean(0)
+    print(f"shutter time: peak at {np.argmax(measured)} (expected {np.argmax(later)}, {np.argmax(earlier)} at t_o); "
+          f"max error {np.abs(measured - later).max() / later.max():.4f} of the peak")
+    assert np.abs(measured - later).max() < 0.05 * later.max()
+    assert np.argmax(later) - np.argmax(earlier) > 10
