@@ -93,3 +93,21 @@ def test_unsupported_lights_are_reported(relativity_addon, factory_blender):
     assert any("no shadows" in warning for warning in warnings)  # the exact camera
     assert not sun.hide_render  # rendered at rest, as the warning says
     effect.remove(scene)
+
+
+def test_light_panel_shows_motion_and_velocity(relativity_addon, factory_blender):
+    """The Active Object sub-panel draws the motion settings for a light (checked against RNA)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow"))
+    from test_ui_workflow import draw_panel
+
+    bpy = factory_blender
+    scene, _camera, lamp = _floor_scene(bpy)
+    log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
+    assert ("prop", "motion") in log and ("prop", "beta") in log
+    assert not [entry for entry in log if entry[0] == "label" and entry[2] == "ERROR"]
+    lamp.data.type = "SUN"
+    log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
+    assert any(entry[0] == "label" and "rendered at rest" in entry[1] for entry in log)
