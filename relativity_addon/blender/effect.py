@@ -8,6 +8,7 @@ One data path from a setting to the render::
     Snapshot  ->  camera.write       exact camera: OSL parameters          (method CAMERA)
               ->  geometry.update    apparent geometry: cache meshes       (method GEOMETRY)
               ->  colour.write       materials' settings group, compositor flags (both)
+              ->  moving_lights.write  lights with constant velocity: OSL in materials (both)
 
 :func:`sync` runs that path; every handler (``handlers.py``) and every property update callback
 calls it, so a setting changed in the panel reaches the next render on either path. The camera,
@@ -17,7 +18,7 @@ is marked invalid (it renders black, never a wrong image).
 """
 
 from ..errors import RelativityError
-from . import animation, busy, camera, colour, geometry, modifier, snapshot
+from . import animation, busy, camera, colour, geometry, modifier, moving_lights, snapshot
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
@@ -56,8 +57,10 @@ def apply(scene, frame_range=None, objects=None):
         result = geometry.apply(scene, snap, objects)
         undo = (lambda: geometry.remove(scene, result))  # noqa: E731
     try:
+        moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
         colour.apply(scene, snap)
     except RelativityError:
+        moving_lights.remove(scene)
         undo()
         raise
     _record(scene, snap)
@@ -71,6 +74,7 @@ def remove(scene):
     for camera_object in camera.applied_cameras():
         removed += bool(camera.remove(camera_object))
     colour.remove(scene)
+    moving_lights.remove(scene)
     _scene_status.pop(scene.name, None)
     return removed
 
@@ -96,6 +100,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         elif method == "GEOMETRY" and update_geometry:
             geometry.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
+            moving_lights.write(scene, snap, attach_new_materials)
             colour.write(scene, snap, attach_new_materials)
     except RelativityError as error:
         if method == "CAMERA":
@@ -150,6 +155,7 @@ def _record(scene, snap):
                 and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
     warnings += geometry.scene_errors(scene)
+    warnings += moving_lights.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     if snap.method == "GEOMETRY":
         for obj in scene.objects:

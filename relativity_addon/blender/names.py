@@ -56,3 +56,12 @@ DOPPLER_LUT_IMAGE = "Relativity Doppler Matrix LUT"
 BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
 LUT_LAYOUT_KEY = "relativity_lut_layout"
 LUT_LAYOUT_VERSION = 1
+
+# --- moving lights --------------------------------------------------------------------------
+MOVING_LIGHT_SHADER_TEXT = "relativistic_moving_light.osl"  # text datablock of the material OSL shader
+MOVING_LIGHTS_GROUP = "Relativity Moving Lights"  # shader group: one script node per moving light
+MOVING_LIGHTS_LIGHTS_KEY = "relativity_moving_lights"  # on that group: the light names of its script nodes
+MOVING_LIGHTS_MATERIAL_KEY = "relativity_moving_lights"  # on materials: the inserted nodes and the old link
+MOVING_LIGHT_NODE_PREFIX = "Relativity Moving Lights"
+LIGHT_SAVED_KEY = "relativity_light_saved"  # on light objects: the user's hide_render while hidden
+SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: the user's Open Shading Language

@@ -131,6 +131,9 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         settings = obj.relativity
         layout = _split(self.layout)
         layout.label(text=obj.name, icon="OBJECT_DATA")
+        if obj.type == "LIGHT":
+            _draw_light(layout, obj)
+            return
         if obj.type != "MESH":
             layout.label(text="Apparent geometry moves meshes only", icon="INFO")
             return
@@ -153,6 +156,19 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
             column.operator(operator, icon="REC")
         for warning in effect.object_warnings(context.scene, obj):
             layout.label(text=warning, icon="ERROR")
+
+
+def _draw_light(layout, obj):
+    """Lights: the same motion settings as meshes (point and spot lights with constant velocity
+    are rendered moving, blender/moving_lights.py)."""
+    settings = obj.relativity
+    layout.prop(settings, "motion")
+    if settings.motion == "CONSTANT":
+        layout.prop(settings, "beta")
+        if obj.data.type not in ("POINT", "SPOT"):
+            layout.label(text=f"Moving {obj.data.type.lower()} lights are rendered at rest", icon="ERROR")
+    elif settings.motion == "ANIMATION":
+        layout.label(text="Animated lights are rendered at rest", icon="ERROR")
 
 
 classes = (

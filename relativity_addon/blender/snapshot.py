@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics.shutter import ShutterModel
-from . import animation
+from . import animation, names
 
 Vector3 = tuple[float, float, float]
 
@@ -34,6 +34,20 @@ class ColourFactors:
     power_of_d: float  # brightness D^p where the spectrum does not give it (4, Chang's 1, or 0)
     camera_power: float  # the D^4 the exact camera's shader already applied (0 on the mesh path)
     camera_path: bool
+
+
+@dataclass(frozen=True)
+class MovingLight:
+    """A light with constant velocity (``Object.relativity.motion == 'CONSTANT'``), read at the frame."""
+
+    name: str
+    kind: str  # Blender's light type: POINT, SPOT, SUN, AREA
+    position: Vector3  # world, at the observer's time t_o: where Blender draws it
+    beta: Vector3  # world axes, fraction of c
+    intensity: Vector3  # W/sr per linear RGB channel in its own frame: power / (4 pi) times its colour
+    axis: Vector3  # world direction of its local -Z (where a spot points)
+    spot_size: float  # full cone angle, radians
+    spot_blend: float
 
 
 @dataclass(frozen=True)
@@ -57,6 +71,7 @@ class Snapshot:
     use_doppler: bool
     use_searchlight: bool
     use_chang_searchlight: bool
+    moving_lights: tuple[MovingLight, ...] = ()
 
     @property
     def time(self) -> float:
@@ -210,6 +225,34 @@ def observer_velocity(scene, camera, frame):
     return check_velocity(scene.relativity.beta, "observer velocity beta")
 
 
+def light_render_hidden(obj):
+    """Whether the user hid the light from renders (the moving-light stage hides it too, keeping
+    the user's value under ``names.LIGHT_SAVED_KEY``)."""
+    saved = obj.get(names.LIGHT_SAVED_KEY)
+    return bool(saved["hide_render"]) if saved is not None else obj.hide_render
+
+
+def moving_lights(scene, frame, depsgraph=None):
+    """Every light of ``scene`` with constant velocity that renders, at ``frame``; RelativityError
+    for a light at or above the speed of light."""
+    found = []
+    for obj in scene.objects:
+        if obj.type != "LIGHT" or obj.relativity.motion != "CONSTANT" or light_render_hidden(obj):
+            continue
+        beta = check_velocity(obj.relativity.beta, f"light {obj.name!r} velocity beta")
+        matrix = camera_matrix(scene, obj, frame, depsgraph)
+        axis = -matrix[:3, 2] / max(np.linalg.norm(matrix[:3, 2]), 1e-30)
+        light = obj.data
+        power = float(light.energy) / (4.0 * math.pi)
+        spot = light.type == "SPOT"
+        found.append(MovingLight(
+            name=obj.name, kind=light.type, position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
+            intensity=tuple(power * float(v) for v in light.color), axis=tuple(float(v) for v in axis),
+            spot_size=float(light.spot_size) if spot else math.pi, spot_blend=float(light.spot_blend) if spot else 0.0,
+        ))
+    return tuple(found)
+
+
 def read(scene, depsgraph=None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
     cannot be rendered with correct physics."""
@@ -247,4 +290,5 @@ def read(scene, depsgraph=None) -> Snapshot:
         use_doppler=bool(settings.use_doppler),
         use_searchlight=bool(settings.use_searchlight),
         use_chang_searchlight=bool(settings.use_chang_searchlight),
+        moving_lights=moving_lights(scene, frame, depsgraph),
     )

@@ -1,0 +1,362 @@
+"""Moving lights: point and spot lights with constant velocity light each surface from their
+retarded position, with eq. 19's ``D^4`` beaming and shadows (docs/moving-lights.md).
+
+Cycles' own lights cannot move during the light's flight, so a moving light is drawn by the
+surfaces instead: every material of the scene gets the group ``Relativity Moving Lights``
+(one OSL script node per moving light, ``shaders/relativistic_moving_light.osl``) added to its
+surface shader, which computes the retarded light position in closed form, traces a shadow ray
+toward it and emits the surface's diffuse reflection of that light. The Blender light itself is
+hidden from renders while the effect is applied. Every change is recorded (the user's
+``hide_render`` on the light, the scene's Open Shading Language setting, each material's old
+surface link) and :func:`remove` restores it exactly.
+
+What is covered (docs/moving-lights.md): point and spot lights with CONSTANT motion,
+surfaces at rest in the scene frame, diffuse reflection (the albedo is the Base Color / Color of
+the first Principled or Diffuse BSDF feeding the output), one shadow ray to a point source on
+the Apparent Geometry path. Behind the exact camera (an OSL camera) Cycles crashes in the
+material's ``trace()`` (measured on 4.5 and 5.2: the camera shader clears the thread's trace
+data), so there the shader traces no shadow ray and moving lights cast no shadows.
+"""
+
+import math
+import os
+
+import bpy
+
+from ..errors import RelativityError
+from . import names, osl
+
+SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
+GROUP = names.MOVING_LIGHTS_GROUP
+MATERIAL_KEY = names.MOVING_LIGHTS_MATERIAL_KEY
+NODE_PREFIX = names.MOVING_LIGHT_NODE_PREFIX
+SUPPORTED_KINDS = {"POINT": 0, "SPOT": 1}
+ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffuse": "Color"}
+
+
+def supported(snap):
+    """The snapshot's moving lights this stage renders (point and spot lights)."""
+    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS]
+
+
+def is_applied(scene):
+    return names.SHADING_SYSTEM_SAVED_KEY in scene
+
+
+# --- the shader and its group ---------------------------------------------------------------
+
+
+def _shader_text():
+    with open(SHADER_PATH, encoding="utf-8") as handle:
+        source = handle.read()
+    text = bpy.data.texts.get(names.MOVING_LIGHT_SHADER_TEXT)
+    if text is None:
+        text = bpy.data.texts.new(names.MOVING_LIGHT_SHADER_TEXT)
+    if text.as_string().rstrip("\n") != source.rstrip("\n"):
+        text.clear()
+        text.write(source)
+    return text
+
+
+def _new_group():
+    group = bpy.data.node_groups.new(GROUP, "ShaderNodeTree")
+    group.interface.new_socket("Albedo", in_out="INPUT", socket_type="NodeSocketColor").default_value = \
+        (0.8, 0.8, 0.8, 1.0)
+    group.interface.new_socket("Emission", in_out="OUTPUT", socket_type="NodeSocketShader")
+    return group
+
+
+def ensure_group(light_names):
+    """The group with one compiled script node per light (rebuilt inside when the lights change;
+    its interface never changes, so the materials' links survive)."""
+    group = bpy.data.node_groups.get(GROUP) or _new_group()
+    if list(group.get(names.MOVING_LIGHTS_LIGHTS_KEY, [])) == list(light_names) and len(group.nodes):
+        return group
+    group.nodes.clear()
+    inputs = group.nodes.new("NodeGroupInput")
+    output = group.nodes.new("NodeGroupOutput")
+    text = _shader_text()
+    previous = None
+    for index, name in enumerate(light_names):
+        node = group.nodes.new("ShaderNodeScript")
+        node.name = node.label = f"light {name}"
+        node.mode = "INTERNAL"
+        node.script = text  # compiles (oslquery must be importable) and creates the sockets
+        node.location = (200.0, -200.0 * index)
+        if "Emission" not in node.outputs or "light_position" not in node.inputs:
+            raise RelativityError("the moving-light OSL shader did not compile (no sockets on its script node)")
+        group.links.new(inputs.outputs["Albedo"], node.inputs["Albedo"])
+        if previous is None:
+            previous = node.outputs["Emission"]
+        else:
+            add = group.nodes.new("ShaderNodeAddShader")
+            add.location = (400.0, -200.0 * index)
+            group.links.new(previous, add.inputs[0])
+            group.links.new(node.outputs["Emission"], add.inputs[1])
+            previous = add.outputs[0]
+    if previous is not None:
+        group.links.new(previous, output.inputs["Emission"])
+    group[names.MOVING_LIGHTS_LIGHTS_KEY] = list(light_names)
+    return group
+
+
+def reception_event(snap):
+    """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame.
+
+    The exact camera's aperture centre at its shutter time ``t_S`` (camera frame), by Gray eq. (1):
+    ``t = t_o + gamma t_S``, ``x = x_cam + gamma beta c t_S``; the apparent-geometry path uses
+    ``(t_o, x_cam)`` (world_lines.py)."""
+    if snap.method != "CAMERA":
+        return 0.0, tuple(float(v) for v in snap.camera_position)
+    ct = snap.speed_of_light * snap.shutter_time * snap.gamma
+    return ct, tuple(float(x + b * ct) for x, b in zip(snap.camera_position, snap.beta, strict=True))
+
+
+def shader_parameters(light, snap):
+    """The script node's inputs for one light (world axes; intensity in W/sr per channel): the
+    light's position at the reception event's time and that event's position."""
+    cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
+    smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0.0 and cos_half < 1.0 else 0.0
+    ct, camera_position = reception_event(snap)
+    return {
+        "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
+        "light_beta": light.beta,
+        "camera_position": camera_position,
+        "intensity": light.intensity,
+        "light_type": SUPPORTED_KINDS[light.kind],
+        "spot_axis": light.axis,
+        "spot_cos_half_angle": cos_half if light.kind == "SPOT" else -1.0,
+        "spot_smooth": smooth,
+        "use_shadows": snap.method != "CAMERA",
+    }
+
+
+def _same(a, b):
+    return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-30)  # sockets hold float32
+
+
+def _set_input(socket, value):
+    """Write a socket's default value only when it changed (a write triggers a depsgraph update,
+    whose handler syncs again)."""
+    current = socket.default_value
+    if isinstance(value, tuple):
+        value = value + tuple(current)[len(value):]  # colour sockets carry alpha
+        if all(_same(a, b) for a, b in zip(current, value, strict=True)):
+            return False
+    elif _same(current, value):
+        return False
+    socket.default_value = value
+    return True
+
+
+def _write_parameters(group, snap):
+    for light in supported(snap):
+        node = group.nodes[f"light {light.name}"]
+        for key, value in shader_parameters(light, snap).items():
+            _set_input(node.inputs[key], value)
+
+
+# --- materials ------------------------------------------------------------------------------
+
+
+def _material_output(tree):
+    outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial"
+               and node.target in ("ALL", "CYCLES")]
+    active = [node for node in outputs if node.is_active_output]
+    return (active or outputs or [None])[0]
+
+
+def _albedo_socket(tree, surface):
+    """The colour input of the first Principled or Diffuse BSDF upstream of the surface socket."""
+    seen, queue = set(), [surface]
+    while queue:
+        socket = queue.pop(0)
+        for link in socket.links:
+            node = link.from_node
+            if node.name in seen:
+                continue
+            seen.add(node.name)
+            if node.bl_idname in ALBEDO_INPUTS:
+                return node.inputs[ALBEDO_INPUTS[node.bl_idname]]
+            queue.extend(node.inputs)
+    return None
+
+
+def _albedo_source(socket):
+    """The socket feeding the albedo, looking through the Doppler colour stage's group (the
+    rest-frame colour is what the light reflects from), or None for the socket's own value."""
+    if not socket.is_linked:
+        return None
+    source = socket.links[0].from_socket
+    node = source.node
+    if node.bl_idname == "ShaderNodeGroup" and node.name.startswith(names.MATERIAL_NODE_PREFIX):
+        colour = node.inputs.get("Color")
+        return colour.links[0].from_socket if colour is not None and colour.is_linked else None
+    return source
+
+
+def attach(material, group):
+    """Add the group's emission to the material's surface: ``surface + moving lights``."""
+    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+        return False
+    tree = material.node_tree
+    output = _material_output(tree)
+    if output is None or not output.inputs["Surface"].is_linked:
+        return False
+    albedo = _albedo_socket(tree, output.inputs["Surface"])
+    if albedo is None:
+        return False
+    source = output.inputs["Surface"].links[0].from_socket
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.name = node.label = f"{NODE_PREFIX}"
+    node.location = (output.location.x - 200.0, output.location.y - 200.0)
+    node.hide = True
+    add = tree.nodes.new("ShaderNodeAddShader")
+    add.name = add.label = f"{NODE_PREFIX} Add"
+    add.location = (output.location.x - 100.0, output.location.y - 150.0)
+    add.hide = True
+    albedo_source = _albedo_source(albedo)
+    if albedo_source is not None:
+        tree.links.new(albedo_source, node.inputs["Albedo"])
+    elif albedo.is_linked:  # through the Doppler group, from its own colour value
+        node.inputs["Albedo"].default_value = albedo.links[0].from_node.inputs["Color"].default_value
+    else:
+        node.inputs["Albedo"].default_value = albedo.default_value
+    tree.links.new(source, add.inputs[0])
+    tree.links.new(node.outputs["Emission"], add.inputs[1])
+    tree.links.new(add.outputs[0], output.inputs["Surface"])
+    material[MATERIAL_KEY] = {"group_node": node.name, "add_node": add.name, "output": output.name,
+                              "source_node": source.node.name, "source_socket": source.identifier}
+    return True
+
+
+def detach(material):
+    """Remove the inserted nodes and link the old surface shader to the output again."""
+    if material is None or MATERIAL_KEY not in material:
+        return False
+    record = material[MATERIAL_KEY].to_dict()
+    tree = material.node_tree
+    if tree is not None:
+        for key in ("group_node", "add_node"):
+            node = tree.nodes.get(record[key])
+            if node is not None:
+                tree.nodes.remove(node)
+        output = tree.nodes.get(record["output"])
+        source_node = tree.nodes.get(record["source_node"])
+        source = None if source_node is None else next(
+            (s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+        if output is not None and source is not None:
+            tree.links.new(source, output.inputs["Surface"])
+    del material[MATERIAL_KEY]
+    return True
+
+
+def _scene_materials(scene):
+    found = {}
+    for obj in scene.objects:
+        for slot in getattr(obj, "material_slots", ()):
+            if slot.material is not None:
+                found[slot.material.name] = slot.material
+    return list(found.values())
+
+
+# --- lights and the scene -------------------------------------------------------------------
+
+
+def _hide_light(obj):
+    if names.LIGHT_SAVED_KEY not in obj:
+        obj[names.LIGHT_SAVED_KEY] = {"hide_render": bool(obj.hide_render)}
+    if not obj.hide_render:
+        obj.hide_render = True
+
+
+def _restore_light(obj):
+    saved = obj.get(names.LIGHT_SAVED_KEY)
+    if saved is None:
+        return False
+    hide = bool(saved["hide_render"])
+    del obj[names.LIGHT_SAVED_KEY]
+    if obj.hide_render != hide:
+        obj.hide_render = hide
+    return True
+
+
+def _enable_osl(scene):
+    if names.SHADING_SYSTEM_SAVED_KEY not in scene:
+        scene[names.SHADING_SYSTEM_SAVED_KEY] = bool(scene.cycles.shading_system)
+    if not scene.cycles.shading_system:
+        scene.cycles.shading_system = True
+
+
+def write(scene, snap, attach_new_materials=False):
+    """Bring the moving lights up to date with the snapshot: hide the moving lights (and show
+    again those no longer moving), rebuild the group when the lights changed, write every light's
+    parameters and attach materials (all on the first write, then new ones on request). With no
+    moving light left, everything is removed. RelativityError (one line) if OSL is unavailable."""
+    lights = supported(snap)
+    if not lights:
+        if is_applied(scene):
+            remove(scene)
+        return None
+    first = not is_applied(scene) or bpy.data.node_groups.get(GROUP) is None
+    try:
+        osl.ensure_oslquery_importable()
+    except osl.OSLUnavailableError as error:
+        raise RelativityError(f"OSL unavailable for moving lights: {error}") from error
+    light_names = [light.name for light in lights]
+    for obj in scene.objects:
+        if obj.type == "LIGHT" and names.LIGHT_SAVED_KEY in obj and obj.name not in light_names:
+            _restore_light(obj)
+    for name in light_names:
+        _hide_light(scene.objects[name])
+    _enable_osl(scene)
+    group = ensure_group(light_names)
+    _write_parameters(group, snap)
+    if first or attach_new_materials:
+        for material in _scene_materials(scene):
+            attach(material, group)
+    return group
+
+
+def apply(scene, snap):
+    return write(scene, snap, attach_new_materials=True)
+
+
+def remove(scene):
+    """Restore everything :func:`write` changed: materials, lights, the scene's shading system;
+    delete the group and the shader text."""
+    for material in bpy.data.materials:
+        detach(material)
+    for obj in bpy.data.objects:
+        if obj.type == "LIGHT":
+            _restore_light(obj)
+    if names.SHADING_SYSTEM_SAVED_KEY in scene:
+        saved = bool(scene[names.SHADING_SYSTEM_SAVED_KEY])
+        del scene[names.SHADING_SYSTEM_SAVED_KEY]
+        if scene.cycles.shading_system != saved:
+            scene.cycles.shading_system = saved
+    group = bpy.data.node_groups.get(GROUP)
+    if group is not None and not any(is_applied(other) for other in bpy.data.scenes):
+        bpy.data.node_groups.remove(group)
+        text = bpy.data.texts.get(names.MOVING_LIGHT_SHADER_TEXT)
+        if text is not None:
+            bpy.data.texts.remove(text)
+
+
+def warnings(scene, snap):
+    """What the moving-light stage does not render right, one line each."""
+    found = [f"Light {light.name!r} ({light.kind.lower()}): moving {light.kind.lower()} lights are rendered at rest"
+             for light in snap.moving_lights if light.kind not in SUPPORTED_KINDS]
+    found += [f"Light {obj.name!r}: Animation motion of lights is not supported, it is rendered at rest"
+              for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
+    if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
+        found.append("Moving lights with a moving observer need the exact camera (Apparent Geometry lights "
+                     "the surfaces where they appear)")
+    if supported(snap) and snap.method == "CAMERA":
+        found.append("Moving lights cast no shadows with the exact camera (OSL trace() crashes Cycles "
+                     "behind an OSL camera)")
+    if supported(snap) and scene.render.engine != "CYCLES":
+        found.append("Moving lights need Cycles (OSL)")
+    return found
+

@@ -1,0 +1,101 @@
+"""Surfaces lit by a light in uniform motion: retarded light position, Doppler factor, irradiance
+(docs/moving-lights.md; Weiskopf, Kraus, Ruder 1999, eq. 19).
+
+Frames and conventions: everything is in the scene frame, where the lit surface and the camera
+are at rest. The light moves with constant velocity ``beta c`` (world axes) and is at
+``light_position`` at the observer's time ``t_o`` (where Blender draws it at the frame). A
+surface point ``x`` is seen by the camera at ``x_cam`` (the reception event ``(t_o, x_cam)``) as
+it was at ``t_x = t_o - |x - x_cam| / c``, and is then lit by the light as it was at the emission
+time ``t_e`` with ``|x - x_L(t_e)| = c (t_x - t_e)``. For uniform motion every time enters only
+as ``c t``, so nothing here depends on the value of ``c``.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .arrays import ArrayLike, FloatArray
+from .radiance import point_light_irradiance
+from .retarded import light_travel_time_uniform
+from .validation import finite_array, unit_vectors, vector_array, velocity_array
+
+
+@dataclass(frozen=True)
+class RetardedLight:
+    """Where a moving light was when it emitted the light a surface point receives.
+
+    ``position`` ``(..., 3)``: the light at the emission time; ``distance`` ``r = c (t_x - t_e)``
+    from there to the surface point; ``direction`` the unit photon direction from the light to
+    the point (scene frame); ``doppler`` ``D = 1 / (gamma (1 - beta . n))`` of that photon
+    (light to surface, both frames' frequencies: ``D = nu_surface / nu_light``).
+    """
+
+    position: FloatArray
+    distance: FloatArray
+    direction: FloatArray
+    doppler: FloatArray
+
+
+def retarded_light(surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike,
+                   light_beta: ArrayLike) -> RetardedLight:
+    """The light's retarded position for each surface point (closed form, a quadratic).
+
+    ``surface_points`` ``(..., 3)``, ``camera_position`` and ``light_position`` ``(3,)`` (the
+    light at ``t_o``), ``light_beta`` ``(3,)`` its velocity over c. The light at ``t_x`` is
+    ``p = light_position - beta |x - x_cam|``; from there the light-travel time is
+    :func:`.retarded.light_travel_time_uniform` with the surface point as the receiver.
+    """
+    x = vector_array(surface_points, "surface_points")
+    camera = vector_array(camera_position, "camera_position")
+    beta = velocity_array(light_beta, "light_beta")
+    light = vector_array(light_position, "light_position")
+    delay = np.linalg.norm(x - camera, axis=-1, keepdims=True)  # c (t_o - t_x)
+    at_surface_time = light - beta * delay
+    # with c = 1 the light-travel time is the distance travelled, r = c (t_x - t_e)
+    distance = light_travel_time_uniform(0.0, x, at_surface_time, beta, 1.0)
+    position = at_surface_time - beta * distance[..., None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        direction = (x - position) / distance[..., None]
+    direction = np.where(distance[..., None] > 0.0, direction, 0.0)
+    gamma = 1.0 / np.sqrt(1.0 - np.sum(beta * beta, axis=-1))
+    doppler = 1.0 / (gamma * (1.0 - np.sum(beta * direction, axis=-1)))
+    return RetardedLight(position, distance, direction, doppler)
+
+
+def moving_point_light_irradiance(surface_points: ArrayLike, surface_normals: ArrayLike, camera_position: ArrayLike,
+                                  light_position: ArrayLike, light_beta: ArrayLike, intensity: ArrayLike
+                                  ) -> FloatArray:
+    """Irradiance ``E = D^4 cos(alpha) I / r^2`` (Weiskopf et al. eq. 19) from a moving point light.
+
+    ``intensity`` I is the light's isotropic radiant intensity in its own frame (W/sr; a
+    Blender point light of power P has ``P / (4 pi)``), ``alpha`` the angle between the surface
+    normal and the direction toward the retarded position. No occlusion.
+    """
+    normals = unit_vectors(surface_normals, "surface_normals")
+    light = retarded_light(surface_points, camera_position, light_position, light_beta)
+    cosine = -np.sum(normals * light.direction, axis=-1)
+    return point_light_irradiance(finite_array(intensity, "intensity"), light.doppler, cosine, light.distance)
+
+
+def light_frame_direction(direction: ArrayLike, light_beta: ArrayLike) -> FloatArray:
+    """The photon direction ``n'`` in the light's rest frame for scene-frame direction ``n``
+    (aberration, docs/physics.md, with the frame S' moving with the light): what a spot light's
+    cone, defined in the light's own frame, is evaluated on."""
+    n = unit_vectors(direction, "direction")
+    beta = velocity_array(light_beta, "light_beta")
+    b2 = np.sum(beta * beta, axis=-1)
+    gamma = 1.0 / np.sqrt(1.0 - b2)
+    bn = np.sum(beta * n, axis=-1)[..., None]
+    # (gamma - 1) (bhat . n) bhat = gamma^2 / (gamma + 1) (beta . n) beta, finite at beta = 0
+    shifted = n + (gamma * gamma / (gamma + 1.0))[..., None] * bn * beta - gamma[..., None] * beta
+    return shifted / (gamma[..., None] * (1.0 - bn))
+
+
+def irradiance_on_plane(points_along: ArrayLike, plane_height: float, camera_position: ArrayLike,
+                        light_position: ArrayLike, light_beta: ArrayLike, intensity: float) -> FloatArray:
+    """Irradiance on the horizontal plane ``z = plane_height`` (normal +Z, lit from above) at the
+    points ``(x, y)`` ``(..., 2)``: the profile a camera at rest sees on a floor."""
+    xy = finite_array(points_along, "points_along")
+    points = np.concatenate([xy, np.full(xy.shape[:-1] + (1,), float(plane_height))], axis=-1)
+    return moving_point_light_irradiance(points, np.broadcast_to([0.0, 0.0, 1.0], points.shape), camera_position,
+                                         light_position, light_beta, intensity)

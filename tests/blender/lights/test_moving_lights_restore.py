@@ -1,0 +1,113 @@
+"""Moving lights change the file only while the effect is applied: the lamp's render visibility,
+the scene's Open Shading Language switch and every material's surface link come back exactly on
+Remove, and a light whose motion is switched off after Set Up renders as Blender's lamp again."""
+
+import importlib
+
+import pytest
+from test_moving_point_light import _floor_scene
+
+from blender_support import ADDON_MODULE
+from relativity_addon.blender import compat
+
+
+def _module(name):
+    return importlib.import_module(f"{ADDON_MODULE}.blender.{name}")
+
+
+def _signature(bpy, scene):
+    def tree(material):
+        nodes = sorted((node.name, node.bl_idname) for node in material.node_tree.nodes)
+        links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+                       for link in material.node_tree.links)
+        return nodes, links, sorted(compat.custom_property_keys(material))
+
+    return {
+        "materials": {material.name: tree(material) for material in bpy.data.materials},
+        "lights": {obj.name: (obj.hide_render, sorted(compat.custom_property_keys(obj)))
+                   for obj in bpy.data.objects if obj.type == "LIGHT"},
+        "osl": scene.cycles.shading_system,
+        "groups": sorted(group.name for group in bpy.data.node_groups),
+        "texts": sorted(text.name for text in bpy.data.texts),
+        "scene_keys": sorted(compat.custom_property_keys(scene)),
+    }
+
+
+@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
+def test_apply_then_remove_restores_everything(relativity_addon, factory_blender, method):
+    bpy = factory_blender
+    effect = _module("effect")
+    scene, _camera, lamp = _floor_scene(bpy, occluder=True, method=method)
+    scene.cycles.shading_system = False
+    before = _signature(bpy, scene)
+    effect.apply(scene)
+    floor = bpy.data.materials["White"]
+    assert lamp.hide_render and scene.cycles.shading_system
+    assert any(node.bl_idname == "ShaderNodeScript" for node in bpy.data.node_groups["Relativity Moving Lights"].nodes)
+    assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
+        == "ShaderNodeAddShader"
+    effect.remove(scene)
+    assert _signature(bpy, scene) == before
+
+
+def test_a_light_hidden_by_the_user_stays_hidden_and_unlit(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, _camera, lamp = _floor_scene(bpy)
+    lamp.hide_render = True
+    snap = _module("snapshot").read(scene)
+    assert snap.moving_lights == ()
+    _module("effect").apply(scene)
+    _module("effect").remove(scene)
+    assert lamp.hide_render
+
+
+def test_switching_motion_off_after_set_up_shows_the_lamp_again(relativity_addon, factory_blender):
+    bpy = factory_blender
+    effect = _module("effect")
+    scene, _camera, lamp = _floor_scene(bpy)
+    scene.cycles.shading_system = False
+    effect.apply(scene)
+    assert lamp.hide_render
+    lamp.relativity.motion = "STATIC"  # the update callback syncs the effect
+    assert not lamp.hide_render
+    assert "Relativity Moving Lights" not in bpy.data.node_groups
+    assert not scene.cycles.shading_system
+    lamp.relativity.motion = "CONSTANT"
+    assert lamp.hide_render and scene.cycles.shading_system
+    effect.remove(scene)
+    assert not lamp.hide_render
+
+
+def test_unsupported_lights_are_reported(relativity_addon, factory_blender):
+    bpy = factory_blender
+    effect = _module("effect")
+    scene, _camera, lamp = _floor_scene(bpy)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    scene.collection.objects.link(sun)
+    sun.relativity.motion = "CONSTANT"
+    sun.relativity.beta = (0.3, 0.0, 0.0)
+    effect.apply(scene)
+    warnings = effect.scene_warnings(scene)
+    print(warnings)
+    assert any("'Sun'" in warning and "at rest" in warning for warning in warnings)
+    assert any("no shadows" in warning for warning in warnings)  # the exact camera
+    assert not sun.hide_render  # rendered at rest, as the warning says
+    effect.remove(scene)
+
+
+def test_light_panel_shows_motion_and_velocity(relativity_addon, factory_blender):
+    """The Active Object sub-panel draws the motion settings for a light (checked against RNA)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow"))
+    from test_ui_workflow import draw_panel
+
+    bpy = factory_blender
+    scene, _camera, lamp = _floor_scene(bpy)
+    log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
+    assert ("prop", "motion") in log and ("prop", "beta") in log
+    assert not [entry for entry in log if entry[0] == "label" and entry[2] == "ERROR"]
+    lamp.data.type = "SUN"
+    log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
+    assert any(entry[0] == "label" and "rendered at rest" in entry[1] for entry in log)
