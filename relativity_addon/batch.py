@@ -102,7 +102,7 @@ def build_parser(with_blend_file):
     parser.add_argument("--seed", type=int)
     parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
                         help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
-                        "one Doppler pass; exact for lit scenes at rest (default: the fast RGB colour)")
+                        "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
     return parser
 
 

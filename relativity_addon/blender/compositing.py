@@ -32,7 +32,7 @@ COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
 COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
 SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
-VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Output Log Doppler")
+VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
 
 
 def compositor_group():
@@ -84,11 +84,7 @@ def compositor_group():
         "kept": Node("ShaderNodeMix", {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
                      {"data_type": "VECTOR", "clamp_factor": True}),
         "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
-        # the spectral mode's Doppler pass: ln D itself (spectral_render)
-        "log_doppler": Node("ShaderNodeCombineXYZ", {0: "ln_d", 1: "ln_d", 2: "ln_d"}),
-        "shown": Node("ShaderNodeMix", {"Factor": "group.Output Log Doppler", 4: "kept.Result", 5: "log_doppler"},
-                      {"data_type": "VECTOR", "clamp_factor": True}),
-        "out_split": Node("ShaderNodeSeparateXYZ", {0: "shown.Result"}),
+        "out_split": Node("ShaderNodeSeparateXYZ", {0: "kept.Result"}),
         "out": Node("CompositorNodeCombineColor", {0: "out_split.X", 1: "out_split.Y", 2: "out_split.Z",
                                                    3: "source_split.Alpha"}),
     })
@@ -117,20 +113,18 @@ def colour_stage_values(snap):
     """Values of the compositor group's flag inputs, from the snapshot."""
     values = materials.settings_values(snap)
     values = {name: values[name] for name in VALUE_NAMES if name in values}
-    mode = _stage_mode["mode"]
-    if mode != "COLOUR":  # spectral passes: the rendered values unchanged, or ln D
+    if _stage_mode["mode"] == "PASS_THROUGH":  # spectral passes: the rendered values unchanged
         values.update({"Use Doppler": 0.0, "Spectral Searchlight": 0.0, "Camera Power": values["Power of D"]})
-    values["Output Log Doppler"] = 1.0 if mode == "LOG_DOPPLER" else 0.0
     return values
 
 
-# What the stage outputs: COLOUR (the fast mode), PASS_THROUGH (a spectral pass) or LOG_DOPPLER.
+# What the stage outputs: COLOUR (the fast mode) or PASS_THROUGH (a spectral pass).
 _stage_mode = {"mode": "COLOUR"}
 
 
 def set_stage_mode(mode):
     """Switch the stage's output for the next renders (written at the next sync)."""
-    if mode not in ("COLOUR", "PASS_THROUGH", "LOG_DOPPLER"):
+    if mode not in ("COLOUR", "PASS_THROUGH"):
         raise ValueError(mode)
     _stage_mode["mode"] = mode
 

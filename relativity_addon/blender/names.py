@@ -42,7 +42,7 @@ GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor group
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
 COMPOSITOR_GROUP = "Relativity Doppler Compositor"
 COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
-COMPOSITOR_GROUPS_VERSION = 5  # 4: the LUT as two nearest texels (4.5's Map UV has no bilinear); 5: ln D output
+COMPOSITOR_GROUPS_VERSION = 4  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear)
 COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
 COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
 LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit

@@ -103,8 +103,8 @@ class RELATIVITY_OT_check_animation(Operator):
 
 
 class RELATIVITY_OT_render_spectral(Operator):
-    """Render the current frame with spectral colour: exact for lamps, sun and sky at rest (one Doppler
-    pass and the chosen number of colour passes); the picture opens as an image"""
+    """Render the current frame with spectral colour: exact for lamps, sun and sky at rest (the chosen
+    number of passes of three wavelengths each); the picture opens as an image"""
 
     bl_idname = "relativity.render_spectral"
     bl_label = "Render Spectral"
@@ -125,7 +125,7 @@ class RELATIVITY_OT_render_spectral(Operator):
         scene = context.scene
         window_manager = context.window_manager
         passes = scene.relativity.spectral_passes
-        window_manager.progress_begin(0, passes + 1)
+        window_manager.progress_begin(0, passes)
         try:
             pixels, info = spectral_render.render(scene, passes, progress=lambda done, _total:
                                                   window_manager.progress_update(done))

@@ -162,7 +162,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
     )
     spectral_passes: IntProperty(
         name="Spectral Passes",
-        description="Colour passes of Render Spectral (three wavelengths each, plus one Doppler pass): "
+        description="Colour passes of Render Spectral (three wavelengths each): "
         "more passes resolve the spectrum more finely (4: Delta E 2000 below 0.2 for blackbodies "
         "seen above 2000 K and every RGB colour)",
         default=4,

@@ -2,9 +2,11 @@
 
 ``physics/spectral_render.py`` has the model. Here, for the scene's current frame:
 
-1. a Doppler pass: the compositor stage outputs ``ln D`` of the first camera hit (the materials'
-   and world's AOV) at a few samples with no bounces, giving every pixel's ``D`` and the range of
-   ``D`` in the picture;
+1. every pixel's ``D`` from its viewing direction through the camera's frame, as the OSL camera
+   computes it (``1 / (gamma (1 - beta.d))``, or ``gamma (1 + beta.d)`` without aberration and
+   behind the Lorentz window), which also holds for surfaces without a material (no AOV) and
+   costs no render; depth of field spreads ``d`` over the lens, which the pixel centre's ``d``
+   approximates;
 2. ``passes`` colour passes: materials (``spectral_nodes``), the world and the lights get their
    spectral values at three wavelengths of the band ``[380 D_min, 780 D_max]`` nm, and the
    compositor stage passes the render through;
@@ -26,7 +28,6 @@ from ..errors import RelativityError
 from ..physics import spectral_render
 from . import compositing, effect, materials, names
 
-DOPPLER_PASS_SAMPLES = 16
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
 
@@ -56,12 +57,11 @@ class _Saved:
     """Everything the passes change, restored by :meth:`restore`."""
 
     def __init__(self, scene):
-        render, cycles = scene.render, scene.cycles
+        render = scene.render
         settings = render.image_settings
         self.scene = scene
         self.render = {key: getattr(render, key) for key in ("filepath", "use_file_extension")}
         self.image = {key: getattr(settings, key) for key in ("file_format", "color_depth", "color_mode")}
-        self.cycles = {key: getattr(cycles, key) for key in ("samples", "max_bounces", "use_denoising")}
         self.lights = {light.name: (tuple(light.color), light.use_temperature) for light in _scene_lights(scene)}
 
     def restore(self):
@@ -70,12 +70,29 @@ class _Saved:
             setattr(scene.render, key, value)
         for key, value in self.image.items():
             setattr(scene.render.image_settings, key, value)
-        for key, value in self.cycles.items():
-            setattr(scene.cycles, key, value)
         for name, (colour, use_temperature) in self.lights.items():
             light = bpy.data.lights.get(name)
             if light is not None:
                 light.color, light.use_temperature = colour, use_temperature
+
+
+def pixel_log_doppler(scene, snap):
+    """``ln D`` at every pixel centre (rows bottom first, as Blender stores images)."""
+    camera = scene.objects[snap.camera]
+    render = scene.render
+    width = int(render.resolution_x * render.resolution_percentage / 100)
+    height = int(render.resolution_y * render.resolution_percentage / 100)
+    corners = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])  # local, z < 0
+    left, right = corners[:, 0].min(), corners[:, 0].max()
+    bottom, top = corners[:, 1].min(), corners[:, 1].max()
+    x = left + (np.arange(width) + 0.5) / width * (right - left)
+    y = bottom + (np.arange(height) + 0.5) / height * (top - bottom)
+    local = np.stack(np.broadcast_arrays(x[None, :], y[:, None], corners[0, 2]), axis=-1)
+    world = local @ np.array(snap.camera_matrix)[:3, :3].T
+    bd = (world / np.linalg.norm(world, axis=-1, keepdims=True)) @ np.array(snap.beta)
+    if snap.use_geometry and not snap.use_lorentz_window:
+        return -np.log(snap.gamma * (1.0 - bd))
+    return np.log(snap.gamma * (1.0 + bd))
 
 
 def _scene_lights(scene):
@@ -110,21 +127,14 @@ def render(scene, passes, progress=None):
         raise RelativityError(f"Spectral passes must be at least 1, got {passes}")
     started = time.monotonic()
     saved = _Saved(scene)
-    total = passes + 1
+    total = passes
+    snap = effect.last_snapshot(scene)
+    if snap is None:
+        raise RelativityError(effect.scene_warnings(scene)[0] if effect.scene_warnings(scene) else
+                              "the relativistic camera is not valid")
+    log_doppler = pixel_log_doppler(scene, snap)
     try:
         with tempfile.TemporaryDirectory(prefix="relativity_spectral_") as folder:
-            compositing.set_stage_mode("LOG_DOPPLER")
-            materials.set_spectral_pass(None)
-            scene.cycles.samples = min(saved.cycles["samples"], DOPPLER_PASS_SAMPLES)
-            scene.cycles.max_bounces = 0
-            scene.cycles.use_denoising = False
-            doppler_pass = _render_exr(scene, os.path.join(folder, "doppler.exr"))
-            log_doppler, alpha = doppler_pass[..., 0].astype(np.float64), doppler_pass[..., 3]
-            if not np.all(np.isfinite(log_doppler)):
-                raise RelativityError("the Doppler pass has pixels without a Doppler factor")
-            if progress:
-                progress(1, total)
-            saved.restore()
             d_min, d_max = float(np.exp(log_doppler.min())), float(np.exp(log_doppler.max()))
             wavelengths = spectral_render.sample_wavelengths(d_min, d_max, passes)
             compositing.set_stage_mode("PASS_THROUGH")
@@ -137,9 +147,11 @@ def render(scene, passes, progress=None):
                     light.color, light.use_temperature = colour, use_temperature
                     spectrum = _light_spectrum(light, trio)
                     light.use_temperature, light.color = False, tuple(spectrum)
-                samples.append(_render_exr(scene, os.path.join(folder, f"pass{index}.exr"))[..., :3])
+                rendered = _render_exr(scene, os.path.join(folder, f"pass{index}.exr"))
+                samples.append(rendered[..., :3])
+                alpha = rendered[..., 3]
                 if progress:
-                    progress(index + 2, total)
+                    progress(index + 1, total)
     except RuntimeError as error:
         message = str(error).strip().splitlines()
         raise RelativityError(f"Spectral render failed: {message[-1] if message else type(error).__name__}") from None
