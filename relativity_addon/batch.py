@@ -137,6 +137,20 @@ def enable_addon():
     importlib.import_module(ADDON_PACKAGE).register()
 
 
+def addon_module(name):
+    """The add-on's ``blender.<name>`` module as registered in this Blender: the installed extension
+    (``bl_ext....relativity_addon``) when it is enabled, which may be another copy than this file's
+    package. Its handlers keep per-render state (the spectral pass), so the modules this script
+    drives must be the registered ones."""
+    import importlib
+
+    import bpy
+
+    props_module = type(bpy.context.scene.relativity).__module__
+    package = props_module.rsplit(".blender.", 1)[0]
+    return importlib.import_module(f"{package}.blender.{name}")
+
+
 def _apply_options(scene, options):
     settings = scene.relativity
     if options.beta is not None:
@@ -217,11 +231,10 @@ def _format_seconds(seconds):
 
 
 def _render_spectral(scene, path, passes):
-    from .blender import spectral_render
-
+    spectral_render = addon_module("spectral_render")
     try:
         pixels, _info = spectral_render.render(scene, passes)
-    except RelativityError as error:
+    except spectral_render.RelativityError as error:
         raise BatchError(str(error)) from None
     spectral_render.store_image(pixels).save_render(path, scene=scene)
 
@@ -234,8 +247,7 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
     if relativistic:
         # The frame-change handler records a failed apparent-geometry update on the object
         # instead of raising; rendering then would show the previous frame's shapes.
-        from .blender import geometry
-
+        geometry = addon_module("geometry")
         errors = geometry.scene_errors(scene)
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
@@ -274,7 +286,7 @@ def run(argv, log=print):
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}") from None
     enable_addon()
-    from .blender import effect
+    effect = addon_module("effect")
 
     scene = bpy.context.scene
     frames = _frames(scene, options)
@@ -301,7 +313,7 @@ def run(argv, log=print):
             _apply_options(scene, options)
             scene.frame_set(frames[0])
             effect.apply(scene, frame_range=(frames[0], frames[-1]))
-    except RelativityError as error:
+    except (RelativityError, effect.RelativityError) as error:
         raise BatchError(str(error)) from None
 
     several = len(frames) > 1

@@ -269,3 +269,25 @@ def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):
           f"fast Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, Y/expected {fast[1] / expected[1]:.3f}")
     assert delta_e < 2.0
     assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+
+
+def test_batch_script_spectral_option(relativity_addon, tmp_path):
+    """``render.py --spectral N`` (what a farm runs): the same lamp-lit wall, written as linear EXR,
+    is the blackbody at ``D T``; --spectral with --reference is refused in one line."""
+    bpy = __import__("bpy")
+    scene, camera = _wall_under_blackbody_lamp(bpy, samples=16)
+    blend = ch.save_blend(bpy, tmp_path / "lit.blend")
+    rest = _xyz(_render_f12(bpy, scene, tmp_path, "rest")[CENTRE].reshape(-1, 3)).mean(axis=0)
+    beta = (0.0, 0.0, -0.6)
+    image = ch.render_image(bpy, blend, tmp_path / "spectral.exr", "--beta=0,0,-0.6", "--speed-of-light=1",
+                            "--spectral=3")
+    doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
+    y_lamp = dh.blackbody_xyz_colour_science(LAMP_TEMPERATURE)[1]
+    expected = np.mean([dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * rest[1]
+                        for d in doppler], axis=0)
+    measured = _xyz(image[CENTRE].reshape(-1, 3)).mean(axis=0)
+    assert dh.delta_e_2000_normalised(measured, expected) < 2.0
+    assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    refused = ch.run_render_script(blend, tmp_path / "x.png", "--reference", "--spectral=2", check=False)
+    assert refused.returncode == 1
+    assert "--spectral needs the exact camera" in refused.stderr
