@@ -195,7 +195,10 @@ def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exac
     targets = [np.linalg.inv(_tables()["xyz_to_rgb"]) @ doppler_rgb_matrix(doppler)]
     for temperature in ANCHOR_TEMPERATURES_K:
         samples = blackbody_samples(np.exp(log_mu), temperature)
-        scale = 1.0 / np.linalg.norm(samples)
+        norm = np.linalg.norm(samples)
+        if not (np.isfinite(norm) and norm > 0.0):
+            continue  # this blackbody has no light at the samples (far Wien tail)
+        scale = 1.0 / norm
         spectra.append(samples[:, None] * scale)
         observed = blackbody_xyz(doppler * temperature) * np.exp(-log_blackbody_luminance(temperature))
         targets.append(observed[..., None] * scale)
@@ -203,6 +206,9 @@ def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exac
     target = np.concatenate(targets, axis=-1) / doppler[:, None, None] ** 4  # (J, 3, S)
     weights = np.swapaxes(table, 1, 2)  # (J, 3, K)
     residual = target - weights @ constrained
+    # where a target under- or overflows (D far beyond the visible band's reach) that pixel keeps
+    # the plain weights
+    residual = np.where(np.all(np.isfinite(residual), axis=(1, 2), keepdims=True), residual, 0.0)
     corrected = weights + residual @ np.linalg.pinv(constrained, rcond=1e-6)
     return np.swapaxes(corrected, 1, 2)
 

@@ -79,3 +79,19 @@ def test_reflectance_product_two_bounces_against_direct_integration():
     expected = spectral.XYZ_to_linear_rec709(expected_xyz)
     assert _delta_e(rgb, expected) < 0.5
     assert spectral.luminance_linear_rec709(rgb) / expected_xyz[1] == pytest.approx(1.0, abs=0.01)
+
+
+@pytest.mark.parametrize("d_range", [(0.01, 0.02), (0.01, 100.0), (50.0, 100.0)])
+def test_no_nan_or_negative_pixel_for_d_from_0_01_to_100(d_range):
+    """A blackbody plus an RGB emitter over the whole Doppler range: finite, non-negative colours,
+    brighter toward larger D (the searchlight)."""
+    low, high = d_range
+    wavelengths = spectral_render.sample_wavelengths(low, high, 4)
+    log_d = np.linspace(np.log(low), np.log(high), 40)
+    emitted = spectral_render.blackbody_samples(wavelengths, 5000.0) + \
+        spectral_render.emission_matrix(wavelengths) @ np.array([0.3, 0.5, 0.2])
+    samples = np.exp(4.0 * log_d)[:, None] * emitted
+    rgb = spectral_render.reconstruct_rgb(samples, log_d, wavelengths)
+    assert np.all(np.isfinite(rgb)) and rgb.min() >= 0.0
+    luminance = spectral_render.luminance(rgb)
+    assert luminance[-1] > luminance[0]
