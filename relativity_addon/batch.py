@@ -265,6 +265,10 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
         cam = scene.camera.data
         if not cam.cycles_custom.get("settings_valid", False):
             raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
+    effect = addon_module("effect")
+    if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
+        warnings = effect.scene_warnings(scene)
+        raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
     if not os.path.isfile(path):
         raise BatchError(f"render wrote no file at {path}")
 

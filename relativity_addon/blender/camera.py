@@ -62,6 +62,11 @@ def is_applied(camera_data):
     return camera_data is not None and names.CAMERA_SAVED_STATE_KEY in camera_data
 
 
+def is_render_only(camera_data):
+    """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
+    return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
+
+
 def _local_to_shader(vector):
     return (vector[0], vector[1], -vector[2])
 
@@ -164,9 +169,10 @@ def compile_shader(camera_data):
         )
 
 
-def _save_state(camera_data):
+def _save_state(camera_data, render_only):
     custom = camera_data.cycles_custom
     camera_data[names.CAMERA_SAVED_STATE_KEY] = {
+        "render_only": render_only,
         "type": camera_data.type,
         "custom_mode": camera_data.custom_mode,
         "custom_shader": camera_data.custom_shader.name if camera_data.custom_shader else "",
@@ -177,9 +183,10 @@ def _save_state(camera_data):
     }
 
 
-def apply(scene, snap):
-    """Turn the snapshot's camera into the relativistic OSL camera and write its parameters.
-    Returns the camera object; RelativityError (one line), with the camera restored, on failure."""
+def apply(scene, snap, render_only=False):
+    """Turn the snapshot's camera into the relativistic OSL camera and write its parameters
+    (``render_only``: for the time of a final render). Returns the camera object;
+    RelativityError (one line), with the camera restored, on failure."""
     camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
     if not is_applied(camera_data):
@@ -192,7 +199,7 @@ def apply(scene, snap):
             osl.ensure_oslquery_importable()
         except osl.OSLUnavailableError as error:
             raise RelativityError(f"OSL unavailable: {error}") from error
-        _save_state(camera_data)
+        _save_state(camera_data, render_only)
         text = ensure_shader_text()
         camera_data.type = "CUSTOM"
         camera_data.custom_mode = "INTERNAL"

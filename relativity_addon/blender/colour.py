@@ -39,6 +39,13 @@ def write(scene, snap, attach_new_materials=False):
     compositing.write_colour_stage(scene, snap)
 
 
+def remove_camera_stage(scene):
+    """Undo what :func:`apply` adds for the exact camera only (the compositor stage and the world's
+    Doppler AOV), after an Apparent Geometry final render; the materials stay attached."""
+    compositing.remove_colour_stage(scene)
+    materials.detach_world(scene.world)
+
+
 def remove(scene):
     """Undo :func:`apply`: the compositor stage, every material and world, and the add-on's node
     groups and lookup tables once no scene uses them."""

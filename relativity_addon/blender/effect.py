@@ -23,12 +23,15 @@ from . import animation, busy, camera, colour, geometry, modifier, moving_lights
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
 _object_warnings = {}
+_final_render_valid = {}  # scene name -> whether its last exact final render's camera was valid
 
 
 def applied_method(scene):
-    """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None."""
+    """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None (the exact
+    camera of an Apparent Geometry final render does not count: it is there for the render)."""
     camera_object = scene.camera
-    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_applied(camera_object.data):
+    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_applied(camera_object.data) \
+            and not camera.is_render_only(camera_object.data):
         return "CAMERA"
     if modifier.applied_objects(scene):
         return "GEOMETRY"
@@ -75,8 +78,82 @@ def remove(scene):
         removed += bool(camera.remove(camera_object))
     colour.remove(scene)
     moving_lights.remove(scene)
+    snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
+
+
+# --- the Apparent Geometry final render -------------------------------------------------------
+
+
+def final_render_problem(scene, snap):
+    """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
+    line), or None when it is. Without a moving observer nothing needs it (the boosted meshes are
+    then scene-frame meshes)."""
+    if snap.method != "GEOMETRY" or snap.geometry_final_render != "EXACT":
+        return "the final render is set to Boosted Meshes" if snap.method == "GEOMETRY" else "not Apparent Geometry"
+    if snap.speed == 0.0 and snap.velocity_source != "CAMERA_ANIMATION":
+        return "the observer is at rest"
+    if snap.engine != "CYCLES":
+        return f"the exact camera needs Cycles, not {snap.engine}"
+    camera_data = scene.objects[snap.camera].data
+    if camera_data.type != "PERSP" and not camera.is_render_only(camera_data):
+        return f"camera {snap.camera!r} is {camera_data.type}, the exact camera replaces a perspective camera only"
+    return None
+
+
+def begin_final_render(scene):
+    """Before a final render (``render_init``) of an Apparent Geometry scene with a moving observer:
+    the exact camera photographs the scene, whose moving objects hold their retarded positions in
+    the scene frame, so lamps, shadows and the world light them where they are
+    (``snapshot.begin_final_render``). :func:`end_final_render` goes back to the boosted-mesh
+    preview. Returns whether the exact camera is used; RelativityError (one line) after undoing."""
+    if applied_method(scene) != "GEOMETRY" or snapshot.in_final_render(scene):
+        return snapshot.in_final_render(scene)
+    problem = final_render_problem(scene, snapshot.read(scene))
+    if problem is not None:
+        if problem.startswith(("camera", "the exact camera")):
+            print(f"Relativity: Apparent Geometry renders the boosted-mesh preview: {problem}")
+        return False
+    snapshot.begin_final_render(scene)
+    try:
+        snap = snapshot.read(scene)
+        camera.apply(scene, snap, render_only=True)
+        colour.apply(scene, snap)
+    except RelativityError:
+        end_final_render(scene)
+        raise
+    sync(scene)
+    return True
+
+
+def end_final_render(scene):
+    """After the render (``render_complete``, ``render_cancel``): back to the boosted-mesh preview;
+    the meshes follow at the next depsgraph update or frame change (a handler of the render thread
+    must not evaluate the depsgraph)."""
+    was_exact = snapshot.in_final_render(scene)
+    snapshot.end_final_render(scene)
+    camera_object = scene.camera
+    if was_exact and camera_object is not None and camera.is_render_only(camera_object.data):
+        _final_render_valid[scene.name] = bool(camera_object.data.cycles_custom.get("settings_valid", False))
+    _remove_render_only_camera(scene)
+    if was_exact:
+        colour.remove_camera_stage(scene)
+        sync(scene, update_geometry=False)
+        for obj in modifier.applied_objects(scene):
+            obj.update_tag()
+
+
+def final_render_was_valid(scene):
+    """False if the exact camera of the scene's last Apparent Geometry final render was invalid
+    (it rendered black: the scene's warnings say why)."""
+    return _final_render_valid.pop(scene.name, True)
+
+
+def _remove_render_only_camera(scene):
+    camera_object = scene.camera
+    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_render_only(camera_object.data):
+        camera.remove(camera_object)
 
 
 def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False):
@@ -90,20 +167,22 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
     if busy.is_computing():
         return None
     method = applied_method(scene)
+    if not snapshot.in_final_render(scene):
+        _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)
     try:
         snap = snapshot.read(scene, depsgraph)
         if method is not None and method != snap.method:
             # applied with the other method (the setting changed where no callback ran)
             raise RelativityError(f"Set up again: the scene is set up for {method.title()}")
-        if method == "CAMERA":
+        if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             camera.write(scene, snap)
-        elif method == "GEOMETRY" and update_geometry:
+        if method == "GEOMETRY" and update_geometry:
             geometry.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
             moving_lights.write(scene, snap, attach_new_materials)
             colour.write(scene, snap, attach_new_materials)
     except RelativityError as error:
-        if method == "CAMERA":
+        if method == "CAMERA" or snapshot.in_final_render(scene):
             camera.invalidate(scene.camera)
         _refused(scene, error)
         return None
@@ -154,6 +233,10 @@ def _record(scene, snap):
         if camera_object is not None and camera_object.data.type != "PERSP" \
                 and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
+    if snap.method == "GEOMETRY":
+        problem = final_render_problem(scene, snap)
+        if snap.speed > 0.0 and problem is not None:
+            warnings.append(f"Lamps, shadows and the world are not relativistic in this render: {problem}")
     warnings += geometry.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)

@@ -33,7 +33,8 @@ def object_signature(snap, obj, depsgraph=None):
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     parts = [
-        snap.frame, snap.speed_of_light, snap.beta, snap.camera, snap.camera_matrix,
+        snap.frame, snap.speed_of_light, snap.beta, snap.camera, snap.camera_matrix, snap.exact_camera,
+        snap.shutter_time if snap.exact_camera else 0.0,
         tuple(map(tuple, evaluated.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
         relativity.tessellation, relativity.samples_per_frame, snap.fps,
         relativity.use_deformation,

@@ -6,7 +6,10 @@ render); ``frame_change_post`` updates the apparent geometry, which needs the ne
 evaluated meshes. ``depsgraph_update_post`` follows every edit. Only objects whose inputs
 changed are recomputed (the frame is one of them), and values are written only where they
 changed, so the handlers' own writes end the loop. ``render_pre`` runs before every render,
-attaching the Doppler colour to materials added since Set Up. A handler never raises: a problem
+attaching the Doppler colour to materials added since Set Up. ``render_init`` (once per still or
+animation render) puts an Apparent Geometry scene with a moving observer behind the exact camera
+for the render, ``render_complete``/``render_cancel`` take it back to the boosted-mesh preview
+(``effect.begin_final_render``). A handler never raises: a problem
 becomes the scene's warning and, for the exact camera, a black (never a wrong) image.
 """
 
@@ -43,11 +46,30 @@ def render_pre(scene, _depsgraph=None):
     _sync(scene, update_geometry=False, attach_new_materials=True)
 
 
+@persistent
+def render_init(scene, _depsgraph=None):
+    try:
+        effect.begin_final_render(scene)
+    except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
+        print(f"Relativity: the final render stays the boosted-mesh preview: {error}")
+
+
+@persistent
+def render_end(scene, _depsgraph=None):
+    try:
+        effect.end_final_render(scene)
+    except Exception as error:  # noqa: BLE001
+        print(f"Relativity: not restored after the render: {type(error).__name__}: {error}")
+
+
 HANDLERS = (
     ("frame_change_pre", frame_change_pre),
     ("frame_change_post", frame_change_post),
     ("depsgraph_update_post", depsgraph_update_post),
     ("render_pre", render_pre),
+    ("render_init", render_init),
+    ("render_complete", render_end),
+    ("render_cancel", render_end),
 )
 
 

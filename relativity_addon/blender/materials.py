@@ -89,12 +89,15 @@ def doppler_factor_group():
         "half_diff": fmath("SUBTRACT", "ln_gs2", "ln_go2"),
         "kinematic": fmath("SUBTRACT", "ln_num", "ln_den"),
         "ln_d": fmath("MULTIPLY_ADD", "half_diff", 0.5, "kinematic"),
+        # the emitter's own part, ln D_s = -ln(gamma_s (1 - bs.k)): D = D_o D_s
+        "ln_gs": fmath("MULTIPLY", "ln_gs2", 0.5),
+        "ln_ds": fmath("SUBTRACT", "ln_gs", "ln_den"),
     }
     return Group(
         DOPPLER_FACTOR,
         "ShaderNodeTree",
         (("Observer Beta", "NodeSocketVector", None),),
-        (("Log Doppler", "NodeSocketFloat", "ln_d"),),
+        (("Log Doppler", "NodeSocketFloat", "ln_d"), ("Log Emitter Doppler", "NodeSocketFloat", "ln_ds")),
         nodes,
     )
 
@@ -230,7 +233,14 @@ def doppler_colour_group():
         "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, {
             "Color": "group.Color", "Temperature": "group.Temperature",
             "Is Blackbody": "group.Is Blackbody", "Is Emission": "group.Is Emission"}),
-        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "fast.Result", 5: "spectral"},
+        # A moving emitter behind the exact camera (Apparent Geometry's final render): the camera
+        # applies the observer's D_o^4 only, the compositor divides by the whole D^4; the rest, D_s^4
+        "emitter_power": fmath("MULTIPLY", "settings.Camera Power", "light_path.Is Camera Ray"),
+        "emitter_log": fmath("MULTIPLY", "emitter_power", "doppler.Log Emitter Doppler"),
+        "emitter_log_safe": fmath("MINIMUM", "emitter_log", EXP_LIMIT),
+        "emitter_gain": fmath("EXPONENT", "emitter_log_safe"),
+        "fast_gained": vmath("SCALE", "fast.Result", scale="emitter_gain"),
+        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "fast_gained", 5: "spectral"},
                     {"data_type": "VECTOR"}),
         "done_path": fmath("MULTIPLY", "group.Is Blackbody", "settings.Camera Path"),
         "done": fmath("MULTIPLY", "done_path", "light_path.Is Camera Ray"),

@@ -101,15 +101,11 @@ def ensure_group(light_names):
 
 
 def reception_event(snap):
-    """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame.
-
-    The exact camera's aperture centre at its shutter time ``t_S`` (camera frame), by Gray eq. (1):
-    ``t = t_o + gamma t_S``, ``x = x_cam + gamma beta c t_S``; the apparent-geometry path uses
-    ``(t_o, x_cam)`` (world_lines.py)."""
-    if snap.method != "CAMERA":
-        return 0.0, tuple(float(v) for v in snap.camera_position)
-    ct = snap.speed_of_light * snap.shutter_time * snap.gamma
-    return ct, tuple(float(x + b * ct) for x, b in zip(snap.camera_position, snap.beta, strict=True))
+    """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame
+    (``Snapshot.mesh_observer``: the exact camera's aperture centre at its shutter time; the
+    boosted-mesh preview's ``(t_o, x_cam)``)."""
+    t, x, _ = snap.mesh_observer
+    return snap.speed_of_light * (t - snap.time), tuple(float(v) for v in x)
 
 
 def shader_parameters(light, snap):
@@ -127,7 +123,7 @@ def shader_parameters(light, snap):
         "spot_axis": light.axis,
         "spot_cos_half_angle": cos_half if light.kind == "SPOT" else -1.0,
         "spot_smooth": smooth,
-        "use_shadows": snap.method != "CAMERA",
+        "use_shadows": not snap.exact_camera,
     }
 
 
@@ -351,9 +347,9 @@ def warnings(scene, snap):
     found += [f"Light {obj.name!r}: Animation motion of lights is not supported, it is rendered at rest"
               for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
-        found.append("Moving lights with a moving observer need the exact camera (Apparent Geometry lights "
-                     "the surfaces where they appear)")
-    if supported(snap) and snap.method == "CAMERA":
+        found.append("Moving lights with a moving observer: the viewport preview lights the surfaces where they "
+                     "appear; the final render is exact")
+    if supported(snap) and (snap.method == "CAMERA" or snap.speed > 0.0):
         found.append("Moving lights cast no shadows with the exact camera (OSL trace() crashes Cycles "
                      "behind an OSL camera)")
     if supported(snap) and scene.render.engine != "CYCLES":

@@ -36,7 +36,7 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 3  # 3: spectral passes; blackbodies shifted for camera rays only
+SHADER_GROUPS_VERSION = 4  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------

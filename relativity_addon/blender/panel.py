@@ -43,6 +43,9 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
         layout = _split(self.layout)
         layout.menu("RELATIVITY_MT_paper_setups_presets", text="Paper Setups")
         layout.prop(scene.relativity, "method")
+        if scene.relativity.method == "GEOMETRY":
+            layout.prop(scene.relativity, "geometry_final_render")
+            layout.label(text="The viewport shows the boosted-mesh preview", icon="INFO")
         for warning in effect.scene_warnings(scene):
             layout.label(text=warning, icon="ERROR")
         column = layout.column(align=True)

@@ -23,6 +23,16 @@ METHOD_ITEMS = (
      "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
 )
 
+GEOMETRY_RENDER_ITEMS = (
+    ("EXACT", "Exact Camera",
+     "Final render with a moving observer: the exact camera photographs the moving objects at their "
+     "retarded positions in the scene frame, so lamps, shadows and the world are right (Cycles, "
+     "perspective camera)"),
+    ("PREVIEW", "Boosted Meshes",
+     "Final render as the viewport preview: meshes carried into the observer frame; lamps, shadows "
+     "and the world are not transformed (not exact under lamps)"),
+)
+
 _SHUTTER_DESCRIPTIONS = {
     "PINHOLE": ("Pinhole", "Every ray passes the aperture centre at the shutter time (no depth of field)"),
     "APERTURE_PLANE": ("Aperture Plane", "Every ray passes its lens point at the shutter time"),
@@ -96,6 +106,13 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         name="Method",
         items=METHOD_ITEMS,
         default="CAMERA",
+        update=_settings_changed,
+    )
+    geometry_final_render: EnumProperty(
+        name="Final Render",
+        description="How Apparent Geometry renders a moving observer with F12 and in the batch script",
+        items=GEOMETRY_RENDER_ITEMS,
+        default="EXACT",
         update=_settings_changed,
     )
     shutter_model: EnumProperty(

@@ -33,7 +33,7 @@ class ColourFactors:
     spectral_searchlight: bool  # exact visible brightness from the spectrum (Doppler and searchlight on)
     power_of_d: float  # brightness D^p where the spectrum does not give it (4, Chang's 1, or 0)
     camera_power: float  # the D^4 the exact camera's shader already applied (0 on the mesh path)
-    camera_path: bool
+    camera_path: bool  # the exact (OSL) camera renders the observer's motion
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,10 @@ class Snapshot:
     beta: Vector3  # observer velocity, world axes, fraction of c
     velocity_source: str  # MANUAL or CAMERA_ANIMATION
     method: str  # CAMERA or GEOMETRY
+    # The exact (OSL) camera renders the observer's motion: method CAMERA, or an Apparent Geometry
+    # final render (the meshes then hold scene-frame retarded positions, see :func:`begin_final_render`)
+    exact_camera: bool
+    geometry_final_render: str  # EXACT or PREVIEW: how an Apparent Geometry final render is made
     engine: str
     camera: str  # camera object name
     camera_matrix: tuple  # its 4x4 world matrix at the frame (rows)
@@ -102,6 +106,20 @@ class Snapshot:
         return self.world_to_camera @ np.array(self.beta)
 
     @property
+    def mesh_observer(self) -> tuple[float, np.ndarray, np.ndarray]:
+        """``(t, x, beta)``: the event and velocity the apparent meshes are computed for.
+
+        Behind the exact camera the meshes stay in the scene frame (``beta`` 0) and are seen from
+        the aperture centre at the shutter time ``t_S`` (camera frame), Gray eq. (1):
+        ``t = t_o + gamma t_S``, ``x = x_cam + gamma beta c t_S``. On the boosted-mesh preview they
+        are seen from ``(t_o, x_cam)`` and carried into the observer frame."""
+        if not self.exact_camera:
+            return self.time, self.camera_position, np.array(self.beta, dtype=np.float64)
+        dt = self.gamma * self.shutter_time
+        beta = np.array(self.beta, dtype=np.float64)
+        return self.time + dt, self.camera_position + beta * (self.speed_of_light * dt), np.zeros(3)
+
+    @property
     def shutter_code(self) -> int:
         """The OSL shader's integer code of the shutter model (the physics core's enum value)."""
         return int(ShutterModel[self.shutter_model])
@@ -113,7 +131,7 @@ class Snapshot:
             power = 0.0
         else:
             power = 1.0 if self.use_chang_searchlight else 4.0
-        camera_path = self.method == "CAMERA"
+        camera_path = self.exact_camera
         return ColourFactors(
             use_doppler=self.use_doppler,
             spectral_searchlight=spectral,
@@ -253,6 +271,26 @@ def moving_lights(scene, frame, depsgraph=None):
     return tuple(found)
 
 
+# Scenes whose Apparent Geometry final render is running with the exact camera.
+_final_renders = set()
+
+
+def begin_final_render(scene):
+    """From now on ``scene`` renders its Apparent Geometry through the exact camera: the observer's
+    motion by the OSL camera (aberration, searchlight, colour, exact for lamps, shadows and the
+    world, which stay in the scene frame), the moving objects at their retarded positions in the
+    scene frame. Set by ``effect.begin_final_render`` for the time of a render."""
+    _final_renders.add(scene.name)
+
+
+def end_final_render(scene):
+    _final_renders.discard(scene.name)
+
+
+def in_final_render(scene):
+    return scene.name in _final_renders
+
+
 def read(scene, depsgraph=None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
     cannot be rendered with correct physics."""
@@ -278,6 +316,8 @@ def read(scene, depsgraph=None) -> Snapshot:
         beta=beta,
         velocity_source=settings.velocity_source,
         method=settings.method,
+        exact_camera=settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene)),
+        geometry_final_render=settings.geometry_final_render,
         engine=scene.render.engine,
         camera=camera.name,
         camera_matrix=tuple(map(tuple, camera_matrix(scene, camera, frame, depsgraph).tolist())),

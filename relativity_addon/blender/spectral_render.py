@@ -1,4 +1,6 @@
 """Spectral mode of the exact camera: a few Cycles passes at rest-frame wavelengths, one picture.
+(Also for Apparent Geometry scenes whose meshes are all at rest: their final renders are exact-camera
+renders, ``effect.begin_final_render``.)
 
 ``physics/spectral_render.py`` has the model. Here, for the scene's current frame:
 
@@ -26,15 +28,26 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import spectral_render
-from . import compositing, effect, materials, names
+from . import compositing, effect, materials, modifier, names, snapshot
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
 
 def check(scene):
     """RelativityError unless the scene is set up for a spectral render."""
-    if effect.applied_method(scene) != "CAMERA":
-        raise RelativityError("Spectral colour needs the Exact Camera: set it up first (Set Up Relativistic Render)")
+    method = effect.applied_method(scene)
+    if method is None:
+        raise RelativityError("Spectral colour needs the effect: set it up first (Set Up Relativistic Render)")
+    if method == "GEOMETRY":
+        # Its passes are exact-camera renders (effect.begin_final_render); each pixel's D is the
+        # observer's, so every mesh must be at rest in the scene.
+        problem = effect.final_render_problem(scene, snapshot.read(scene))
+        if problem is not None and problem != "the observer is at rest":
+            raise RelativityError(f"Spectral colour with Apparent Geometry needs the exact final render: {problem}")
+        moving = [obj.name for obj in modifier.applied_objects(scene) if obj.relativity.motion != "STATIC"]
+        if moving:
+            raise RelativityError(f"Spectral colour with Apparent Geometry: object {moving[0]!r} moves; each "
+                                  "pixel's D is the observer's (use the fast colour for moving objects)")
     settings = scene.relativity
     if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
         raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "

@@ -1,5 +1,8 @@
 """Where each vertex of a moving object is seen: its apparent world position and velocity for
 the observer event of a snapshot, by the object's motion source (``Object.relativity.motion``).
+Behind the exact camera (``Snapshot.exact_camera``) the positions are retarded positions in the
+scene frame and the velocities scene-frame ones (``Snapshot.mesh_observer``); on the boosted-mesh
+preview they are carried into the observer frame.
 
 - STATIC and CONSTANT: the mesh is the object's rest-frame shape; with a constant velocity it is
   Lorentz-contracted along ``beta`` about the object origin, and the retarded times have a closed
@@ -35,7 +38,8 @@ def to_world(matrix, points):
 def apparent_world_positions(scene, obj, obj_eval, rest, snap):
     """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
     points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all)."""
-    t_o, x_o, beta_o, c = snap.time, snap.camera_position, np.array(snap.beta), snap.speed_of_light
+    t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
+    c = snap.speed_of_light
     matrix_now = matrix_array(obj_eval.matrix_world)
     motion = obj.relativity.motion
     if motion == "ANIMATION" and obj.relativity.use_deformation:
