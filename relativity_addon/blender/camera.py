@@ -115,6 +115,7 @@ def shader_parameters(scene, camera_data, snap):
         "use_lorentz_window": snap.use_lorentz_window,
         "use_geometry": snap.use_geometry,
         "use_searchlight": snap.use_searchlight,
+        "exposure": snap.exposure,
         "settings_valid": True,
     }
 

@@ -114,6 +114,12 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row = column.row()
         row.active = settings.use_searchlight
         row.prop(settings, "use_chang_searchlight")
+        column = layout.column()
+        column.active = settings.use_searchlight
+        column.prop(settings, "exposure_mode")
+        snap = effect.last_snapshot(context.scene)
+        if settings.exposure_mode == "COMPENSATED" and snap is not None:
+            column.label(text=f"Exposure x{snap.exposure:.4g} ({math.log2(snap.exposure):+.2f} stops)")
         if settings.method == "CAMERA":
             column = layout.column(heading="Spectral")
             column.prop(settings, "spectral_passes")

@@ -177,6 +177,19 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         default=False,
         update=_settings_changed,
     )
+    exposure_mode: EnumProperty(
+        name="Exposure",
+        description="Brightness of the frame under the searchlight",
+        items=(
+            ("FIXED", "Fixed", "Physically honest: the searchlight brightens the front and darkens the back as it is"),
+            ("COMPENSATED", "Compensated",
+             "One factor per frame from the observer's velocity and the field of view, exp(-4 <ln D>) over the "
+             "image, so that a fly-through stays watchable; written into the output's metadata (Cycles, exact "
+             "camera)"),
+        ),
+        default="FIXED",
+        update=_settings_changed,
+    )
     spectral_passes: IntProperty(
         name="Spectral Passes",
         description="Colour passes of Render Spectral (three wavelengths each): "

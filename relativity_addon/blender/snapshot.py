@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RelativityError
+from ..physics import exposure
 from ..physics.shutter import ShutterModel
 from . import animation, names
 
@@ -75,6 +76,8 @@ class Snapshot:
     use_doppler: bool
     use_searchlight: bool
     use_chang_searchlight: bool
+    exposure_mode: str  # FIXED or COMPENSATED
+    exposure: float  # the one factor the camera multiplies the frame by (1 when FIXED)
     moving_lights: tuple[MovingLight, ...] = ()
 
     @property
@@ -291,6 +294,27 @@ def in_final_render(scene):
     return scene.name in _final_renders
 
 
+def view_window(scene, camera):
+    """The camera's image on the plane at unit distance: ``(left, right, bottom, top)`` in its
+    local axes (Blender's own view frame: sensor fit, aspect and shift included)."""
+    corners = camera.data.view_frame(scene=scene)
+    xs = [corner.x / -corner.z for corner in corners]
+    ys = [corner.y / -corner.z for corner in corners]
+    return min(xs), max(xs), min(ys), max(ys)
+
+
+def frame_exposure(scene, camera, settings, beta, camera_matrix):
+    """The exposure factor of the frame (``physics.exposure.compensation``; 1 when FIXED)."""
+    if settings.exposure_mode != "COMPENSATED" or not any(beta):
+        return 1.0
+    linear = camera_matrix[:3, :3]
+    u, _, vt = np.linalg.svd(linear)
+    beta_camera = (u @ vt).T @ np.array(beta)
+    aberration = settings.use_geometry and not settings.use_lorentz_window
+    power = 1.0 if settings.use_chang_searchlight else 4.0
+    return exposure.compensation(beta_camera, view_window(scene, camera), aberration, power)
+
+
 def read(scene, depsgraph=None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
     cannot be rendered with correct physics."""
@@ -306,6 +330,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         raise RelativityError("arbitrary shutter plane needs a non-zero normal")
     if not _finite(settings.shutter_plane_point):
         raise RelativityError("the shutter plane point must be finite")
+    matrix = camera_matrix(scene, camera, frame, depsgraph)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
     return Snapshot(
@@ -320,7 +345,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         geometry_final_render=settings.geometry_final_render,
         engine=scene.render.engine,
         camera=camera.name,
-        camera_matrix=tuple(map(tuple, camera_matrix(scene, camera, frame, depsgraph).tolist())),
+        camera_matrix=tuple(map(tuple, matrix.tolist())),
         shutter_model=settings.shutter_model,
         shutter_time=float(settings.shutter_time),
         shutter_plane_point=tuple(float(v) for v in settings.shutter_plane_point),
@@ -330,5 +355,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         use_doppler=bool(settings.use_doppler),
         use_searchlight=bool(settings.use_searchlight),
         use_chang_searchlight=bool(settings.use_chang_searchlight),
+        exposure_mode=settings.exposure_mode,
+        exposure=frame_exposure(scene, camera, settings, beta, matrix) if settings.use_searchlight else 1.0,
         moving_lights=moving_lights(scene, frame, depsgraph),
     )

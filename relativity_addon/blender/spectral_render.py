@@ -27,7 +27,7 @@ import bpy
 import numpy as np
 
 from ..errors import RelativityError
-from ..physics import spectral_render
+from ..physics import exposure, spectral_render
 from . import compositing, effect, materials, modifier, names, snapshot
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
@@ -91,21 +91,11 @@ class _Saved:
 
 def pixel_log_doppler(scene, snap):
     """``ln D`` at every pixel centre (rows bottom first, as Blender stores images)."""
-    camera = scene.objects[snap.camera]
     render = scene.render
-    width = int(render.resolution_x * render.resolution_percentage / 100)
-    height = int(render.resolution_y * render.resolution_percentage / 100)
-    corners = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])  # local, z < 0
-    left, right = corners[:, 0].min(), corners[:, 0].max()
-    bottom, top = corners[:, 1].min(), corners[:, 1].max()
-    x = left + (np.arange(width) + 0.5) / width * (right - left)
-    y = bottom + (np.arange(height) + 0.5) / height * (top - bottom)
-    local = np.stack(np.broadcast_arrays(x[None, :], y[:, None], corners[0, 2]), axis=-1)
-    world = local @ np.array(snap.camera_matrix)[:3, :3].T
-    bd = (world / np.linalg.norm(world, axis=-1, keepdims=True)) @ np.array(snap.beta)
-    if snap.use_geometry and not snap.use_lorentz_window:
-        return -np.log(snap.gamma * (1.0 - bd))
-    return np.log(snap.gamma * (1.0 + bd))
+    size = (int(render.resolution_x * render.resolution_percentage / 100),
+            int(render.resolution_y * render.resolution_percentage / 100))
+    directions = exposure.pixel_directions(snapshot.view_window(scene, scene.objects[snap.camera]), size)
+    return exposure.log_doppler(directions, snap.beta_camera, snap.use_geometry and not snap.use_lorentz_window)
 
 
 def _scene_lights(scene):
