@@ -108,6 +108,19 @@ def world_matrices(obj, frames):
     return world_matrices(parent, frames) @ parent_inverse @ matrices
 
 
+def has_own_animation(obj, scene=None):
+    """Whether keyframes turn or scale the object (or an object parent): its own animation, which a
+    CONSTANT object plays at its proper time (``world_lines``). Objects whose keyframes are not
+    their motion (:func:`keyframe_motion_problem`) are left as Blender shows them."""
+    if keyframe_motion_problem(obj, scene) is not None:
+        return False
+    while obj is not None:
+        if any(path not in ("location", "delta_location") for path, _ in _transform_fcurves(obj)):
+            return True
+        obj = obj.parent
+    return False
+
+
 def world_matrix_at(obj, frame):
     """``matrix_world`` at ``frame`` from keyframes alone (object parents; no constraints)."""
     return Matrix(world_matrices(obj, [frame])[0].tolist())

@@ -46,6 +46,9 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap):
         world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
     elif motion == "ANIMATION":
         world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
+    elif motion == "CONSTANT" and animation.has_own_animation(obj, scene):
+        beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
+        world, _, beta_seen = proper_time_apparent_positions(obj, scene, rest, matrix_now, beta_u, t_o, x_o, beta_o, c)
     else:
         beta_u = np.zeros(3)
         if motion == "CONSTANT":
@@ -58,6 +61,30 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap):
         world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
         beta_seen = beta_seen[:1]  # one velocity for every vertex
     return world, beta_seen
+
+
+def proper_time_apparent_positions(obj, scene, rest_local, matrix_now, beta_u, t_o, x_o, beta_o, c):
+    """A CONSTANT object with its own animation (a spinning wheel, a clock's hand: rotation and
+    scale keyframes, under its parents): the animation runs at the object's proper time
+    ``tau = t / gamma`` (its clock reads 0 at scene time 0), evaluated at each vertex's retarded
+    time by the sampled solver; the origin moves with ``beta`` through where Blender draws it at
+    ``t_o`` (its keyframed location is not a motion of a CONSTANT object)."""
+    fps = animation.frames_per_second(scene)
+    gamma = 1.0 / np.sqrt(1.0 - beta_u @ beta_u)
+    origin_now = matrix_now[:3, 3].copy()
+
+    def matrices(times):
+        times = np.asarray(times, dtype=np.float64)
+        own = animation.world_matrices(obj, times / gamma * fps)
+        own[:, :3, 3] = origin_now + (times - t_o)[:, None] * (beta_u * c)
+        return own
+
+    step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    try:
+        return sampling.apparent_positions_from_matrix_function(
+            matrices, step, rest_local, t_o, x_o, beta_o, c, world_matrix_now=matrices([t_o])[0])
+    except ValueError as error:
+        raise RelativityError(f"object {obj.name!r}: {error}") from None
 
 
 def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None):
