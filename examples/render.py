@@ -10,8 +10,8 @@ keyframed motion; refused with the frame number if it reaches c), --method camer
 --no-searchlight, --shutter MODEL, --shutter-time S, --lorentz-window, --speed-of-light C,
 --frame N or --frames A-B (several frames: the frame number goes before the extension,
 out/fly_0001.png, or replaces a run of '#' in PATH), --seed N, --reference (render the file's own
-camera unchanged). Prints one progress line per frame with the time left. Exits non-zero with a
-one-line reason on any failure.
+camera unchanged), --proper-time (frame K at the traveller's time K / fps). Prints one progress
+line per frame with the time left. Exits non-zero with a one-line reason on any failure.
 """
 
 import os

@@ -103,6 +103,9 @@ def build_parser(with_blend_file):
     parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
                         help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
                         "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
+    parser.add_argument("--proper-time", action="store_true",
+                        help="step frames in the traveller's proper time: frame K is rendered at the scene time "
+                        "where the observer's clock (0 at frame 0) reads K / fps")
     return parser
 
 
@@ -180,6 +183,10 @@ def _apply_options(scene, options):
         settings.use_lorentz_window = True
 
 
+def animation_fps(scene):
+    return scene.render.fps / scene.render.fps_base
+
+
 def _output_format(scene, out_path):
     extension = os.path.splitext(out_path)[1].lower()
     image_settings = scene.render.image_settings
@@ -239,11 +246,18 @@ def _render_spectral(scene, path, passes):
     spectral_render.store_image(pixels).save_render(path, scene=scene)
 
 
-def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
-    if (scene.frame_current, scene.frame_subframe) != (frame, 0.0):
-        # Not for the first frame, which applying the effect computed: setting it again would only
-        # repeat the frame-change handlers (measured: 4 s of a 1M-vertex frame in the geometry path).
-        scene.frame_set(frame)
+def _set_frame(scene, frame):
+    """Go to ``frame`` (sub-frames allowed), unless the scene is there already: not for the first
+    frame, which applying the effect computed: setting it again would only repeat the frame-change
+    handlers (measured: 4 s of a 1M-vertex frame in the geometry path)."""
+    whole = math.floor(frame)
+    if (scene.frame_current, scene.frame_subframe) != (whole, frame - whole):
+        scene.frame_set(whole, subframe=frame - whole)
+
+
+def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, scene_frame=None):
+    """Render output ``frame`` (at ``scene_frame``, default the same: they differ with --proper-time)."""
+    _set_frame(scene, frame if scene_frame is None else scene_frame)
     if relativistic:
         # The frame-change handler records a failed apparent-geometry update on the object
         # instead of raising; rendering then would show the previous frame's shapes.
@@ -308,15 +322,22 @@ def run(argv, log=print):
     relativistic = not options.reference
     if options.spectral and options.reference:
         raise BatchError("--spectral needs the exact camera (--method camera), not --reference")
+    scene_frames = list(frames)
     try:
+        if options.proper_time:
+            if options.reference:
+                raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
+            _apply_options(scene, options)
+            scene_frames = [float(f) for f in addon_module("traveller").frames_at_proper_times(
+                scene, [frame / animation_fps(scene) for frame in frames])]
         if options.reference:
             effect.remove(scene)
             if scene.camera is None:
                 raise BatchError("scene has no active camera")
         else:
             _apply_options(scene, options)
-            scene.frame_set(frames[0])
-            effect.apply(scene, frame_range=(frames[0], frames[-1]))
+            _set_frame(scene, scene_frames[0])
+            effect.apply(scene, frame_range=(scene_frames[0], scene_frames[-1]))
     except (RelativityError, effect.RelativityError) as error:
         raise BatchError(str(error)) from None
 
@@ -324,9 +345,9 @@ def run(argv, log=print):
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
     started = time.monotonic()
-    for done, (frame, path) in enumerate(zip(frames, paths, strict=True), start=1):
+    for done, (frame, scene_frame, path) in enumerate(zip(frames, scene_frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
-        _render_frame(bpy, scene, frame, path, relativistic, options.spectral)
+        _render_frame(bpy, scene, frame, path, relativistic, options.spectral, scene_frame)
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(

@@ -18,12 +18,13 @@ is marked invalid (it renders black, never a wrong image).
 """
 
 from ..errors import RelativityError
-from . import animation, busy, camera, colour, geometry, metadata, modifier, moving_lights, snapshot
+from . import animation, busy, camera, colour, geometry, metadata, modifier, moving_lights, snapshot, traveller
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
 _object_warnings = {}
 _final_render_valid = {}  # scene name -> whether its last exact final render's camera was valid
+_traveller_times = {}  # scene name -> the observer's proper time at the last synced frame
 
 
 def applied_method(scene):
@@ -246,6 +247,10 @@ def _record(scene, snap):
     warnings += geometry.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
+    try:
+        _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)
+    except (RelativityError, ValueError):
+        _traveller_times.pop(scene.name, None)
     if snap.method == "GEOMETRY":
         for obj in scene.objects:
             if obj.type == "MESH" and obj.relativity.enabled:
@@ -277,6 +282,12 @@ def _status(scene):
 def last_snapshot(scene):
     """The snapshot of the scene's last sync, or None if that sync was refused."""
     return _status(scene)[0]
+
+
+def traveller_time(scene):
+    """The observer's proper time (seconds, 0 at frame 0) at the scene's last synced frame, or None."""
+    _status(scene)
+    return _traveller_times.get(scene.name)
 
 
 def scene_warnings(scene):

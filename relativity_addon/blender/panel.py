@@ -76,6 +76,10 @@ class RELATIVITY_PT_observer(_RelativityPanel, Panel):
         box.label(text=f"Speed: {speed:.6g} c")
         gamma = 1.0 / math.sqrt(1.0 - speed * speed) if speed < 1.0 else math.nan
         box.label(text=f"Gamma: {gamma:.6g}" if speed < 1.0 else "Gamma: undefined (speed >= c)")
+        tau = effect.traveller_time(context.scene)  # as of the last sync
+        if tau is not None:
+            fps = context.scene.render.fps / context.scene.render.fps_base
+            box.label(text=f"Time: scene {context.scene.frame_current / fps:.4g} s, traveller {tau:.4g} s")
         if settings.velocity_source == "CAMERA_ANIMATION":
             layout.operator("relativity.check_animation", icon="TIME")
         _preset_row(layout, "speed_of_light", "Speed of Light")

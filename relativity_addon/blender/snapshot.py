@@ -212,6 +212,27 @@ def camera_beta_at(scene, frame, camera=None):
     return tuple(float(x) for x in (after - before) / dt / c)
 
 
+def observer_speeds(scene, frames):
+    """The observer's speed ``|beta|`` at each of ``frames`` (array, sub-frames allowed): the
+    setting, or the camera's keyframes (central differences, as :func:`camera_beta_at`, for all
+    frames at once). RelativityError at or above the speed of light."""
+    frames = np.asarray(frames, dtype=np.float64)
+    settings = scene.relativity
+    if settings.velocity_source != "CAMERA_ANIMATION":
+        speed = math.sqrt(sum(b * b for b in check_velocity(settings.beta, "observer velocity beta")))
+        return np.full(len(frames), speed)
+    camera = active_camera(scene)
+    animation.check_supported(camera, scene)
+    c = check_speed_of_light(settings.speed_of_light)
+    before = animation.world_matrices(camera, frames - STEP_FRAMES)[:, :3, 3]
+    after = animation.world_matrices(camera, frames + STEP_FRAMES)[:, :3, 3]
+    speeds = np.linalg.norm(after - before, axis=1) * animation.frames_per_second(scene) / (2.0 * STEP_FRAMES * c)
+    if np.any(speeds >= 1.0):
+        raise RelativityError(f"camera {camera.name!r} reaches the speed of light at frame "
+                              f"{float(frames[np.argmax(speeds >= 1.0)]):g}")
+    return speeds
+
+
 def _checked_camera_speed(camera, beta, frame):
     speed = math.sqrt(sum(b * b for b in beta))
     if not math.isfinite(speed) or speed >= 1.0:

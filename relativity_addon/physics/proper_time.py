@@ -1,0 +1,40 @@
+"""Proper time along a world line: ``tau = integral dt / gamma(t)`` (docs/physics.md), and its
+inverse, the scene time at which a traveller's clock reads a given time.
+
+A moving observer's (or object's) clock runs slow by ``1 / gamma``; a fly-through whose frames
+step in the traveller's proper time shows frame ``k`` at the scene time ``t_k`` with
+``tau(t_k) = k / fps``.
+"""
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .arrays import FloatArray
+from .validation import finite_array
+
+
+def proper_times(times: ArrayLike, speeds: ArrayLike) -> FloatArray:
+    """``tau`` at each of ``times`` (increasing, seconds) for speeds ``|beta|`` there, ``tau = 0`` at
+    ``times[0]``: the trapezoidal integral of ``sqrt(1 - beta^2)``."""
+    times = finite_array(times, "times")
+    speeds = finite_array(speeds, "speeds")
+    if times.shape != speeds.shape or times.ndim != 1 or len(times) < 2:
+        raise ValueError("times and speeds must be matching 1-D arrays of at least two samples")
+    if np.any(np.diff(times) <= 0.0):
+        raise ValueError("times must increase")
+    if np.any(np.abs(speeds) >= 1.0):
+        raise ValueError("speeds must be below 1 (the speed of light)")
+    rate = np.sqrt(1.0 - speeds * speeds)
+    return np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(times))])
+
+
+def scene_times(tau: ArrayLike, times: ArrayLike, taus: ArrayLike) -> FloatArray:
+    """The scene times at which the clock reads ``tau``, from its readings ``taus`` at ``times``
+    (``tau`` increases strictly with t: linear interpolation between samples). ValueError outside
+    the sampled range."""
+    tau = np.atleast_1d(finite_array(tau, "tau"))
+    taus = finite_array(taus, "taus")
+    if tau.min() < taus[0] or tau.max() > taus[-1]:
+        raise ValueError(f"proper time {tau.min():.6g}..{tau.max():.6g} s outside the sampled "
+                         f"{taus[0]:.6g}..{taus[-1]:.6g} s")
+    return np.interp(tau, taus, np.asarray(times, dtype=np.float64))

@@ -1,0 +1,37 @@
+"""Proper time against the closed forms of docs/physics.md: uniform motion (tau = t / gamma) and
+constant proper acceleration (tau = (c / a) asinh(a t / c), v = a t / sqrt(1 + (a t / c)^2))."""
+
+import numpy as np
+import pytest
+
+from relativity_addon.physics import proper_time
+
+
+def test_uniform_motion():
+    times = np.linspace(0.0, 10.0, 11)
+    taus = proper_time.proper_times(times, np.full(11, 0.8))
+    assert np.allclose(taus, times * 0.6)
+    assert proper_time.scene_times(3.0, times, taus)[0] == pytest.approx(5.0)
+
+
+def test_constant_proper_acceleration():
+    c, a = 10.0, 4.0
+    times = np.linspace(0.0, 8.0, 4001)
+    at = a * times / c
+    speeds = at / np.sqrt(1.0 + at * at)
+    taus = proper_time.proper_times(times, speeds)
+    assert np.allclose(taus, c / a * np.arcsinh(at), atol=1e-6)
+    tau_k = np.arange(1, 40) / 24.0
+    assert np.allclose(proper_time.scene_times(tau_k, times, taus), c / a * np.sinh(a * tau_k / c), atol=1e-6)
+
+
+@pytest.mark.parametrize("speeds, message", [(np.full(3, 1.0), "below 1"), (np.array([0.1, np.nan, 0.1]), "finite")])
+def test_bad_input(speeds, message):
+    with pytest.raises(ValueError, match=message):
+        proper_time.proper_times(np.arange(3.0), speeds)
+
+
+def test_outside_the_samples():
+    times = np.linspace(0.0, 1.0, 3)
+    with pytest.raises(ValueError, match="outside"):
+        proper_time.scene_times(2.0, times, proper_time.proper_times(times, np.zeros(3)))
