@@ -18,7 +18,7 @@ is marked invalid (it renders black, never a wrong image).
 """
 
 from ..errors import RelativityError
-from . import animation, busy, camera, colour, geometry, modifier, moving_lights, snapshot
+from . import animation, busy, camera, colour, geometry, lamp_doppler, modifier, moving_lights, snapshot
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
@@ -62,7 +62,9 @@ def apply(scene, frame_range=None, objects=None):
     try:
         moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
         colour.apply(scene, snap)
+        lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
     except RelativityError:
+        lamp_doppler.remove(scene)
         moving_lights.remove(scene)
         undo()
         raise
@@ -78,6 +80,7 @@ def remove(scene):
         removed += bool(camera.remove(camera_object))
     colour.remove(scene)
     moving_lights.remove(scene)
+    lamp_doppler.remove(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
@@ -181,6 +184,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         if method is not None:
             moving_lights.write(scene, snap, attach_new_materials)
             colour.write(scene, snap, attach_new_materials)
+            lamp_doppler.write(scene, snap)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
             camera.invalidate(scene.camera)
@@ -239,6 +243,7 @@ def _record(scene, snap):
             warnings.append(f"Lamps, shadows and the world are not relativistic in this render: {problem}")
     warnings += geometry.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
+    warnings += lamp_doppler.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     if snap.method == "GEOMETRY":
         for obj in scene.objects:

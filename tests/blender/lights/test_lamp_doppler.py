@@ -1,0 +1,217 @@
+"""Lamps at rest lighting an object moving at 0.5c (Weiskopf et al. eq. 18, then eq. 14), real
+Cycles renders on the Apparent Geometry path with a camera at rest (docs/lamp-doppler.md).
+
+The object is a cube turned 45 degrees about Z, moving along +X; one lamp far ahead (+X), one far
+behind (-X). The camera looks from the side (-Y): it sees the front-left face lit only by the lamp
+ahead and the front-right face lit only by the lamp behind. Light from a lamp at rest reaches an
+object moving with ``beta`` with ``D = gamma (1 - beta . k)`` (docs/physics.md; ``k`` lamp -> object):
+``sqrt(3)`` from ahead, ``1/sqrt(3)`` from behind. At a given scene-frame distance the object-frame
+irradiance is ``D^2`` times the irradiance at rest (eq. 18 with ``r' = D r``, eq. 25), and its
+spectrum is the lamp's shifted by ``D`` (``D^5 I(lambda D)`` per wavelength, eq. 18).
+
+Eq. 14 (the object-to-camera factor, applied by the materials) and the apparent shape are the same
+with and without eq. 18, so each face's brightness with eq. 18 over its brightness without (the
+same render with the stage switched off, as before this stage existed) is eq. 18's factor alone;
+the side ratio is eq. 18's ratio times the side ratio of eq. 14 and the geometry.
+"""
+
+import importlib
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from blender_support import ADDON_MODULE
+from relativity_addon.blender import compat
+from relativity_addon.physics import spectral
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
+import camera_helpers as ch  # noqa: E402
+
+RESOLUTION = (96, 64)
+BETA = 0.5
+LAMP_DISTANCE = 30.0  # far: one D per lamp and object is exact to 1e-3 here
+POWER = 40000.0
+ALBEDO = 0.5
+C = 10.0
+CAMERA_DISTANCE = 12.0
+ROTATION = 25.0  # degrees about Z
+D_AHEAD = math.sqrt((1.0 + BETA) / (1.0 - BETA))
+D_BEHIND = 1.0 / D_AHEAD
+
+
+def _module(name):
+    return importlib.import_module(f"{ADDON_MODULE}.blender.{name}")
+
+
+def _scene(bpy, beta=BETA, samples=16, temperature=None):
+    scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=samples, location=(0.0, -CAMERA_DISTANCE, 0.0),
+                                 rotation_euler=(math.pi / 2.0, 0.0, 0.0))
+    camera.data.lens = 60.0
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.max_bounces = 0
+    material = bpy.data.materials.new("Grey")
+    tree = compat.material_node_tree(material)
+    tree.nodes.clear()
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (ALBEDO, ALBEDO, ALBEDO, 1.0)
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(diffuse.outputs[0], output.inputs["Surface"])
+    mesh = bpy.data.meshes.new("Cube")
+    corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    mesh.from_pydata(corners, [], faces)
+    mesh.materials.append(material)
+    cube = bpy.data.objects.new("Cube", mesh)
+    cube.rotation_euler = (0.0, 0.0, math.radians(ROTATION))
+    cube.location = (beta * CAMERA_DISTANCE, 0.0, 0.0)  # seen (light-travel time) near the image centre
+    scene.collection.objects.link(cube)
+    cube.relativity.enabled = True
+    cube.relativity.motion = "CONSTANT"
+    cube.relativity.beta = (beta, 0.0, 0.0)
+    for name, x in (("Ahead", LAMP_DISTANCE), ("Behind", -LAMP_DISTANCE)):
+        light = bpy.data.lights.new(name, "POINT")
+        light.energy = POWER
+        light.shadow_soft_size = 0.0
+        if temperature is not None:
+            light.use_temperature = True
+            light.temperature = temperature
+        lamp = bpy.data.objects.new(name, light)
+        lamp.location = (x, 0.0, 0.0)
+        scene.collection.objects.link(lamp)
+    scene.relativity.speed_of_light = C
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    scene.relativity.method = "GEOMETRY"
+    bpy.context.view_layer.update()
+    return scene, cube
+
+
+def _render(bpy, scene, path):
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    bpy.ops.render.render(write_still=True)
+    return ch.read_exr(bpy, path)
+
+
+def _edge(image):
+    """The image column of the cube's front edge: the largest brightness step along the middle row."""
+    row = ch.luminance(image)[image.shape[0] // 2]
+    lit = np.nonzero(row > 0.02 * row.max())[0]
+    steps = np.abs(np.diff(row[lit.min() + 2:lit.max() - 1]))
+    edge = lit.min() + 2 + int(np.argmax(steps))
+    y = ch.luminance(image)
+    rows = np.nonzero(np.minimum(y[:, edge - 3], y[:, edge + 3]) > 0.02 * y.max())[0]
+    return edge, lit.min(), lit.max(), slice(rows.min() + 2, rows.max() - 1)
+
+
+def _faces(image, edges):
+    """Mean RGB of the face lit from ahead (right of the front edge: +X) and of the face lit from
+    behind (left), two pixels away from every edge, over the rows where both are lit."""
+    edge, left, right, band = edges
+    return image[band, edge + 2:right - 1].reshape(-1, 3).mean(axis=0), \
+        image[band, left + 2:edge - 1].reshape(-1, 3).mean(axis=0)
+
+
+def _renders(bpy, scene, monkeypatch, tmp_path):
+    """(with eq. 18, without): the same applied scene, the stage switched off for the second;
+    each as (face lit from ahead, face lit from behind) mean RGB."""
+    effect = _module("effect")
+    effect.apply(scene)
+    with_eq18 = _render(bpy, scene, tmp_path / "with.exr")
+    _module("lamp_doppler").remove(scene)
+    monkeypatch.setattr(_module("lamp_doppler"), "write", lambda *args, **kwargs: 0)
+    without = _render(bpy, scene, tmp_path / "without.exr")
+    monkeypatch.undo()
+    edges = _edge(without)
+    return _faces(with_eq18, edges), _faces(without, edges)
+
+
+def test_lit_sides_follow_eq_18_brightness(relativity_addon, factory_blender, tmp_path, monkeypatch):
+    """Searchlight on, Doppler colour off (total energy): each face gains D^2 over eq. 14 alone,
+    the lamp ahead 3x, the lamp behind 1/3x, so the two sides' ratio gains 9x."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    scene.relativity.use_doppler = False
+    (ahead, behind), (ahead0, behind0) = _renders(bpy, scene, monkeypatch, tmp_path)
+    gain_ahead = ch.luminance(ahead) / ch.luminance(ahead0)
+    gain_behind = ch.luminance(behind) / ch.luminance(behind0)
+    ratio, ratio0 = ch.luminance(ahead) / ch.luminance(behind), ch.luminance(ahead0) / ch.luminance(behind0)
+    print(f"gain ahead {gain_ahead:.4f} (D^2 = {D_AHEAD**2:.4f}), behind {gain_behind:.4f} "
+          f"(D^2 = {D_BEHIND**2:.4f}); side ratio {ratio:.4f} with eq. 18, {ratio0:.4f} without")
+    assert gain_ahead == pytest.approx(D_AHEAD**2, rel=0.03)
+    assert gain_behind == pytest.approx(D_BEHIND**2, rel=0.03)
+    assert ratio / ratio0 == pytest.approx((D_AHEAD / D_BEHIND) ** 2, rel=0.04)
+
+
+@pytest.mark.parametrize("temperature", [None, 4000.0])
+def test_lit_sides_follow_eq_18_colour(relativity_addon, factory_blender, tmp_path, monkeypatch, temperature):
+    """Doppler colour and searchlight on: the light reaching each face is the lamp's spectrum
+    shifted by D and scaled by D^-2 (eq. 18 with r' = D r), computed here with colour-science:
+    for a white lamp, ``D^-2 M(D) (1, 1, 1)``, M the project's up-sampled-RGB matrix
+    (physics/spectral.py); for a 4000 K lamp, a blackbody at ``D T`` with luminance
+    ``D^-2 Y(D T)/Y(T)``. The materials multiply every channel by the same eq. 14 factor with and
+    without eq. 18, so each channel's gain is the lamp's."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy, temperature=temperature)
+    faces, faces0 = _renders(bpy, scene, monkeypatch, tmp_path)
+    for name, doppler, face, face0 in zip(("ahead", "behind"), (D_AHEAD, D_BEHIND), faces, faces0, strict=True):
+        if temperature is None:
+            expected = spectral.doppler_shift_rgb((1.0, 1.0, 1.0), doppler) / doppler**2
+        else:
+            rest = spectral.blackbody_linear_rgb(temperature, gamut_map=True)
+            shifted = spectral.blackbody_linear_rgb(doppler * temperature, gamut_map=True)
+            y_ratio = spectral.blackbody_luminance_ratio(temperature, doppler)
+            expected = shifted / spectral.luminance_linear_rec709(shifted) * y_ratio / doppler**2 \
+                / (rest / spectral.luminance_linear_rec709(rest))
+        gain = face / face0
+        print(f"{temperature} {name}: D {doppler:.4f}, channel gains {np.round(gain, 4)}, "
+              f"expected {np.round(expected, 4)}")
+        np.testing.assert_allclose(gain, expected, rtol=0.03)
+
+
+def test_object_at_rest_renders_as_without_the_effect(relativity_addon, factory_blender, tmp_path):
+    """Velocity 0: no copy, and the render is the plain render's (no stage, no light linking)."""
+    bpy = factory_blender
+    scene, cube = _scene(bpy, beta=0.0)
+    plain = _render(bpy, scene, tmp_path / "plain.exr")
+    _module("effect").apply(scene)
+    assert not any(_module("lamp_doppler").is_copy(obj) for obj in scene.objects)
+    applied = _render(bpy, scene, tmp_path / "applied.exr")
+    assert plain.max() > 0.05
+    np.testing.assert_allclose(applied, plain, rtol=1e-4, atol=1e-5)
+
+
+def _state(bpy):
+    return {
+        "objects": sorted(obj.name for obj in bpy.data.objects),
+        "lights": sorted((light.name, tuple(light.color), light.energy, light.use_temperature)
+                         for light in bpy.data.lights),
+        "collections": sorted(collection.name for collection in bpy.data.collections),
+        "linking": sorted((obj.name, str(obj.light_linking.receiver_collection),
+                           str(obj.light_linking.blocker_collection), tuple(obj.keys()))
+                          for obj in bpy.data.objects),
+        "scene keys": sorted(bpy.context.scene.keys()),
+    }
+
+
+def test_remove_restores_lights_collections_and_light_linking(relativity_addon, factory_blender, tmp_path):
+    """Apply (copies, collections, light linking), change a lamp, sync, then remove: the scene's
+    lights, collections and light-linking settings are exactly as before; a render matches."""
+    bpy = factory_blender
+    scene, cube = _scene(bpy, temperature=5000.0)
+    before = _state(bpy)
+    plain = _render(bpy, scene, tmp_path / "plain.exr")
+    effect = _module("effect")
+    effect.apply(scene)
+    added = [obj for obj in scene.objects if _module("lamp_doppler").is_copy(obj)]
+    assert len(added) == 2 and scene.objects["Ahead"].light_linking.receiver_collection is not None
+    scene.objects["Ahead"].data.energy = POWER  # an edit while applied: the copies follow, nothing new
+    effect.sync(scene)
+    effect.remove(scene)
+    assert _state(bpy) == before
+    cube.relativity.enabled = False  # the plain render had no apparent geometry either
+    np.testing.assert_allclose(_render(bpy, scene, tmp_path / "removed.exr"), plain, rtol=1e-4, atol=1e-5)
