@@ -192,7 +192,7 @@ def _state(bpy):
                          for light in bpy.data.lights),
         "collections": sorted(collection.name for collection in bpy.data.collections),
         "linking": sorted((obj.name, str(obj.light_linking.receiver_collection),
-                           str(obj.light_linking.blocker_collection), tuple(obj.keys()))
+                           str(obj.light_linking.blocker_collection), tuple(k for k in obj.keys() if k != "relativity"))
                           for obj in bpy.data.objects),
         "scene keys": sorted(bpy.context.scene.keys()),
     }
