@@ -111,7 +111,8 @@ def _blackbody_unit_rgb(temperature_k):
     """Linear Rec.709 colour of a blackbody at ``temperature_k``, gamut-mapped, luminance 1 (Blender's)."""
     rgb = spectral_render.xyz_to_linear_rec709(spectral_render.blackbody_xyz(temperature_k))
     mapped = spectral_render.gamut_map(rgb)
-    return mapped / spectral_render.luminance(mapped)
+    y = float(spectral_render.luminance(mapped))
+    return mapped / y if y > 0.0 and np.isfinite(y) else np.zeros(3)  # no visible light left (a few K)
 
 
 def _same_luminance(rgb, reference):
