@@ -4,10 +4,12 @@ For every lamp at rest (point, spot, area, sun) and every moving object of the A
 path (CONSTANT or rigid ANIMATION motion), the lamp's light on that object is received with
 ``D = gamma (1 - beta . k)`` (``beta`` the object's scene-frame velocity, ``k`` the direction lamp
 -> object centre): the object-frame irradiance is ``D^2`` times what Cycles computes in the scene
-frame, its spectrum shifted by ``D`` (``physics/lamp_doppler.py``). Cycles cannot vary a lamp per
-receiver, so the stage adds, per lamp and object, a **copy of the lamp** whose colour carries that
-factor, light-linked to receive only that object, and excludes the moving objects from the
-lamp's own light linking. The observer's Doppler factor (eq. 14) stays the materials' job.
+frame, its spectrum shifted by ``D``, and it arrives from the aberrated direction ``k'``
+(``physics/lamp_doppler.py``). Cycles cannot vary a lamp per receiver, so the stage adds, per lamp
+and object, a **copy of the lamp** whose colour carries that factor, turned about the object's
+centre from ``k`` to ``k'``, light-linked to receive only that object, and excludes the moving
+objects from the lamp's own light linking. The observer's Doppler factor (eq. 14) stays the
+materials' job.
 
 One ``D`` per lamp and object (at the object's centre, its retarded position for the camera
 event in the scene frame): docs/lamp-doppler.md measures what that leaves out.
@@ -22,6 +24,7 @@ import dataclasses
 import math
 
 import bpy
+import mathutils
 import numpy as np
 
 from ..errors import RelativityError
@@ -92,16 +95,27 @@ def movers(scene, snap):
     return found
 
 
-def doppler(lamp, mover):
-    """``D`` of ``lamp``'s light reaching ``mover``'s centre."""
-    matrix = np.array(lamp.matrix_world, dtype=np.float64)
-    if lamp.data.type == "SUN":
-        direction = -matrix[:3, 2]
-    else:
-        direction = np.array(mover.centre) - matrix[:3, 3]
-        if np.linalg.norm(direction) < 1e-9:
-            direction = -np.array(mover.beta)  # lamp at the centre: take it as straight ahead
-    return float(lamp_doppler.lamp_to_object_doppler(direction, mover.beta))
+def lamp_matrix(scene, lamp, snap):
+    """The lamp's world matrix at the snapshot's frame (its keyframes evaluated there)."""
+    return np.asarray(snapshot.camera_matrix(scene, lamp, snap.frame), dtype=np.float64)
+
+
+def incidence(matrix, kind, mover):
+    """The photon direction ``k`` (scene frame) from a lamp with world ``matrix`` to ``mover``'s centre."""
+    if kind == "SUN":
+        return -matrix[:3, 2]
+    direction = np.array(mover.centre) - matrix[:3, 3]
+    if np.linalg.norm(direction) < 1e-9:
+        return -np.array(mover.beta)  # lamp at the centre: take it as straight ahead
+    return direction
+
+
+def placement(matrix, kind, mover):
+    """``(D, copy's world matrix)``: eq. 18's factor for the lamp's light on ``mover`` and the lamp
+    turned about the centre to the direction the object sees it from in its own frame."""
+    k = incidence(matrix, kind, mover)
+    doppler_factor = float(lamp_doppler.lamp_to_object_doppler(k, mover.beta))
+    return doppler_factor, lamp_doppler.aberrated_lamp_matrix(matrix, mover.centre, k, mover.beta)
 
 
 def copy_colour(lamp, doppler_factor, snap):
@@ -150,8 +164,6 @@ def _build(scene, pairs, mover_names):
         copy = bpy.data.objects.new(f"{PREFIX} {lamp.name} on {obj.name}", data)
         copy[COPY_KEY] = [lamp.name, obj.name]
         scene.collection.objects.link(copy)
-        copy.parent = lamp  # follows the lamp: identity local transform
-        copy.matrix_parent_inverse.identity()
         for key in ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter"):
             setattr(copy, key, getattr(lamp, key))
         copy.visible_camera = False  # the lamp itself is seen once
@@ -205,9 +217,12 @@ def write(scene, snap):
     copies = {tuple(bpy.data.objects[name][COPY_KEY]): bpy.data.objects[name] for name in _record(scene)["copies"]}
     for lamp, mover in pairs:
         copy = copies[(lamp.name, mover.name)]
+        doppler_factor, matrix = placement(lamp_matrix(scene, lamp, snap), lamp.data.type, mover)
         _follow(copy.data, lamp.data)
         _set(copy.data, "use_temperature", False)
-        _set(copy.data, "color", copy_colour(lamp, doppler(lamp, mover), snap))
+        _set(copy.data, "color", copy_colour(lamp, doppler_factor, snap))
+        if not np.allclose(np.array(copy.matrix_world), matrix, rtol=1e-6, atol=1e-9):
+            copy.matrix_world = mathutils.Matrix(matrix.tolist())
     return len(pairs)
 
 

@@ -26,8 +26,10 @@ white, docs/spectral-model.md), and for a blackbody lamp at ``T`` a blackbody at
 luminance ``Y(D T) / Y(T)``. :func:`lamp_rgb_factor` gives the colour a copy of the lamp needs so
 that Cycles' scene-frame irradiance ``cos(alpha) I / r^2`` becomes the object-frame one.
 
-The renderer applies one ``D`` per lamp and object (at the object's centre); :func:`exact_irradiance`
-and :func:`one_factor_irradiance` measure what that leaves out (docs/lamp-doppler.md).
+The renderer applies one ``D`` per lamp and object (at the object's centre) and lights the object
+from the lamp's object-frame (aberrated) direction at the centre (:func:`aberrated_lamp_matrix`);
+:func:`exact_irradiance` and :func:`one_factor_irradiance` measure what that leaves out
+(docs/lamp-doppler.md).
 
 numpy only (Blender's Python has no colour-science): the colour tables are those of
 :mod:`.spectral_render`.
@@ -71,6 +73,29 @@ def aberrated_direction(direction: ArrayLike, beta_object: ArrayLike) -> FloatAr
     bk = np.sum(beta * k, axis=-1, keepdims=True)
     along = np.where(speed2 > 0.0, (gamma - 1.0) * bk / np.where(speed2 > 0.0, speed2, 1.0), 0.0)
     return (k + along * beta - gamma * beta) / (gamma * (1.0 - bk))
+
+
+def aberrated_lamp_matrix(lamp_matrix: ArrayLike, centre: ArrayLike, direction: ArrayLike,
+                          beta_object: ArrayLike) -> FloatArray:
+    """The lamp's 4x4 world matrix turned about ``centre`` so that its light arrives along the
+    object-frame direction ``k'`` (:func:`aberrated_direction` of ``direction``, lamp -> centre)
+    instead of ``k``: the rotation taking ``k`` to ``k'`` (smallest angle, about ``k x k'``) applied
+    to the lamp's position about the centre and to its orientation. Cycles then lights the object
+    from where it sees the lamp in its own frame (at the centre's direction)."""
+    matrix = finite_array(lamp_matrix, "lamp_matrix").copy()
+    k = unit_vectors(direction, "direction")
+    k_object = aberrated_direction(k, beta_object)
+    axis = np.cross(k, k_object)
+    sine, cosine = float(np.linalg.norm(axis)), float(k @ k_object)
+    if sine < 1e-12:
+        return matrix  # on the axis of motion (or at rest): no aberration
+    axis = axis / sine
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    rotation = np.eye(3) + sine * cross + (1.0 - cosine) * cross @ cross  # Rodrigues
+    centre = finite_array(centre, "centre")
+    matrix[:3, :3] = rotation @ matrix[:3, :3]
+    matrix[:3, 3] = centre + rotation @ (matrix[:3, 3] - centre)
+    return matrix
 
 
 def lamp_rgb_factor(doppler: float, rgb: ArrayLike | None = None, temperature_k: float | None = None,
@@ -139,15 +164,22 @@ def exact_irradiance(points: ArrayLike, rest_normals: ArrayLike, lamp: ArrayLike
 
 
 def one_factor_irradiance(points: ArrayLike, scene_normals: ArrayLike, lamp: ArrayLike, centre: ArrayLike,
-                          beta_object: ArrayLike, intensity: float = 1.0) -> FloatArray:
+                          beta_object: ArrayLike, intensity: float = 1.0, aberrate: bool = True) -> FloatArray:
     """What the renderer computes: Cycles' scene-frame ``cos(alpha) / r^2 I`` on the scene-frame
-    (contracted) surface, times ``D^2`` of the direction lamp -> ``centre``."""
+    (contracted) surface from the lamp's copy (turned about ``centre`` to the aberrated direction
+    with ``aberrate``), times ``D^2`` of the direction lamp -> ``centre``."""
     points = finite_array(points, "points")
-    offset = points - finite_array(lamp, "lamp")
+    lamp = finite_array(lamp, "lamp")
+    centre = finite_array(centre, "centre")
+    doppler = lamp_to_object_doppler(centre - lamp, beta_object)
+    if aberrate:
+        placed = np.eye(4)
+        placed[:3, 3] = lamp
+        lamp = aberrated_lamp_matrix(placed, centre, centre - lamp, beta_object)[:3, 3]
+    offset = points - lamp
     r = np.linalg.norm(offset, axis=-1)
     k = offset / r[..., None]
     cos_scene = np.maximum(-np.sum(unit_vectors(scene_normals, "scene_normals") * k, axis=-1), 0.0)
-    doppler = lamp_to_object_doppler(np.asarray(centre, dtype=np.float64) - lamp, beta_object)
     return irradiance_factor(doppler) * cos_scene / r**2 * intensity
 
 

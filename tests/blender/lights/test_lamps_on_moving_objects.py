@@ -37,6 +37,7 @@ POWER = 40000.0
 ALBEDO = 0.5
 C = 10.0
 CAMERA_DISTANCE = 12.0
+LENS, SENSOR = 60.0, 36.0  # mm: the camera's focal length and (horizontal) sensor width
 ROTATION = 25.0  # degrees about Z
 D_AHEAD = math.sqrt((1.0 + BETA) / (1.0 - BETA))
 D_BEHIND = 1.0 / D_AHEAD
@@ -49,7 +50,9 @@ def _module(name):
 def _scene(bpy, beta=BETA, samples=16, temperature=None):
     scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=samples, location=(0.0, -CAMERA_DISTANCE, 0.0),
                                  rotation_euler=(math.pi / 2.0, 0.0, 0.0))
-    camera.data.lens = 60.0
+    camera.data.lens = LENS
+    camera.data.sensor_width = SENSOR
+    camera.data.sensor_fit = "HORIZONTAL"
     scene.cycles.pixel_filter_type = "BOX"
     scene.cycles.max_bounces = 0
     material = bpy.data.materials.new("Grey")
@@ -130,6 +133,62 @@ def _renders(bpy, scene, monkeypatch, tmp_path):
     return _faces(with_eq18, edges), _faces(without, edges)
 
 
+def _apparent(points):
+    """Where the camera (at rest, at t_o) sees points of the cube that are at ``points`` at t_o:
+    x_e = p - u tau with tau from docs/physics.md's closed form for uniform motion."""
+    u = np.array([BETA * C, 0.0, 0.0])
+    delta = np.array([0.0, -CAMERA_DISTANCE, 0.0]) - points
+    du = delta @ u
+    tau = (du + np.sqrt(du**2 + (C**2 - u @ u) * np.sum(delta * delta, axis=-1))) / (C**2 - u @ u)
+    return points - tau[..., None] * u
+
+
+def _face_predictions():
+    """For the face lit from ahead and the one lit from behind, at the apparent position of the
+    face's centre: (image column, radiance as rendered, radiance by eqs. 18 and 14 exactly).
+
+    Both: albedo / pi * E' * D_oc^4 (eq. 14, D_oc = 1 / (gamma (1 - beta . k)), k toward the
+    camera), Blender's point light of power P having intensity P / (4 pi). As rendered: Cycles'
+    cosine on the apparent (retarded) face and D of the lamp -> cube centre direction; exactly:
+    eq. 18's cosine between the rest-frame normal and the object-frame photon direction
+    (aberrated), with the point's own D."""
+    gamma = 1.0 / math.sqrt(1.0 - BETA**2)
+    beta = np.array([BETA, 0.0, 0.0])
+    theta = math.radians(ROTATION)
+    origin = np.array([BETA * CAMERA_DISTANCE, 0.0, 0.0])
+    contract = np.diag([1.0 / gamma, 1.0, 1.0])
+    camera = np.array([0.0, -CAMERA_DISTANCE, 0.0])
+    centre = _apparent(origin[None])[0]
+    result = []
+    for normal, lamp in (((math.sin(theta), -math.cos(theta), 0.0), (LAMP_DISTANCE, 0.0, 0.0)),
+                         ((-math.cos(theta), -math.sin(theta), 0.0), (-LAMP_DISTANCE, 0.0, 0.0))):
+        normal, lamp = np.array(normal), np.array(lamp)
+        along = np.cross(normal, (0.0, 0.0, 1.0))
+        rest = np.array([normal, normal + 0.01 * along, normal + (0.0, 0.0, 0.01)])  # centre and two neighbours
+        seen = _apparent(origin + rest @ contract.T)
+        apparent_normal = np.cross(seen[1] - seen[0], seen[2] - seen[0])
+        apparent_normal *= np.sign(apparent_normal @ normal) / np.linalg.norm(apparent_normal)
+        point = seen[0]
+        k = (point - lamp) / np.linalg.norm(point - lamp)
+        to_camera = (camera - point) / np.linalg.norm(camera - point)
+        d_camera = 1.0 / (gamma * (1.0 - beta @ to_camera))
+        d_lamp = gamma * (1.0 - beta @ k)
+        d_centre = gamma * (1.0 - beta @ ((centre - lamp) / np.linalg.norm(centre - lamp)))
+        k_object = (k + (gamma - 1.0) * k[0] * np.array([1.0, 0.0, 0.0]) - gamma * beta) / (gamma * (1.0 - beta @ k))
+        scale = ALBEDO / math.pi * POWER / (4.0 * math.pi) / np.sum((point - lamp) ** 2) * d_camera**4
+        rendered = scale * d_centre**2 * -(apparent_normal @ k)
+        exact = scale * d_lamp**2 * -(normal @ k_object)
+        column = RESOLUTION[0] / 2.0 + point[0] / (point[1] + CAMERA_DISTANCE) * LENS / SENSOR * RESOLUTION[0]
+        result.append((column, rendered, exact))
+    return result
+
+
+def _at_column(image, column):
+    """Luminance at a (fractional) image column, linearly between pixel centres, over the middle rows."""
+    rows = ch.luminance(image)[RESOLUTION[1] // 2 - 4:RESOLUTION[1] // 2 + 4].mean(axis=0)
+    return float(np.interp(column, np.arange(RESOLUTION[0]) + 0.5, rows))
+
+
 def test_lit_sides_follow_eq_18_brightness(relativity_addon, factory_blender, tmp_path, monkeypatch):
     """Searchlight on, Doppler colour off (total energy): each face gains D^2 over eq. 14 alone,
     the lamp ahead 3x, the lamp behind 1/3x, so the two sides' ratio gains 9x."""
@@ -137,6 +196,14 @@ def test_lit_sides_follow_eq_18_brightness(relativity_addon, factory_blender, tm
     scene, _ = _scene(bpy)
     scene.relativity.use_doppler = False
     (ahead, behind), (ahead0, behind0) = _renders(bpy, scene, monkeypatch, tmp_path)
+    image = ch.read_exr(bpy, tmp_path / "with.exr")
+    (column_a, rendered_a, exact_a), (column_b, rendered_b, exact_b) = _face_predictions()
+    seen_a, seen_b = _at_column(image, column_a), _at_column(image, column_b)
+    print(f"face centres: ahead {seen_a:.4f} (predicted as rendered {rendered_a:.4f}, exactly {exact_a:.4f}), "
+          f"behind {seen_b:.4f} ({rendered_b:.4f}, {exact_b:.4f}); side ratio {seen_a / seen_b:.4f}, "
+          f"predicted {rendered_a / rendered_b:.4f}, exact eqs. 18 and 14 {exact_a / exact_b:.4f}")
+    assert seen_a == pytest.approx(rendered_a, rel=0.03)
+    assert seen_b == pytest.approx(rendered_b, rel=0.03)
     gain_ahead = ch.luminance(ahead) / ch.luminance(ahead0)
     gain_behind = ch.luminance(behind) / ch.luminance(behind0)
     ratio, ratio0 = ch.luminance(ahead) / ch.luminance(behind), ch.luminance(ahead0) / ch.luminance(behind0)
