@@ -115,3 +115,22 @@ def test_one_factor_per_object_converges_with_distance():
             one = lamp_doppler.one_factor_irradiance(point, facing, lamp_axis, (0.0, 0.0, 0.0), beta)
             assert one == pytest.approx(exact, rel=1e-12)
     assert spreads[0] > spreads[1] > spreads[2] and spreads[2] < 0.03
+
+
+@settings(max_examples=100, deadline=None)
+@given(directions, velocities(0.95))
+def test_turned_lamp_is_seen_along_the_aberrated_direction(k, beta):
+    """The copy turned about the centre: same distance, seen from the centre along -k' where k' is
+    the photon direction boosted into the object's frame; its axes turned by the same rotation."""
+    centre = np.array([1.0, -2.0, 0.5])
+    lamp = np.eye(4)
+    lamp[:3, :3] = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    lamp[:3, 3] = centre - 6.0 * k
+    turned = lamp_doppler.aberrated_lamp_matrix(lamp, centre, k, beta)
+    energy, momentum = _boost(1.0, k, beta)
+    offset = centre - turned[:3, 3]
+    assert np.linalg.norm(offset) == pytest.approx(6.0, rel=1e-9)
+    np.testing.assert_allclose(offset / 6.0, momentum / energy, atol=1e-7)
+    rotation = turned[:3, :3] @ lamp[:3, :3].T
+    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-9)
+    np.testing.assert_allclose(rotation @ k, momentum / energy, atol=1e-7)

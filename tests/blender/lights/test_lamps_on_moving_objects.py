@@ -282,3 +282,67 @@ def test_remove_restores_lights_collections_and_light_linking(relativity_addon, 
     assert _state(bpy) == before
     cube.relativity.enabled = False  # the plain render had no apparent geometry either
     np.testing.assert_allclose(_render(bpy, scene, tmp_path / "removed.exr"), plain, rtol=1e-4, atol=1e-5)
+
+
+def test_copy_of_a_side_lamp_lights_from_the_aberrated_direction(relativity_addon, factory_blender):
+    """A lamp beside the cube's path: its copy sits at the lamp's distance from the cube's (seen)
+    centre, along the direction the cube sees the lamp from in its own frame (the photon direction
+    boosted, docs/physics.md), with colour D^2 (searchlight, Doppler colour off); moving the lamp
+    and syncing moves the copy."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    scene.relativity.use_doppler = False
+    for name in ("Behind",):
+        bpy.data.objects.remove(bpy.data.objects[name])
+    lamp = scene.objects["Ahead"]
+    effect = _module("effect")
+    centre = _apparent(np.array([[BETA * CAMERA_DISTANCE, 0.0, 0.0]]))[0]
+    gamma = 1.0 / math.sqrt(1.0 - BETA**2)
+    beta = np.array([BETA, 0.0, 0.0])
+    for position in ((0.0, 20.0, 3.0), (-5.0, -15.0, 0.0)):
+        lamp.location = position
+        bpy.context.view_layer.update()
+        if effect.applied_method(scene) is None:
+            effect.apply(scene)
+        else:
+            effect.sync(scene)
+        (copy,) = [obj for obj in scene.objects if _module("lamp_doppler").is_copy(obj)]
+        k = (centre - np.array(position)) / np.linalg.norm(centre - np.array(position))
+        doppler = gamma * (1.0 - beta @ k)
+        k_object = (k + (gamma - 1.0) * k[0] * np.array([1.0, 0.0, 0.0]) - gamma * beta) / doppler
+        seen_from = centre - np.array(copy.matrix_world.translation)
+        np.testing.assert_allclose(np.linalg.norm(seen_from), np.linalg.norm(centre - np.array(position)), rtol=1e-5)
+        np.testing.assert_allclose(seen_from / np.linalg.norm(seen_from), k_object, atol=1e-5)
+        np.testing.assert_allclose(tuple(copy.data.color), [doppler**2] * 3, rtol=1e-5)
+        assert not copy.visible_camera and copy.light_linking.receiver_collection is not None
+
+
+def test_keyframed_motion_gives_the_constant_velocity_factor(relativity_addon, factory_blender):
+    """The same cube keyframed at 0.5c (linear, extrapolated) instead of CONSTANT: its lamp copies
+    carry the same D^2 (the centre's velocity and retarded position come from its keyframes)."""
+    bpy = factory_blender
+    colours = {}
+    for motion in ("CONSTANT", "ANIMATION"):
+        scene, cube = _scene(bpy)
+        scene.relativity.use_doppler = False
+        scene.objects["Behind"].location = (-20.0, 10.0, 0.0)  # off the axis: the copy is turned too
+        if motion == "ANIMATION":
+            cube.relativity.motion = "ANIMATION"
+            fps = scene.render.fps / scene.render.fps_base
+            start = cube.location.x
+            for frame in (1, 25):
+                cube.location.x = start + BETA * C * (frame - scene.frame_current) / fps
+                cube.keyframe_insert("location", index=0, frame=frame)
+            fcurve = next(f for f in compat.action_fcurves(cube.animation_data) if f.array_index == 0)
+            for point in fcurve.keyframe_points:
+                point.interpolation = "LINEAR"
+            fcurve.extrapolation = "LINEAR"
+            scene.frame_set(scene.frame_current)
+        _module("effect").apply(scene)
+        colours[motion] = {obj.name: (tuple(obj.data.color), tuple(obj.matrix_world.translation))
+                           for obj in scene.objects if _module("lamp_doppler").is_copy(obj)}
+        _module("effect").remove(scene)
+    assert set(colours["CONSTANT"]) == set(colours["ANIMATION"]) and len(colours["CONSTANT"]) == 2
+    for name, (colour, position) in colours["CONSTANT"].items():
+        np.testing.assert_allclose(colours["ANIMATION"][name][0], colour, rtol=1e-4)
+        np.testing.assert_allclose(colours["ANIMATION"][name][1], position, atol=1e-3)  # float32 keys, sampled
