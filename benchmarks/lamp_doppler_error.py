@@ -12,7 +12,9 @@ direction aberrated into the object's frame) against what the renderer computes 
 - ``one D``: irradiance-weighted mean ``|error|`` of the one-D factor alone (scene-frame cosines exact);
 - ``total``: irradiance-weighted mean ``|E_render - E'| / E'`` with the scene-frame cosine too, with
   the lamp where it is (unturned) and as rendered (the copy turned about the centre to the
-  aberrated direction, ``lamp_doppler.aberrated_lamp_matrix``).
+  aberrated direction, ``lamp_doppler.aberrated_lamp_matrix``);
+- ``rest normals``: the same if the object were shaded with its rest-frame normals (not done yet:
+  Cycles shades the scene-frame surface).
 
 Numpy only (no Blender).
 """
@@ -39,6 +41,7 @@ def table(beta_x, count, distances=(3.0, 10.0, 30.0)):
             lamp = distance * np.array(direction)
             exact = lamp_doppler.exact_irradiance(points, rest_normals, lamp, beta)
             rendered = lamp_doppler.one_factor_irradiance(points, scene_normals, lamp, (0.0, 0.0, 0.0), beta)
+            rest_shaded = lamp_doppler.one_factor_irradiance(points, rest_normals, lamp, (0.0, 0.0, 0.0), beta)
             unturned = lamp_doppler.one_factor_irradiance(points, scene_normals, lamp, (0.0, 0.0, 0.0), beta,
                                                           aberrate=False)
             offset = points - lamp
@@ -51,7 +54,8 @@ def table(beta_x, count, distances=(3.0, 10.0, 30.0)):
             rows.append((distance, name, float(centre), float(np.max(np.abs(one_d[lit]))),
                          float(np.sum(np.abs(one_d[lit]) * weights) / np.sum(weights)),
                          float(np.sum(np.abs(unturned - exact)) / np.sum(exact)),
-                         float(np.sum(np.abs(rendered - exact)) / np.sum(exact))))
+                         float(np.sum(np.abs(rendered - exact)) / np.sum(exact)),
+                         float(np.sum(np.abs(rest_shaded - exact)) / np.sum(exact))))
     return rows
 
 
@@ -61,10 +65,11 @@ def main():
     parser.add_argument("--count", type=int, default=20000)
     args = parser.parse_args()
     print(f"sphere of rest radius 1 at {args.beta} c, point lamp at rest at distance d")
-    print("| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | total, as rendered |")
-    print("|---|---|---|---|---|---|---|")
-    for distance, name, centre, spread, one_d, unturned, total in table(args.beta, args.count):
-        print(f"| {distance:g} | {name} | {centre:.3f} | {spread:.1%} | {one_d:.1%} | {unturned:.1%} | {total:.1%} |")
+    print("| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | total, as rendered | rest normals |")
+    print("|---|---|---|---|---|---|---|---|")
+    for distance, name, centre, spread, one_d, unturned, total, rest in table(args.beta, args.count):
+        print(f"| {distance:g} | {name} | {centre:.3f} | {spread:.1%} | {one_d:.1%} | {unturned:.1%} | {total:.1%} "
+              f"| {rest:.1%} |")
 
 
 if __name__ == "__main__":
