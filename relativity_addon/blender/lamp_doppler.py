@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import lamp_doppler
-from . import modifier, names, snapshot, sources, world_lines
+from . import modifier, names, rest_normals, snapshot, sources, world_lines
 
 KEY = names.LAMP_DOPPLER_KEY
 COPY_KEY = names.LAMP_DOPPLER_COPY_KEY
@@ -211,7 +211,9 @@ def write(scene, snap):
         remove(scene)
         record = None
     if not pairs:
+        rest_normals.remove(scene)
         return 0
+    rest_normals.write(scene, [scene.objects[name] for name in sorted({mover.name for _, mover in pairs})])
     if record is None:
         _build(scene, pairs, sorted({mover.name for _, mover in pairs}))
     copies = {tuple(bpy.data.objects[name][COPY_KEY]): bpy.data.objects[name] for name in _record(scene)["copies"]}
@@ -241,6 +243,7 @@ def apply(scene, snap):
 def remove(scene):
     """Delete the copies, their light data and the collections; give the lamps back their own
     (empty) light linking. Returns the number of copies removed."""
+    rest_normals.remove(scene)
     record = _record(scene)
     if record is None:
         return 0
