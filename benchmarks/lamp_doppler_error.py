@@ -11,10 +11,9 @@ direction aberrated into the object's frame) against what the renderer computes 
 - ``D^2 spread``: largest ``|D_centre^2 / D(x)^2 - 1|`` over the lit points (the one-D approximation alone);
 - ``one D``: irradiance-weighted mean ``|error|`` of the one-D factor alone (scene-frame cosines exact);
 - ``total``: irradiance-weighted mean ``|E_render - E'| / E'`` with the scene-frame cosine too, with
-  the lamp where it is (unturned) and as rendered (the copy turned about the centre to the
-  aberrated direction, ``lamp_doppler.aberrated_lamp_matrix``);
-- ``rest normals``: the same if the object were shaded with its rest-frame normals (not done yet:
-  Cycles shades the scene-frame surface).
+  the lamp where it is (unturned) and with the copy turned about the centre to the aberrated
+  direction (``lamp_doppler.aberrated_lamp_matrix``), on the contracted surface's normals and on
+  the rest-frame normals (what the add-on renders, ``blender/rest_normals.py``).
 
 Numpy only (no Blender).
 """
@@ -65,7 +64,8 @@ def main():
     parser.add_argument("--count", type=int, default=20000)
     args = parser.parse_args()
     print(f"sphere of rest radius 1 at {args.beta} c, point lamp at rest at distance d")
-    print("| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | total, as rendered | rest normals |")
+    print("| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | turned, contracted normals "
+          "| turned, rest normals (as rendered) |")
     print("|---|---|---|---|---|---|---|---|")
     for distance, name, centre, spread, one_d, unturned, total, rest in table(args.beta, args.count):
         print(f"| {distance:g} | {name} | {centre:.3f} | {spread:.1%} | {one_d:.1%} | {unturned:.1%} | {total:.1%} "

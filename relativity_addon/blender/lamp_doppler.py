@@ -8,8 +8,9 @@ frame, its spectrum shifted by ``D``, and it arrives from the aberrated directio
 (``physics/lamp_doppler.py``). Cycles cannot vary a lamp per receiver, so the stage adds, per lamp
 and object, a **copy of the lamp** whose colour carries that factor, turned about the object's
 centre from ``k`` to ``k'``, light-linked to receive only that object, and excludes the moving
-objects from the lamp's own light linking. The observer's Doppler factor (eq. 14) stays the
-materials' job.
+objects from the lamp's own light linking; the objects lit this way are shaded with their
+rest-frame normals (``rest_normals.py``: eq. 18's cosine). The observer's Doppler factor (eq. 14)
+stays the materials' job.
 
 One ``D`` per lamp and object (at the object's centre, its retarded position for the camera
 event in the scene frame): docs/lamp-doppler.md measures what that leaves out.

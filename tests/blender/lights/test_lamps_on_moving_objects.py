@@ -1,18 +1,20 @@
 """Lamps at rest lighting an object moving at 0.5c (Weiskopf et al. eq. 18, then eq. 14), real
 Cycles renders on the Apparent Geometry path with a camera at rest (docs/lamp-doppler.md).
 
-The object is a cube turned 45 degrees about Z, moving along +X; one lamp far ahead (+X), one far
-behind (-X). The camera looks from the side (-Y): it sees the front-left face lit only by the lamp
-ahead and the front-right face lit only by the lamp behind. Light from a lamp at rest reaches an
-object moving with ``beta`` with ``D = gamma (1 - beta . k)`` (docs/physics.md; ``k`` lamp -> object):
-``sqrt(3)`` from ahead, ``1/sqrt(3)`` from behind. At a given scene-frame distance the object-frame
-irradiance is ``D^2`` times the irradiance at rest (eq. 18 with ``r' = D r``, eq. 25), and its
-spectrum is the lamp's shifted by ``D`` (``D^5 I(lambda D)`` per wavelength, eq. 18).
+The object is a cube turned 25 degrees about Z, moving along +X; one lamp far ahead (+X), one far
+behind (-X). The camera looks from the side (-Y): it sees (Penrose-Terrell rotation included) the
+face lit only by the lamp ahead on the right and the face lit only by the lamp behind on the left.
+Light from a lamp at rest reaches an object moving with ``beta`` with ``D = gamma (1 - beta . k)``
+(docs/physics.md; ``k`` lamp -> object): ``sqrt(3)`` from ahead, ``1/sqrt(3)`` from behind. At a
+given scene-frame distance the object-frame irradiance is ``D^2`` times the irradiance at rest
+(eq. 18 with ``r' = D r``, eq. 25), and its spectrum is the lamp's shifted by ``D``
+(``D^5 I(lambda D)`` per wavelength, eq. 18).
 
 Eq. 14 (the object-to-camera factor, applied by the materials) and the apparent shape are the same
-with and without eq. 18, so each face's brightness with eq. 18 over its brightness without (the
-same render with the stage switched off, as before this stage existed) is eq. 18's factor alone;
-the side ratio is eq. 18's ratio times the side ratio of eq. 14 and the geometry.
+with and without eq. 18's factor, so each face's brightness over its brightness in the same
+render with D set to 1 is eq. 18's factor alone. The face centres' absolute radiance and the
+sides' ratio are compared with eqs. 18 and 14 written out here (rest-frame cosine, aberrated
+photon direction, the point's own D, retarded positions).
 """
 
 import importlib
