@@ -248,28 +248,29 @@ def remove(scene):
     record = _record(scene)
     if record is None:
         return 0
-    for name, receiver in record["lamps"].items():
-        lamp = bpy.data.objects.get(name)
-        if lamp is not None and lamp.type == "LIGHT":
-            lamp.light_linking.receiver_collection = bpy.data.collections.get(receiver) if receiver else None
-            if KEY in lamp:
-                del lamp[KEY]
-    removed = 0
-    for name in record["copies"]:
-        obj = bpy.data.objects.get(name)
-        if obj is not None and COPY_KEY in obj:
-            bpy.data.objects.remove(obj)
-            removed += 1
-    for name in record["lights"]:
-        light = bpy.data.lights.get(name)
-        if light is not None and light.users == 0:
+    ours = set(record["collections"])
+    mine = [obj for obj in bpy.data.objects if scene.objects.get(obj.name) is obj or obj.name in record["lamps"]
+            or obj.name in record["copies"]]
+    for lamp in mine:  # by the mark, not only the name: a lamp renamed while applied too
+        if lamp.type == "LIGHT" and KEY in lamp:
+            receiver = lamp.light_linking.receiver_collection
+            if receiver is None or receiver.name in ours:
+                saved = record["lamps"].get(lamp.name, "")
+                lamp.light_linking.receiver_collection = bpy.data.collections.get(saved) if saved else None
+            del lamp[KEY]
+    copies = [obj for obj in mine if COPY_KEY in obj]
+    lights = {obj.data for obj in copies} | {bpy.data.lights.get(name) for name in record["lights"]}
+    for obj in copies:
+        bpy.data.objects.remove(obj)
+    for light in lights - {None}:
+        if light.users == 0:
             bpy.data.lights.remove(light)
     for name in record["collections"]:
         collection = bpy.data.collections.get(name)
         if collection is not None:
             bpy.data.collections.remove(collection)
     del scene[KEY]
-    return removed
+    return len(copies)
 
 
 def warnings(scene, snap):

@@ -291,7 +291,11 @@ def test_remove_restores_lights_collections_and_light_linking(relativity_addon, 
     assert cube.data.attributes.get(_module("names").REST_NORMAL_ATTRIBUTE) is not None
     scene.objects["Ahead"].data.energy = POWER  # an edit while applied: the copies follow, nothing new
     effect.sync(scene)
+    scene.objects["Behind"].name = "Renamed"  # a lamp renamed while applied: its copy is rebuilt
+    effect.sync(scene)
+    assert sum(_module("lamp_doppler").is_copy(obj) for obj in scene.objects) == 2
     effect.remove(scene)
+    scene.objects["Renamed"].name = "Behind"
     assert _state(bpy) == before
     cube.relativity.enabled = False  # the plain render had no apparent geometry either
     np.testing.assert_allclose(_render(bpy, scene, tmp_path / "removed.exr"), plain, rtol=1e-4, atol=1e-5)
