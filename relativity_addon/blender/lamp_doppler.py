@@ -79,7 +79,9 @@ def _local_centre(obj):
 def movers(scene, snap):
     """The moving objects of the Apparent Geometry path: centre and scene-frame velocity, with
     light-travel time from the camera event and no boost (the scene frame)."""
-    at_rest_observer = dataclasses.replace(snap, beta=(0.0, 0.0, 0.0))
+    # the scene frame: the exact camera's meshes are there already (seen from the aperture at the
+    # shutter time); the boosted-mesh preview's observer is taken at rest for this
+    at_rest_observer = snap if snap.exact_camera else dataclasses.replace(snap, beta=(0.0, 0.0, 0.0))
     found = []
     for obj in modifier.applied_objects(scene):
         motion = obj.relativity.motion

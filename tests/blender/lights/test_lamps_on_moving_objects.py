@@ -363,3 +363,26 @@ def test_keyframed_motion_gives_the_constant_velocity_factor(relativity_addon, f
     for name, (colour, position) in colours["CONSTANT"].items():
         np.testing.assert_allclose(colours["ANIMATION"][name][0], colour, rtol=1e-4)
         np.testing.assert_allclose(colours["ANIMATION"][name][1], position, atol=1e-3)  # float32 keys, sampled
+
+
+def test_moving_observer_final_render_keeps_eq_18(relativity_addon, factory_blender, tmp_path, monkeypatch):
+    """Observer at 0.2c: the Apparent Geometry final render photographs the scene-frame meshes
+    through the exact camera, with the lamp copies and light linking as at rest: each face still
+    gains eq. 18's D^2 (the scene-frame factor; eq. 14 now carries the observer's motion)."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    scene.relativity.use_doppler = False
+    scene.relativity.beta = (0.0, 0.2, 0.0)
+    cameras = []
+
+    def probe(render_scene, *_):
+        cameras.append(render_scene.camera.data.type)
+
+    bpy.app.handlers.render_pre.append(probe)
+    try:
+        (ahead, behind), (ahead0, behind0) = _renders(bpy, scene, monkeypatch, tmp_path)
+    finally:
+        bpy.app.handlers.render_pre.remove(probe)
+    assert cameras == ["CUSTOM", "CUSTOM"] and scene.camera.data.type == "PERSP"  # exact camera for the renders
+    assert ch.luminance(ahead) / ch.luminance(ahead0) == pytest.approx(D_AHEAD**2, rel=0.03)
+    assert ch.luminance(behind) / ch.luminance(behind0) == pytest.approx(D_BEHIND**2, rel=0.03)
