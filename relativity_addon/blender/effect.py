@@ -18,7 +18,19 @@ is marked invalid (it renders black, never a wrong image).
 """
 
 from ..errors import RelativityError
-from . import animation, busy, camera, colour, geometry, metadata, modifier, moving_lights, snapshot, traveller
+from . import (
+    animation,
+    busy,
+    camera,
+    colour,
+    geometry,
+    lamp_doppler,
+    metadata,
+    modifier,
+    moving_lights,
+    snapshot,
+    traveller,
+)
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
@@ -64,7 +76,9 @@ def apply(scene, frame_range=None, objects=None):
         moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
         colour.apply(scene, snap)
         metadata.write(scene, snap)
+        lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
     except RelativityError:
+        lamp_doppler.remove(scene)
         moving_lights.remove(scene)
         metadata.remove(scene)
         undo()
@@ -82,6 +96,7 @@ def remove(scene):
     colour.remove(scene)
     moving_lights.remove(scene)
     metadata.remove(scene)
+    lamp_doppler.remove(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
@@ -186,6 +201,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
             moving_lights.write(scene, snap, attach_new_materials)
             colour.write(scene, snap, attach_new_materials)
             metadata.write(scene, snap)
+            lamp_doppler.write(scene, snap)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
             camera.invalidate(scene.camera)
@@ -246,6 +262,7 @@ def _record(scene, snap):
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += geometry.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
+    warnings += lamp_doppler.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)

@@ -66,3 +66,13 @@ MOVING_LIGHTS_MATERIAL_KEY = "relativity_moving_lights"  # on materials: the ins
 MOVING_LIGHT_NODE_PREFIX = "Relativity Moving Lights"
 LIGHT_SAVED_KEY = "relativity_light_saved"  # on light objects: the user's hide_render while hidden
 SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: the user's Open Shading Language
+
+# --- lamps at rest lighting moving objects (eq. 18) -------------------------------------------
+LAMP_DOPPLER_PREFIX = "Relativity Eq18"  # copies of lamps and their light-linking collections
+LAMP_DOPPLER_KEY = "relativity_lamp_doppler"  # on the scene: what the stage added and changed
+LAMP_DOPPLER_COPY_KEY = "relativity_lamp_copy"  # on a lamp copy: (lamp name, object name)
+REST_NORMAL_ATTRIBUTE = "relativity_rest_normal"  # corner normals of the rest shape (object space)
+REST_NORMAL_KEY = "relativity_rest_normals"  # on the scene: the meshes given that attribute
+REST_NORMAL_MATERIAL_KEY = "relativity_rest_normal_node"  # on materials: the inserted group node's name
+REST_NORMAL_GROUP = "Relativity Rest Normal"  # shader group: rest-frame normal in world axes
+REST_NORMAL_GROUP_VERSION = 1

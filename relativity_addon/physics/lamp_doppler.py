@@ -1,0 +1,201 @@
+"""Lamps at rest lighting moving objects: Weiskopf et al. (1999) eq. 18 in the scene frame.
+
+A lamp at rest in the scene frame lights an object moving with velocity ``beta`` (fraction of c,
+scene frame). A photon from the lamp travelling along the unit direction ``k`` (scene frame) is
+received by the object with Doppler factor (docs/physics.md, observer moving through the source's
+frame)
+
+    D = gamma (1 - beta . k)          (D > 1: the object runs into the light, blueshift)
+
+Eq. 18 gives the object-frame spectral irradiance ``E'_lambda = D^5 cos(alpha') / r'^2 I_lambda(lambda D)``
+(this project's ``D``; the paper writes its reciprocal) with ``alpha'`` and ``r'`` measured in the
+object's frame. A renderer measures the distance in the scene (= the lamp's) frame: the emission
+and absorption events are light-like separated, so ``r' = D r`` (eq. 25 in this convention), and
+
+    E'_lambda = D^3 cos(alpha') / r^2 I_lambda(lambda D),    E' = D^2 cos(alpha') / r^2 I.
+
+So at a given scene-frame distance a lamp straight ahead of an object at 0.5c (``D = sqrt(3)``)
+delivers ``D^2 = 3`` times the irradiance of a lamp at rest relative to it, a lamp behind ``1/3``
+(the often quoted ``D^4`` = 9 and 1/9 of eq. 19 hold at equal *object-frame* distance ``r'``; it is
+the same relation). This is the plane-wave result: a wave's intensity transforms as ``D^2``.
+
+Colour (Doppler colour on): the object-frame irradiance spectrum is the lamp's spectrum shifted
+and scaled, ``D^-2 [D^5 I_lambda(lambda D)]``. The bracket is what the project's colour model
+computes for an emitter seen with ``D``: ``M(D) rgb`` for an RGB lamp (up-sampled, lit by 6504 K
+white, docs/spectral-model.md), and for a blackbody lamp at ``T`` a blackbody at ``D T`` with
+luminance ``Y(D T) / Y(T)``. :func:`lamp_rgb_factor` gives the colour a copy of the lamp needs so
+that Cycles' scene-frame irradiance ``cos(alpha) I / r^2`` becomes the object-frame one.
+
+The renderer applies one ``D`` per lamp and object (at the object's centre) and lights the object
+from the lamp's object-frame (aberrated) direction at the centre (:func:`aberrated_lamp_matrix`);
+:func:`exact_irradiance` and :func:`one_factor_irradiance` measure what that leaves out
+(docs/lamp-doppler.md).
+
+numpy only (Blender's Python has no colour-science): the colour tables are those of
+:mod:`.spectral_render`.
+"""
+
+import numpy as np
+
+from . import spectral_render
+from .arrays import ArrayLike, FloatArray
+from .validation import finite_array, positive_array, unit_vectors, velocity_array
+
+IRRADIANCE_POWER = 2.0
+"""``E'/E = D^2``: object-frame irradiance over scene-frame irradiance at the same event."""
+
+
+def _gamma(beta):
+    return 1.0 / np.sqrt(1.0 - np.sum(beta * beta, axis=-1))
+
+
+def lamp_to_object_doppler(direction: ArrayLike, beta_object: ArrayLike) -> FloatArray:
+    """``D = gamma (1 - beta . k)`` of light from a lamp at rest reaching an object moving with
+    ``beta_object``; ``direction`` is the photon direction ``k`` (lamp -> object), scene frame."""
+    k = unit_vectors(direction, "direction")
+    beta = velocity_array(beta_object, "beta_object")
+    return _gamma(beta) * (1.0 - np.sum(beta * k, axis=-1))
+
+
+def irradiance_factor(doppler: ArrayLike) -> FloatArray:
+    """``E'/E = D^2``: bolometric object-frame irradiance over the scene-frame irradiance Cycles
+    computes at the same event (distance measured in the lamp's frame)."""
+    return positive_array(doppler, "doppler") ** IRRADIANCE_POWER
+
+
+def aberrated_direction(direction: ArrayLike, beta_object: ArrayLike) -> FloatArray:
+    """The photon direction ``k'`` in the object's frame (docs/physics.md, aberration):
+    ``k' = (k + (gamma - 1)(bhat.k) bhat - gamma beta) / (gamma (1 - beta.k))``."""
+    k = unit_vectors(direction, "direction")
+    beta = velocity_array(beta_object, "beta_object")
+    gamma = _gamma(beta)[..., None]
+    speed2 = np.sum(beta * beta, axis=-1, keepdims=True)
+    bk = np.sum(beta * k, axis=-1, keepdims=True)
+    along = np.where(speed2 > 0.0, (gamma - 1.0) * bk / np.where(speed2 > 0.0, speed2, 1.0), 0.0)
+    return (k + along * beta - gamma * beta) / (gamma * (1.0 - bk))
+
+
+def aberrated_lamp_matrix(lamp_matrix: ArrayLike, centre: ArrayLike, direction: ArrayLike,
+                          beta_object: ArrayLike) -> FloatArray:
+    """The lamp's 4x4 world matrix turned about ``centre`` so that its light arrives along the
+    object-frame direction ``k'`` (:func:`aberrated_direction` of ``direction``, lamp -> centre)
+    instead of ``k``: the rotation taking ``k`` to ``k'`` (smallest angle, about ``k x k'``) applied
+    to the lamp's position about the centre and to its orientation. Cycles then lights the object
+    from where it sees the lamp in its own frame (at the centre's direction)."""
+    matrix = finite_array(lamp_matrix, "lamp_matrix").copy()
+    k = unit_vectors(direction, "direction")
+    k_object = aberrated_direction(k, beta_object)
+    axis = np.cross(k, k_object)
+    sine, cosine = float(np.linalg.norm(axis)), float(k @ k_object)
+    if sine < 1e-12:
+        return matrix  # on the axis of motion (or at rest): no aberration
+    axis = axis / sine
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    rotation = np.eye(3) + sine * cross + (1.0 - cosine) * cross @ cross  # Rodrigues
+    centre = finite_array(centre, "centre")
+    matrix[:3, :3] = rotation @ matrix[:3, :3]
+    matrix[:3, 3] = centre + rotation @ (matrix[:3, 3] - centre)
+    return matrix
+
+
+def lamp_rgb_factor(doppler: float, rgb: ArrayLike | None = None, temperature_k: float | None = None,
+                    use_doppler: bool = True, use_searchlight: bool = True) -> FloatArray:
+    """Per-channel factor ``f`` (3,) so that a lamp of colour ``rgb`` (or a blackbody at
+    ``temperature_k``, Blender's luminance-1 colour) with colour ``f * rgb`` lights the object
+    as eq. 18 says, ``>= 0`` and finite.
+
+    - Doppler and searchlight: ``D^-2 gamut(M(D) rgb) / rgb``; blackbody ``D^-2 Y(DT)/Y(T) rgb_unit(DT) / rgb_unit(T)``.
+    - Doppler only (brightness kept): the same colours scaled to the lamp's own luminance.
+    - searchlight only: ``D^2`` in every channel.
+    - neither: 1.
+    A channel the lamp does not emit (0) gets factor 0: its light cannot be made from nothing.
+    """
+    doppler = float(positive_array(doppler, "doppler"))
+    if not use_doppler:
+        return np.full(3, irradiance_factor(doppler) if use_searchlight else 1.0)
+    if temperature_k is not None:
+        rest = _blackbody_unit_rgb(temperature_k)
+        shifted = _blackbody_unit_rgb(doppler * temperature_k)
+        if use_searchlight:
+            log_ratio = spectral_render.log_blackbody_luminance(doppler * temperature_k) - \
+                spectral_render.log_blackbody_luminance(temperature_k)
+            shifted = shifted * np.exp(min(float(log_ratio), 80.0)) / irradiance_factor(doppler)
+    else:
+        rest = finite_array(rgb if rgb is not None else (1.0, 1.0, 1.0), "rgb")
+        shifted = spectral_render.gamut_map(spectral_render.doppler_rgb_matrix(doppler) @ rest)
+        if use_searchlight:
+            shifted = shifted / irradiance_factor(doppler)
+        else:
+            shifted = _same_luminance(shifted, rest)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = np.where(rest > 1e-6, shifted / np.where(rest > 1e-6, rest, 1.0), 0.0)
+    return np.clip(factor, 0.0, 1e30)
+
+
+def _blackbody_unit_rgb(temperature_k):
+    """Linear Rec.709 colour of a blackbody at ``temperature_k``, gamut-mapped, luminance 1 (Blender's)."""
+    rgb = spectral_render.xyz_to_linear_rec709(spectral_render.blackbody_xyz(temperature_k))
+    mapped = spectral_render.gamut_map(rgb)
+    y = float(spectral_render.luminance(mapped))
+    return mapped / y if y > 0.0 and np.isfinite(y) else np.zeros(3)  # no visible light left (a few K)
+
+
+def _same_luminance(rgb, reference):
+    y, y0 = spectral_render.luminance(rgb), spectral_render.luminance(reference)
+    return rgb * (y0 / y) if y > 0.0 else rgb * 0.0
+
+
+# --- what one factor per lamp and object leaves out --------------------------------------------
+
+
+def exact_irradiance(points: ArrayLike, rest_normals: ArrayLike, lamp: ArrayLike, beta_object: ArrayLike,
+                     intensity: float = 1.0) -> FloatArray:
+    """Eq. 18 (bolometric) per point: ``E' = D^2 cos(alpha') / r^2 I``, with ``D`` from each
+    point's own direction, ``alpha'`` between the object-frame (rest) normal and the object-frame
+    photon direction, ``r`` the scene-frame distance from the lamp at rest. 0 where unlit."""
+    points = finite_array(points, "points")
+    offset = points - finite_array(lamp, "lamp")
+    r = np.linalg.norm(offset, axis=-1)
+    k = offset / r[..., None]
+    doppler = lamp_to_object_doppler(k, beta_object)
+    k_object = aberrated_direction(k, beta_object)
+    cos_object = np.maximum(-np.sum(unit_vectors(rest_normals, "rest_normals") * k_object, axis=-1), 0.0)
+    return irradiance_factor(doppler) * cos_object / r**2 * intensity
+
+
+def one_factor_irradiance(points: ArrayLike, scene_normals: ArrayLike, lamp: ArrayLike, centre: ArrayLike,
+                          beta_object: ArrayLike, intensity: float = 1.0, aberrate: bool = True) -> FloatArray:
+    """What the renderer computes: Cycles' scene-frame ``cos(alpha) / r^2 I`` on the scene-frame
+    (contracted) surface from the lamp's copy (turned about ``centre`` to the aberrated direction
+    with ``aberrate``), times ``D^2`` of the direction lamp -> ``centre``."""
+    points = finite_array(points, "points")
+    lamp = finite_array(lamp, "lamp")
+    centre = finite_array(centre, "centre")
+    doppler = lamp_to_object_doppler(centre - lamp, beta_object)
+    if aberrate:
+        placed = np.eye(4)
+        placed[:3, 3] = lamp
+        lamp = aberrated_lamp_matrix(placed, centre, centre - lamp, beta_object)[:3, 3]
+    offset = points - lamp
+    r = np.linalg.norm(offset, axis=-1)
+    k = offset / r[..., None]
+    cos_scene = np.maximum(-np.sum(unit_vectors(scene_normals, "scene_normals") * k, axis=-1), 0.0)
+    return irradiance_factor(doppler) * cos_scene / r**2 * intensity
+
+
+def contracted_sphere(radius: float, centre: ArrayLike, beta_object: ArrayLike, count: int = 4000):
+    """Points, scene-frame normals and rest-frame normals of a sphere of rest radius ``radius``
+    moving with ``beta_object``, Lorentz-contracted about ``centre`` at one scene time (a
+    Fibonacci lattice of ``count`` points)."""
+    beta = velocity_array(beta_object, "beta_object")
+    index = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * index / count
+    phi = np.pi * (1.0 + 5.0**0.5) * index
+    rest_normals = np.stack([np.sqrt(1.0 - z * z) * np.cos(phi), np.sqrt(1.0 - z * z) * np.sin(phi), z], axis=-1)
+    speed = float(np.linalg.norm(beta))
+    bhat = beta / speed if speed > 0.0 else np.zeros(3)
+    gamma = float(_gamma(beta))
+    contraction = np.eye(3) - (1.0 - 1.0 / gamma) * np.outer(bhat, bhat)
+    points = np.asarray(centre, dtype=np.float64) + radius * rest_normals @ contraction.T
+    scene_normals = rest_normals @ np.linalg.inv(contraction)  # inverse transpose (symmetric)
+    return points, scene_normals / np.linalg.norm(scene_normals, axis=-1, keepdims=True), rest_normals
