@@ -70,10 +70,8 @@ def keyframe_camera(scene, camera, frames, c, beta_max, searchlight):
     """Keyframe every frame (linear) on the hyperbolic world line; cruise after 60% of the shot.
 
     One key past the last frame keeps the last frame's velocity (a central difference there would
-    otherwise see the camera stop). With the searchlight on, the film exposure follows the D^4
-    brightening straight ahead (D = sqrt((1 + beta) / (1 - beta))), partly, as a camera operator
-    would: -0.75 log2(D^4) stops, keyframed so that every frame renders alone the same.
-    """
+    otherwise see the camera stop). With the searchlight on, the exposure is the add-on's
+    Compensated one (docs/camera.md, "Exposure")."""
     fps = scene.render.fps / scene.render.fps_base
     t_cruise = 0.6 * (frames - 1) / fps
     u_max = beta_max / math.sqrt(1.0 - beta_max * beta_max)
@@ -86,14 +84,9 @@ def keyframe_camera(scene, camera, frames, c, beta_max, searchlight):
         for point in fcurve.keyframe_points:
             point.interpolation = "LINEAR"
     if searchlight:
-        view = scene.view_settings
-        for frame in range(1, frames + 1):
-            # Chord speeds around the frame, as the add-on's central difference sees them.
-            before = positions[frame - 2] if frame > 1 else positions[0]
-            speed = (positions[frame] - before) / ((2 if frame > 1 else 1) / fps) / c
-            beta = min(speed, beta_max)
-            view.exposure = -0.75 * 4.0 * math.log2(math.sqrt((1.0 + beta) / (1.0 - beta)))
-            view.keyframe_insert("exposure", frame=frame)
+        # One exposure per frame from the observer's velocity (the add-on's Compensated exposure,
+        # in each file's metadata), so that the brightening ahead does not burn the film out.
+        scene.relativity.exposure_mode = "COMPENSATED"
 
 
 def build(out_dir, frames, beta_max, c, resolution, samples, searchlight=True):
