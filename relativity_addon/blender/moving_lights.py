@@ -24,7 +24,7 @@ import os
 import bpy
 
 from ..errors import RelativityError
-from . import names, osl
+from . import moving_lamps, names, osl
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
@@ -35,8 +35,10 @@ ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffus
 
 
 def supported(snap):
-    """The snapshot's moving lights this stage renders (point and spot lights)."""
-    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS]
+    """The snapshot's moving lights this stage renders: point and spot lights, with constant
+    velocity, or keyframed (ANIMATION) where stand-in lamps draw them (:func:`uses_lamps`)."""
+    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS
+            and (light.motion == "CONSTANT" or uses_lamps(snap))]
 
 
 def is_applied(scene):
@@ -289,7 +291,13 @@ def _enable_osl(scene):
         scene.cycles.shading_system = True
 
 
-def write(scene, snap, attach_new_materials=False):
+def uses_lamps(snap):
+    """Whether the moving lights are drawn by stand-in lamps (``moving_lamps.py``, with shadows
+    behind Cycles' OSL camera) rather than by the material shader (with traced shadows)."""
+    return snap.method == "CAMERA"
+
+
+def write(scene, snap, attach_new_materials=False, depsgraph=None):
     """Bring the moving lights up to date with the snapshot: hide the moving lights (and show
     again those no longer moving), rebuild the group when the lights changed, write every light's
     parameters and attach materials (all on the first write, then new ones on request). With no
@@ -311,6 +319,10 @@ def write(scene, snap, attach_new_materials=False):
     for name in light_names:
         _hide_light(scene.objects[name])
     _enable_osl(scene)
+    if uses_lamps(snap):
+        moving_lamps.write(scene, snap, lights, lambda light: shader_parameters(light, snap),
+                           reception_event(snap)[0], depsgraph)
+        return None
     group = ensure_group(light_names)
     _write_parameters(group, snap)
     if first or attach_new_materials:
@@ -325,7 +337,8 @@ def apply(scene, snap):
 
 def remove(scene):
     """Restore everything :func:`write` changed: materials, lights, the scene's shading system;
-    delete the group and the shader text."""
+    delete the group, the stand-in lamps and the shader texts."""
+    moving_lamps.remove(scene)
     for material in bpy.data.materials:
         detach(material)
     for obj in bpy.data.objects:
@@ -348,14 +361,15 @@ def warnings(scene, snap):
     """What the moving-light stage does not render right, one line each."""
     found = [f"Light {light.name!r} ({light.kind.lower()}): moving {light.kind.lower()} lights are rendered at rest"
              for light in snap.moving_lights if light.kind not in SUPPORTED_KINDS]
-    found += [f"Light {obj.name!r}: Animation motion of lights is not supported, it is rendered at rest"
-              for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
+    if not uses_lamps(snap):
+        found += [f"Light {obj.name!r}: Animation motion of lights needs the exact camera, it is rendered at rest"
+                  for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
         found.append("Moving lights with a moving observer need the exact camera (Apparent Geometry lights "
                      "the surfaces where they appear)")
-    if supported(snap) and snap.method == "CAMERA":
-        found.append("Moving lights cast no shadows with the exact camera (OSL trace() crashes Cycles "
-                     "behind an OSL camera)")
+    if supported(snap) and uses_lamps(snap):
+        found.append("Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
+                     "between neighbouring lamps (docs/moving-lights.md)")
     if supported(snap) and scene.render.engine != "CYCLES":
         found.append("Moving lights need Cycles (OSL)")
     return found

@@ -65,3 +65,6 @@ MOVING_LIGHTS_MATERIAL_KEY = "relativity_moving_lights"  # on materials: the ins
 MOVING_LIGHT_NODE_PREFIX = "Relativity Moving Lights"
 LIGHT_SAVED_KEY = "relativity_light_saved"  # on light objects: the user's hide_render while hidden
 SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: the user's Open Shading Language
+MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader
+MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and lights): "<prefix> <light> <index>"
+MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}
