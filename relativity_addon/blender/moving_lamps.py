@@ -22,9 +22,10 @@ import warnings
 
 import bpy
 import numpy as np
+from mathutils import Vector
 
 from ..errors import RelativityError
-from ..physics.lorentz import camera_to_scene_direction
+from ..physics.lorentz import aberrate, camera_to_scene_direction
 from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
 from . import animation, names
 
@@ -125,8 +126,13 @@ def lamp_path(scene, snap, light, values, reception_time, points):
 # --- the stand-in lamps ---------------------------------------------------------------------
 
 
-def _new_lamp(scene, name, text):
-    light = bpy.data.lights.new(name, "POINT")
+def _new_lamp(scene, name, text, kind="POINT"):
+    light = bpy.data.lights.new(name, kind)
+    if kind == "SUN":  # direction, strength and angle are written by _write_sun; no shader
+        obj = bpy.data.objects.new(name, light)
+        obj.rotation_mode = "QUATERNION"
+        scene.collection.objects.link(obj)
+        return obj
     light.energy = 4.0 * math.pi  # 1 W/sr: the shader's Emission carries the intensity
     light.color = (1.0, 1.0, 1.0)
     light.shadow_soft_size = 0.0
@@ -181,13 +187,13 @@ def _record(scene):
     return {} if stored is None else {key: list(value) for key, value in stored.to_dict().items()}
 
 
-def _lamps_for(scene, light_name, count, text):
+def _lamps_for(scene, light_name, count, text, kind="POINT"):
     record = _record(scene)
     existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
-    if len(existing) != count:
+    if len(existing) != count or any(bpy.data.objects[name].data.type != kind for name in existing):
         for name in existing:
             _delete(name)
-        existing = [_new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text).name
+        existing = [_new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
                     for index in range(count)]
         record[light_name] = existing
         scene[names.MOVING_LAMPS_KEY] = record
@@ -206,6 +212,9 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
         scene[names.MOVING_LAMPS_KEY] = record
     points = None
     for light in lights:
+        if light.kind == "SUN":
+            _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
+            continue
         values = parameters(light)
         if points is None:
             points = visible_points(scene, snap, depsgraph, values["camera_position"])
@@ -215,6 +224,7 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
             before, after = max(index - 1, 0), min(index + 1, last)
             inputs = {key: values[key] for key in ("camera_position", "intensity", "light_beta", "spot_axis",
                                                     "spot_cos_half_angle", "spot_smooth")}
+            inputs["lambert"] = int(values["lambert"])
             inputs.update(lamp_time=float(times[index]), previous_time=float(times[before]),
                           previous_position=tuple(positions[before]), next_time=float(times[after]),
                           next_position=tuple(positions[after]))
@@ -222,6 +232,32 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
             node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
             for key, value in inputs.items():
                 _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
+
+
+def sun_in_scene_frame(axis, beta):
+    """A sun (plane wave) moving with ``beta``: the photon direction in the scene frame (its own
+    frame's ``axis`` aberrated) and ``D = 1 / (gamma (1 - beta . k))``; the irradiance on a surface
+    facing it scales by ``D^2`` (radiance ``D^4`` times the disc's solid angle ``1 / D^2``) and its
+    angular diameter by ``1 / D``."""
+    beta = np.array(beta, float)
+    k = aberrate(np.array(axis, float), -beta)
+    gamma = 1.0 / math.sqrt(1.0 - float(beta @ beta))
+    return k, 1.0 / (gamma * (1.0 - float(beta @ k)))
+
+
+def _write_sun(scene, light, obj):
+    """The stand-in sun: the user's sun aberrated, ``D^2`` its strength, ``1 / D`` its angle."""
+    user = scene.objects[light.name].data
+    direction, doppler = sun_in_scene_frame(light.axis, light.beta)
+    stand_in = obj.data
+    _set(stand_in, "energy", float(user.energy) * doppler * doppler)
+    _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
+    _set(stand_in, "color", tuple(user.color))
+    for key in ("use_shadow", "use_temperature", "temperature"):
+        if hasattr(user, key) and getattr(stand_in, key) != getattr(user, key):
+            setattr(stand_in, key, getattr(user, key))
+    rotation = Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y")
+    _set(obj, "rotation_quaternion", tuple(rotation))
 
 
 def remove(scene):

@@ -30,15 +30,18 @@ SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders"
 GROUP = names.MOVING_LIGHTS_GROUP
 MATERIAL_KEY = names.MOVING_LIGHTS_MATERIAL_KEY
 NODE_PREFIX = names.MOVING_LIGHT_NODE_PREFIX
-SUPPORTED_KINDS = {"POINT": 0, "SPOT": 1}
+SUPPORTED_KINDS = {"POINT": 0, "SPOT": 1}  # by the material shader
+LAMP_KINDS = {"POINT", "SPOT", "SUN", "AREA"}  # by stand-in lamps (moving_lamps.py)
 ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffuse": "Color"}
 
 
 def supported(snap):
     """The snapshot's moving lights this stage renders: point and spot lights, with constant
     velocity, or keyframed (ANIMATION) where stand-in lamps draw them (:func:`uses_lamps`)."""
-    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS
-            and (light.motion == "CONSTANT" or uses_lamps(snap))]
+    if uses_lamps(snap):
+        return [light for light in snap.moving_lights if light.kind in LAMP_KINDS
+                and (light.motion == "CONSTANT" or light.kind != "SUN")]
+    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
 
 
 def is_applied(scene):
@@ -124,8 +127,10 @@ def shader_parameters(light, snap):
         "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
         "light_beta": light.beta,
         "camera_position": camera_position,
-        "intensity": light.intensity,
-        "light_type": SUPPORTED_KINDS[light.kind],
+        # an area light's centre: a Lambertian emitter of power P has I = P / pi along its axis
+        "intensity": tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity,
+        "lambert": light.kind == "AREA",
+        "light_type": SUPPORTED_KINDS.get(light.kind, 0),
         "spot_axis": light.axis,
         "spot_cos_half_angle": cos_half if light.kind == "SPOT" else -1.0,
         "spot_smooth": smooth,
@@ -155,7 +160,8 @@ def _write_parameters(group, snap):
     for light in supported(snap):
         node = group.nodes[f"light {light.name}"]
         for key, value in shader_parameters(light, snap).items():
-            _set_input(node.inputs[key], value)
+            if key in node.inputs:  # "lambert" is the stand-in lamps' (area lights)
+                _set_input(node.inputs[key], value)
 
 
 # --- materials ------------------------------------------------------------------------------
@@ -359,11 +365,9 @@ def remove(scene):
 
 def warnings(scene, snap):
     """What the moving-light stage does not render right, one line each."""
-    found = [f"Light {light.name!r} ({light.kind.lower()}): moving {light.kind.lower()} lights are rendered at rest"
-             for light in snap.moving_lights if light.kind not in SUPPORTED_KINDS]
-    if not uses_lamps(snap):
-        found += [f"Light {obj.name!r}: Animation motion of lights needs the exact camera, it is rendered at rest"
-                  for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
+    drawn = {light.name for light in supported(snap)}
+    found = [f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "
+             "with this motion need the exact camera)" for light in snap.moving_lights if light.name not in drawn]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
         found.append("Moving lights with a moving observer need the exact camera (Apparent Geometry lights "
                      "the surfaces where they appear)")
