@@ -200,10 +200,28 @@ def _lamps_for(scene, light_name, count, text, kind="POINT"):
     return [bpy.data.objects[name] for name in existing]
 
 
+def _stored_times(scene, light_name):
+    """The stand-ins' times of the last placement (their shaders' inputs), or None."""
+    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
+    if not objects or any(obj is None or obj.data.type != "POINT" for obj in objects):
+        return None
+    return np.array([obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["lamp_time"].default_value
+                     for obj in objects], float)
+
+
+def _positions(scene, snap, light, values, reception_time, times):
+    """The light's positions at the times ``c (t - t_reception)``."""
+    if light.motion == "ANIMATION":
+        return _keyframe_path(scene.objects[light.name], snap, reception_time, times)
+    return np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
+
+
 def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
     """Place and set the stand-in lamps of ``lights`` (``parameters(light)``: the material
     shader's inputs, ``moving_lights.shader_parameters``; ``reception_time`` ``c (t_reception -
-    t_o)``); delete those of lights no longer moving."""
+    t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
+    is given or none exist yet; without one, the last placement's times are kept and the lamps move
+    along the path to them."""
     text = _shader_text()
     record = _record(scene)
     for stale in set(record) - {light.name for light in lights}:
@@ -216,9 +234,13 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
-        if points is None:
-            points = visible_points(scene, snap, depsgraph, values["camera_position"])
-        times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+        times = None if depsgraph is not None else _stored_times(scene, light.name)
+        if times is None:  # place them (the camera's view is ray-cast)
+            if points is None:
+                points = visible_points(scene, snap, depsgraph, values["camera_position"])
+            times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+        else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
+            positions = _positions(scene, snap, light, values, reception_time, times)
         last = len(times) - 1
         for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
             before, after = max(index - 1, 0), min(index + 1, last)
