@@ -44,7 +44,7 @@ def _shader_text():
     return text
 
 
-def view_directions(scene, snap, columns=48, rows=36, margin=0.05):
+def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
     camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame)."""
     camera = scene.objects[snap.camera]

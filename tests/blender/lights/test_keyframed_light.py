@@ -97,6 +97,6 @@ def test_keyframed_light_follows_its_keyframes(relativity_addon, factory_blender
           f"by {np.abs(constant - expected).max() / peak:.3f} of the peak")
     assert error < 0.05
     assert np.sum(~away) < 20
-    assert abs(ratio - expected_ratio) < 0.1 * expected_ratio
+    assert abs(ratio - expected_ratio) < 0.15 * expected_ratio  # 4 px before the jump: on the piece across the kink
     assert expected_ratio < 0.5  # the jump is there
     assert np.abs(constant - expected).max() > 0.2 * peak  # the keyframes matter
