@@ -235,7 +235,9 @@ def light_render_hidden(obj):
 
 def _keyframe_beta(scene, obj, frame, step=0.01):
     """An animated object's velocity over c at ``frame`` from its keyframes (central difference)."""
-    animation.check_supported(obj, scene)
+    problem = animation.keyframe_motion_problem(obj, scene)
+    if problem is not None:
+        raise RelativityError(f"light {obj.name!r} moves by its keyframes, but {problem}: set its motion to Constant")
     positions = animation.world_matrices(obj, [frame - step, frame + step])[:, :3, 3]
     c = check_speed_of_light(scene.relativity.speed_of_light)
     per_frame = (positions[1] - positions[0]) / (2.0 * step)

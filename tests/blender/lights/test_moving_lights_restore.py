@@ -120,3 +120,20 @@ def test_light_panel_shows_motion_and_velocity(relativity_addon, factory_blender
     lamp.data.type = "SUN"
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
     assert any(entry[0] == "label" and "rendered at rest" in entry[1] for entry in log)
+
+
+def test_keyframed_light_with_a_constraint_is_refused_in_one_line(relativity_addon, factory_blender):
+    """Keyframes alone do not give a constrained light's path: Set Up refuses, naming the light,
+    and leaves the scene as it was."""
+    bpy = factory_blender
+    effect = _module("effect")
+    errors = importlib.import_module(f"{ADDON_MODULE}.errors")
+    scene, _camera, lamp = _floor_scene(bpy)
+    lamp.relativity.motion = "ANIMATION"
+    lamp.constraints.new("TRACK_TO")
+    before = _signature(bpy, scene)
+    with pytest.raises(errors.RelativityError) as raised:
+        effect.apply(scene)
+    print(raised.value)
+    assert "'Lamp'" in str(raised.value) and "constraints" in str(raised.value) and "\n" not in str(raised.value)
+    assert _signature(bpy, scene) == before
