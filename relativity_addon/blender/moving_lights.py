@@ -1,4 +1,4 @@
-"""Moving lights: point and spot lights with constant velocity light each surface from their
+"""Moving lights: lights with a velocity light each surface from their
 retarded position, with eq. 19's ``D^4`` beaming and shadows (docs/moving-lights.md).
 
 Cycles' own lights cannot move during the light's flight, so a moving light is drawn by the
@@ -10,12 +10,13 @@ hidden from renders while the effect is applied. Every change is recorded (the u
 ``hide_render`` on the light, the scene's Open Shading Language setting, each material's old
 surface link) and :func:`remove` restores it exactly.
 
-What is covered (docs/moving-lights.md): point and spot lights with CONSTANT motion,
-surfaces at rest in the scene frame, diffuse reflection (the albedo is the Base Color / Color of
-the first Principled or Diffuse BSDF feeding the output), one shadow ray to a point source on
-the Apparent Geometry path. Behind the exact camera (an OSL camera) Cycles crashes in the
-material's ``trace()`` (measured on 4.5 and 5.2: the camera shader clears the thread's trace
-data), so there the shader traces no shadow ray and moving lights cast no shadows.
+This is the Apparent Geometry path's renderer and the stage's entry point. Behind the exact camera
+(an OSL camera) a material's ``trace()`` crashes Cycles (measured on 4.5 and 5.2: the camera shader
+clears the thread's trace data), so there :func:`write` hands the lights to ``moving_lamps.py``
+(stand-in lamps whose shadows Cycles traces; :func:`uses_lamps`). What is covered:
+docs/moving-lights.md. Here: point and spot lights with CONSTANT motion, surfaces at rest in the
+scene frame, diffuse reflection (the albedo is the Base Color / Color of the first Principled or
+Diffuse BSDF feeding the output), one shadow ray to a point source.
 """
 
 import math
