@@ -198,7 +198,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         if method == "GEOMETRY" and update_geometry:
             geometry.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
-            moving_lights.write(scene, snap, attach_new_materials)
+            moving_lights.write(scene, snap, attach_new_materials, depsgraph)
             colour.write(scene, snap, attach_new_materials)
             metadata.write(scene, snap)
             lamp_doppler.write(scene, snap)

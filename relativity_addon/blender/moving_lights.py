@@ -1,4 +1,4 @@
-"""Moving lights: point and spot lights with constant velocity light each surface from their
+"""Moving lights: lights with a velocity light each surface from their
 retarded position, with eq. 19's ``D^4`` beaming and shadows (docs/moving-lights.md).
 
 Cycles' own lights cannot move during the light's flight, so a moving light is drawn by the
@@ -10,12 +10,13 @@ hidden from renders while the effect is applied. Every change is recorded (the u
 ``hide_render`` on the light, the scene's Open Shading Language setting, each material's old
 surface link) and :func:`remove` restores it exactly.
 
-What is covered (docs/moving-lights.md): point and spot lights with CONSTANT motion,
-surfaces at rest in the scene frame, diffuse reflection (the albedo is the Base Color / Color of
-the first Principled or Diffuse BSDF feeding the output), one shadow ray to a point source on
-the Apparent Geometry path. Behind the exact camera (an OSL camera) Cycles crashes in the
-material's ``trace()`` (measured on 4.5 and 5.2: the camera shader clears the thread's trace
-data), so there the shader traces no shadow ray and moving lights cast no shadows.
+This is the Apparent Geometry path's renderer and the stage's entry point. Behind the exact camera
+(an OSL camera) a material's ``trace()`` crashes Cycles (measured on 4.5 and 5.2: the camera shader
+clears the thread's trace data), so there :func:`write` hands the lights to ``moving_lamps.py``
+(stand-in lamps whose shadows Cycles traces; :func:`uses_lamps`). What is covered:
+docs/moving-lights.md. Here: point and spot lights with CONSTANT motion, surfaces at rest in the
+scene frame, diffuse reflection (the albedo is the Base Color / Color of the first Principled or
+Diffuse BSDF feeding the output), one shadow ray to a point source.
 """
 
 import math
@@ -24,19 +25,24 @@ import os
 import bpy
 
 from ..errors import RelativityError
-from . import names, osl
+from . import moving_lamps, names, osl
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
 MATERIAL_KEY = names.MOVING_LIGHTS_MATERIAL_KEY
 NODE_PREFIX = names.MOVING_LIGHT_NODE_PREFIX
-SUPPORTED_KINDS = {"POINT": 0, "SPOT": 1}
+SUPPORTED_KINDS = {"POINT": 0, "SPOT": 1}  # by the material shader
+LAMP_KINDS = {"POINT", "SPOT", "SUN", "AREA"}  # by stand-in lamps (moving_lamps.py)
 ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffuse": "Color"}
 
 
 def supported(snap):
-    """The snapshot's moving lights this stage renders (point and spot lights)."""
-    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS]
+    """The snapshot's moving lights this stage renders: point and spot lights, with constant
+    velocity, or keyframed (ANIMATION) where stand-in lamps draw them (:func:`uses_lamps`)."""
+    if uses_lamps(snap):
+        return [light for light in snap.moving_lights if light.kind in LAMP_KINDS
+                and (light.motion == "CONSTANT" or light.kind != "SUN")]
+    return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
 
 
 def is_applied(scene):
@@ -118,8 +124,10 @@ def shader_parameters(light, snap):
         "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
         "light_beta": light.beta,
         "camera_position": camera_position,
-        "intensity": light.intensity,
-        "light_type": SUPPORTED_KINDS[light.kind],
+        # an area light's centre: a Lambertian emitter of power P has I = P / pi along its axis
+        "intensity": tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity,
+        "lambert": light.kind == "AREA",
+        "light_type": SUPPORTED_KINDS.get(light.kind, 0),
         "spot_axis": light.axis,
         "spot_cos_half_angle": cos_half if light.kind == "SPOT" else -1.0,
         "spot_smooth": smooth,
@@ -145,11 +153,26 @@ def _set_input(socket, value):
     return True
 
 
+def _silence_group(snap):
+    """Light nothing and trace nothing from the materials (behind the OSL camera the stand-in lamps
+    light the scene, and trace() would crash Cycles)."""
+    group = bpy.data.node_groups.get(GROUP)
+    if group is None:
+        return
+    for light in supported(snap):
+        node = group.nodes.get(f"light {light.name}")
+        if node is not None:
+            for key, value in (("intensity", (0.0, 0.0, 0.0)), ("use_shadows", False)):
+                if key in node.inputs:
+                    _set_input(node.inputs[key], value)
+
+
 def _write_parameters(group, snap):
     for light in supported(snap):
         node = group.nodes[f"light {light.name}"]
         for key, value in shader_parameters(light, snap).items():
-            _set_input(node.inputs[key], value)
+            if key in node.inputs:  # "lambert" is the stand-in lamps' (area lights)
+                _set_input(node.inputs[key], value)
 
 
 # --- materials ------------------------------------------------------------------------------
@@ -285,7 +308,13 @@ def _enable_osl(scene):
         scene.cycles.shading_system = True
 
 
-def write(scene, snap, attach_new_materials=False):
+def uses_lamps(snap):
+    """Whether the moving lights are drawn by stand-in lamps (``moving_lamps.py``, with shadows
+    behind Cycles' OSL camera) rather than by the material shader (with traced shadows)."""
+    return snap.exact_camera
+
+
+def write(scene, snap, attach_new_materials=False, depsgraph=None):
     """Bring the moving lights up to date with the snapshot: hide the moving lights (and show
     again those no longer moving), rebuild the group when the lights changed, write every light's
     parameters and attach materials (all on the first write, then new ones on request). With no
@@ -307,6 +336,12 @@ def write(scene, snap, attach_new_materials=False):
     for name in light_names:
         _hide_light(scene.objects[name])
     _enable_osl(scene)
+    if uses_lamps(snap):
+        _silence_group(snap)  # the preview's material nodes, during an Apparent Geometry final render
+        moving_lamps.write(scene, snap, lights, lambda light: shader_parameters(light, snap),
+                           reception_event(snap)[0], depsgraph)
+        return None
+    moving_lamps.remove(scene)  # after an Apparent Geometry final render
     group = ensure_group(light_names)
     _write_parameters(group, snap)
     if first or attach_new_materials:
@@ -321,7 +356,8 @@ def apply(scene, snap):
 
 def remove(scene):
     """Restore everything :func:`write` changed: materials, lights, the scene's shading system;
-    delete the group and the shader text."""
+    delete the group, the stand-in lamps and the shader texts."""
+    moving_lamps.remove(scene)
     for material in bpy.data.materials:
         detach(material)
     for obj in bpy.data.objects:
@@ -342,16 +378,15 @@ def remove(scene):
 
 def warnings(scene, snap):
     """What the moving-light stage does not render right, one line each."""
-    found = [f"Light {light.name!r} ({light.kind.lower()}): moving {light.kind.lower()} lights are rendered at rest"
-             for light in snap.moving_lights if light.kind not in SUPPORTED_KINDS]
-    found += [f"Light {obj.name!r}: Animation motion of lights is not supported, it is rendered at rest"
-              for obj in scene.objects if obj.type == "LIGHT" and obj.relativity.motion == "ANIMATION"]
+    drawn = {light.name for light in supported(snap)}
+    found = [f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "
+             "with this motion need the exact camera)" for light in snap.moving_lights if light.name not in drawn]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
         found.append("Moving lights with a moving observer: the viewport preview lights the surfaces where they "
                      "appear; the final render is exact")
-    if supported(snap) and (snap.method == "CAMERA" or snap.speed > 0.0):
-        found.append("Moving lights cast no shadows with the exact camera (OSL trace() crashes Cycles "
-                     "behind an OSL camera)")
+    if supported(snap) and uses_lamps(snap):
+        found.append("Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
+                     "between neighbouring lamps (docs/moving-lights.md)")
     if supported(snap) and scene.render.engine != "CYCLES":
         found.append("Moving lights need Cycles (OSL)")
     return found

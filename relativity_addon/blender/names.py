@@ -76,3 +76,6 @@ REST_NORMAL_KEY = "relativity_rest_normals"  # on the scene: the meshes given th
 REST_NORMAL_MATERIAL_KEY = "relativity_rest_normal_node"  # on materials: the inserted group node's name
 REST_NORMAL_GROUP = "Relativity Rest Normal"  # shader group: rest-frame normal in world axes
 REST_NORMAL_GROUP_VERSION = 1
+MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader
+MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and lights): "<prefix> <light> <index>"
+MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}

@@ -172,16 +172,23 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
 
 
 def _draw_light(layout, obj):
-    """Lights: the same motion settings as meshes (point and spot lights with constant velocity
-    are rendered moving, blender/moving_lights.py)."""
+    """Lights: the same motion settings as meshes (blender/moving_lights.py: point and spot lights
+    with constant velocity on both paths; with the exact camera also sun and area lights and
+    keyframed point, spot and area lights)."""
     settings = obj.relativity
     layout.prop(settings, "motion")
+    kind = obj.data.type
     if settings.motion == "CONSTANT":
         layout.prop(settings, "beta")
-        if obj.data.type not in ("POINT", "SPOT"):
-            layout.label(text=f"Moving {obj.data.type.lower()} lights are rendered at rest", icon="ERROR")
+        if kind not in ("POINT", "SPOT"):
+            layout.label(text=f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent "
+                              "Geometry)", icon="INFO")
     elif settings.motion == "ANIMATION":
-        layout.label(text="Animated lights are rendered at rest", icon="ERROR")
+        if kind == "SUN":
+            layout.label(text="Animated sun lights are rendered at rest", icon="ERROR")
+        else:
+            layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)",
+                         icon="INFO")
 
 
 classes = (

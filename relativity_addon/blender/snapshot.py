@@ -49,6 +49,7 @@ class MovingLight:
     axis: Vector3  # world direction of its local -Z (where a spot points)
     spot_size: float  # full cone angle, radians
     spot_blend: float
+    motion: str = "CONSTANT"  # or ANIMATION: position and beta (at the frame) from its keyframes
 
 
 @dataclass(frozen=True)
@@ -274,14 +275,27 @@ def light_render_hidden(obj):
     return bool(saved["hide_render"]) if saved is not None else obj.hide_render
 
 
+def _keyframe_beta(scene, obj, frame, step=0.01):
+    """An animated object's velocity over c at ``frame`` from its keyframes (central difference)."""
+    problem = animation.keyframe_motion_problem(obj, scene)
+    if problem is not None:
+        raise RelativityError(f"light {obj.name!r} moves by its keyframes, but {problem}: set its motion to Constant")
+    positions = animation.world_matrices(obj, [frame - step, frame + step])[:, :3, 3]
+    c = check_speed_of_light(scene.relativity.speed_of_light)
+    per_frame = (positions[1] - positions[0]) / (2.0 * step)
+    return tuple(float(v) for v in per_frame * animation.frames_per_second(scene) / c)
+
+
 def moving_lights(scene, frame, depsgraph=None):
-    """Every light of ``scene`` with constant velocity that renders, at ``frame``; RelativityError
+    """Every light of ``scene`` with constant velocity or keyframed motion that renders, at ``frame``; RelativityError
     for a light at or above the speed of light."""
     found = []
     for obj in scene.objects:
-        if obj.type != "LIGHT" or obj.relativity.motion != "CONSTANT" or light_render_hidden(obj):
+        motion = obj.relativity.motion
+        if obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
-        beta = check_velocity(obj.relativity.beta, f"light {obj.name!r} velocity beta")
+        beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
+        beta = check_velocity(beta, f"light {obj.name!r} velocity beta")
         matrix = camera_matrix(scene, obj, frame, depsgraph)
         axis = -matrix[:3, 2] / max(np.linalg.norm(matrix[:3, 2]), 1e-30)
         light = obj.data
@@ -291,6 +305,7 @@ def moving_lights(scene, frame, depsgraph=None):
             name=obj.name, kind=light.type, position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
             intensity=tuple(power * float(v) for v in light.color), axis=tuple(float(v) for v in axis),
             spot_size=float(light.spot_size) if spot else math.pi, spot_blend=float(light.spot_blend) if spot else 0.0,
+            motion=motion,
         ))
     return tuple(found)
 

@@ -99,3 +99,71 @@ def irradiance_on_plane(points_along: ArrayLike, plane_height: float, camera_pos
     points = np.concatenate([xy, np.full(xy.shape[:-1] + (1,), float(plane_height))], axis=-1)
     return moving_point_light_irradiance(points, np.broadcast_to([0.0, 0.0, 1.0], points.shape), camera_position,
                                          light_position, light_beta, intensity)
+
+
+def retarded_times(surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike,
+                   light_beta: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """``c (t_e - t_o)`` for each surface point (the light's position then is
+    ``light_position + beta c (t_e - t_o)``) and the irradiance ``D^4 / r^2`` per unit intensity
+    (no cosine, no occlusion): the points' retarded times and how much light they get."""
+    x = vector_array(surface_points, "surface_points")
+    light = retarded_light(x, camera_position, light_position, light_beta)
+    delay = np.linalg.norm(x - vector_array(camera_position, "camera_position"), axis=-1)
+    with np.errstate(divide="ignore"):
+        irradiance = light.doppler ** 4 / light.distance ** 2
+    return -delay - light.distance, irradiance
+
+
+def lamp_times(times: ArrayLike, irradiance: ArrayLike, spacing: float, max_lamps: int,
+               relevance: float = 0.01) -> FloatArray:
+    """Where on its path (``c (t - t_o)``, ascending) to put the point lamps that stand in for a
+    moving light: evenly over the retarded times of the points that get at least ``relevance`` of
+    the brightest point's irradiance, at most ``spacing`` apart (in ``c t``, a length along the path
+    times 1 / beta), at most ``max_lamps`` of them. A point outside that span is lit from the end lamp."""
+    times = finite_array(times, "times").ravel()
+    irradiance = np.asarray(irradiance, float).ravel()
+    keep = np.isfinite(irradiance) & (irradiance > 0.0)
+    if not np.any(keep):
+        return np.zeros(1)
+    keep &= irradiance >= relevance * irradiance[keep].max()
+    low, high = float(times[keep].min()), float(times[keep].max())
+    if not high - low > 0.0:
+        return np.array([low])
+    count = int(min(max(np.ceil((high - low) / max(spacing, 1e-12)) + 1, 2), max(max_lamps, 2)))
+    return np.linspace(low, high, count)
+
+
+def path_position(times: ArrayLike, path_times: ArrayLike, path_positions: ArrayLike) -> FloatArray:
+    """The light's position at ``times`` on a path sampled at ascending ``path_times`` (``c t``),
+    straight between samples and extended straight beyond the first and last."""
+    s = np.asarray(times, float)
+    knots = finite_array(path_times, "path_times")
+    points = vector_array(path_positions, "path_positions")
+    if knots.size == 1:
+        return np.broadcast_to(points[0], s.shape + (3,)).copy()
+    index = np.clip(np.searchsorted(knots, s) - 1, 0, knots.size - 2)
+    fraction = (s - knots[index]) / (knots[index + 1] - knots[index])
+    return points[index] + fraction[..., None] * (points[index + 1] - points[index])
+
+
+def retarded_times_on_path(surface_points: ArrayLike, camera_position: ArrayLike, path_times: ArrayLike,
+                           path_positions: ArrayLike, iterations: int = 400) -> tuple[FloatArray, FloatArray]:
+    """:func:`retarded_times` for a light on a sampled path (:func:`path_position`): the retarded
+    time ``s = -|x - camera| - |x - x_L(s)|`` by fixed-point iteration (it contracts by the light's
+    speed, which must stay below c), and ``D^4 / r^2`` with the velocity of the path's piece."""
+    x = vector_array(surface_points, "surface_points")
+    knots = finite_array(path_times, "path_times")
+    points = vector_array(path_positions, "path_positions")
+    delay = np.linalg.norm(x - vector_array(camera_position, "camera_position"), axis=-1)
+    s = -delay
+    for _ in range(iterations):
+        s = -delay - np.linalg.norm(x - path_position(s, knots, points), axis=-1)
+    step = 1e-4 * max(float(knots.max() - knots.min()), 1e-9)
+    beta = (path_position(s + step, knots, points) - path_position(s - step, knots, points)) / (2.0 * step)
+    r = -delay - s
+    with np.errstate(divide="ignore", invalid="ignore"):
+        n = (x - path_position(s, knots, points)) / r[..., None]
+        gamma = 1.0 / np.sqrt(1.0 - np.sum(beta * beta, axis=-1))
+        doppler = 1.0 / (gamma * (1.0 - np.sum(beta * n, axis=-1)))
+        irradiance = doppler ** 4 / r ** 2
+    return s, irradiance

@@ -127,3 +127,76 @@ def test_eq_19_on_a_floor_written_out():
 def test_rejects_light_at_or_above_c():
     with pytest.raises(ValueError, match="below 1"):
         moving_lights.retarded_light((1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (1.0, 0.0, 0.0))
+
+
+# --- the stand-in lamps' placement (blender/moving_lamps.py) ---------------------------------------
+
+
+def _bisect_on_path(x, camera, position_at):
+    """s = c (t_e - t_o) with |x - x_L(s)| = -|x - camera| - s, by bisection (the defining equation)."""
+    c_tx = -np.linalg.norm(x - camera)
+
+    def g(s):  # > 0 when s is before the emission time
+        return (c_tx - s) - np.linalg.norm(x - position_at(s))
+
+    low, high = c_tx - 1e4, c_tx
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if g(middle) > 0.0 else (low, middle)
+    return 0.5 * (low + high)
+
+
+def test_retarded_times_on_a_straight_path_match_the_closed_form():
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-5.0, 5.0, (50, 3))
+    camera, light, beta = np.array([0.0, 0.0, 5.0]), np.array([1.5, 0.0, 1.0]), np.array([0.5, 0.2, 0.0])
+    closed, irradiance = moving_lights.retarded_times(x, camera, light, beta)
+    knots = np.linspace(-60.0, 0.0, 7)
+    on_path, irradiance_path = moving_lights.retarded_times_on_path(x, camera, knots, light + knots[:, None] * beta)
+    bisected = [_bisect_on_path(p, camera, lambda s: light + s * beta) for p in x]
+    assert_allclose(closed, bisected, atol=1e-9)
+    assert_allclose(on_path, bisected, atol=1e-9)
+    assert_allclose(irradiance_path, irradiance, rtol=1e-6)
+    light_then = moving_lights.retarded_light(x, camera, light, beta)
+    assert_allclose(irradiance, light_then.doppler**4 / light_then.distance**2)
+
+
+def test_retarded_times_on_a_bent_path_and_its_doppler_factor():
+    """A light at 0.3c until s = -8, 0.6c after: the retarded time by bisection, D from the piece."""
+    kink = -8.0
+
+    def position_at(s):
+        return np.array([1.5 + 0.6 * s if s >= kink else 1.5 + 0.6 * kink + 0.3 * (s - kink), 0.0, 1.0])
+
+    knots = np.array([-80.0, kink, 0.0])
+    path = np.array([position_at(s) for s in knots])
+    x = np.stack([np.linspace(-4.0, 4.0, 41), np.zeros(41), np.zeros(41)], axis=-1)
+    camera = np.array([0.0, 0.0, 5.0])
+    times, irradiance = moving_lights.retarded_times_on_path(x, camera, knots, path)
+    expected = np.array([_bisect_on_path(p, camera, position_at) for p in x])
+    assert_allclose(times, expected, atol=1e-9)
+    assert np.any(times > kink) and np.any(times < kink)
+    speed = np.where(expected >= kink, 0.6, 0.3)
+    source = np.array([position_at(s) for s in expected])
+    r = np.linalg.norm(x - source, axis=-1)
+    n_x = (x - source)[:, 0] / r
+    d = np.sqrt(1.0 - speed**2) / (1.0 - speed * n_x)
+    assert_allclose(irradiance, d**4 / r**2, rtol=1e-6)
+
+
+def test_lamp_times_span_the_lit_points_evenly():
+    times = np.array([-10.0, -8.0, -5.0, -2.0, -1.0])
+    irradiance = np.array([1e-4, 0.5, 1.0, 0.2, 0.02])  # the first gets under 1 % of the brightest
+    placed = moving_lights.lamp_times(times, irradiance, spacing=1.0, max_lamps=16)
+    assert placed[0] == -8.0 and placed[-1] == -1.0
+    assert_allclose(np.diff(placed), 1.0)
+    assert len(moving_lights.lamp_times(times, irradiance, spacing=0.01, max_lamps=5)) == 5
+    assert_allclose(moving_lights.lamp_times(times[:1], irradiance[:1], 1.0, 16), [-10.0])
+    assert_allclose(moving_lights.lamp_times(times, np.zeros(5), 1.0, 16), [0.0])  # nothing lit
+
+
+def test_path_position_is_straight_between_and_beyond_its_samples():
+    knots = np.array([-2.0, 0.0])
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.0]])
+    assert_allclose(moving_lights.path_position(np.array([-1.0, -4.0, 2.0]), knots, points),
+                    [[0.5, 1.0, 0.0], [-1.0, -2.0, 0.0], [2.0, 4.0, 0.0]])

@@ -29,6 +29,8 @@ def _signature(bpy, scene):
         "osl": scene.cycles.shading_system,
         "groups": sorted(group.name for group in bpy.data.node_groups),
         "texts": sorted(text.name for text in bpy.data.texts),
+        "objects": sorted(obj.name for obj in bpy.data.objects),
+        "light_data": sorted(light.name for light in bpy.data.lights),
         "scene_keys": sorted(compat.custom_property_keys(scene)),
     }
 
@@ -43,9 +45,17 @@ def test_apply_then_remove_restores_everything(relativity_addon, factory_blender
     effect.apply(scene)
     floor = bpy.data.materials["White"]
     assert lamp.hide_render and scene.cycles.shading_system
-    assert any(node.bl_idname == "ShaderNodeScript" for node in bpy.data.node_groups["Relativity Moving Lights"].nodes)
-    assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
-        == "ShaderNodeAddShader"
+    if method == "GEOMETRY":  # the material shader
+        assert any(node.bl_idname == "ShaderNodeScript"
+                   for node in bpy.data.node_groups["Relativity Moving Lights"].nodes)
+        assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
+            == "ShaderNodeAddShader"
+    else:  # stand-in lamps with a light shader; the materials are left alone
+        stand_ins = [obj for obj in scene.objects if obj.type == "LIGHT" and obj is not lamp]
+        assert len(stand_ins) >= 2
+        assert all(any(node.bl_idname == "ShaderNodeScript" for node in obj.data.node_tree.nodes) for obj in stand_ins)
+        assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
+            == "ShaderNodeBsdfDiffuse"
     effect.remove(scene)
     assert _signature(bpy, scene) == before
 
@@ -84,13 +94,12 @@ def test_unsupported_lights_are_reported(relativity_addon, factory_blender):
     scene, _camera, lamp = _floor_scene(bpy)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     scene.collection.objects.link(sun)
-    sun.relativity.motion = "CONSTANT"
-    sun.relativity.beta = (0.3, 0.0, 0.0)
+    sun.relativity.motion = "ANIMATION"  # a keyframed sun is not drawn moving (a constant-velocity one is)
     effect.apply(scene)
     warnings = effect.scene_warnings(scene)
     print(warnings)
     assert any("'Sun'" in warning and "at rest" in warning for warning in warnings)
-    assert any("no shadows" in warning for warning in warnings)  # the exact camera
+    assert any("stand-in lamps" in warning for warning in warnings)  # the exact camera
     assert not sun.hide_render  # rendered at rest, as the warning says
     effect.remove(scene)
 
@@ -111,3 +120,20 @@ def test_light_panel_shows_motion_and_velocity(relativity_addon, factory_blender
     lamp.data.type = "SUN"
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, lamp)
     assert any(entry[0] == "label" and "rendered at rest" in entry[1] for entry in log)
+
+
+def test_keyframed_light_with_a_constraint_is_refused_in_one_line(relativity_addon, factory_blender):
+    """Keyframes alone do not give a constrained light's path: Set Up refuses, naming the light,
+    and leaves the scene as it was."""
+    bpy = factory_blender
+    effect = _module("effect")
+    errors = importlib.import_module(f"{ADDON_MODULE}.errors")
+    scene, _camera, lamp = _floor_scene(bpy)
+    lamp.relativity.motion = "ANIMATION"
+    lamp.constraints.new("TRACK_TO")
+    before = _signature(bpy, scene)
+    with pytest.raises(errors.RelativityError) as raised:
+        effect.apply(scene)
+    print(raised.value)
+    assert "'Lamp'" in str(raised.value) and "constraints" in str(raised.value) and "\n" not in str(raised.value)
+    assert _signature(bpy, scene) == before

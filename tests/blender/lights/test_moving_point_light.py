@@ -38,6 +38,9 @@ OCCLUDER_CENTRE = np.array([-1.3, 0.4, 0.5])
 OCCLUDER_HALF = 0.2
 SPOT_SIZE = math.radians(80.0)  # full cone angle
 SPOT_BLEND = 0.3
+# Behind the exact camera moving lights are stand-in lamps on the light's path (blender/moving_lamps.py):
+# Cycles samples one of them per light sample and only two light a point, so these renders need more samples.
+SAMPLES_LAMPS = 64
 
 
 def _effect():
@@ -152,7 +155,7 @@ def _pixel_x(bpy, scene, camera, world_x):
 
 def test_floor_profile_follows_eq_19_with_retarded_positions(relativity_addon, factory_blender, tmp_path):
     bpy = factory_blender
-    scene, camera, lamp = _floor_scene(bpy)
+    scene, camera, lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
     _effect().apply(scene)
     assert lamp.hide_render  # the lamp at rest does not light the floor as well
     image = _render(bpy, scene, tmp_path / "moving.exr")
@@ -263,7 +266,7 @@ def test_moving_spot_light_cone_is_aberrated(relativity_addon, factory_blender, 
     """A spot light at 0.5c pointing down: its cone is defined in its own frame, so on the floor
     it is aberrated forward (and beamed): eq. 19 times the cone of the aberrated direction."""
     bpy = factory_blender
-    scene, camera, _lamp = _floor_scene(bpy, kind="SPOT")
+    scene, camera, _lamp = _floor_scene(bpy, kind="SPOT", samples=SAMPLES_LAMPS)
     _effect().apply(scene)
     image = _render(bpy, scene, tmp_path / "spot.exr")[..., 1]
     points = _floor_points(bpy, scene, camera)
@@ -285,7 +288,7 @@ def test_shutter_time_is_when_the_camera_receives_the_light(relativity_addon, fa
     """The exact camera at rest with shutter time t_S receives the light at t_o + t_S: the pool of
     light moves on with the lamp (here c t_S = 1.5, the lamp 0.75 further on)."""
     bpy = factory_blender
-    scene, camera, _lamp = _floor_scene(bpy)
+    scene, camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
     scene.relativity.shutter_time = 0.15
     _effect().apply(scene)
     image = _render(bpy, scene, tmp_path / "later.exr")[..., 1]

@@ -1,0 +1,294 @@
+"""Moving lights behind Cycles' OSL camera, with shadows: stand-in point lamps on the light's path.
+
+A material's OSL ``trace()`` crashes Cycles behind an OSL camera (docs/moving-lights.md), so the
+material shader of ``moving_lights.py`` cannot cast shadows there. Here Cycles' own lamps do:
+each moving light gets a few point lamps (radius 0) on its straight path, spread over the
+retarded positions that the surfaces near the camera see, and Cycles traces their shadow rays.
+Each lamp's light shader (``shaders/relativistic_moving_lamp.osl``) computes, for the receiving
+point, the light's exact retarded position and gives the two lamps around it linear weights and
+the strength ``w D^4 (t / r)^3``: a diffuse surface then gets eq. 19's ``D^4 I cos / r^2`` exactly,
+and its shadow is the weighted blend of the two lamps' shadows.
+
+The lamps are placed from ``scene.ray_cast`` over the camera's view (a grid of its rays, 5 %
+wider, from its reception event): the hit points that get at least 1 % of the brightest one's irradiance set the
+span of retarded times (``physics.moving_lights.lamp_times``). Everything made here (objects,
+lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the scene and deleted by
+:func:`remove`; the user's light is hidden by ``moving_lights.py``.
+"""
+
+import math
+import os
+import warnings
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+from ..errors import RelativityError
+from ..physics.lorentz import aberrate, camera_to_scene_direction
+from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
+from . import animation, names
+
+SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LAMP_SHADER_TEXT)
+MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
+SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
+
+
+def _shader_text():
+    with open(SHADER_PATH, encoding="utf-8") as handle:
+        source = handle.read()
+    text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT) or bpy.data.texts.new(names.MOVING_LAMP_SHADER_TEXT)
+    if text.as_string().rstrip("\n") != source.rstrip("\n"):
+        text.clear()
+        text.write(source)
+    return text
+
+
+def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
+    """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
+    camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame)."""
+    camera = scene.objects[snap.camera]
+    corners = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])  # local, z < 0
+    depth = -corners[0, 2]
+    left, right = corners[:, 0].min() / depth, corners[:, 0].max() / depth
+    bottom, top = corners[:, 1].min() / depth, corners[:, 1].max() / depth
+    widen_x, widen_y = margin * (right - left), margin * (top - bottom)
+    x = np.linspace(left - widen_x, right + widen_x, columns)
+    y = np.linspace(bottom - widen_y, top + widen_y, rows)
+    local = np.stack(np.broadcast_arrays(x[None, :], y[:, None], -1.0), axis=-1).reshape(-1, 3)
+    world = local @ np.array(snap.camera_matrix)[:3, :3].T
+    world /= np.linalg.norm(world, axis=-1, keepdims=True)
+    if snap.exact_camera and snap.use_geometry and any(snap.beta):
+        world = camera_to_scene_direction(world, snap.beta)
+    return world
+
+
+def visible_points(scene, snap, depsgraph, origin):
+    """Surface points the camera sees (the first hit of each ray of :func:`view_directions`)."""
+    if depsgraph is None:
+        try:
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        except (AttributeError, RuntimeError):
+            return np.zeros((0, 3))
+    points = []
+    for direction in view_directions(scene, snap):
+        hit, location, *_rest = scene.ray_cast(depsgraph, origin, tuple(float(v) for v in direction))
+        if hit:
+            points.append(tuple(location))
+    return np.array(points, float).reshape(-1, 3)
+
+
+def _spacing(times, irradiance, speed):
+    """Wanted ``c t`` between lamps: SPACING of the median distance of the lit points, over the speed."""
+    lit = np.isfinite(irradiance) & (irradiance >= 0.01 * np.nanmax(irradiance))
+    distance = float(np.median(1.0 / np.sqrt(irradiance[lit])))  # ~ r (D^4 ~ 1 for a typical point)
+    return SPACING * distance / max(speed, 1e-9)
+
+
+def _keyframe_path(obj, snap, reception_time, times):
+    """The animated light's world positions at the times ``c (t - t_reception)`` (keyframes)."""
+    frames = snap.frame + (reception_time + np.asarray(times, float)) / snap.speed_of_light * snap.fps
+    return animation.world_matrices(obj, frames)[:, :3, 3]
+
+
+def lamp_path(scene, snap, light, values, reception_time, points):
+    """Where the stand-in lamps go: their times ``c (t - t_reception)`` on the light's path (ascending)
+    and positions, for these surface points (the lit ones' retarded times; at least one lamp)."""
+    camera_position = values["camera_position"]
+    if light.motion != "ANIMATION":
+        origin, beta = np.array(values["light_position"], float), np.array(light.beta, float)
+        speed = float(np.linalg.norm(beta))
+        if len(points) == 0 or speed == 0.0:
+            return np.zeros(1), origin[None, :]
+        times, irradiance = retarded_times(points, camera_position, origin, beta)
+        times = lamp_times(times, irradiance, _spacing(times, irradiance, speed), MAX_LAMPS)
+        return times, origin + times[:, None] * beta
+    obj = scene.objects[light.name]  # its keyframes were checked by snapshot.moving_lights
+    here = _keyframe_path(obj, snap, reception_time, [0.0])[0]
+    if len(points) == 0:
+        return np.zeros(1), here[None, :]
+    reach = float(np.max(np.linalg.norm(points - camera_position, axis=-1) + np.linalg.norm(points - here, axis=-1)))
+    knots = np.linspace(-4.0 * reach, 0.0, 257)
+    path = _keyframe_path(obj, snap, reception_time, knots)
+    speed = float(np.max(np.linalg.norm(np.diff(path, axis=0), axis=-1)) / (knots[1] - knots[0]))
+    if speed >= 1.0:
+        raise RelativityError(f"light {light.name!r} moves at {speed:.3f}c on its keyframes (must be below c)")
+    if speed == 0.0:
+        return np.zeros(1), here[None, :]
+    knots = np.linspace(-reach * 2.0 / (1.0 - speed), 0.0, 513)
+    times, irradiance = retarded_times_on_path(points, camera_position, knots,
+                                               _keyframe_path(obj, snap, reception_time, knots))
+    times = lamp_times(times, irradiance, _spacing(times, irradiance, speed), MAX_LAMPS)
+    return times, _keyframe_path(obj, snap, reception_time, times)
+
+
+# --- the stand-in lamps ---------------------------------------------------------------------
+
+
+def _new_lamp(scene, name, text, kind="POINT"):
+    light = bpy.data.lights.new(name, kind)
+    if kind == "SUN":  # direction, strength and angle are written by _write_sun; no shader
+        obj = bpy.data.objects.new(name, light)
+        obj.rotation_mode = "QUATERNION"
+        scene.collection.objects.link(obj)
+        return obj
+    light.energy = 4.0 * math.pi  # 1 W/sr: the shader's Emission carries the intensity
+    light.color = (1.0, 1.0, 1.0)
+    light.shadow_soft_size = 0.0
+    with warnings.catch_warnings():  # 5.x: use_nodes is deprecated (always on)
+        warnings.simplefilter("ignore", DeprecationWarning)
+        light.use_nodes = True
+    tree = light.node_tree
+    tree.nodes.clear()
+    node = tree.nodes.new("ShaderNodeScript")
+    node.name = node.label = names.MOVING_LAMP_PREFIX
+    node.mode = "INTERNAL"
+    node.script = text
+    if "Emission" not in node.outputs or "lamp_time" not in node.inputs:
+        bpy.data.lights.remove(light)
+        raise RelativityError("the moving-lamp OSL shader did not compile (no sockets on its script node)")
+    output = tree.nodes.new("ShaderNodeOutputLight")
+    output.location = (300.0, 0.0)
+    tree.links.new(node.outputs["Emission"], output.inputs["Surface"])
+    obj = bpy.data.objects.new(name, light)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def _delete(name):
+    obj = bpy.data.objects.get(name)
+    if obj is None:
+        return
+    light = obj.data
+    bpy.data.objects.remove(obj)
+    if light is not None and light.users == 0:
+        bpy.data.lights.remove(light)
+
+
+def _same(a, b):
+    return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-9)
+
+
+def _set(owner, key, value):
+    """Write only a changed value (a write triggers a depsgraph update, whose handler syncs)."""
+    current = getattr(owner, key)
+    if isinstance(value, tuple):
+        value = value + tuple(current)[len(value):]
+        if all(_same(a, b) for a, b in zip(current, value, strict=True)):
+            return
+    elif _same(current, value):
+        return
+    setattr(owner, key, value)
+
+
+def _record(scene):
+    stored = scene.get(names.MOVING_LAMPS_KEY)
+    return {} if stored is None else {key: list(value) for key, value in stored.to_dict().items()}
+
+
+def _lamps_for(scene, light_name, count, text, kind="POINT"):
+    record = _record(scene)
+    existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
+    if len(existing) != count or any(bpy.data.objects[name].data.type != kind for name in existing):
+        for name in existing:
+            _delete(name)
+        existing = [_new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
+                    for index in range(count)]
+        record[light_name] = existing
+        scene[names.MOVING_LAMPS_KEY] = record
+    return [bpy.data.objects[name] for name in existing]
+
+
+def _stored_times(scene, light_name):
+    """The stand-ins' times of the last placement (their shaders' inputs), or None."""
+    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
+    if not objects or any(obj is None or obj.data.type != "POINT" for obj in objects):
+        return None
+    return np.array([obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["lamp_time"].default_value
+                     for obj in objects], float)
+
+
+def _positions(scene, snap, light, values, reception_time, times):
+    """The light's positions at the times ``c (t - t_reception)``."""
+    if light.motion == "ANIMATION":
+        return _keyframe_path(scene.objects[light.name], snap, reception_time, times)
+    return np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
+
+
+def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
+    """Place and set the stand-in lamps of ``lights`` (``parameters(light)``: the material
+    shader's inputs, ``moving_lights.shader_parameters``; ``reception_time`` ``c (t_reception -
+    t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
+    is given or none exist yet; without one, the last placement's times are kept and the lamps move
+    along the path to them."""
+    text = _shader_text()
+    record = _record(scene)
+    for stale in set(record) - {light.name for light in lights}:
+        for name in record.pop(stale):
+            _delete(name)
+        scene[names.MOVING_LAMPS_KEY] = record
+    points = None
+    for light in lights:
+        if light.kind == "SUN":
+            _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
+            continue
+        values = parameters(light)
+        times = None if depsgraph is not None else _stored_times(scene, light.name)
+        if times is None:  # place them (the camera's view is ray-cast)
+            if points is None:
+                points = visible_points(scene, snap, depsgraph, values["camera_position"])
+            times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+        else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
+            positions = _positions(scene, snap, light, values, reception_time, times)
+        last = len(times) - 1
+        for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
+            before, after = max(index - 1, 0), min(index + 1, last)
+            inputs = {key: values[key] for key in ("camera_position", "intensity", "light_beta", "spot_axis",
+                                                    "spot_cos_half_angle", "spot_smooth")}
+            inputs["lambert"] = int(values["lambert"])
+            inputs.update(lamp_time=float(times[index]), previous_time=float(times[before]),
+                          previous_position=tuple(positions[before]), next_time=float(times[after]),
+                          next_position=tuple(positions[after]))
+            _set(obj, "location", tuple(float(v) for v in positions[index]))
+            node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
+            for key, value in inputs.items():
+                _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
+
+
+def sun_in_scene_frame(axis, beta):
+    """A sun (plane wave) moving with ``beta``: the photon direction in the scene frame (its own
+    frame's ``axis`` aberrated) and ``D = 1 / (gamma (1 - beta . k))``; the irradiance on a surface
+    facing it scales by ``D^2`` (radiance ``D^4`` times the disc's solid angle ``1 / D^2``) and its
+    angular diameter by ``1 / D``."""
+    beta = np.array(beta, float)
+    k = aberrate(np.array(axis, float), -beta)
+    gamma = 1.0 / math.sqrt(1.0 - float(beta @ beta))
+    return k, 1.0 / (gamma * (1.0 - float(beta @ k)))
+
+
+def _write_sun(scene, light, obj):
+    """The stand-in sun: the user's sun aberrated, ``D^2`` its strength, ``1 / D`` its angle."""
+    user = scene.objects[light.name].data
+    direction, doppler = sun_in_scene_frame(light.axis, light.beta)
+    stand_in = obj.data
+    _set(stand_in, "energy", float(user.energy) * doppler * doppler)
+    _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
+    _set(stand_in, "color", tuple(user.color))
+    for key in ("use_shadow", "use_temperature", "temperature"):
+        if hasattr(user, key) and getattr(stand_in, key) != getattr(user, key):
+            setattr(stand_in, key, getattr(user, key))
+    rotation = Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y")
+    _set(obj, "rotation_quaternion", tuple(rotation))
+
+
+def remove(scene):
+    """Delete every stand-in lamp and the shader text."""
+    for names_of_light in _record(scene).values():
+        for name in names_of_light:
+            _delete(name)
+    if names.MOVING_LAMPS_KEY in scene:
+        del scene[names.MOVING_LAMPS_KEY]
+    if not any(names.MOVING_LAMPS_KEY in other for other in bpy.data.scenes):
+        text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT)
+        if text is not None:
+            bpy.data.texts.remove(text)

@@ -1,0 +1,101 @@
+"""Moving sun and area lights behind the exact camera (blender/moving_lamps.py), on the floor of
+test_moving_point_light.py, against relations written out here in numpy (docs/physics.md):
+
+- A sun is a plane wave: moving with beta, its photon direction in the scene frame is its own
+  frame's direction aberrated (k = aberrate(k', -beta)) and the irradiance on a surface facing it
+  is D^2 times its strength (radiance D^4 times the disc's solid angle 1 / D^2),
+  D = 1 / (gamma (1 - beta . k)). Shadows fall along k.
+- An area light is drawn as its centre: a point source with intensity (P / pi) cos(theta') in its
+  own frame (a Lambertian emitter of power P), theta' the angle between its axis and the photon
+  direction aberrated into its frame, with eq. 19 from retarded positions. At rest it is compared
+  with Blender's own area light (the error of the centre-point approximation).
+"""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import test_moving_point_light as floor  # noqa: E402
+
+ch = floor.ch
+SUN_STRENGTH = 3.0  # W/m^2
+SUN_BETA = np.array([0.5, 0.0, 0.0])
+
+
+def test_moving_sun_is_aberrated_and_d_squared_brighter(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene, camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, occluder=True, kind="SUN")
+    sun.data.energy = SUN_STRENGTH
+    sun.data.angle = 0.0  # hard shadows
+    floor._effect().apply(scene)  # the sun points down its local -Z: straight down
+    assert sun.hide_render
+    image = floor._render(bpy, scene, tmp_path / "sun.exr")[..., 1]
+    points = floor._floor_points(bpy, scene, camera)
+    k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)  # photon direction, scene frame
+    d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
+    lit = floor.ALBEDO / math.pi * d * d * SUN_STRENGTH * (-k[2])
+    shadow = floor._blocked(points - 10.0 * k, points)
+    at_rest_shadow = floor._blocked(points + 10.0 * np.array([0.0, 0.0, 1.0]), points)
+    seen = floor._blocked(np.broadcast_to(floor.CAMERA, points.shape), points)
+    edge = np.zeros_like(shadow)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            edge |= np.roll(np.roll(shadow, dy, 0), dx, 1) != shadow
+    judged = ~seen & ~edge
+    brightness = image[judged & ~shadow].mean() / lit
+    wrong = ((image < 0.5 * lit) != shadow) & judged
+    print(f"sun at 0.5c: k = {np.round(k, 4)}, D = {d:.4f}; floor {brightness:.4f} of D^2 E cos / pi "
+          f"(at rest: {1.0 / (d * d * -k[2]):.4f}); shadow {shadow.sum()} px, {wrong.sum()} judged px wrong; "
+          f"an unaberrated shadow shares {(shadow & at_rest_shadow).sum()} px")
+    assert brightness == pytest.approx(1.0, abs=0.01)
+    assert wrong.sum() <= 0.02 * shadow.sum()
+    assert (shadow & at_rest_shadow).sum() < 0.7 * shadow.sum()
+
+
+def _area_scene(bpy, beta, size, samples=floor.SAMPLES_LAMPS):
+    scene, camera, lamp = floor._floor_scene(bpy, beta=beta, kind="AREA", samples=samples)
+    lamp.data.size = size
+    return scene, camera, lamp
+
+
+@pytest.mark.parametrize("size", [0.2, 1.0])
+def test_area_light_at_rest_against_blenders_own(relativity_addon, factory_blender, tmp_path, size):
+    """beta = 0: the centre-point approximation against Blender's area light (pointing down)."""
+    bpy = factory_blender
+    scene, _camera, lamp = _area_scene(bpy, (0.0, 0.0, 0.0), size, samples=16)  # one stand-in lamp
+    floor._effect().apply(scene)
+    assert lamp.hide_render
+    ours = floor._render(bpy, scene, tmp_path / "ours.exr")[..., 1]
+    floor._effect().remove(scene)
+    lamp.relativity.motion = "STATIC"
+    blender = floor._render(bpy, scene, tmp_path / "blender.exr")[..., 1]
+    lit = blender > 0.1 * blender.max()
+    ratio = ours[lit].mean() / blender[lit].mean()
+    largest = np.abs(ours - blender)[lit].max() / blender.max()
+    print(f"area light {size} m at 1 m: centre point / Blender's area light over {lit.sum()} px: mean {ratio:.4f}, "
+          f"largest difference {largest:.4f} of the peak")
+    assert ratio == pytest.approx(1.0, abs=0.02 if size < 0.5 else 0.06)
+    assert largest < (0.05 if size < 0.5 else 0.4)  # a 1 m panel 1 m above the floor is no point
+
+
+def test_moving_area_light_follows_eq_19_with_its_cosine(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene, camera, _lamp = _area_scene(bpy, floor.BETA, 0.2)
+    floor._effect().apply(scene)
+    image = floor._render(bpy, scene, tmp_path / "area.exr")[..., 1]
+    points = floor._floor_points(bpy, scene, camera)
+    radiance, source, _ = floor._expected_radiance(points, floor.BETA)  # isotropic P / (4 pi)
+    n = (points - source) / np.linalg.norm(points - source, axis=-1, keepdims=True)
+    cos_own = np.array([ch.aberrate(v, floor.BETA)[2] * -1.0 for v in n.reshape(-1, 3)]).reshape(n.shape[:-1])
+    expected = radiance * 4.0 * np.maximum(cos_own, 0.0)  # (P / pi) cos(theta') instead of P / (4 pi)
+    isotropic_cosine = radiance * 4.0 * np.maximum(-n[..., 2], 0.0)  # the cosine not aberrated
+    measured, profile = image[floor.ROWS].mean(0), expected[floor.ROWS].mean(0)
+    error = np.abs(measured - profile).max() / profile.max()
+    unaberrated = np.abs(isotropic_cosine[floor.ROWS].mean(0) - profile).max() / profile.max()
+    print(f"area light at 0.5c: max error {error:.4f} of the peak (its cosine unaberrated: {unaberrated:.3f})")
+    assert error < 0.05
+    assert unaberrated > 3.0 * error
