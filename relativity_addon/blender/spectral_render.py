@@ -73,7 +73,7 @@ class _Saved:
         render = scene.render
         settings = render.image_settings
         self.scene = scene
-        self.render = {key: getattr(render, key) for key in ("filepath", "use_file_extension")}
+        self.render = {key: getattr(render, key) for key in ("filepath", "use_file_extension", "use_persistent_data")}
         self.image = {key: getattr(settings, key) for key in ("file_format", "color_depth", "color_mode")}
         self.lights = {light.name: (tuple(light.color), light.use_temperature) for light in _scene_lights(scene)}
 
@@ -141,6 +141,7 @@ def render(scene, passes, progress=None):
             d_min, d_max = float(np.exp(log_doppler.min())), float(np.exp(log_doppler.max()))
             wavelengths = spectral_render.sample_wavelengths(d_min, d_max, passes)
             compositing.set_stage_mode("PASS_THROUGH")
+            scene.render.use_persistent_data = True  # the passes differ in colours only: keep the scene's BVH
             samples = []
             for index in range(passes):
                 trio = spectral_render.pass_wavelengths(wavelengths, index)
