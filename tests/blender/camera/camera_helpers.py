@@ -250,6 +250,28 @@ def read_exr(bpy, path):
     return read_image(bpy, path)[:, :, :3].astype(float)
 
 
+def render_exr(bpy, scene, path):
+    """F12 in this process into a 32-bit EXR at ``path``; its linear RGB, top row first."""
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    bpy.ops.render.render(write_still=True)
+    return read_exr(bpy, path)
+
+
+def diffuse_material(bpy, name, colour):
+    """A Diffuse BSDF material of linear RGB ``colour``."""
+    material = bpy.data.materials.new(name)
+    tree = compat.material_node_tree(material)
+    tree.nodes.clear()
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (*colour, 1.0)
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(diffuse.outputs[0], output.inputs["Surface"])
+    return material
+
+
 def render_image(bpy, blend, out, *options):
     run_render_script(blend, out, *options)
     return read_exr(bpy, out)

@@ -46,12 +46,7 @@ def _note_exposure(path):
 
 
 def _render(bpy, scene, path):
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.ops.render.render(write_still=True)
-    return ch.read_exr(bpy, path)
+    return ch.render_exr(bpy, scene, path)
 
 
 def test_compensation_scales_the_frame_by_one_factor(relativity_addon, tmp_path):

@@ -59,12 +59,7 @@ def add_emitter_plane(bpy, scene, name, x_range, y_range, colour=(0.5, 0.5, 0.5)
 
 
 def render(bpy, scene, path):
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.ops.render.render(write_still=True)
-    return ch.read_exr(bpy, path)
+    return ch.render_exr(bpy, scene, path)
 
 
 def pixel_photon_directions(bpy, scene, camera):

@@ -23,13 +23,7 @@ def _pool_scene(bpy):
     scene.cycles.max_bounces = 0  # direct light only: the pool itself
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=64, y_subdivisions=64, size=16.0, location=(0.0, 0.0, -6.0))
     wall = bpy.context.active_object
-    material = bpy.data.materials.new("White")
-    tree = ch.compat.material_node_tree(material)
-    tree.nodes.clear()
-    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(bsdf.outputs[0], output.inputs["Surface"])
-    wall.data.materials.append(material)
+    wall.data.materials.append(ch.diffuse_material(bpy, "White", (0.8, 0.8, 0.8)))
     light = bpy.data.lights.new("Lamp", "POINT")
     light.energy = 300.0
     light.shadow_soft_size = 0.0

@@ -75,14 +75,7 @@ def _pixel_doppler(bpy, scene, camera, beta):
 
 
 def _diffuse(bpy, name, colour):
-    material = bpy.data.materials.new(name)
-    tree = ch.compat.material_node_tree(material)
-    tree.nodes.clear()
-    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*colour, 1.0)
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(bsdf.outputs[0], output.inputs["Surface"])
-    return material
+    return ch.diffuse_material(bpy, name, colour)
 
 
 def _quad(bpy, scene, name, corners, material):

@@ -94,12 +94,7 @@ def _scene(bpy, beta=BETA, samples=16, temperature=None):
 
 
 def _render(bpy, scene, path):
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.ops.render.render(write_still=True)
-    return ch.read_exr(bpy, path)
+    return ch.render_exr(bpy, scene, path)
 
 
 def _edge(image):
