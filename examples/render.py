@@ -20,7 +20,6 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from relativity_addon import batch  # noqa: E402
-from relativity_addon.blender import compat  # noqa: E402
 
 if __name__ == "__main__":
-    compat.run_main(batch.main)
+    batch.command_line()

@@ -103,6 +103,18 @@ def build_parser(with_blend_file):
     parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
                         help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
                         "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
+    parser.add_argument("--threads", type=_positive_int, help="Cycles render threads (default: all cores)")
+    parser.add_argument("--resume", action=argparse.BooleanOptionalAction,
+                        help="skip frames whose output exists and reads back as a complete image "
+                        "(default: on with --workers/--scheduler, off otherwise)")
+    cluster = parser.add_argument_group("distributed rendering (Dask; docs/farm.md)")
+    where = cluster.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_positive_int,
+                       help="render on a local Dask cluster of N worker processes, one frame task each")
+    where.add_argument("--scheduler", metavar="ADDRESS", help="render on a running Dask cluster, e.g. tcp://HOST:8786")
+    cluster.add_argument("--chunk", type=_positive_int, default=1, help="frames per task (default 1)")
+    cluster.add_argument("--retries", type=int, default=2,
+                         help="times a task whose worker or Blender process died is run again (default 2)")
     return parser
 
 
@@ -239,6 +251,14 @@ def _render_spectral(scene, path, passes):
     spectral_render.store_image(pixels).save_render(path, scene=scene)
 
 
+def partial_path(path):
+    """Where a frame is written before it is complete; renamed to ``path`` when it is. A hidden name
+    in the same folder (the rename is atomic), unique per process."""
+    directory, name = os.path.split(path)
+    stem, extension = os.path.splitext(name)
+    return os.path.join(directory, f".{stem}.{os.getpid()}.partial{extension}")
+
+
 def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
     if (scene.frame_current, scene.frame_subframe) != (frame, 0.0):
         # Not for the first frame, which applying the effect computed: setting it again would only
@@ -251,22 +271,35 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
         errors = geometry.scene_errors(scene)
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
-    scene.render.filepath = path
     if os.path.exists(path):
         os.remove(path)
+    partial = partial_path(path)
+    scene.render.filepath = partial
     try:
-        if spectral_passes:
-            _render_spectral(scene, path, spectral_passes)
-        else:
-            bpy.ops.render.render(write_still=True)
-    except RuntimeError as error:
-        raise BatchError(f"render of frame {frame} failed: {str(error).strip().splitlines()[-1]}") from None
-    if relativistic and scene.relativity.method == "CAMERA":
-        cam = scene.camera.data
-        if not cam.cycles_custom.get("settings_valid", False):
-            raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
-    if not os.path.isfile(path):
-        raise BatchError(f"render wrote no file at {path}")
+        try:
+            if spectral_passes:
+                _render_spectral(scene, partial, spectral_passes)
+            else:
+                bpy.ops.render.render(write_still=True)
+        except RuntimeError as error:
+            raise BatchError(f"render of frame {frame} failed: {str(error).strip().splitlines()[-1]}") from None
+        if relativistic and scene.relativity.method == "CAMERA":
+            cam = scene.camera.data
+            if not cam.cycles_custom.get("settings_valid", False):
+                raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
+        if not os.path.isfile(partial):
+            raise BatchError(f"render wrote no file at {path}")
+        os.replace(partial, path)
+    finally:
+        if os.path.exists(partial):
+            os.remove(partial)
+
+
+def parse(argv):
+    """(options, parser) for the command line ``argv`` (either invocation form)."""
+    arguments, with_blend_file = _split_argv(argv)
+    parser = build_parser(with_blend_file)
+    return parser.parse_args(arguments), parser
 
 
 def run(argv, log=print):
@@ -274,8 +307,8 @@ def run(argv, log=print):
 
     import bpy
 
-    arguments, with_blend_file = _split_argv(argv)
-    options = build_parser(with_blend_file).parse_args(arguments)
+    options, _ = parse(argv)
+    with_blend_file = not _running_inside_blender(argv)
     out_path = os.path.abspath(options.out)
 
     if with_blend_file:
@@ -299,6 +332,9 @@ def run(argv, log=print):
     if options.resolution is not None:
         scene.render.resolution_x, scene.render.resolution_y = options.resolution
         scene.render.resolution_percentage = 100
+    if options.threads is not None:
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = options.threads
     _output_format(scene, out_path)
 
     relativistic = not options.reference
@@ -319,6 +355,14 @@ def run(argv, log=print):
     several = len(frames) > 1
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
+    if options.resume:
+        from . import image_files
+
+        complete = [path for path in paths if image_files.is_complete(path)]
+        if complete:
+            log(f"render.py: --resume: {len(complete)} of {len(paths)} frames already complete, skipped", flush=True)
+        frames = [frame for frame, path in zip(frames, paths, strict=True) if path not in complete]
+        paths = [path for path in paths if path not in complete]
     started = time.monotonic()
     for done, (frame, path) in enumerate(zip(frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
@@ -333,9 +377,32 @@ def run(argv, log=print):
     return paths
 
 
+def command_line():
+    """The entry point of ``examples/render.py``. A distributed render's coordinator never imports
+    bpy (its worker processes, which start by importing the main script, neither)."""
+    try:
+        options, _ = parse(sys.argv)
+        distributed = options.workers is not None or options.scheduler is not None
+    except BatchError:
+        distributed = False
+    if distributed and not _running_inside_blender(sys.argv):
+        sys.exit(main())
+    from .blender import compat
+
+    compat.run_main(main)
+
+
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
+        options, parser = parse(argv)
+        if options.workers is not None or options.scheduler is not None:
+            if _running_inside_blender(argv):
+                raise BatchError("--workers and --scheduler need the bpy wheel form: "
+                                 "python examples/render.py FILE.blend ...")
+            from . import farm  # Dask is imported only here
+
+            return farm.render(options, parser)
         paths = run(argv)
     except BatchError as error:
         print(f"render.py: error: {error}", file=sys.stderr)
