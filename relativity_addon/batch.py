@@ -10,14 +10,11 @@ import math
 import os
 import sys
 
-from .errors import RelativityError
+from .errors import BatchError, RelativityError
+from .frame_files import format_seconds, frame_output_path, partial_path
 from .physics.shutter import ShutterModel
 
 ADDON_PACKAGE = "relativity_addon"
-
-
-class BatchError(Exception):
-    """A one-line reason why the batch render cannot proceed."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -207,24 +204,6 @@ def _output_format(scene, out_path):
     scene.render.use_file_extension = False
 
 
-def frame_output_path(out_path, frame, several):
-    """The file for ``frame``: a run of '#' becomes the zero-padded frame number; otherwise,
-    when several frames are rendered, ``_NNNN`` is inserted before the extension."""
-    import re
-
-    directory, name = os.path.split(out_path)
-    run = re.search(r"#+", name)
-    if run:
-        width = len(run.group(0))
-        number = f"-{abs(frame):0{max(width - 1, 1)}d}" if frame < 0 else f"{frame:0{width}d}"
-        return os.path.join(directory, name[:run.start()] + number + name[run.end():])
-    if not several:
-        return out_path
-    stem, extension = os.path.splitext(name)
-    number = f"-{abs(frame):03d}" if frame < 0 else f"{frame:04d}"
-    return os.path.join(directory, f"{stem}_{number}{extension}")
-
-
 def _frames(scene, options):
     if options.frames is not None:
         first, last = options.frames
@@ -234,14 +213,6 @@ def _frames(scene, options):
     return [scene.frame_current]
 
 
-def _format_seconds(seconds):
-    if seconds < 60.0:
-        return f"{seconds:.1f} s"
-    minutes, seconds = divmod(int(round(seconds)), 60)
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
-
-
 def _render_spectral(scene, path, passes):
     spectral_render = addon_module("spectral_render")
     try:
@@ -249,14 +220,6 @@ def _render_spectral(scene, path, passes):
     except spectral_render.RelativityError as error:
         raise BatchError(str(error)) from None
     spectral_render.store_image(pixels).save_render(path, scene=scene)
-
-
-def partial_path(path):
-    """Where a frame is written before it is complete; renamed to ``path`` when it is. A hidden name
-    in the same folder (the rename is atomic), unique per process."""
-    directory, name = os.path.split(path)
-    stem, extension = os.path.splitext(name)
-    return os.path.join(directory, f".{stem}.{os.getpid()}.partial{extension}")
 
 
 def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
@@ -356,9 +319,9 @@ def run(argv, log=print):
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
     if options.resume:
-        from . import image_files
+        from . import frame_files
 
-        complete = [path for path in paths if image_files.is_complete(path)]
+        complete = [path for path in paths if frame_files.is_complete(path)]
         if complete:
             log(f"render.py: --resume: {len(complete)} of {len(paths)} frames already complete, skipped", flush=True)
         frames = [frame for frame, path in zip(frames, paths, strict=True) if path not in complete]
@@ -370,8 +333,8 @@ def run(argv, log=print):
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(
-            f"render.py: frame {frame} ({done}/{len(frames)}) in {_format_seconds(now - frame_started)}, "
-            f"about {_format_seconds(left)} left: {path}",
+            f"render.py: frame {frame} ({done}/{len(frames)}) in {format_seconds(now - frame_started)}, "
+            f"about {format_seconds(left)} left: {path}",
             flush=True,
         )
     return paths

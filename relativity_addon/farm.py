@@ -18,7 +18,8 @@ import os
 import sys
 import time
 
-from . import batch, image_files
+from . import frame_files
+from .errors import BatchError
 
 # Options of the coordinator, not passed on to the per-task batch script.
 COORDINATOR_OPTIONS = {"help", "blend_file", "out", "frame", "frames", "workers", "scheduler", "chunk", "resume",
@@ -136,7 +137,7 @@ def _frames(options):
         return list(range(first, last + 1))
     if options.frame is not None:
         return [options.frame]
-    raise batch.BatchError("--workers and --scheduler need --frames A-B or --frame N")
+    raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
 def _connect(options, log):
@@ -145,14 +146,14 @@ def _connect(options, log):
         import dask
         from distributed import Client, LocalCluster
     except ImportError:
-        raise batch.BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
+        raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
 
     if options.scheduler is not None:
         try:
             client = Client(options.scheduler, timeout="20s")
         except (OSError, TimeoutError) as error:
-            raise batch.BatchError(f"cannot reach the Dask scheduler at {options.scheduler}: {error}") from None
+            raise BatchError(f"cannot reach the Dask scheduler at {options.scheduler}: {error}") from None
         services = client.scheduler_info().get("services", {})
         workers = len(client.scheduler_info().get("workers", {}))
         log(f"render.py: Dask scheduler {options.scheduler}, {workers} worker(s)", flush=True)
@@ -183,7 +184,7 @@ class _Job:
 
     def finished(self, frames, reason, seconds, worker):
         for frame in frames:
-            problem = image_files.problem(self.paths[frame])
+            problem = frame_files.problem(self.paths[frame])
             if reason is None and problem is None:
                 self.rendered.append(frame)
             else:
@@ -193,14 +194,14 @@ class _Job:
         elapsed = time.monotonic() - self.started
         left = elapsed / done * (todo - done) if done else 0.0
         status = "failed" if any(frame in self.failed for frame in frames) else "done"
-        where = f" in {batch._format_seconds(seconds)} on {worker}" if worker else ""
+        where = f" in {frame_files.format_seconds(seconds)} on {worker}" if worker else ""
         self.log(f"render.py: {_label(frames)} {status}{where} ({done}/{todo}; {len(self.failed)} failed), "
-                 f"about {batch._format_seconds(left)} left", flush=True)
+                 f"about {frame_files.format_seconds(left)} left", flush=True)
 
     def summary(self, error_log):
         elapsed = time.monotonic() - self.started
         self.log(f"render.py: {self.total} frames: {len(self.rendered)} rendered, {self.skipped} skipped "
-                 f"(already complete), {len(self.failed)} failed, in {batch._format_seconds(elapsed)}", flush=True)
+                 f"(already complete), {len(self.failed)} failed, in {frame_files.format_seconds(elapsed)}", flush=True)
         reasons = {}
         for frame in sorted(self.failed):
             reasons.setdefault(self.failed[frame], []).append(frame)
@@ -214,19 +215,19 @@ def render(options, parser, log=print, error_log=None):
     error_log = error_log or (lambda line: print(line, file=sys.stderr, flush=True))
     blend = os.path.abspath(options.blend_file)
     if not os.path.isfile(blend):
-        raise batch.BatchError(f"no such .blend file: {options.blend_file}")
+        raise BatchError(f"no such .blend file: {options.blend_file}")
     if options.retries < 0:
-        raise batch.BatchError("--retries must be 0 or more")
+        raise BatchError("--retries must be 0 or more")
     frames = _frames(options)
     out = os.path.abspath(options.out)
     if os.path.splitext(out)[1].lower() not in (".png", ".exr"):
-        raise batch.BatchError(f"--out must end in .png or .exr, got {options.out!r}")
+        raise BatchError(f"--out must end in .png or .exr, got {options.out!r}")
     pattern = output_pattern(out, len(frames) > 1)
-    paths = {frame: batch.frame_output_path(pattern, frame, several=False) for frame in frames}
+    paths = {frame: frame_files.frame_output_path(pattern, frame, several=False) for frame in frames}
     os.makedirs(os.path.dirname(out), exist_ok=True)
     remove_partials(paths.values())
     resume = options.resume is not False
-    skipped = [frame for frame in frames if resume and image_files.is_complete(paths[frame])]
+    skipped = [frame for frame in frames if resume and frame_files.is_complete(paths[frame])]
     todo = [frame for frame in frames if frame not in skipped]
     if skipped:
         log(f"render.py: resume: {len(skipped)} of {len(frames)} frames already complete, skipped", flush=True)

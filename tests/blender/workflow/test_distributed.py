@@ -15,7 +15,7 @@ import psutil
 import pytest
 
 import workflow_helpers as wh
-from relativity_addon import batch, farm, image_files
+from relativity_addon import batch, farm, frame_files
 
 TINY = ("--resolution=32x32",)
 
@@ -67,7 +67,7 @@ def test_four_frames_on_two_workers_equal_one_process_and_resume(moving_blend, t
     assert result.returncode == 0, result.stderr[-3000:]
     images = {}
     for name in names:
-        assert image_files.problem(cluster.parent / name) is None
+        assert frame_files.problem(cluster.parent / name) is None
         images[name] = wh.read_image(bpy, cluster.parent / name)
         np.testing.assert_array_equal(images[name], wh.read_image(bpy, single.parent / name), err_msg=name)
     assert not np.array_equal(images[names[0]], images[names[3]])  # the frames differ
@@ -78,7 +78,7 @@ def test_four_frames_on_two_workers_equal_one_process_and_resume(moving_blend, t
     data = (cluster.parent / names[0]).read_bytes()
     for damaged in (data[:-1], data[: len(data) // 2], data[:500] + bytes([data[500] ^ 0xFF]) + data[501:]):
         (tmp_path / "damaged.png").write_bytes(damaged)
-        assert image_files.problem(tmp_path / "damaged.png") is not None
+        assert frame_files.problem(tmp_path / "damaged.png") is not None
 
     # Resume: delete frame 2, corrupt frame 3 (a flipped byte); the rerun renders exactly those two.
     (cluster.parent / names[1]).unlink()
@@ -139,7 +139,7 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     assert _listing(out.parent) == names  # nothing half-written left behind
     images = []
     for name in names:
-        assert image_files.problem(out.parent / name) is None  # every chunk's CRC, all pixel rows
+        assert frame_files.problem(out.parent / name) is None  # every chunk's CRC, all pixel rows
         images.append(wh.read_image(bpy, out.parent / name))
         assert images[-1].shape == (32, 32, 4) and images[-1][..., 0].max() > 0.5  # the sphere
     assert not np.array_equal(*images)  # two different frames (pixels against one process: test above)
@@ -166,11 +166,11 @@ def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path):
     assert "3 frames: 2 rendered, 0 skipped (already complete), 1 failed" in result.stdout
     assert _listing(out.parent) == ["f_0002.exr", "f_0004.exr"]
     for name in ("f_0002.exr", "f_0004.exr"):
-        assert image_files.problem(out.parent / name) is None
+        assert frame_files.problem(out.parent / name) is None
         assert np.isfinite(wh.read_image(bpy, out.parent / name)).all()
     data = (out.parent / "f_0002.exr").read_bytes()
     (tmp_path / "cut.exr").write_bytes(data[:-1])
-    assert "cut short" in image_files.problem(tmp_path / "cut.exr")
+    assert "cut short" in frame_files.problem(tmp_path / "cut.exr")
 
 
 def test_task_options_chunks_and_output_names():

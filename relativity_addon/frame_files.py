@@ -1,5 +1,8 @@
-"""Is a rendered frame on disk complete? Pure Python (no bpy, no imaging library), so the
+"""Frame output files: their names, the partial name a frame is written to before it is complete,
+and whether a file on disk is a complete image. Pure Python (no bpy, no imaging library), so the
 coordinator of a distributed render (``farm.py``) can check outputs without starting Blender.
+
+Completeness:
 
 - PNG: the signature, every chunk's CRC, IHDR first and IEND last with nothing after it, and the
   image data decompresses to exactly the size IHDR announces (a truncated, cut or byte-flipped
@@ -12,6 +15,7 @@ coordinator of a distributed render (``farm.py``) can check outputs without star
 
 import math
 import os
+import re
 import struct
 import zlib
 
@@ -20,6 +24,38 @@ PNG_CHANNELS = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}  # colour type -> samples per pixe
 EXR_MAGIC = 20000630
 # Scan lines per chunk for each EXR compression (OpenEXR's numbering).
 EXR_LINES_PER_CHUNK = {0: 1, 1: 1, 2: 1, 3: 16, 4: 32, 5: 16, 6: 32, 7: 32, 8: 32, 9: 256}
+
+
+def frame_output_path(out_path, frame, several):
+    """The file for ``frame``: a run of '#' becomes the zero-padded frame number; otherwise,
+    when several frames are rendered, ``_NNNN`` is inserted before the extension."""
+    directory, name = os.path.split(out_path)
+    run = re.search(r"#+", name)
+    if run:
+        width = len(run.group(0))
+        number = f"-{abs(frame):0{max(width - 1, 1)}d}" if frame < 0 else f"{frame:0{width}d}"
+        return os.path.join(directory, name[:run.start()] + number + name[run.end():])
+    if not several:
+        return out_path
+    stem, extension = os.path.splitext(name)
+    number = f"-{abs(frame):03d}" if frame < 0 else f"{frame:04d}"
+    return os.path.join(directory, f"{stem}_{number}{extension}")
+
+
+def partial_path(path):
+    """Where a frame is written before it is complete; renamed to ``path`` when it is. A hidden name
+    in the same folder (the rename is atomic), unique per process."""
+    directory, name = os.path.split(path)
+    stem, extension = os.path.splitext(name)
+    return os.path.join(directory, f".{stem}.{os.getpid()}.partial{extension}")
+
+
+def format_seconds(seconds):
+    if seconds < 60.0:
+        return f"{seconds:.1f} s"
+    minutes, seconds = divmod(int(round(seconds)), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
 
 
 def problem(path):
