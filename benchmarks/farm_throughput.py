@@ -14,7 +14,9 @@ it (the cluster's start included). Printed per sample count, medians over the ro
 - a task: the wall time of one frame task's Blender process on a worker (start Python, import
   bpy, open the file, enable the add-on, apply the effect, render, write, exit), and the per-task
   overhead: a task minus a frame in a running process;
-- the cluster's start (launch to the coordinator's "local Dask cluster" line).
+- the cluster's start (launch to the coordinator's "local Dask cluster" line);
+- the cluster again with ``--chunk`` frames/workers (one task, one Blender start, per worker) and
+  its ratio to the single process.
 
 The single process renders with all cores (Cycles' default), each worker's Blender with
 cores / workers threads.
@@ -75,7 +77,9 @@ def measure(blend, work, options, samples, rounds):
     single = [sys.executable, RENDER_SCRIPT, blend, *common, f"--out={os.path.join(work, 'single', 'f.png')}"]
     cluster = [sys.executable, RENDER_SCRIPT, blend, *common, f"--out={os.path.join(work, 'cluster', 'f.png')}",
                f"--workers={options.workers}", "--no-resume"]
-    result = {key: [] for key in ("single", "cluster", "frame", "task", "start")}
+    chunk = -(-options.frames // options.workers)
+    chunked = [*cluster, f"--chunk={chunk}"]
+    result = {key: [] for key in ("single", "cluster", "chunked", "frame", "task", "start")}
     run([*single[:3], "--frames=1-1", *single[4:]])  # warm-up: file cache, bytecode, kernels
     for _ in range(rounds):
         wall, lines = run(single)
@@ -87,6 +91,7 @@ def measure(blend, work, options, samples, rounds):
         tasks = [seconds_of(text) for _, text in lines if re.match(r"render\.py: frame \d+ done in", text)]
         result["task"].append(statistics.median(tasks))
         result["start"].append(next(at for at, text in lines if "local Dask cluster" in text))
+        result["chunked"].append(run(chunked)[0])
     return {key: statistics.median(values) for key, values in result.items()}
 
 
@@ -108,13 +113,15 @@ def main():
     print(f"{options.frames} frames of {options.resolution}, exact camera; single process (all {os.cpu_count()} "
           f"cores) vs Dask LocalCluster of {options.workers} workers (a fresh Blender per frame); "
           f"medians of {options.repeats} alternating rounds")
+    chunk = -(-options.frames // options.workers)
     print(f"  {'samples':>7s}{'single s':>10s}{'cluster s':>11s}{'ratio':>7s}{'single f/s':>12s}{'cluster f/s':>13s}"
-          f"{'frame s':>9s}{'task s':>8s}{'overhead s':>12s}{'start s':>9s}")
+          f"{'frame s':>9s}{'task s':>8s}{'overhead s':>12s}{'start s':>9s}{f'chunk {chunk} s':>11s}{'ratio':>7s}")
     for samples in (int(value) for value in options.samples.split(",")):
         m = measure(blend, work, options, samples, options.repeats)
         print(f"  {samples:7d}{m['single']:10.2f}{m['cluster']:11.2f}{m['cluster'] / m['single']:7.2f}"
               f"{options.frames / m['single']:12.2f}{options.frames / m['cluster']:13.2f}{m['frame']:9.2f}"
-              f"{m['task']:8.2f}{m['task'] - m['frame']:12.2f}{m['start']:9.2f}", flush=True)
+              f"{m['task']:8.2f}{m['task'] - m['frame']:12.2f}{m['start']:9.2f}{m['chunked']:11.2f}"
+              f"{m['chunked'] / m['single']:7.2f}", flush=True)
     print(f"(load average at the end: {os.getloadavg()[0]:.2f})")
 
 

@@ -173,6 +173,14 @@ def _connect(options, log):
     return client, cluster
 
 
+def _identity(path):
+    try:
+        status = os.stat(path)
+    except FileNotFoundError:
+        return None
+    return status.st_ino, status.st_mtime_ns
+
+
 class _Job:
     """Progress and the final account of a distributed render."""
 
@@ -181,14 +189,22 @@ class _Job:
         self.total, self.skipped = len(paths), len(skipped)
         self.rendered, self.failed = [], {}
         self.started = time.monotonic()
+        # A frame counts as rendered only if its file was replaced during the job (the rename
+        # gives it a new inode): an old output of a frame a failed chunk never reached is no result.
+        self.before = {frame: _identity(path) for frame, path in paths.items()}
 
     def finished(self, frames, reason, seconds, worker):
+        """A task of ``frames`` ended; ``reason``: why it failed (a chunk fails at its first bad
+        frame; the frames before it are complete)."""
         for frame in frames:
-            problem = frame_files.problem(self.paths[frame])
-            if reason is None and problem is None:
+            path = self.paths[frame]
+            problem = frame_files.problem(path)
+            if problem is None and _identity(path) == self.before[frame]:
+                problem = "not written by this job"
+            if problem is None:
                 self.rendered.append(frame)
             else:
-                self.failed[frame] = reason or f"no complete output ({problem}): {self.paths[frame]}"
+                self.failed[frame] = reason or f"no complete output ({problem}): {path}"
         done = len(self.rendered) + len(self.failed)
         todo = self.total - self.skipped
         elapsed = time.monotonic() - self.started
