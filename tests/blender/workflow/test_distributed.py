@@ -3,6 +3,7 @@ processes, each task a fresh Blender process): frames equal a single-process ren
 pixel, a killed worker loses nothing, a frame above c fails alone with its reason, a rerun renders
 only what is missing or corrupt. Frames are tiny (32x32, 1-2 samples): the cost is the processes."""
 
+import json
 import os
 import re
 import signal
@@ -145,10 +146,43 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     assert not np.array_equal(*images)  # two different frames (pixels against one process: test above)
 
 
-def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path):
-    """Linear keys, c = 10 units/s at 24 fps: 0.1 units a frame (0.24 c) except between frames 2.5
-    and 3.5, 0.5 units a frame (1.2 c). Only frame 3's velocity (a central difference of
-    half-width 1/64 frame) lies in the fast segment. Output .exr: the checker reads real EXR."""
+@pytest.fixture
+def running_cluster(tmp_path):
+    """``dask scheduler`` and ``dask worker --nworkers 2`` processes, as on a farm (the add-on
+    importable on the workers through PYTHONPATH). Yields the scheduler's address."""
+    scheduler_file = tmp_path / "scheduler.json"
+    dask = [sys.executable, "-m", "dask"]
+    env = wh._env()
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = [*dask, "scheduler", "--port=0", "--no-dashboard", f"--scheduler-file={scheduler_file}"]
+    started = [subprocess.Popen(scheduler, env=env, **quiet)]
+    try:
+        address, deadline = None, time.monotonic() + 60
+        while address is None and time.monotonic() < deadline:
+            try:
+                address = json.loads(scheduler_file.read_text())["address"]
+            except (FileNotFoundError, ValueError, KeyError):  # not yet written, or half
+                time.sleep(0.1)
+        assert address, "the scheduler wrote no address"
+        started.append(subprocess.Popen(
+            [*dask, "worker", address, "--nworkers=2", "--nthreads=1", "--no-dashboard"],
+            env={**env, "PYTHONPATH": str(wh.REPO_ROOT)}, **quiet))
+        yield address
+    finally:
+        for process in reversed(started):
+            process.terminate()
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+
+
+def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path, running_cluster):
+    """On a running cluster (--scheduler). Linear keys, c = 10 units/s at 24 fps: 0.1 units a frame
+    (0.24 c) except between frames 2.5 and 3.5, 0.5 units a frame (1.2 c). Only frame 3's velocity
+    (a central difference of half-width 1/64 frame) lies in the fast segment. Output .exr: the
+    checker reads real EXR."""
     bpy = factory_blender
     scene, camera, _ = wh.new_scene(bpy, resolution=(32, 32))
     scene.frame_start, scene.frame_end = 1, 5
@@ -156,8 +190,9 @@ def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path):
     blend = wh.save_blend(bpy, tmp_path / "fast.blend")
     out = tmp_path / "out" / "f.exr"
     result = wh.run_render_script(blend, "--frames=2-4", "--velocity-from-animation", "--speed-of-light=10",
-                                  "--samples=1", *TINY, f"--out={out}", "--workers=2")
+                                  "--samples=1", *TINY, f"--out={out}", f"--scheduler={running_cluster}", "--threads=1")
     assert result.returncode == 1, result.stderr[-3000:]
+    assert f"Dask scheduler {running_cluster}" in result.stdout
     errors = wh.error_lines(result)
     assert len(errors) == 1, result.stderr[-3000:]
     assert errors[0].startswith("render.py: error: frame 3: camera 'Camera' moves at 1.2 c at frame 3"), errors
