@@ -99,6 +99,18 @@ def test_four_frames_on_two_workers_equal_one_process_and_resume(moving_blend, t
         np.testing.assert_array_equal(wh.read_image(bpy, cluster.parent / name), images[name], err_msg=name)
     assert _listing(cluster.parent) == names
 
+    # The single-process script resumes too (--resume): nothing left to render, nothing touched.
+    def identities():
+        return {name: (os.stat(cluster.parent / name).st_ino, os.stat(cluster.parent / name).st_mtime_ns)
+                for name in names}
+
+    kept = identities()
+    result = wh.run_render_script(moving_blend, *common, f"--out={cluster}", "--resume")
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "--resume: 4 of 4 frames already complete, skipped" in result.stdout
+    assert "wrote 0 files" in result.stdout
+    assert identities() == kept
+
 
 def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     """SIGKILL to a worker process while the Blender process it started renders a frame: the
