@@ -10,8 +10,15 @@ keyframed motion; refused with the frame number if it reaches c), --method camer
 --no-searchlight, --shutter MODEL, --shutter-time S, --lorentz-window, --speed-of-light C,
 --frame N or --frames A-B (several frames: the frame number goes before the extension,
 out/fly_0001.png, or replaces a run of '#' in PATH), --seed N, --reference (render the file's own
-camera unchanged), --proper-time (frame K at the traveller's time K / fps). Prints one progress
-line per frame with the time left. Exits non-zero with a one-line reason on any failure.
+camera unchanged), --proper-time (frame K at the traveller's time K / fps), --threads N, --resume
+(skip frames whose output is already a complete image). Prints one progress line per frame with
+the time left. Exits non-zero with a one-line reason on any failure.
+
+On a Dask cluster (docs/farm.md): --workers N (a local cluster of N worker processes) or
+--scheduler tcp://HOST:8786, with --chunk N (frames per task) and --retries N; each task renders
+in a fresh Blender process, --resume is on, and the exit status is 1 if any frame failed:
+
+    python examples/render.py flythrough.blend --frames 1-240 --out out/f.png --workers 4
 """
 
 import os
@@ -20,7 +27,6 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from relativity_addon import batch  # noqa: E402
-from relativity_addon.blender import compat  # noqa: E402
 
 if __name__ == "__main__":
-    compat.run_main(batch.main)
+    batch.command_line()

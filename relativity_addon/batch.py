@@ -10,14 +10,11 @@ import math
 import os
 import sys
 
-from .errors import RelativityError
+from .errors import BatchError, RelativityError
+from .frame_files import format_seconds, frame_output_path, partial_path
 from .physics.shutter import ShutterModel
 
 ADDON_PACKAGE = "relativity_addon"
-
-
-class BatchError(Exception):
-    """A one-line reason why the batch render cannot proceed."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -106,6 +103,18 @@ def build_parser(with_blend_file):
     parser.add_argument("--proper-time", action="store_true",
                         help="step frames in the traveller's proper time: frame K is rendered at the scene time "
                         "where the observer's clock (0 at frame 0) reads K / fps")
+    parser.add_argument("--threads", type=_positive_int, help="Cycles render threads (default: all cores)")
+    parser.add_argument("--resume", action=argparse.BooleanOptionalAction,
+                        help="skip frames whose output exists and reads back as a complete image "
+                        "(default: on with --workers/--scheduler, off otherwise)")
+    cluster = parser.add_argument_group("distributed rendering (Dask; docs/farm.md)")
+    where = cluster.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_positive_int,
+                       help="render on a local Dask cluster of N worker processes, one frame task each")
+    where.add_argument("--scheduler", metavar="ADDRESS", help="render on a running Dask cluster, e.g. tcp://HOST:8786")
+    cluster.add_argument("--chunk", type=_positive_int, default=1, help="frames per task (default 1)")
+    cluster.add_argument("--retries", type=int, default=2,
+                         help="times a task whose worker or Blender process died is run again (default 2)")
     return parser
 
 
@@ -202,24 +211,6 @@ def _output_format(scene, out_path):
     scene.render.use_file_extension = False
 
 
-def frame_output_path(out_path, frame, several):
-    """The file for ``frame``: a run of '#' becomes the zero-padded frame number; otherwise,
-    when several frames are rendered, ``_NNNN`` is inserted before the extension."""
-    import re
-
-    directory, name = os.path.split(out_path)
-    run = re.search(r"#+", name)
-    if run:
-        width = len(run.group(0))
-        number = f"-{abs(frame):0{max(width - 1, 1)}d}" if frame < 0 else f"{frame:0{width}d}"
-        return os.path.join(directory, name[:run.start()] + number + name[run.end():])
-    if not several:
-        return out_path
-    stem, extension = os.path.splitext(name)
-    number = f"-{abs(frame):03d}" if frame < 0 else f"{frame:04d}"
-    return os.path.join(directory, f"{stem}_{number}{extension}")
-
-
 def _frames(scene, options):
     if options.frames is not None:
         first, last = options.frames
@@ -227,14 +218,6 @@ def _frames(scene, options):
     if options.frame is not None:
         return [options.frame]
     return [scene.frame_current]
-
-
-def _format_seconds(seconds):
-    if seconds < 60.0:
-        return f"{seconds:.1f} s"
-    minutes, seconds = divmod(int(round(seconds)), 60)
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
 
 
 def _render_spectral(scene, path, passes):
@@ -265,26 +248,39 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
         errors = geometry.scene_errors(scene)
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
-    scene.render.filepath = path
     if os.path.exists(path):
         os.remove(path)
+    partial = partial_path(path)
+    scene.render.filepath = partial
     try:
-        if spectral_passes:
-            _render_spectral(scene, path, spectral_passes)
-        else:
-            bpy.ops.render.render(write_still=True)
-    except RuntimeError as error:
-        raise BatchError(f"render of frame {frame} failed: {str(error).strip().splitlines()[-1]}") from None
-    if relativistic and scene.relativity.method == "CAMERA":
-        cam = scene.camera.data
-        if not cam.cycles_custom.get("settings_valid", False):
-            raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
-    effect = addon_module("effect")
-    if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
-        warnings = effect.scene_warnings(scene)
-        raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
-    if not os.path.isfile(path):
-        raise BatchError(f"render wrote no file at {path}")
+        try:
+            if spectral_passes:
+                _render_spectral(scene, partial, spectral_passes)
+            else:
+                bpy.ops.render.render(write_still=True)
+        except RuntimeError as error:
+            raise BatchError(f"render of frame {frame} failed: {str(error).strip().splitlines()[-1]}") from None
+        if relativistic and scene.relativity.method == "CAMERA":
+            cam = scene.camera.data
+            if not cam.cycles_custom.get("settings_valid", False):
+                raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
+        effect = addon_module("effect")
+        if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
+            warnings = effect.scene_warnings(scene)
+            raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
+        if not os.path.isfile(partial):
+            raise BatchError(f"render wrote no file at {path}")
+        os.replace(partial, path)
+    finally:
+        if os.path.exists(partial):
+            os.remove(partial)
+
+
+def parse(argv):
+    """(options, parser) for the command line ``argv`` (either invocation form)."""
+    arguments, with_blend_file = _split_argv(argv)
+    parser = build_parser(with_blend_file)
+    return parser.parse_args(arguments), parser
 
 
 def run(argv, log=print):
@@ -292,8 +288,8 @@ def run(argv, log=print):
 
     import bpy
 
-    arguments, with_blend_file = _split_argv(argv)
-    options = build_parser(with_blend_file).parse_args(arguments)
+    options, _ = parse(argv)
+    with_blend_file = not _running_inside_blender(argv)
     out_path = os.path.abspath(options.out)
 
     if with_blend_file:
@@ -317,6 +313,9 @@ def run(argv, log=print):
     if options.resolution is not None:
         scene.render.resolution_x, scene.render.resolution_y = options.resolution
         scene.render.resolution_percentage = 100
+    if options.threads is not None:
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = options.threads
     _output_format(scene, out_path)
 
     relativistic = not options.reference
@@ -344,6 +343,15 @@ def run(argv, log=print):
     several = len(frames) > 1
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
+    if options.resume:
+        from . import frame_files
+
+        complete = [path for path in paths if frame_files.is_complete(path)]
+        if complete:
+            log(f"render.py: --resume: {len(complete)} of {len(paths)} frames already complete, skipped", flush=True)
+        keep = [path not in complete for path in paths]
+        frames, scene_frames, paths = ([item for item, kept in zip(items, keep, strict=True) if kept]
+                                       for items in (frames, scene_frames, paths))
     started = time.monotonic()
     for done, (frame, scene_frame, path) in enumerate(zip(frames, scene_frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
@@ -351,16 +359,39 @@ def run(argv, log=print):
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(
-            f"render.py: frame {frame} ({done}/{len(frames)}) in {_format_seconds(now - frame_started)}, "
-            f"about {_format_seconds(left)} left: {path}",
+            f"render.py: frame {frame} ({done}/{len(frames)}) in {format_seconds(now - frame_started)}, "
+            f"about {format_seconds(left)} left: {path}",
             flush=True,
         )
     return paths
 
 
+def command_line():
+    """The entry point of ``examples/render.py``. A distributed render's coordinator never imports
+    bpy (its worker processes, which start by importing the main script, neither)."""
+    try:
+        options, _ = parse(sys.argv)
+        distributed = options.workers is not None or options.scheduler is not None
+    except BatchError:
+        distributed = False
+    if distributed and not _running_inside_blender(sys.argv):
+        sys.exit(main())
+    from .blender import compat
+
+    compat.run_main(main)
+
+
 def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
+        options, parser = parse(argv)
+        if options.workers is not None or options.scheduler is not None:
+            if _running_inside_blender(argv):
+                raise BatchError("--workers and --scheduler need the bpy wheel form: "
+                                 "python examples/render.py FILE.blend ...")
+            from . import farm  # Dask is imported only here
+
+            return farm.render(options, parser)
         paths = run(argv)
     except BatchError as error:
         print(f"render.py: error: {error}", file=sys.stderr)

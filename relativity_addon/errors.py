@@ -9,3 +9,7 @@ class RelativityError(Exception):
     script's last line before it exits non-zero), never with a traceback: it names what is wrong
     and, where there is one, what to do about it.
     """
+
+
+class BatchError(Exception):
+    """A one-line reason why the batch render (``examples/render.py``) cannot proceed."""

@@ -1,0 +1,87 @@
+"""The Flamenco 3 job type (flamenco/relativistic_render.js): valid JavaScript (esprima, a parser
+from the Python registry, always; node's own parser where node is installed), and, run in node
+with stand-ins for Flamenco's ``author``/``path``/``print``, its tasks' command lines are ones the
+batch script accepts, covering the frame range once in chunks."""
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+JOB_TYPE = REPO_ROOT / "flamenco" / "relativistic_render.js"
+NODE = shutil.which("node") or shutil.which("nodejs")
+
+HARNESS = r"""
+const fs = require("fs"), vm = require("vm"), nodePath = require("path");
+const source = fs.readFileSync(process.argv[1], "utf8");
+const settings = JSON.parse(process.argv[2]);
+const tasks = [];
+const context = {
+  print: () => {},
+  path: nodePath.posix,
+  author: {
+    Task: (name, type) => ({ name, type, commands: [], addCommand(c) { this.commands.push(c); } }),
+    Command: (type, parameters) => ({ type, parameters }),
+  },
+};
+vm.createContext(context);
+vm.runInContext(source + "\nthis.JOB_TYPE = JOB_TYPE; this.compileJob = compileJob;", context);
+context.compileJob({ name: "shot", settings, addTask: (task) => tasks.push(task) });
+const keys = context.JOB_TYPE.settings.map((s) => s.key);
+process.stdout.write(JSON.stringify({ keys, tasks }));
+"""
+
+
+def test_job_type_parses_as_javascript():
+    import esprima  # pinned in requirements/blender-*.txt: this check runs everywhere
+    program = esprima.parseScript(JOB_TYPE.read_text(encoding="utf-8"))
+    names = {node.id.name for node in program.body if node.type == "FunctionDeclaration"}
+    declared = {
+        declaration.id.name
+        for node in program.body if node.type == "VariableDeclaration" for declaration in node.declarations
+    }
+    assert "compileJob" in names and "JOB_TYPE" in declared  # what Flamenco's job compiler calls
+    with pytest.raises(esprima.Error):
+        esprima.parseScript(JOB_TYPE.read_text(encoding="utf-8") + "\nfunction broken( {")
+
+
+@pytest.mark.skipif(NODE is None, reason="no node (JavaScript engine) on PATH; the esprima parse above still runs")
+def test_job_type_compiles_tasks_the_batch_script_accepts():
+    from relativity_addon import batch
+
+    assert subprocess.run([NODE, "--check", str(JOB_TYPE)], capture_output=True).returncode == 0
+    settings = {
+        "frames": "3-12", "chunk_size": 4, "render_script": "/farm/relativity/examples/render.py",
+        "render_output_root": "/farm/out", "file_format": "exr", "beta": "0, 0.9, 0",
+        "velocity_from_animation": False, "method": "geometry", "samples": 16, "spectral_passes": 0,
+        "resume": True, "extra_args": "--seed=3  --no-searchlight", "blendfile": "/farm/shot.blend",
+    }
+    result = subprocess.run([NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps(settings)],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    compiled = json.loads(result.stdout)
+    assert set(settings) <= set(compiled["keys"])
+    parser = batch.build_parser(with_blend_file=False)
+    covered = []
+    for task in compiled["tasks"]:
+        (command,) = task["commands"]
+        assert task["type"] == "blender" and command["type"] == "blender-render"
+        parameters = command["parameters"]
+        assert parameters["blendfile"] == "/farm/shot.blend" and parameters["exe"] == "{blender}"
+        args = parameters["args"]
+        assert args[:3] == ["--python", "/farm/relativity/examples/render.py", "--"]
+        options = parser.parse_args(args[3:])  # the batch script's parser, Blender form
+        assert options.out == "/farm/out/shot/frame_####.exr"
+        assert options.beta == (0.0, 0.9, 0.0) and options.method == "geometry" and options.samples == 16
+        assert options.seed == 3 and options.no_searchlight and options.resume
+        assert not options.velocity_from_animation and options.spectral is None
+        first, last = options.frames
+        covered += range(first, last + 1)
+    assert covered == list(range(3, 13)) and len(compiled["tasks"]) == 3  # 3-6, 7-10, 11-12
+
+    bad = subprocess.run([NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps({**settings, "frames": "1,5"})],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode != 0 and "frames must be FIRST-LAST" in bad.stderr
