@@ -118,6 +118,9 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row = column.row()
         row.active = settings.use_searchlight
         row.prop(settings, "use_chang_searchlight")
+        row = column.row()
+        row.active = settings.use_doppler and not settings.use_searchlight
+        row.prop(settings, "doppler_only_brightness")
         column = layout.column()
         column.active = settings.use_searchlight
         column.prop(settings, "exposure_mode")

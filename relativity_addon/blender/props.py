@@ -177,6 +177,18 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         default=False,
         update=_settings_changed,
     )
+    doppler_only_brightness: EnumProperty(
+        name="Doppler Only",
+        description="Brightness of Doppler colour without the searchlight",
+        items=(
+            ("REST", "Rest Brightness", "The shifted colour keeps the rest-frame brightness"),
+            ("SPECTRUM", "Shifted Spectrum",
+             "Weiskopf et al. (1999) Fig. 8: the shifted spectrum L(lambda D) with no further factor, "
+             "so a blackbody at T shows Y(D T) / (D^5 Y(T)) of its rest brightness"),
+        ),
+        default="REST",
+        update=_settings_changed,
+    )
     exposure_mode: EnumProperty(
         name="Exposure",
         description="Brightness of the frame under the searchlight",

@@ -32,7 +32,7 @@ class ColourFactors:
 
     use_doppler: bool
     spectral_searchlight: bool  # exact visible brightness from the spectrum (Doppler and searchlight on)
-    power_of_d: float  # brightness D^p where the spectrum does not give it (4, Chang's 1, or 0)
+    power_of_d: float  # brightness D^p besides the spectrum's (4, Chang's 1, 0, or -5 for L(lambda D) alone)
     camera_power: float  # the D^4 the exact camera's shader already applied (0 on the mesh path)
     camera_path: bool  # the exact (OSL) camera renders the observer's motion
 
@@ -80,6 +80,7 @@ class Snapshot:
     exposure_mode: str  # FIXED or COMPENSATED
     exposure: float  # the one factor the camera multiplies the frame by (1 when FIXED)
     moving_lights: tuple[MovingLight, ...] = ()
+    doppler_only_brightness: str = "REST"  # or SPECTRUM: Doppler without searchlight as Weiskopf's Fig. 8
 
     @property
     def time(self) -> float:
@@ -135,6 +136,9 @@ class Snapshot:
             power = 0.0
         else:
             power = 1.0 if self.use_chang_searchlight else 4.0
+        if self.use_doppler and not self.use_searchlight and self.doppler_only_brightness == "SPECTRUM":
+            # L(lambda D) alone (Weiskopf et al. 1999, Fig. 8): eq. 14's visible factor without its D^5
+            spectral, power = True, -5.0
         camera_path = self.exact_camera
         return ColourFactors(
             use_doppler=self.use_doppler,
@@ -394,4 +398,5 @@ def read(scene, depsgraph=None) -> Snapshot:
         exposure_mode=settings.exposure_mode,
         exposure=frame_exposure(scene, camera, settings, beta, matrix) if settings.use_searchlight else 1.0,
         moving_lights=moving_lights(scene, frame, depsgraph),
+        doppler_only_brightness=settings.doppler_only_brightness,
     )

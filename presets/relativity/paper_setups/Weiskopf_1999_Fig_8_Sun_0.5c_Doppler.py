@@ -6,6 +6,7 @@ settings = scene.relativity
 # Weiskopf, Kraus, Ruder (1999) Fig. 8 (Doppler only): the Sun (blackbody 5762 K) passing by at 0.5 c. The
 # camera method moves the observer instead: a camera moving at 0.5 c along its local +X sees a Sun at
 # rest pass by to the left (the same relative motion, the photo taken in the camera's frame).
+# "Doppler only" as the paper defines it: the shifted spectrum L(lambda D) with no further factor.
 if scene.camera is not None:
     settings.velocity_source = 'MANUAL'
     settings.beta = scene.camera.matrix_world.to_quaternion() @ Vector((0.5, 0.0, 0.0))
@@ -13,3 +14,4 @@ if scene.camera is not None:
     settings.use_geometry = True
     settings.use_doppler = True
     settings.use_searchlight = False
+    settings.doppler_only_brightness = 'SPECTRUM'  # the paper's L(lambda D), no further factor

@@ -92,6 +92,7 @@ CASES = [
     case("CAMERA", "scene", "use_doppler", False),
     case("CAMERA", "scene", "use_searchlight", False),
     case("CAMERA", "scene", "use_chang_searchlight", True),
+    case("CAMERA", "scene", "doppler_only_brightness", "SPECTRUM", base={"use_searchlight": False}),
     case("CAMERA", "scene", "velocity_source", "CAMERA_ANIMATION"),
     case("CAMERA", "Blackbody", "temperature", 9000.0),
     case("CAMERA", "scene", "method", "GEOMETRY"),  # switching the method after Set Up
@@ -101,6 +102,8 @@ CASES = [
     case("GEOMETRY", "scene", "use_doppler", False),
     case("GEOMETRY", "scene", "use_searchlight", False),
     case("GEOMETRY", "scene", "use_chang_searchlight", True),
+    case("GEOMETRY", "scene", "doppler_only_brightness", "SPECTRUM",
+         base={"use_searchlight": False, "geometry_final_render": "PREVIEW"}),
     case("GEOMETRY", "scene", "velocity_source", "CAMERA_ANIMATION"),
     case("GEOMETRY", "scene", "method", "CAMERA"),
     case("GEOMETRY", "Mover", "enabled", False),

@@ -1,0 +1,293 @@
+"""Numbers measured on the gallery's renders (``examples/gallery.py``), with what physics expects.
+
+Expected values are docs/physics.md written out in numpy here (Doppler factor and aberration from
+each pixel's viewing direction) and, for blackbodies, Planck spectra through the CIE 1931
+observer from colour-science (skipped when colour-science is not installed). Images are linear
+Rec.709 arrays [row (top first), column, channel]; a pixel (column i, row j) has its centre at
+(i + 0.5, j + 0.5).
+"""
+
+import math
+
+import numpy as np
+
+SUN_TEMPERATURE = 5762.0
+
+
+def luminance(rgb):
+    return rgb[..., 0] * 0.2126 + rgb[..., 1] * 0.7152 + rgb[..., 2] * 0.0722
+
+
+def view_directions(context):
+    """Unit camera-local viewing direction at every pixel centre, shape (h, w, 3)."""
+    left, right, bottom, top = context["window"]
+    width, height = context["size"]
+    u = left + (np.arange(width) + 0.5) / width * (right - left)
+    v = top - (np.arange(height) + 0.5) / height * (top - bottom)
+    uu, vv = np.meshgrid(u, v)
+    d = np.stack([uu, vv, -np.ones_like(uu)], axis=-1)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def doppler(context):
+    """D = 1 / (gamma (1 - beta . d')) per pixel: the observer moves with beta, d' its camera-frame
+    viewing direction (docs/physics.md)."""
+    beta = np.asarray(context["beta_local"], float)
+    gamma = 1.0 / math.sqrt(1.0 - beta @ beta)
+    return 1.0 / (gamma * (1.0 - view_directions(context) @ beta))
+
+
+def project(context, direction):
+    left, right, bottom, top = context["window"]
+    width, height = context["size"]
+    x, y, z = direction
+    return np.array([(x / -z - left) / (right - left) * width, (top - y / -z) / (top - bottom) * height])
+
+
+def aberrate(k, beta):
+    """Photon direction k (scene frame) -> k' in the frame moving with beta (docs/physics.md)."""
+    k, beta = np.asarray(k, float), np.asarray(beta, float)
+    b2 = beta @ beta
+    if b2 == 0.0:
+        return k
+    g = 1.0 / math.sqrt(1.0 - b2)
+    bhat = beta / math.sqrt(b2)
+    return (k + (g - 1.0) * (bhat @ k) * bhat - g * beta) / (g * (1.0 - beta @ k))
+
+
+def sphere_image_centroid(context, centre, radius, samples=360):
+    """Area centroid (pixels) of the aberrated cone of rays of a sphere seen from the origin."""
+    centre = np.asarray(centre, float)
+    axis = centre / np.linalg.norm(centre)
+    half = math.asin(radius / np.linalg.norm(centre))
+    e1 = np.cross(axis, [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(axis, e1)
+    points = []
+    for phi in np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False):
+        view = math.cos(half) * axis + math.sin(half) * (math.cos(phi) * e1 + math.sin(phi) * e2)
+        points.append(project(context, -aberrate(-view, context["beta_local"])))
+    x, y = np.array(points).T
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cross = x * yn - xn * y
+    area = cross.sum() / 2.0
+    return np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
+
+
+def centroid(intensity, weights_mask=None):
+    height, width = intensity.shape
+    w = np.clip(intensity, 0.0, None) if weights_mask is None else np.clip(intensity, 0.0, None) * weights_mask
+    ys, xs = np.mgrid[0:height, 0:width] + 0.5
+    total = w.sum()
+    return np.array([(xs * w).sum() / total, (ys * w).sum() / total]) if total > 0 else None
+
+
+def spot(intensity, pixel, half):
+    """Centroid and RMS radius (pixels) of the spot in a square window around ``pixel``."""
+    height, width = intensity.shape
+    c0, r0 = int(round(pixel[0])), int(round(pixel[1]))
+    rows = slice(max(r0 - half, 0), min(r0 + half + 1, height))
+    cols = slice(max(c0 - half, 0), min(c0 + half + 1, width))
+    patch = np.clip(intensity[rows, cols], 0.0, None)
+    ys, xs = np.mgrid[rows, cols] + 0.5
+    total = patch.sum()
+    if total <= 0.0:
+        return None, float("nan")
+    centre = np.array([(xs * patch).sum(), (ys * patch).sum()]) / total
+    rms = math.sqrt((((xs - centre[0]) ** 2 + (ys - centre[1]) ** 2) * patch).sum() / total)
+    return centre, rms
+
+
+# --- families ---------------------------------------------------------------------------------
+
+
+def _boxes(width, height):
+    return {
+        "centre": (slice(2 * height // 5, 3 * height // 5 + 1), slice(2 * width // 5, 3 * width // 5 + 1)),
+        "left edge": (slice(2 * height // 5, 3 * height // 5 + 1), slice(0, max(width // 10, 1))),
+    }
+
+
+def street(images, contexts):
+    out = {}
+    geometry = images.get("weiskopf_fig5_street_geometry")
+    if geometry is None:
+        return out
+    context = contexts["weiskopf_fig5_street_geometry"]
+    d = doppler(context)
+    y5 = luminance(geometry)
+    for name, power in (("weiskopf_fig7_street_searchlight", 4), ("weiskopf_fig6_street_chang", 1)):
+        if name not in images:
+            continue
+        y = luminance(images[name])
+        values = {}
+        for label, box in _boxes(*context["size"]).items():
+            measured = y[box].sum() / y5[box].sum()
+            expected = (d[box] ** power * y5[box]).sum() / y5[box].sum()
+            values[f"{label} brightness / Fig. 5"] = measured
+            values[f"{label} expected <D^{power}>"] = expected
+            values[f"{label} mean D"] = d[box].mean()
+        out[name] = values
+    if "weiskopf_fig4_street_rest" in images:
+        out["weiskopf_fig5_street_geometry"] = {"D at the image centre": d[d.shape[0] // 2, d.shape[1] // 2],
+                                                "D at the image corner": d[0, 0]}
+    return out
+
+
+def _blackbody_y():
+    try:
+        import colour
+    except ImportError:
+        return None
+    shape = colour.SpectralShape(360, 830, 1)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    factors = np.linspace(0.3, 3.0, 136)
+    ys = np.array([colour.sd_to_XYZ(colour.sd_blackbody(f * SUN_TEMPERATURE, shape), cmfs,
+                                    method="Integration")[1] for f in factors])
+    y_rest = colour.sd_to_XYZ(colour.sd_blackbody(SUN_TEMPERATURE, shape), cmfs, method="Integration")[1]
+    return lambda d: np.interp(d, factors, ys) / y_rest
+
+
+def _cct(rgb):
+    import colour
+
+    xyz = colour.RGB_to_XYZ(rgb, colour.RGB_COLOURSPACES["ITU-R BT.709"], illuminant=None,
+                            chromatic_adaptation_transform=None, apply_cctf_decoding=False)
+    uv = colour.xy_to_UCS_uv(colour.XYZ_to_xy(xyz))
+    return float(colour.temperature.uv_to_CCT(uv, method="Ohno 2013")[0])
+
+
+def _sun_cores(y):
+    """Per Sun (left to right): the mask of its image's inner pixels (all 3 x 3 neighbours lit)."""
+    lit = y > 0.02 * y.max()
+    inner = lit.copy()
+    inner[1:-1, 1:-1] = np.all([np.roll(np.roll(lit, i, 0), j, 1)[1:-1, 1:-1]
+                                for i in (-1, 0, 1) for j in (-1, 0, 1)], axis=0)
+    inner[[0, -1], :] = False
+    inner[:, [0, -1]] = False
+    columns = inner.any(axis=0)
+    runs, start = [], None
+    for x, on in enumerate(list(columns) + [False]):
+        if on and start is None:
+            start = x
+        elif not on and start is not None:
+            mask = np.zeros_like(inner)
+            mask[:, start:x] = inner[:, start:x]
+            runs.append(mask)
+            start = None
+    return runs
+
+
+def suns(images, contexts):
+    out = {}
+    rest = images.get("weiskopf_sun_rest")
+    ratio = _blackbody_y()
+    if rest is None or ratio is None:
+        return out
+    y_rest = luminance(rest)
+    cores = _sun_cores(y_rest)
+    if not cores:
+        return out
+    y0 = max(y_rest[mask].mean() for mask in cores)
+    for name, spectrum_only in (("weiskopf_fig8_sun_doppler", True), ("weiskopf_fig9_sun_doppler_searchlight", False)):
+        if name not in images:
+            continue
+        image, d = images[name], doppler(contexts[name])
+        y = luminance(image)
+        values = {}
+        for index, mask in enumerate(_sun_cores(y)):
+            dm = d[mask]
+            expected = (ratio(dm) / dm**5).mean() if spectrum_only else ratio(dm).mean()
+            measured = y[mask].mean() / y0
+            formula = "Y(DT)/(D^5 Y(T))" if spectrum_only else "Y(DT)/Y(T)"
+            values[f"Sun {index + 1} mean D"] = dm.mean()
+            values[f"Sun {index + 1} brightness / rest"] = measured
+            values[f"Sun {index + 1} expected {formula}"] = expected
+            values[f"Sun {index + 1} colour temperature seen (K)"] = _cct(image[mask].mean(axis=0))
+            values[f"Sun {index + 1} D T (K)"] = dm.mean() * SUN_TEMPERATURE
+        out[name] = values
+    return out
+
+
+def sphere_arrays(images, contexts):
+    out, radii = {}, {}
+    for name in ("gray_fig3b_aperture_plane", "gray_fig4_aperture_plane_huge", "gray_fig5_detector_plane",
+                 "gray_fig7_focus_surface"):
+        if name not in images:
+            continue
+        context = contexts[name]
+        y = luminance(images[name])
+        half = max(2, round(10 * context["size"][0] / 320))
+        pixels = [project(context, p) for p in context["points"]]
+        spots = [spot(y, p, half) for p in pixels]
+        offsets = [np.linalg.norm(c - p) for (c, _), p in zip(spots, pixels, strict=True) if c is not None]
+        radius = np.array([r for _, r in spots])
+        radii[name] = radius
+        out[name] = {
+            "spots found (of 81)": len(offsets),
+            "RMS spot radius median (px)": np.nanmedian(radius),
+            "RMS radius, centre sphere (px)": radius[40],
+            "RMS radius, sphere at (1, 0, 10) near beta (px)": radius[44],
+            "RMS radius, sphere at (-1, 0, 10) (px)": radius[36],
+            "spot centroid to grid pixel, max (px)": max(offsets),
+            "spot centroid to grid pixel, median (px)": np.median(offsets),
+        }
+    if "gray_fig4_aperture_plane_huge" in radii and "gray_fig5_detector_plane" in radii:
+        ratio = np.nanmedian(radii["gray_fig4_aperture_plane_huge"] / radii["gray_fig5_detector_plane"])
+        out["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] = ratio
+    return out
+
+
+def tiles(images, contexts):
+    out = {}
+    for name in ("gray_fig1a_rest", "gray_fig1b_pinhole", "gray_fig1_wide_aperture"):
+        if name not in images:
+            continue
+        context, image = contexts[name], images[name]
+        red = np.clip(image[..., 0] - image[..., 1], 0.0, None)
+        measured = centroid(red)
+        expected = sphere_image_centroid(context, *context["red"])
+        y = luminance(image)
+        sharp = np.abs(np.diff(y, axis=1)).mean() + np.abs(np.diff(y, axis=0)).mean()
+        out[name] = {"red sphere centroid x (px)": measured[0], "red sphere centroid y (px)": measured[1],
+                     "pinhole aberration formula x (px)": expected[0], "pinhole aberration formula y (px)": expected[1],
+                     "mean |luminance gradient| (per px)": sharp}
+    return out
+
+
+def cylinders(images, contexts):
+    rest, moving = images.get("gray_fig8a_rest"), images.get("gray_fig8b_fixed_point_surface")
+    if rest is None or moving is None:
+        return {}
+    context = contexts["gray_fig8a_rest"]
+    from gallery_scenes import FIXED_PLANE, MARKERS
+
+    half = max(2, round(10 * context["size"][0] / 320))
+    shifts = []
+    for x, y in MARKERS:
+        pixel = project(context, (x, y, -FIXED_PLANE))
+        a, _ = spot(np.clip(rest[..., 0] - rest[..., 1], 0, None), pixel, half)
+        b, _ = spot(np.clip(moving[..., 0] - moving[..., 1], 0, None), pixel, half)
+        if a is not None and b is not None:
+            shifts.append(np.linalg.norm(a - b))
+    return {"gray_fig8b_fixed_point_surface": {
+        "red discs found": len(shifts),
+        "red discs in the focus plane, max shift from Fig. 8(a) (px)": max(shifts),
+        "mean |Fig. 8(b) - Fig. 8(a)|, whole image": np.abs(moving - rest).mean()}}
+
+
+def portrait(images, contexts):
+    rest = images.get("gray_fig9a_rest")
+    out = {}
+    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window"):
+        if rest is not None and name in images:
+            out[name] = {"mean |image - Fig. 9(a)|": np.abs(images[name] - rest).mean(),
+                         "mean of Fig. 9(a)": rest.mean()}
+    return out
+
+
+def measure_all(images, contexts):
+    numbers = {}
+    for family in (street, suns, tiles, sphere_arrays, cylinders, portrait):
+        numbers.update(family(images, contexts))
+    return {name: {key: float(value) for key, value in values.items()} for name, values in numbers.items()}

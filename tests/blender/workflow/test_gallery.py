@@ -1,0 +1,83 @@
+"""The gallery (examples/gallery.py) end to end at a tiny size: every figure renders, and one
+physical number per family is right.
+
+Expected values come from docs/physics.md and docs/spectral-model.md: the searchlight ratio of
+two renders that differ only in it is the brightness-weighted mean of D^4 (D^1 for Chang et
+al.'s), a blackbody seen at D shows Y(D T) / (D^5 Y(T)) of its rest brightness under the
+paper's "Doppler only" (Y from colour-science here) and Y(D T) / Y(T) with the searchlight,
+Gray's detector-plane shutter images the sphere array sharply at the grid points while the
+aperture-plane one blurs it, the fixed-point-surface shutter keeps the focus plane in place and
+the Lorentz window gives the photo at rest.
+"""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import workflow_helpers as wh
+
+GALLERY_SCRIPT = wh.REPO_ROOT / "examples" / "gallery.py"
+TEMPERATURE = 5762.0
+
+
+def _y(temperature):
+    import colour
+
+    shape = colour.SpectralShape(360, 830, 1)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    return colour.sd_to_XYZ(colour.sd_blackbody(temperature, shape), cmfs, method="Integration")[1]
+
+
+def test_gallery_renders_every_figure(factory_blender, tmp_path):
+    names = subprocess.run([sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True,
+                           timeout=120, env=wh._env()).stdout.split()
+    assert len(names) == 19
+    result = subprocess.run([sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48",
+                             "--samples=2"], capture_output=True, text=True, timeout=600, env=wh._env())
+    assert result.returncode == 0, result.stderr[-2000:]
+    for name in names:
+        image = wh.read_image(factory_blender, tmp_path / f"{name}.png")
+        assert image.shape == (48, 64, 4) and np.isfinite(image).all(), name
+        assert image[..., :3].max() > 0.2, f"{name} is black"
+    sheet = wh.read_image(factory_blender, tmp_path / "contact_sheet.png")
+    assert sheet.shape[0] > 48 and sheet[..., :3].max() > 0.2
+    numbers = json.loads((tmp_path / "measurements.json").read_text())["numbers"]
+    print(json.dumps(numbers, indent=1))
+
+    # Weiskopf Figs. 5-7: searchlight ratio D^4 (D at the centre ~2.8), Chang's D^1
+    fig7, fig6 = numbers["weiskopf_fig7_street_searchlight"], numbers["weiskopf_fig6_street_chang"]
+    assert fig7["centre brightness / Fig. 5"] == pytest.approx(fig7["centre expected <D^4>"], rel=0.15)
+    assert fig6["centre brightness / Fig. 5"] == pytest.approx(fig6["centre expected <D^1>"], rel=0.1)
+    assert fig7["centre brightness / Fig. 5"] > 10 * fig6["centre brightness / Fig. 5"] > 10
+
+    # Weiskopf Figs. 8-9: blackbody brightness against colour-science at each Sun's D
+    fig8, fig9 = numbers["weiskopf_fig8_sun_doppler"], numbers["weiskopf_fig9_sun_doppler_searchlight"]
+    suns = [key.split(" mean D")[0] for key in fig8 if key.endswith("mean D")]
+    assert len(suns) >= 4
+    ds = []
+    for sun in suns:
+        d = fig8[f"{sun} mean D"]
+        ds.append(d)
+        ratio = _y(d * TEMPERATURE) / _y(TEMPERATURE)
+        assert fig8[f"{sun} brightness / rest"] == pytest.approx(ratio / d**5, rel=0.05), sun
+        if f"{sun} mean D" in fig9:
+            assert fig9[f"{sun} brightness / rest"] == pytest.approx(_y(fig9[f"{sun} mean D"] * TEMPERATURE)
+                                                                      / _y(TEMPERATURE), rel=0.05), sun
+    assert min(ds) < 0.8 and max(ds) > 1.1
+
+    # Gray Fig. 1(b): a sphere where aberration puts it; Figs. 4-5: coma versus sharp
+    fig1b = numbers["gray_fig1b_pinhole"]
+    assert abs(fig1b["red sphere centroid x (px)"] - fig1b["pinhole aberration formula x (px)"]) < 0.5
+    assert abs(fig1b["red sphere centroid y (px)"] - fig1b["pinhole aberration formula y (px)"]) < 0.5
+    assert numbers["gray_fig5_detector_plane"]["spot centroid to grid pixel, max (px)"] < 1.0
+    assert numbers["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] > 1.2
+    # Gray Fig. 8: the focus plane stays put; Fig. 9: the Lorentz window gives the photo at rest
+    fig8b = numbers["gray_fig8b_fixed_point_surface"]
+    assert fig8b["red discs found"] == 4
+    assert fig8b["red discs in the focus plane, max shift from Fig. 8(a) (px)"] < 0.25
+    assert fig8b["mean |Fig. 8(b) - Fig. 8(a)|, whole image"] > 0.01
+    window, moving = numbers["gray_fig9c_lorentz_window"], numbers["gray_fig9b_moving"]
+    assert window["mean |image - Fig. 9(a)|"] < 0.05 * moving["mean |image - Fig. 9(a)|"]
