@@ -254,6 +254,13 @@ def _record(scene, snap):
         if camera_object is not None and camera_object.data.type != "PERSP" \
                 and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
+    if snap.engine == "CYCLES" and snap.use_searchlight and snap.speed > 0.0:
+        clamping = (scene.cycles.sample_clamp_direct, scene.cycles.sample_clamp_indirect)
+        clamps = [value for value in clamping if value > 0]
+        if clamps:
+            brightest = (snap.gamma * (1.0 + snap.speed)) ** 4
+            warnings.append(f"Cycles' Clamping ({min(clamps):g}) cuts the searchlight's brightening (up to "
+                            f"x{brightest:.3g} ahead): set Light Paths > Clamping to 0")
     if snap.method == "GEOMETRY":
         problem = final_render_problem(scene, snap)
         if snap.speed > 0.0 and problem is not None:

@@ -277,3 +277,21 @@ def test_user_preset_saved_and_loaded(relativity_addon, factory_blender):
     bpy.ops.script.execute_preset(filepath=path, menu_idname="RELATIVITY_MT_shutter_presets")
     assert settings.shutter_model == "FOCUS_SURFACE" and settings.shutter_time == -0.25
     os.remove(path)
+
+
+def test_clamping_warning(relativity_addon, factory_blender):
+    """Cycles clamps samples after the camera's D^4: the panel says so while clamping is on."""
+    bpy = factory_blender
+    scene, camera, sphere = wh.new_scene(bpy)
+    scene.relativity.beta = (0.0, 0.0, -0.8)
+    scene.cycles.sample_clamp_indirect = 10.0
+    scene.cycles.sample_clamp_direct = 0.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    log = draw_panel(bpy, "RELATIVITY_PT_main", scene, camera)
+    warnings = [e[1] for e in log if e[0] == "label" and e[2] == "ERROR"]
+    assert any("Clamping (10)" in warning and "x81" in warning for warning in warnings), warnings
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.frame_set(scene.frame_current)  # the warnings are as of the last sync (the UI's depsgraph update)
+    log = draw_panel(bpy, "RELATIVITY_PT_main", scene, camera)
+    assert not [e for e in log if e[0] == "label" and e[2] == "ERROR" and "Clamping" in e[1]]
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
