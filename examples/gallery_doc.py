@@ -108,8 +108,9 @@ exact camera applies the searchlight's `D^4` to the camera ray's throughput, so 
 light seen ahead is cut: in the street at 0.8c the centre came out 4.5 % darker than `<D^4>` with
 the default clamp (64.64 against 67.71 at 320x240, 16 samples; the same 4.5 % for Chang's `D^1`),
 and within 1 % with no clamping (67.29 against 67.71, Chang's 2.848 against 2.865, same size and
-samples). The gallery renders with both clamps off. The add-on does not change the user's clamp
-settings yet.
+samples). The gallery renders with both clamps off. Since then the add-on scales the clamps by the
+brightest `D^4`, `(gamma (1 + beta))^4`, while the exact camera renders, and gives the user's values
+back on removal (`blender/clamping.py`).
 """
 
 

@@ -22,6 +22,7 @@ from . import (
     animation,
     busy,
     camera,
+    clamping,
     colour,
     geometry,
     lamp_doppler,
@@ -76,11 +77,13 @@ def apply(scene, frame_range=None, objects=None):
         moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
         colour.apply(scene, snap)
         metadata.write(scene, snap)
+        clamping.write(scene, snap)
         lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
     except RelativityError:
         lamp_doppler.remove(scene)
         moving_lights.remove(scene)
         metadata.remove(scene)
+        clamping.remove(scene)
         undo()
         raise
     _record(scene, snap)
@@ -96,6 +99,7 @@ def remove(scene):
     colour.remove(scene)
     moving_lights.remove(scene)
     metadata.remove(scene)
+    clamping.remove(scene)
     lamp_doppler.remove(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
@@ -201,6 +205,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
             moving_lights.write(scene, snap, attach_new_materials, depsgraph)
             colour.write(scene, snap, attach_new_materials)
             metadata.write(scene, snap)
+            clamping.write(scene, snap)
             lamp_doppler.write(scene, snap)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
@@ -254,13 +259,6 @@ def _record(scene, snap):
         if camera_object is not None and camera_object.data.type != "PERSP" \
                 and not camera.is_applied(camera_object.data):
             warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
-    if snap.engine == "CYCLES" and snap.use_searchlight and snap.speed > 0.0:
-        clamping = (scene.cycles.sample_clamp_direct, scene.cycles.sample_clamp_indirect)
-        clamps = [value for value in clamping if value > 0]
-        if clamps:
-            brightest = (snap.gamma * (1.0 + snap.speed)) ** 4
-            warnings.append(f"Cycles' Clamping ({min(clamps):g}) cuts the searchlight's brightening (up to "
-                            f"x{brightest:.3g} ahead): set Light Paths > Clamping to 0")
     if snap.method == "GEOMETRY":
         problem = final_render_problem(scene, snap)
         if snap.speed > 0.0 and problem is not None:

@@ -7,6 +7,7 @@ new layout gets a new version stamp instead.
 
 # --- exact camera ---------------------------------------------------------------------------
 SHADER_TEXT = "relativistic_camera.osl"  # text datablock holding the OSL camera shader
+CLAMP_SAVED_KEY = "relativity_saved_clamping"  # on the scene: the user's Cycles clamps while applied
 STAMP_SAVED_KEY = "relativity_saved_note"  # on the scene: the user's metadata note while the effect is applied
 CAMERA_SAVED_STATE_KEY = "relativity_saved_state"  # on camera data while the OSL camera is applied
 

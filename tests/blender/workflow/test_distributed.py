@@ -118,7 +118,9 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     second writer), every frame ends whole, exit status 0."""
     bpy = factory_blender
     out = tmp_path / "out" / "f.png"
-    common = ("--frames=1-2", "--beta=0,0,-0.5", "--samples=2", *TINY)
+    # Enough samples that Cycles renders for a few seconds (on a busy machine too): the kill must
+    # land while it renders.
+    common = ("--frames=1-2", "--beta=0,0,-0.5", "--samples=256", *TINY)
     command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *common, f"--out={out}", "--workers=2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
     victim = orphan = None
