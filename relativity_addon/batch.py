@@ -100,6 +100,9 @@ def build_parser(with_blend_file):
     parser.add_argument("--velocity-from-animation", action="store_true",
                           help="observer velocity from the active camera's keyframed motion")
     parser.add_argument("--seed", type=int)
+    parser.add_argument("--stereo", choices=STEREO_CHOICES,
+                        help="render Blender's stereo pair (the camera's Stereoscopy settings): one anaglyph or "
+                        "side-by-side image, or the two views as OUT_L and OUT_R")
     parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
                         help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
                         "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
@@ -180,6 +183,30 @@ def _apply_options(scene, options):
         settings.use_lorentz_window = True
 
 
+STEREO_CHOICES = ("anaglyph", "side-by-side", "views")
+
+
+def _stereo_output(scene, mode):
+    """Blender's own stereoscopy (multiview, Stereo 3D), written as one image or as two views."""
+    render = scene.render
+    render.use_multiview = True
+    render.views_format = "STEREO_3D"
+    for view in render.stereo_views:
+        view.use = True
+    image_settings = render.image_settings
+    if mode == "views":
+        image_settings.views_format = "INDIVIDUAL"
+        return
+    image_settings.views_format = "STEREO_3D"
+    image_settings.stereo_3d_format.display_mode = "ANAGLYPH" if mode == "anaglyph" else "SIDEBYSIDE"
+
+
+def view_paths(path):
+    """The files Blender writes for the two views of ``path`` (``--stereo views``)."""
+    stem, extension = os.path.splitext(path)
+    return [f"{stem}_L{extension}", f"{stem}_R{extension}"]
+
+
 def _output_format(scene, out_path):
     extension = os.path.splitext(out_path)[1].lower()
     image_settings = scene.render.image_settings
@@ -252,8 +279,9 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
     scene.render.filepath = path
-    if os.path.exists(path):
-        os.remove(path)
+    for old in [path, *(view_paths(path) if scene.render.use_multiview else [])]:
+        if os.path.exists(old):
+            os.remove(old)
     try:
         if spectral_passes:
             _render_spectral(scene, path, spectral_passes)
@@ -269,8 +297,10 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None):
     if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
         warnings = effect.scene_warnings(scene)
         raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
-    if not os.path.isfile(path):
-        raise BatchError(f"render wrote no file at {path}")
+    views = scene.render.use_multiview and scene.render.image_settings.views_format == "INDIVIDUAL"
+    for written in view_paths(path) if views else [path]:
+        if not os.path.isfile(written):
+            raise BatchError(f"render wrote no file at {written}")
 
 
 def run(argv, log=print):
@@ -304,6 +334,10 @@ def run(argv, log=print):
         scene.render.resolution_x, scene.render.resolution_y = options.resolution
         scene.render.resolution_percentage = 100
     _output_format(scene, out_path)
+    if options.stereo:
+        if options.spectral:
+            raise BatchError("--stereo and --spectral cannot be combined")
+        _stereo_output(scene, options.stereo)
 
     relativistic = not options.reference
     if options.spectral and options.reference:

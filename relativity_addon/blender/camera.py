@@ -55,6 +55,8 @@ REQUIRED_PARAMETERS = (
     "use_geometry",
     "use_searchlight",
     "settings_valid",
+    "use_eye_offset",
+    "camera_origin",
 )
 
 
@@ -115,8 +117,15 @@ def lens_warnings(camera_object):
     if camera_object is None or camera_object.type != "CAMERA" or lens_type(camera_object.data) != "PANO":
         return []
     if camera_object.data.dof.use_dof:
-        return [f"Camera {camera_object.name!r}: the relativistic panorama is a pinhole, depth of field is not rendered"]
+        name = camera_object.name
+        return [f"Camera {name!r}: the relativistic panorama is a pinhole, depth of field is not rendered"]
     return []
+
+
+def stereo_eyes(scene):
+    """Whether the scene renders Blender's stereo pair (each eye offset from the camera)."""
+    render = scene.render
+    return bool(render.use_multiview and render.views_format == "STEREO_3D")
 
 
 def _fitted_sensor(scene, camera_data):
@@ -198,6 +207,8 @@ def shader_parameters(scene, camera_data, snap):
         "use_geometry": snap.use_geometry,
         "use_searchlight": snap.use_searchlight,
         "settings_valid": True,
+        "use_eye_offset": stereo_eyes(scene),
+        "camera_origin": tuple(float(row[3]) for row in snap.camera_matrix[:3]),
         **_projection_parameters(scene, camera_data),
     }
 
@@ -305,6 +316,9 @@ def write(scene, snap):
         name = snap.shutter_model.replace("_", " ").lower()
         raise RelativityError(f"the {name} shutter needs a perspective camera's lens: camera "
                               f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)")
+    if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
+        raise RelativityError(f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
+                              "share one shutter plane; use off-axis or parallel convergence")
     if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
         ensure_shader_text()
         compile_shader(camera_data)

@@ -82,7 +82,7 @@ def expected_centroid(project, camera_rotation, center, radius, camera_location,
 # --- scenes ------------------------------------------------------------------------------
 
 
-def _panorama_scene(bpy, panorama_type, resolution, samples=2, fov=math.radians(180.0)):
+def _panorama_scene(bpy, panorama_type, resolution, samples=2, fov=math.pi):
     scene, camera_object = ch.new_scene(bpy, resolution=resolution, samples=samples,
                                         rotation_euler=CAMERA_ROTATION, location=CAMERA_LOCATION)
     data = camera_object.data
