@@ -17,6 +17,14 @@ GRAY_BETA = np.array([0.1, 0.99, 0.0])  # Gray's (0.1, 0, 0.99) in their axes, w
 SIZE = (200, 150)
 
 
+def _read_png(bpy, path):
+    """Linear RGB of a PNG written with the Standard view transform (sRGB-encoded). The stereo
+    tests write PNG views: Blender 4.5 writes each view's EXR as a multi-view EXR, which its own
+    image loader opens as an empty multilayer image."""
+    encoded = ch.read_image(bpy, path)[:, :, :3].astype(float)
+    return np.where(encoded <= 0.04045, encoded / 12.92, ((encoded + 0.055) / 1.055) ** 2.4)
+
+
 def _eye_event(camera, eye_local, beta_world, ct_shutter):
     """Scene-frame position (world) of the eye's pinhole at camera time t_S, Gray eq. (1) with the
     camera object's origin as the shared origin."""
@@ -56,12 +64,12 @@ def test_vertical_disparity_follows_aberration_per_eye(factory_blender, tmp_path
         markers.append((center, radius))
     blend = ch.save_blend(bpy, tmp_path / "stereo.blend")
     beta = ",".join(f"{b:.17g}" for b in GRAY_BETA)
-    ch.run_render_script(blend, tmp_path / "pair.exr", f"--beta={beta}", "--shutter=pinhole", "--shutter-time=-1",
+    ch.run_render_script(blend, tmp_path / "pair.png", f"--beta={beta}", "--shutter=pinhole", "--shutter-time=-1",
                          "--speed-of-light=1", "--no-searchlight", "--stereo=views")
 
     measured, expected, naive = {}, {}, {}
     for eye, offset in eyes.items():
-        intensity = ch.luminance(ch.read_exr(bpy, tmp_path / f"pair_{eye}.exr"))
+        intensity = ch.luminance(_read_png(bpy, tmp_path / f"pair_{eye}.png"))
         model = _eye_camera(camera, _eye_event(camera, offset, GRAY_BETA, -1.0))
         # The same eye without the shared origin (each eye its own Lorentz origin): what a shader
         # ignoring the eye offset would render; the test must tell the two apart.
@@ -106,10 +114,10 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
     cases = (("rest", "--beta=0,0,0"), ("window", f"--beta={beta}", "--lorentz-window"))
     pairs, anaglyphs = [], []
     for name, *options in cases:
-        ch.run_render_script(blend, tmp_path / f"{name}.exr", *common, *options, "--stereo=views")
-        pairs.append([ch.read_exr(bpy, tmp_path / f"{name}_{eye}.exr") for eye in "LR"])
-        anaglyphs.append(ch.render_image(bpy, blend, tmp_path / f"{name}-anaglyph.exr", *common, *options,
-                                         "--stereo=anaglyph"))
+        ch.run_render_script(blend, tmp_path / f"{name}.png", *common, *options, "--stereo=views")
+        pairs.append([_read_png(bpy, tmp_path / f"{name}_{eye}.png") for eye in "LR"])
+        ch.run_render_script(blend, tmp_path / f"{name}-anaglyph.png", *common, *options, "--stereo=anaglyph")
+        anaglyphs.append(_read_png(bpy, tmp_path / f"{name}-anaglyph.png"))
     (rest_l, rest_r), (window_l, window_r) = pairs
     differences = [np.abs(window_l - rest_l).mean(), np.abs(window_r - rest_r).mean()]
     anaglyph_difference = np.abs(anaglyphs[1] - anaglyphs[0]).mean()
