@@ -1,4 +1,4 @@
-"""Render time of the relativistic panorama against Blender's own panoramic camera.
+"""Render time of the relativistic panorama and stereo pair against Blender's own cameras.
 
     python benchmarks/panorama_overhead.py [--samples 64] [--resolution 320x160] [--repeats 5]
                                            [--types EQUIRECTANGULAR,FISHEYE_EQUISOLID]
@@ -8,7 +8,8 @@ equirectangular one), Cycles on the CPU, same seed. For each panorama type the c
 rendered alternately (Blender's panorama, relativistic at rest, relativistic at 0.5c, then
 again), each round's times divided by that round's Blender time, and the median ratio printed
 next to the median times. At beta = 0 both trace the same rays: the ratio is the camera's own
-cost (target <= 1.10); at speed the view changes, which is not camera overhead.
+cost (target <= 1.10); at speed the view changes, which is not camera overhead. STEREO renders
+the perspective camera's stereo pair (Blender's multiview) both ways.
 """
 
 import argparse
@@ -28,7 +29,8 @@ def main():
     parser.add_argument("--samples", type=int, default=64)
     parser.add_argument("--resolution", default="320x160")
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--types", default="EQUIRECTANGULAR,FISHEYE_EQUISOLID")
+    parser.add_argument("--types", default="EQUIRECTANGULAR,FISHEYE_EQUISOLID,STEREO",
+                        help="panorama types, and STEREO: the perspective camera's stereo pair (multiview)")
     options = parser.parse_args()
     resolution = tuple(int(v) for v in options.resolution.lower().split("x"))
 
@@ -39,13 +41,17 @@ def main():
 
     relativity_addon.register()
     out = tempfile.mkdtemp(prefix="panorama-overhead-")
-    cases = (("Blender panorama", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
+    cases = (("Blender's camera", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
              ("relativistic beta=0.5", (0.0, 0.48, -0.13)))
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
     for panorama_type in options.types.split(","):
         scene = build_scene(bpy, resolution, options.samples)
-        scene.camera.data.type = "PANO"
-        scene.camera.data.panorama_type = panorama_type
+        if panorama_type == "STEREO":
+            scene.render.use_multiview = True
+            scene.render.views_format = "STEREO_3D"
+        else:
+            scene.camera.data.type = "PANO"
+            scene.camera.data.panorama_type = panorama_type
 
         def render(beta, name, scene=scene):
             if beta is None:
@@ -62,7 +68,7 @@ def main():
             for label, beta in cases:
                 times[label].append(render(beta, f"{panorama_type}-{round_index}.png"))
         effect.remove(scene)
-        base = times["Blender panorama"]
+        base = times["Blender's camera"]
         print(f" {panorama_type}:")
         for label, _ in cases:
             ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]

@@ -316,6 +316,9 @@ def write(scene, snap):
         name = snap.shutter_model.replace("_", " ").lower()
         raise RelativityError(f"the {name} shutter needs a perspective camera's lens: camera "
                               f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)")
+    if stereo_eyes(scene) and lens_type(camera_data) == "PANO":
+        raise RelativityError(f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
+                              "are not rendered by the relativistic camera; switch Stereoscopy off")
     if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
         raise RelativityError(f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
                               "share one shutter plane; use off-axis or parallel convergence")

@@ -9,6 +9,7 @@ expected positions come from eqs. (1) and (2) written out in numpy (camera_helpe
 import math
 
 import numpy as np
+import pytest
 
 import camera_helpers as ch
 
@@ -130,3 +131,40 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
     # Blender's anaglyph: red from the left eye, green and blue from the right one.
     assert np.allclose(anaglyphs[0][..., 0], rest_l[..., 0], atol=0.02)
     assert np.allclose(anaglyphs[0][..., 1:], rest_r[..., 1:], atol=0.02)
+
+
+def test_stereo_settings_reach_the_camera_and_toe_in_is_refused(factory_blender):
+    """In-process: the eye-offset parameters follow Blender's stereo settings; toe-in (eyes turned
+    apart) and stereo panoramas (spherical stereo) are refused in one line, the camera restored."""
+    import relativity_addon
+    from relativity_addon.blender import effect
+
+    bpy = factory_blender
+    relativity_addon.register()
+    try:
+        scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1, rotation_euler=ROTATION,
+                                            location=(1.0, -2.0, 0.5))
+        scene.relativity.beta = tuple(0.5 * GRAY_BETA)
+        effect.apply(scene)
+        custom = camera_object.data.cycles_custom
+        assert not custom["use_eye_offset"]
+        scene.render.use_multiview = True
+        scene.render.views_format = "STEREO_3D"
+        effect.sync(scene)
+        assert custom["use_eye_offset"] and custom["settings_valid"]
+        assert tuple(custom["camera_origin"]) == pytest.approx((1.0, -2.0, 0.5))
+        camera_object.data.stereo.convergence_mode = "TOE"
+        effect.sync(scene)
+        assert not custom["settings_valid"]
+        assert any("toe-in" in w for w in effect.scene_warnings(scene))
+        effect.remove(scene)
+        with pytest.raises(effect.RelativityError, match="toe-in"):
+            effect.apply(scene)
+        assert camera_object.data.type == "PERSP"
+        camera_object.data.stereo.convergence_mode = "OFFAXIS"
+        camera_object.data.type = "PANO"
+        with pytest.raises(effect.RelativityError, match="stereo panoramas"):
+            effect.apply(scene)
+        assert camera_object.data.type == "PANO"
+    finally:
+        relativity_addon.unregister()
