@@ -97,6 +97,9 @@ def build_parser(with_blend_file):
     parser.add_argument("--velocity-from-animation", action="store_true",
                           help="observer velocity from the active camera's keyframed motion")
     parser.add_argument("--seed", type=int)
+    parser.add_argument("--stereo", choices=STEREO_CHOICES,
+                        help="render Blender's stereo pair (the camera's Stereoscopy settings): one anaglyph or "
+                        "side-by-side image, or the two views as OUT_L and OUT_R")
     parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
                         help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
                         "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
@@ -196,6 +199,30 @@ def animation_fps(scene):
     return scene.render.fps / scene.render.fps_base
 
 
+STEREO_CHOICES = ("anaglyph", "side-by-side", "views")
+
+
+def _stereo_output(scene, mode):
+    """Blender's own stereoscopy (multiview, Stereo 3D), written as one image or as two views."""
+    render = scene.render
+    render.use_multiview = True
+    render.views_format = "STEREO_3D"
+    for view in render.stereo_views:
+        view.use = True
+    image_settings = render.image_settings
+    if mode == "views":
+        image_settings.views_format = "INDIVIDUAL"
+        return
+    image_settings.views_format = "STEREO_3D"
+    image_settings.stereo_3d_format.display_mode = "ANAGLYPH" if mode == "anaglyph" else "SIDEBYSIDE"
+
+
+def view_paths(path):
+    """The files Blender writes for the two views of ``path`` (``--stereo views``)."""
+    stem, extension = os.path.splitext(path)
+    return [f"{stem}_L{extension}", f"{stem}_R{extension}"]
+
+
 def _output_format(scene, out_path):
     extension = os.path.splitext(out_path)[1].lower()
     image_settings = scene.render.image_settings
@@ -248,9 +275,13 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
         errors = geometry.scene_errors(scene)
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
-    if os.path.exists(path):
-        os.remove(path)
+    views = scene.render.use_multiview and scene.render.image_settings.views_format == "INDIVIDUAL"
+    targets = view_paths(path) if views else [path]
+    for old in targets:
+        if os.path.exists(old):
+            os.remove(old)
     partial = partial_path(path)
+    partials = view_paths(partial) if views else [partial]
     scene.render.filepath = partial
     try:
         try:
@@ -268,12 +299,15 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
         if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
             warnings = effect.scene_warnings(scene)
             raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
-        if not os.path.isfile(partial):
-            raise BatchError(f"render wrote no file at {path}")
-        os.replace(partial, path)
+        for written, target in zip(partials, targets, strict=True):
+            if not os.path.isfile(written):
+                raise BatchError(f"render wrote no file at {target}")
+        for written, target in zip(partials, targets, strict=True):
+            os.replace(written, target)
     finally:
-        if os.path.exists(partial):
-            os.remove(partial)
+        for written in partials:
+            if os.path.exists(written):
+                os.remove(written)
 
 
 def parse(argv):
@@ -317,6 +351,10 @@ def run(argv, log=print):
         scene.render.threads_mode = "FIXED"
         scene.render.threads = options.threads
     _output_format(scene, out_path)
+    if options.stereo:
+        if options.spectral:
+            raise BatchError("--stereo and --spectral cannot be combined")
+        _stereo_output(scene, options.stereo)
 
     relativistic = not options.reference
     if options.spectral and options.reference:

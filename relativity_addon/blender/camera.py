@@ -9,6 +9,14 @@ of the camera data, so :func:`remove` restores it exactly (and undo covers both)
 Coordinate conventions: Cycles' camera shaders use +Z forward, +Y up, +X right. Blender's
 camera object looks down its local -Z with +Y up and +X right, so a vector in the camera's
 local axes maps to shader coordinates as (x, y, -z).
+
+Blender's panoramic cameras (equirectangular, fisheye equidistant and equisolid, mirror ball) go
+through the same shader: it maps the raster position to the camera-frame direction as Blender's
+own panorama does, then Lorentz-transforms the ray like the perspective camera's. A panorama is a
+pinhole: the shutter models that need a thin lens (detector plane, focus surface, fixed-point
+surface) are refused, depth of field is not rendered (a warning). The panorama settings stay on
+the camera data (the same properties in 4.5 and 5.x), and :func:`remove` gives back the camera
+type, so a panoramic camera comes back panoramic.
 """
 
 import os
@@ -26,6 +34,15 @@ REQUIRED_PARAMETERS = (
     "frame_right",
     "frame_bottom",
     "frame_top",
+    "projection",
+    "longitude_min",
+    "longitude_max",
+    "latitude_min",
+    "latitude_max",
+    "fisheye_fov",
+    "fisheye_lens",
+    "sensor_width",
+    "sensor_height",
     "lens_focal_length",
     "aperture_scale",
     "beta",
@@ -38,7 +55,15 @@ REQUIRED_PARAMETERS = (
     "use_geometry",
     "use_searchlight",
     "settings_valid",
+    "use_eye_offset",
+    "camera_origin",
 )
+
+
+# Blender's panorama types the shader renders -> its PROJECTION_* code (0 is the perspective camera).
+PANORAMA_PROJECTIONS = {"EQUIRECTANGULAR": 1, "FISHEYE_EQUIDISTANT": 2, "FISHEYE_EQUISOLID": 3, "MIRRORBALL": 4}
+# Shutter models defined by a thin lens's geometry (detector, focus distance): perspective only.
+LENS_SHUTTERS = ("DETECTOR_PLANE", "FOCUS_SURFACE", "FIXED_POINT_SURFACE")
 
 
 def shader_source():
@@ -65,6 +90,72 @@ def is_applied(camera_data):
 def is_render_only(camera_data):
     """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
     return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
+
+
+def lens_type(camera_data):
+    """The camera's own type (PERSP, PANO, ...): the saved one while the OSL camera is applied."""
+    if is_applied(camera_data):
+        return camera_data[names.CAMERA_SAVED_STATE_KEY]["type"]
+    return camera_data.type
+
+
+def type_problem(camera_name, camera_data):
+    """Why the exact camera cannot replace this camera (one line), or None."""
+    kind = lens_type(camera_data)
+    if kind == "PERSP":
+        return None
+    if kind == "PANO":
+        if camera_data.panorama_type in PANORAMA_PROJECTIONS:
+            return None
+        return (f"camera {camera_name!r} is a {camera_data.panorama_type} panorama: the relativistic camera "
+                "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras")
+    return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
+
+
+def lens_warnings(camera_object):
+    """One-line notes on what the exact camera does not render for this camera."""
+    if camera_object is None or camera_object.type != "CAMERA" or lens_type(camera_object.data) != "PANO":
+        return []
+    if camera_object.data.dof.use_dof:
+        name = camera_object.name
+        return [f"Camera {name!r}: the relativistic panorama is a pinhole, depth of field is not rendered"]
+    return []
+
+
+def stereo_eyes(scene):
+    """Whether the scene renders Blender's stereo pair (each eye offset from the camera)."""
+    render = scene.render
+    return bool(render.use_multiview and render.views_format == "STEREO_3D")
+
+
+def _fitted_sensor(scene, camera_data):
+    """Sensor width and height (mm) as Blender fits them to the image (fisheye equisolid)."""
+    render = scene.render
+    x_ratio = render.resolution_x * render.pixel_aspect_x
+    y_ratio = render.resolution_y * render.pixel_aspect_y
+    fit = camera_data.sensor_fit
+    horizontal = x_ratio > y_ratio if fit == "AUTO" else fit == "HORIZONTAL"
+    size = camera_data.sensor_height if fit == "VERTICAL" else camera_data.sensor_width
+    if horizontal:
+        return size, size * y_ratio / x_ratio
+    return size * x_ratio / y_ratio, size
+
+
+def _projection_parameters(scene, camera_data):
+    kind = lens_type(camera_data)
+    projection = PANORAMA_PROJECTIONS.get(camera_data.panorama_type, 0) if kind == "PANO" else 0
+    sensor_width, sensor_height = _fitted_sensor(scene, camera_data)
+    return {
+        "projection": projection,
+        "longitude_min": camera_data.longitude_min,
+        "longitude_max": camera_data.longitude_max,
+        "latitude_min": camera_data.latitude_min,
+        "latitude_max": camera_data.latitude_max,
+        "fisheye_fov": camera_data.fisheye_fov,
+        "fisheye_lens": camera_data.fisheye_lens,
+        "sensor_width": sensor_width,
+        "sensor_height": sensor_height,
+    }
 
 
 def _local_to_shader(vector):
@@ -117,6 +208,9 @@ def shader_parameters(scene, camera_data, snap):
         "use_searchlight": snap.use_searchlight,
         "exposure": snap.exposure,
         "settings_valid": True,
+        "use_eye_offset": stereo_eyes(scene),
+        "camera_origin": tuple(float(row[3]) for row in snap.camera_matrix[:3]),
+        **_projection_parameters(scene, camera_data),
     }
 
 
@@ -191,11 +285,9 @@ def apply(scene, snap, render_only=False):
     camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
     if not is_applied(camera_data):
-        if camera_data.type != "PERSP":
-            raise RelativityError(
-                f"camera {camera_object.name!r} is {camera_data.type}, "
-                "the relativistic camera replaces a perspective camera only"
-            )
+        problem = type_problem(camera_object.name, camera_data)
+        if problem is not None:
+            raise RelativityError(problem)
         try:
             osl.ensure_oslquery_importable()
         except osl.OSLUnavailableError as error:
@@ -221,6 +313,16 @@ def write(scene, snap):
         raise RelativityError(f"camera {camera_object.name!r} is not the relativistic camera")
     if camera_data.type != "CUSTOM":
         raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
+    if lens_type(camera_data) == "PANO" and snap.shutter_model in LENS_SHUTTERS:
+        name = snap.shutter_model.replace("_", " ").lower()
+        raise RelativityError(f"the {name} shutter needs a perspective camera's lens: camera "
+                              f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)")
+    if stereo_eyes(scene) and lens_type(camera_data) == "PANO":
+        raise RelativityError(f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
+                              "are not rendered by the relativistic camera; switch Stereoscopy off")
+    if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
+        raise RelativityError(f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
+                              "share one shutter plane; use off-axis or parallel convergence")
     if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
         ensure_shader_text()
         compile_shader(camera_data)

@@ -119,10 +119,7 @@ def final_render_problem(scene, snap):
         return "the observer is at rest"
     if snap.engine != "CYCLES":
         return f"the exact camera needs Cycles, not {snap.engine}"
-    camera_data = scene.objects[snap.camera].data
-    if camera_data.type != "PERSP" and not camera.is_render_only(camera_data):
-        return f"camera {snap.camera!r} is {camera_data.type}, the exact camera replaces a perspective camera only"
-    return None
+    return camera.type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
 def begin_final_render(scene):
@@ -256,9 +253,11 @@ def _record(scene, snap):
         warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
     if snap.method == "CAMERA":
         camera_object = scene.objects.get(snap.camera)
-        if camera_object is not None and camera_object.data.type != "PERSP" \
-                and not camera.is_applied(camera_object.data):
-            warnings.append(f"Camera {camera_object.name!r} is not a perspective camera")
+        problem = camera_object and camera.type_problem(camera_object.name, camera_object.data)
+        if problem:
+            warnings.append(problem[0].upper() + problem[1:])
+    if snap.exact_camera:
+        warnings += camera.lens_warnings(scene.objects.get(snap.camera))
     if snap.method == "GEOMETRY":
         problem = final_render_problem(scene, snap)
         if snap.speed > 0.0 and problem is not None:

@@ -220,7 +220,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
             path = next(os.path.join(d, name) for d in directories if os.path.isfile(os.path.join(d, name)))
             assert bpy.ops.script.execute_preset(filepath=path, menu_idname=menu) == {"FINISHED"}, name
     assert found["speed"] == ["0.5c.py", "0.8c.py", "0.999c.py", "0.99c.py", "0.9c.py"]
-    assert len(found["shutter"]) == 5 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 6
+    assert len(found["shutter"]) == 5 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 7
 
     rotation = np.array(camera.matrix_world.to_quaternion().to_matrix())
 
@@ -244,6 +244,14 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     normal = np.array(settings.shutter_plane_normal)
     np.testing.assert_allclose(normal / np.linalg.norm(normal), beta_local / np.linalg.norm(beta_local), atol=1e-6)
     assert settings.use_lorentz_window and settings.shutter_model == "ARBITRARY_PLANE"
+    # Fig. 11: the same with Blender's stereo pair, eyes 0.4 apart converging at 5, as an anaglyph.
+    load("paper_setups", "Gray_2020_Fig_11_stereo_Lorentz_window.py")
+    np.testing.assert_allclose(beta_local, rotation.T @ np.array(settings.beta), atol=1e-6)
+    stereo = camera.data.stereo
+    assert (stereo.convergence_mode, stereo.interocular_distance, stereo.convergence_distance) == \
+        ("OFFAXIS", pytest.approx(0.4), pytest.approx(5.0))
+    assert scene.render.use_multiview and scene.render.views_format == "STEREO_3D"
+    assert scene.render.image_settings.stereo_3d_format.display_mode == "ANAGLYPH"
 
     load("paper_setups", "Weiskopf_1999_Fig_8_Sun_0.5c_Doppler.py")
     np.testing.assert_allclose(tuple(settings.beta), 0.5 * right, atol=1e-6)
