@@ -57,13 +57,7 @@ def _scene(bpy, beta=BETA, samples=16, temperature=None):
     camera.data.sensor_fit = "HORIZONTAL"
     scene.cycles.pixel_filter_type = "BOX"
     scene.cycles.max_bounces = 0
-    material = bpy.data.materials.new("Grey")
-    tree = compat.material_node_tree(material)
-    tree.nodes.clear()
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (ALBEDO, ALBEDO, ALBEDO, 1.0)
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(diffuse.outputs[0], output.inputs["Surface"])
+    material = ch.diffuse_material(bpy, "Grey", (ALBEDO, ALBEDO, ALBEDO))
     mesh = bpy.data.meshes.new("Cube")
     corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]

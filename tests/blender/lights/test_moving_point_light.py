@@ -52,13 +52,7 @@ def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA", ki
     camera.data.lens = 25.0  # the floor from x = -3.6 to 3.6 in view
     scene.cycles.pixel_filter_type = "BOX"
     scene.cycles.filter_width = 1.0
-    material = bpy.data.materials.new("White")
-    tree = compat.material_node_tree(material)
-    tree.nodes.clear()
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (ALBEDO, ALBEDO, ALBEDO, 1.0)
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(diffuse.outputs[0], output.inputs["Surface"])
+    material = ch.diffuse_material(bpy, "White", (ALBEDO, ALBEDO, ALBEDO))
     _quad(bpy, scene, "Floor", (0.0, 0.0, 0.0), 100.0, material)
     if occluder:
         black = bpy.data.materials.new("Black")
