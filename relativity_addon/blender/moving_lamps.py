@@ -27,7 +27,7 @@ from mathutils import Vector
 from ..errors import RelativityError
 from ..physics.lorentz import aberrate, camera_to_scene_direction
 from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
-from . import animation, names
+from . import animation, names, snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
@@ -47,11 +47,7 @@ def _shader_text():
 def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
     camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame)."""
-    camera = scene.objects[snap.camera]
-    corners = np.array([tuple(corner) for corner in camera.data.view_frame(scene=scene)])  # local, z < 0
-    depth = -corners[0, 2]
-    left, right = corners[:, 0].min() / depth, corners[:, 0].max() / depth
-    bottom, top = corners[:, 1].min() / depth, corners[:, 1].max() / depth
+    left, right, bottom, top = snapshot.view_window(scene, scene.objects[snap.camera])
     widen_x, widen_y = margin * (right - left), margin * (top - bottom)
     x = np.linspace(left - widen_x, right + widen_x, columns)
     y = np.linspace(bottom - widen_y, top + widen_y, rows)

@@ -102,9 +102,7 @@ class Snapshot:
     @property
     def world_to_camera(self) -> np.ndarray:
         """Rotation ``(3, 3)`` taking world vectors to camera axes (scale and shear removed)."""
-        linear = np.array([row[:3] for row in self.camera_matrix[:3]], dtype=np.float64)
-        u, _, vt = np.linalg.svd(linear)  # nearest rotation (polar decomposition)
-        return (u @ vt).T
+        return world_to_camera(np.array(self.camera_matrix, dtype=np.float64))
 
     @property
     def beta_camera(self) -> np.ndarray:
@@ -343,13 +341,18 @@ def view_window(scene, camera):
     return min(xs), max(xs), min(ys), max(ys)
 
 
+def world_to_camera(camera_matrix):
+    """Rotation ``(3, 3)`` taking world vectors to the axes of a camera with world matrix
+    ``camera_matrix`` (4x4): the nearest rotation (polar decomposition), scale and shear removed."""
+    u, _, vt = np.linalg.svd(np.asarray(camera_matrix, dtype=np.float64)[:3, :3])
+    return (u @ vt).T
+
+
 def frame_exposure(scene, camera, settings, beta, camera_matrix):
     """The exposure factor of the frame (``physics.exposure.compensation``; 1 when FIXED)."""
     if settings.exposure_mode != "COMPENSATED" or not any(beta):
         return 1.0
-    linear = camera_matrix[:3, :3]
-    u, _, vt = np.linalg.svd(linear)
-    beta_camera = (u @ vt).T @ np.array(beta)
+    beta_camera = world_to_camera(camera_matrix) @ np.array(beta)
     aberration = settings.use_geometry and not settings.use_lorentz_window
     power = 1.0 if settings.use_chang_searchlight else 4.0
     return exposure.compensation(beta_camera, view_window(scene, camera), aberration, power)

@@ -121,17 +121,6 @@ CASES = [
 # --- the scene --------------------------------------------------------------------------------
 
 
-def _diffuse_material(bpy, name, colour):
-    material = bpy.data.materials.new(name)
-    tree = wh.compat.material_node_tree(material)
-    tree.nodes.clear()
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (*colour, 1.0)
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(diffuse.outputs[0], output.inputs["Surface"])
-    return material
-
-
 def _emitter(bpy, name, colour, strength=1.0):
     material = ch.emission_material(bpy, name, strength=strength)
     material.node_tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
@@ -183,7 +172,7 @@ def build_scene(bpy, method, scene_settings, object_settings):
     mesh = bpy.data.meshes.new("Floor")
     mesh.from_pydata([(-4.0, -1.2, -1.5), (4.0, -1.2, -1.5), (4.0, -1.2, -11.0), (-4.0, -1.2, -11.0)], [],
                      [(0, 1, 2, 3)])
-    mesh.materials.append(_diffuse_material(bpy, "Floor", (0.8, 0.8, 0.8)))
+    mesh.materials.append(ch.diffuse_material(bpy, "Floor", (0.8, 0.8, 0.8)))
     floor = bpy.data.objects.new("Floor", mesh)
     scene.collection.objects.link(floor)
 
