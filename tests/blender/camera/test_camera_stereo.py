@@ -120,6 +120,12 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
         ch.run_render_script(blend, tmp_path / f"{name}-anaglyph.png", *common, *options, "--stereo=anaglyph")
         anaglyphs.append(_read_png(bpy, tmp_path / f"{name}-anaglyph.png"))
     (rest_l, rest_r), (window_l, window_r) = pairs
+    # Side by side (not squeezed): the left view, then the right one, in one image twice as wide.
+    ch.run_render_script(blend, tmp_path / "window-sbs.png", *common, *cases[1][1:], "--stereo=side-by-side")
+    side_by_side = _read_png(bpy, tmp_path / "window-sbs.png")
+    assert side_by_side.shape[1] == 2 * window_l.shape[1]
+    halves = np.split(side_by_side, 2, axis=1)
+    assert np.abs(halves[0] - window_l).max() < 0.01 and np.abs(halves[1] - window_r).max() < 0.01
     differences = [np.abs(window_l - rest_l).mean(), np.abs(window_r - rest_r).mean()]
     anaglyph_difference = np.abs(anaglyphs[1] - anaglyphs[0]).mean()
     parallax = np.abs(rest_l - rest_r).mean()
