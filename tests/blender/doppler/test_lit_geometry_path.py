@@ -98,3 +98,24 @@ def test_final_render_restores_the_preview(relativity_addon, tmp_path):
     after = positions()
     assert np.allclose(after, before, atol=1e-5), "the preview's boosted meshes are back"
     assert np.abs(after[:, 2] + 6.0).max() > 0.1, "the preview meshes are boosted, not at rest (z = -6)"
+
+
+def test_panoramic_final_render_matches_the_exact_camera(relativity_addon, tmp_path):
+    """With Blender's equirectangular camera the final render goes through the exact panorama too:
+    it equals the exact camera's render of the same scene, the preview does not, and the camera is
+    the user's panorama again afterwards."""
+    bpy = __import__("bpy")
+    scene = _pool_scene(bpy)
+    scene.render.resolution_x, scene.render.resolution_y = 128, 64
+    scene.camera.data.type = "PANO"
+    scene.camera.data.panorama_type = "EQUIRECTANGULAR"
+    exact = _render(bpy, scene, "CAMERA", tmp_path)
+    mesh = _render(bpy, scene, "GEOMETRY", tmp_path)
+    preview = _render(bpy, scene, "GEOMETRY", tmp_path, "PREVIEW")
+    assert (scene.camera.data.type, scene.camera.data.panorama_type) == ("PANO", "EQUIRECTANGULAR")
+    level = exact.mean()
+    difference, preview_difference = np.abs(mesh - exact).mean() / level, np.abs(preview - exact).mean() / level
+    print(f"equirectangular: mean |Apparent Geometry - exact| / mean {difference:.4f}, preview {preview_difference:.3f}")
+    assert level > 1e-3, "the pool must be in the panorama"
+    assert difference < 0.02
+    assert preview_difference > 0.2, "the preview lights the meshes where they appear: it must differ"
