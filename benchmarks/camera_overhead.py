@@ -53,6 +53,35 @@ def timed_render(bpy, scene, path):
     return time.perf_counter() - start
 
 
+def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
+    """Renders ``cases`` ((label, beta or None for Blender's own camera), the first one the
+    reference) alternately ``repeats`` times after one warm-up round (shader compilation, kernel
+    loading, caches) and prints each case's median time and its median ratio to the reference's
+    time of the same round."""
+    from relativity_addon.blender import effect
+
+    def render(beta, name):
+        if beta is None:
+            effect.remove(scene)
+        else:
+            scene.relativity.beta = beta
+            effect.apply(scene)
+        return timed_render(bpy, scene, os.path.join(out, prefix + name))
+
+    for _, beta in cases:
+        render(beta, "warmup.png")
+    times = {label: [] for label, _ in cases}
+    for round_index in range(repeats):
+        for label, beta in cases:
+            times[label].append(render(beta, f"{round_index}.png"))
+    effect.remove(scene)
+    base = times[cases[0][0]]
+    for label, _ in cases:
+        ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
+        print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
+              f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=128)
@@ -64,34 +93,15 @@ def main():
     import bpy
 
     import relativity_addon
-    from relativity_addon.blender import effect
 
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
     out = tempfile.mkdtemp(prefix="camera-overhead-")
     cases = (("perspective", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
              ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)))
-
-    def render(beta, name):
-        if beta is None:
-            effect.remove(scene)
-        else:
-            scene.relativity.beta = beta
-            effect.apply(scene)
-        return timed_render(bpy, scene, os.path.join(out, name))
-
-    for _, beta in cases:  # warm-up: shader compilation, kernel loading, caches
-        render(beta, "warmup.png")
-    times = {label: [] for label, _ in cases}
-    for round_index in range(options.repeats):
-        for label, beta in cases:
-            times[label].append(render(beta, f"{round_index}.png"))
-    base = times["perspective"]
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
-    for label, _ in cases:
-        ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
-        print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
-              f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
+    compare_cameras(bpy, scene, cases, options.repeats, out)
+
 
 if __name__ == "__main__":
     from relativity_addon.blender import compat

@@ -14,14 +14,13 @@ the perspective camera's stereo pair (Blender's multiview) both ways.
 
 import argparse
 import os
-import statistics
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from camera_overhead import build_scene, timed_render  # noqa: E402
+from camera_overhead import build_scene, compare_cameras  # noqa: E402
 
 
 def main():
@@ -37,7 +36,6 @@ def main():
     import bpy
 
     import relativity_addon
-    from relativity_addon.blender import effect
 
     relativity_addon.register()
     out = tempfile.mkdtemp(prefix="panorama-overhead-")
@@ -52,28 +50,8 @@ def main():
         else:
             scene.camera.data.type = "PANO"
             scene.camera.data.panorama_type = panorama_type
-
-        def render(beta, name, scene=scene):
-            if beta is None:
-                effect.remove(scene)
-            else:
-                scene.relativity.beta = beta
-                effect.apply(scene)
-            return timed_render(bpy, scene, os.path.join(out, name))
-
-        for _, beta in cases:  # warm-up: shader compilation, kernel loading, caches
-            render(beta, "warmup.png")
-        times = {label: [] for label, _ in cases}
-        for round_index in range(options.repeats):
-            for label, beta in cases:
-                times[label].append(render(beta, f"{panorama_type}-{round_index}.png"))
-        effect.remove(scene)
-        base = times["Blender's camera"]
         print(f" {panorama_type}:")
-        for label, _ in cases:
-            ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
-            print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
-                  f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
+        compare_cameras(bpy, scene, cases, options.repeats, out, prefix=f"{panorama_type}-")
 
 
 if __name__ == "__main__":
