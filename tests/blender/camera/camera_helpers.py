@@ -113,7 +113,13 @@ def expected_sphere_centroid(camera, center, radius, beta, samples=720):
     to a closed curve; the centroid of the enclosed polygon is what an emission-only sphere's
     intensity-weighted centroid measures (without searchlight).
     """
-    to_center = np.asarray(center, float) - camera.location
+    return aberrated_outline_centroid(camera.project_direction, camera.location, center, radius, beta, samples)
+
+
+def aberrated_outline_centroid(project, location, center, radius, beta, samples=720):
+    """Area centroid (pixels) of the sphere's cone of rays from ``location``, aberrated by ``beta``
+    and mapped to pixels by ``project`` (a world-axes viewing direction -> pixel)."""
+    to_center = np.asarray(center, float) - location
     distance = np.linalg.norm(to_center)
     axis = to_center / distance
     half_angle = math.asin(radius / distance)
@@ -122,9 +128,8 @@ def expected_sphere_centroid(camera, center, radius, beta, samples=720):
     points = []
     for phi in np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False):
         view = math.cos(half_angle) * axis + math.sin(half_angle) * (math.cos(phi) * e1 + math.sin(phi) * e2)
-        k = -view
-        view_camera = -normalized(aberrate(k, beta))
-        points.append(camera.project_direction(view_camera))
+        view_camera = -normalized(aberrate(-view, beta))
+        points.append(project(view_camera))
     polygon = np.array(points)
     x, y = polygon[:, 0], polygon[:, 1]
     xn, yn = np.roll(x, -1), np.roll(y, -1)

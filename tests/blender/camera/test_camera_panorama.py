@@ -60,26 +60,8 @@ def equidistant_direction(px, py, size, fov):
 
 def expected_centroid(project, camera_rotation, center, radius, camera_location, beta, samples=360):
     """Area centroid (pixels) of a sphere's image: its cone of rays, aberrated, projected."""
-    to_center = np.asarray(center, float) - camera_location
-    distance = np.linalg.norm(to_center)
-    axis = to_center / distance
-    half_angle = math.asin(radius / distance)
-    e1 = ch.normalized(np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0]))
-    e2 = np.cross(axis, e1)
-    points = []
-    for phi in np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False):
-        view = math.cos(half_angle) * axis + math.sin(half_angle) * (math.cos(phi) * e1 + math.sin(phi) * e2)
-        view_camera = -ch.normalized(ch.aberrate(-view, beta))
-        points.append(project(camera_rotation.T @ view_camera))
-    polygon = np.array(points)
-    x, y = polygon[:, 0], polygon[:, 1]
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    cross = x * yn - xn * y
-    area = cross.sum() / 2.0
-    return np.array([((x + xn) * cross).sum() / (6.0 * area), ((y + yn) * cross).sum() / (6.0 * area)])
-
-
-# --- scenes ------------------------------------------------------------------------------
+    return ch.aberrated_outline_centroid(lambda view: project(camera_rotation.T @ view), camera_location,
+                                         center, radius, beta, samples)
 
 
 def _panorama_scene(bpy, panorama_type, resolution, samples=2, fov=math.pi):

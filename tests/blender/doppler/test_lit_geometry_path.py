@@ -115,7 +115,8 @@ def test_panoramic_final_render_matches_the_exact_camera(relativity_addon, tmp_p
     assert (scene.camera.data.type, scene.camera.data.panorama_type) == ("PANO", "EQUIRECTANGULAR")
     level = exact.mean()
     difference, preview_difference = np.abs(mesh - exact).mean() / level, np.abs(preview - exact).mean() / level
-    print(f"equirectangular: mean |Apparent Geometry - exact| / mean {difference:.4f}, preview {preview_difference:.3f}")
+    print(f"equirectangular: mean |Apparent Geometry - exact| / mean {difference:.4f}, "
+          f"preview {preview_difference:.3f}")
     assert level > 1e-3, "the pool must be in the panorama"
     assert difference < 0.02
     assert preview_difference > 0.2, "the preview lights the meshes where they appear: it must differ"
