@@ -212,7 +212,7 @@ def suns(images, contexts):
 def sphere_arrays(images, contexts):
     out, radii = {}, {}
     for name in ("gray_fig3b_aperture_plane", "gray_fig4_aperture_plane_huge", "gray_fig5_detector_plane",
-                 "gray_fig7_focus_surface"):
+                 "gray_fig6b_phase_hologram", "gray_fig7_focus_surface"):
         if name not in images:
             continue
         context = contexts[name]
@@ -232,9 +232,10 @@ def sphere_arrays(images, contexts):
             "spot centroid to grid pixel, max (px)": max(offsets),
             "spot centroid to grid pixel, median (px)": np.median(offsets),
         }
-    if "gray_fig4_aperture_plane_huge" in radii and "gray_fig5_detector_plane" in radii:
-        ratio = np.nanmedian(radii["gray_fig4_aperture_plane_huge"] / radii["gray_fig5_detector_plane"])
-        out["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] = ratio
+    for name in ("gray_fig4_aperture_plane_huge", "gray_fig6b_phase_hologram"):
+        if name in radii and "gray_fig5_detector_plane" in radii:
+            ratio = np.nanmedian(radii[name] / radii["gray_fig5_detector_plane"])
+            out[name]["RMS radius / Fig. 5's (same aperture 0.2), median"] = ratio
     return out
 
 
@@ -276,13 +277,83 @@ def cylinders(images, contexts):
         "mean |Fig. 8(b) - Fig. 8(a)|, whole image": np.abs(moving - rest).mean()}}
 
 
+def window_residual_pixels(context, pixels):
+    """Where Fig. 9(a) shows the backdrop points that Fig. 10's ``pixels`` (n, 2) see: the chief
+    rays of the detector-plane shutter (ideal lens) through the Lorentz window, from the physics
+    core (``shutter.lens_time``, ``shutter.lorentz_window_ray``), met with the backdrop plane."""
+    from gallery_scenes import BACKDROP_DEPTH, GRAY_BETA, PORTRAIT_FOCUS, PORTRAIT_LENS_MM
+
+    from relativity_addon.physics.shutter import fixed_point_plane, lens_time, lorentz_window_ray
+
+    left, right, bottom, top = context["window"]
+    width, height = context["size"]
+    pixels = np.asarray(pixels, float)
+    view = np.stack([left + pixels[:, 0] / width * (right - left), top - pixels[:, 1] / height * (top - bottom),
+                     -np.ones(len(pixels))], axis=-1)
+    object_points = view * PORTRAIT_FOCUS
+    image_distance = 1.0 / (1.0 / (PORTRAIT_LENS_MM * 1e-3) - 1.0 / PORTRAIT_FOCUS)
+    lens = np.zeros_like(object_points)
+    t_lens = lens_time("DETECTOR_PLANE", lens, object_points, c=1.0, shutter_time=context["shutter_time"],
+                       detector_point=-object_points * (image_distance / PORTRAIT_FOCUS))
+    window_point, window_normal = fixed_point_plane(context["window_time"], GRAY_BETA, 1.0)
+    _, origin, forward = lorentz_window_ray(lens, object_points, t_lens, GRAY_BETA, 1.0, window_point, window_normal)
+    backdrop = origin - forward * ((origin[:, 2] + BACKDROP_DEPTH) / forward[:, 2])[:, None]
+    return np.array([project(context, point) for point in backdrop])
+
+
+def match_shift(moved, rest, pixel, half, search):
+    """The shift s (pixels) for which ``rest`` around ``pixel + s`` best matches ``moved`` around
+    ``pixel`` (least squares over whole-pixel shifts, refined by a parabola through the minimum)."""
+    c0, r0 = int(round(pixel[0])), int(round(pixel[1]))
+    patch = moved[r0 - half:r0 + half + 1, c0 - half:c0 + half + 1]
+    height, width = rest.shape
+    costs = np.full((2 * search + 1, 2 * search + 1), np.inf)
+    for dy in range(-search, search + 1):
+        for dx in range(-search, search + 1):
+            r, c = r0 + dy, c0 + dx
+            if half <= r < height - half and half <= c < width - half:
+                window = rest[r - half:r + half + 1, c - half:c + half + 1]
+                costs[dy + search, dx + search] = ((window - patch) ** 2).sum()
+    iy, ix = np.unravel_index(np.argmin(costs), costs.shape)
+    shift = np.array([ix, iy], float) - search
+    for axis, index in ((0, ix), (1, iy)):
+        if 0 < index < 2 * search:
+            line = costs[iy, index - 1:index + 2] if axis == 0 else costs[index - 1:index + 2, ix]
+            if np.all(np.isfinite(line)) and line[0] + line[2] - 2 * line[1] > 0:
+                shift[axis] += 0.5 * (line[0] - line[2]) / (line[0] + line[2] - 2 * line[1])
+    return shift
+
+
 def portrait(images, contexts):
     rest = images.get("gray_fig9a_rest")
     out = {}
-    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window"):
+    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"):
         if rest is not None and name in images:
             out[name] = {"mean |image - Fig. 9(a)|": np.abs(images[name] - rest).mean(),
                          "mean of Fig. 9(a)": rest.mean()}
+    name = "gray_fig10_window_detector_plane"
+    if name in out:
+        # The backdrop beside the portrait, at the left and right edges (top, middle, bottom):
+        # how far Fig. 10 shows it from where Fig. 9(a) does, against the physics core.
+        context = contexts[name]
+        width, height = context["size"]
+        half, search = max(2, round(12 * width / 320)), max(3, round(24 * width / 320))
+        y_rest, y_moved = luminance(rest), luminance(images[name])
+        errors = []
+        for fx in (0.1, 0.9):
+            for fy in (0.2, 0.5, 0.8):
+                pixel = np.array([fx * width, fy * height])
+                measured = match_shift(y_moved, y_rest, pixel, half, search)
+                # the patch's mean predicted shift (the shift grows fast toward the edge)
+                ys, xs = np.mgrid[-half:half + 1, -half:half + 1]
+                patch = np.stack([xs.ravel(), ys.ravel()], axis=-1) + np.round(pixel) + 0.5
+                predicted = (window_residual_pixels(context, patch) - patch).mean(axis=0)
+                errors.append(np.linalg.norm(measured - predicted))
+                if fy == 0.5:
+                    side = "left" if fx < 0.5 else "right"
+                    out[name][f"backdrop shift, {side} edge, measured (px)"] = np.linalg.norm(measured)
+                    out[name][f"backdrop shift, {side} edge, physics core (px)"] = np.linalg.norm(predicted)
+        out[name]["measured - physics core, max over 6 edge patches (px)"] = max(errors)
     return out
 
 
