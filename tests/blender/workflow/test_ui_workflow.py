@@ -261,6 +261,10 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     fig10_lens_time = lens_time("DETECTOR_PLANE", np.zeros(3), np.array([0.0, 0.0, -1e3]), c=1.0,
                                 shutter_time=settings.shutter_time, detector_point=np.array([0.0, 0.0, image_distance]))
     assert fig10_lens_time == pytest.approx(fig9_lens_time, abs=1e-6)
+    # The shutter panel shows the lens for the detector plane and the window's settings.
+    shown = [entry[1] for entry in draw_panel(bpy, "RELATIVITY_PT_shutter", scene) if entry[0] == "prop"]
+    assert shown == ["shutter_model", "shutter_time", "imaging_element", "use_lorentz_window",
+                     "lorentz_window_shutter", "lorentz_window_time"]
     # Fig. 11: the same with Blender's stereo pair, eyes 0.4 apart converging at 5, as an anaglyph.
     load("paper_setups", "Gray_2020_Fig_11_stereo_Lorentz_window.py")
     np.testing.assert_allclose(beta_local, rotation.T @ np.array(settings.beta), atol=1e-6)
