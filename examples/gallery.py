@@ -46,12 +46,14 @@ FIGURES = {
     "gray_fig3b_aperture_plane": (gs.sphere_array, ("APERTURE_PLANE", 0.05), 1.0),
     "gray_fig4_aperture_plane_huge": (gs.sphere_array, ("APERTURE_PLANE", 0.2), 1.0),
     "gray_fig5_detector_plane": (gs.sphere_array, ("DETECTOR_PLANE", 0.2), 1.0),
+    "gray_fig6b_phase_hologram": (gs.sphere_array, ("DETECTOR_PLANE", 0.2, "PHASE_HOLOGRAM"), 1.0),
     "gray_fig7_focus_surface": (gs.sphere_array, ("FOCUS_SURFACE", 0.05), 1.0),
     "gray_fig8a_rest": (gs.cylinders, (False,), 0.0),
     "gray_fig8b_fixed_point_surface": (gs.cylinders, (True,), 0.0),
     "gray_fig9a_rest": (gs.portrait, ("REST",), 0.0),
     "gray_fig9b_moving": (gs.portrait, ("MOVING",), 0.0),
     "gray_fig9c_lorentz_window": (gs.portrait, ("WINDOW",), 0.0),
+    "gray_fig10_window_detector_plane": (gs.portrait, ("WINDOW_DETECTOR",), 0.0),
 }
 
 

@@ -212,7 +212,7 @@ def suns(images, contexts):
 def sphere_arrays(images, contexts):
     out, radii = {}, {}
     for name in ("gray_fig3b_aperture_plane", "gray_fig4_aperture_plane_huge", "gray_fig5_detector_plane",
-                 "gray_fig7_focus_surface"):
+                 "gray_fig6b_phase_hologram", "gray_fig7_focus_surface"):
         if name not in images:
             continue
         context = contexts[name]
@@ -232,9 +232,10 @@ def sphere_arrays(images, contexts):
             "spot centroid to grid pixel, max (px)": max(offsets),
             "spot centroid to grid pixel, median (px)": np.median(offsets),
         }
-    if "gray_fig4_aperture_plane_huge" in radii and "gray_fig5_detector_plane" in radii:
-        ratio = np.nanmedian(radii["gray_fig4_aperture_plane_huge"] / radii["gray_fig5_detector_plane"])
-        out["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] = ratio
+    for name in ("gray_fig4_aperture_plane_huge", "gray_fig6b_phase_hologram"):
+        if name in radii and "gray_fig5_detector_plane" in radii:
+            ratio = np.nanmedian(radii[name] / radii["gray_fig5_detector_plane"])
+            out[name]["RMS radius / Fig. 5's (same aperture 0.2), median"] = ratio
     return out
 
 
@@ -276,13 +277,73 @@ def cylinders(images, contexts):
         "mean |Fig. 8(b) - Fig. 8(a)|, whole image": np.abs(moving - rest).mean()}}
 
 
+def window_residual_pixels(context, pixels):
+    """Where Fig. 9(a) shows the backdrop points that Fig. 10's ``pixels`` (n, 2) see: the chief
+    rays of the detector-plane shutter (ideal lens) through the Lorentz window, from the physics
+    core (``shutter.lens_time``, ``shutter.lorentz_window_ray``), met with the backdrop plane."""
+    from gallery_scenes import BACKDROP_DEPTH, GRAY_BETA, PORTRAIT_FOCUS, PORTRAIT_LENS_MM
+
+    from relativity_addon.physics.shutter import fixed_point_plane, lens_time, lorentz_window_ray
+
+    left, right, bottom, top = context["window"]
+    width, height = context["size"]
+    pixels = np.asarray(pixels, float)
+    view = np.stack([left + pixels[:, 0] / width * (right - left), top - pixels[:, 1] / height * (top - bottom),
+                     -np.ones(len(pixels))], axis=-1)
+    object_points = view * PORTRAIT_FOCUS
+    image_distance = 1.0 / (1.0 / (PORTRAIT_LENS_MM * 1e-3) - 1.0 / PORTRAIT_FOCUS)
+    lens = np.zeros_like(object_points)
+    t_lens = lens_time("DETECTOR_PLANE", lens, object_points, c=1.0, shutter_time=context["shutter_time"],
+                       detector_point=-object_points * (image_distance / PORTRAIT_FOCUS))
+    window_point, window_normal = fixed_point_plane(context["window_time"], GRAY_BETA, 1.0)
+    _, origin, forward = lorentz_window_ray(lens, object_points, t_lens, GRAY_BETA, 1.0, window_point, window_normal)
+    backdrop = origin - forward * ((origin[:, 2] + BACKDROP_DEPTH) / forward[:, 2])[:, None]
+    u, v = backdrop[:, 0] / -backdrop[:, 2], backdrop[:, 1] / -backdrop[:, 2]
+    return np.stack([(u - left) / (right - left) * width, (top - v) / (top - bottom) * height], axis=-1)
+
+
+def bilinear(image, pixels):
+    """``image`` sampled at pixel coordinates (n, 2) (pixel centres at i + 0.5), edges clamped."""
+    height, width = image.shape
+    x = np.clip(pixels[:, 0] - 0.5, 0.0, width - 1.0)
+    y = np.clip(pixels[:, 1] - 0.5, 0.0, height - 1.0)
+    x0, y0 = np.minimum(x.astype(int), width - 2), np.minimum(y.astype(int), height - 2)
+    fx, fy = x - x0, y - y0
+    top = image[y0, x0] * (1 - fx) + image[y0, x0 + 1] * fx
+    bottom = image[y0 + 1, x0] * (1 - fx) + image[y0 + 1, x0 + 1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
 def portrait(images, contexts):
     rest = images.get("gray_fig9a_rest")
     out = {}
-    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window"):
+    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"):
         if rest is not None and name in images:
             out[name] = {"mean |image - Fig. 9(a)|": np.abs(images[name] - rest).mean(),
                          "mean of Fig. 9(a)": rest.mean()}
+    name = "gray_fig10_window_detector_plane"
+    if name in out:
+        # The backdrop in the strips beside the portrait (outer 15 % of the width): Fig. 10 against
+        # Fig. 9(a) as it is, and against Fig. 9(a) moved by the physics core's window rays (each
+        # pixel shows what Fig. 9(a) shows where its ray meets the backdrop)
+        context = contexts[name]
+        width, height = context["size"]
+        y_rest, y_moved = luminance(rest), luminance(images[name])
+        rows, columns = np.mgrid[0:height, 0:width]
+        strip = (columns < 0.15 * width) | (columns >= 0.85 * width)
+        pixels = np.stack([columns[strip], rows[strip]], axis=-1) + 0.5
+        source = window_residual_pixels(context, pixels)
+        shift = np.linalg.norm(source - pixels, axis=1)
+        # only where Fig. 9(a) shows the point (not beyond its edge)
+        inside = np.all((source >= 1.0) & (source <= np.array([width, height]) - 1.0), axis=1)
+        moved_rest = bilinear(y_rest, source[inside])
+        seen = y_moved[strip][inside]
+        left = pixels[:, 0] < width / 2
+        values = out[name]
+        values["backdrop shift by the physics core, left strip, max (px)"] = shift[left].max()
+        values["backdrop shift by the physics core, right strip, max (px)"] = shift[~left].max()
+        values["strips: mean |Fig. 10 - Fig. 9(a)|"] = np.abs(seen - y_rest[strip][inside]).mean()
+        values["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"] = np.abs(seen - moved_rest).mean()
     return out
 
 

@@ -219,9 +219,10 @@ def detector_shutter_time():
     return 1.0 / (1.0 / (GRAY_LENS_MM * 1e-3) - 1.0 / GRAY_FOCUS)
 
 
-def sphere_array(scene, model, aperture_radius):
+def sphere_array(scene, model, aperture_radius, imaging_element="IDEAL_LENS"):
     """Gray's 9 x 9 array of small white spheres on the scene-frame surface the moving camera
-    (shutter ``model``) focuses on the camera-frame plane at distance 10."""
+    (shutter ``model``) focuses on the camera-frame plane at distance 10. The phase hologram
+    (Fig. 6b) gives the chief rays the ideal lens's times, so the spheres stay where they are."""
     world(scene, (0.0, 0.0, 0.0), 0.0)
     # Shutter times as Gray's: the axial chief ray passes the lens at t = 0 (Figs. 5-7)
     shutter_time = {"DETECTOR_PLANE": detector_shutter_time(), "FOCUS_SURFACE": -GRAY_FOCUS}.get(model, 0.0)
@@ -237,7 +238,7 @@ def sphere_array(scene, model, aperture_radius):
         else:
             _share(scene, f"S{index}", mesh, centre)
     camera = gray_camera(scene, GRAY_LENS_MM, GRAY_FOCUS, aperture_radius)
-    gray_settings(scene, shutter_model=model, shutter_time=shutter_time)
+    gray_settings(scene, shutter_model=model, shutter_time=shutter_time, imaging_element=imaging_element)
     return {"camera": camera, "points": points}
 
 
@@ -284,13 +285,31 @@ def cylinders(scene, moving):
     return {"camera": camera}
 
 
+PORTRAIT_LENS_MM = 50.0
+PORTRAIT_FOCUS = 4.4
+BACKDROP_DEPTH = 10.0
+FIG9_PLANE_POINT = (0.111, 0.0, -1.1)
+
+
+def fig10_shutter_time(window_time=-1.0):
+    """Gray's Fig. 10 caption: the detector-plane shutter opens when the chief ray along the axis,
+    which crosses Fig. 9's shutter plane at ``window_time`` (c = 1), reaches the detector: a
+    distance ``a`` to the lens centre, then the image distance (the preset's formula)."""
+    normal = np.array(GRAY_BETA) / np.linalg.norm(GRAY_BETA)
+    a = float(np.array(FIG9_PLANE_POINT) @ normal) / float(np.array([0.0, 0.0, -1.0]) @ normal)
+    focal_length = PORTRAIT_LENS_MM * 1e-3
+    return window_time + a + 1.0 / (1.0 / focal_length - 1.0 / PORTRAIT_FOCUS)
+
+
 def portrait(scene, variant):
     """Gray's Fig. 9: a portrait-like scene (head, eyes, body, a tiled backdrop); ``variant`` REST,
     MOVING (shutter in the plane of spatial fixed points for t_S = -1) or WINDOW (plus the
-    Lorentz window in that plane)."""
+    Lorentz window in that plane). Fig. 10: WINDOW_DETECTOR, the window in that plane with the
+    detector-plane shutter (``lorentz_window_shutter = 'SHUTTER_MODEL'``)."""
     world(scene, (0.0, 0.0, 0.0), 0.0)
     backdrop = emission_checker("Backdrop", (0.45, 0.5, 0.55), (0.2, 0.22, 0.25), 16.0, 1.0)
-    plane(scene, "Backdrop", [(-6, -5, -10), (6, -5, -10), (6, 5, -10), (-6, 5, -10)], backdrop)
+    plane(scene, "Backdrop", [(-6, -5, -BACKDROP_DEPTH), (6, -5, -BACKDROP_DEPTH), (6, 5, -BACKDROP_DEPTH),
+                              (-6, 5, -BACKDROP_DEPTH)], backdrop)
     add_sphere(scene, "Head", (0.0, 0.35, -5.0), 0.7, emission("Skin", (0.85, 0.6, 0.48)))
     add_sphere(scene, "Hair", (0.0, 0.65, -5.15), 0.68, emission("Hair", (0.25, 0.15, 0.08)))
     white, pupil = emission("Eye", (0.95, 0.95, 0.95)), emission("Pupil", (0.02, 0.05, 0.12))
@@ -300,8 +319,11 @@ def portrait(scene, variant):
     add_sphere(scene, "Nose", (0.0, 0.25, -4.32), 0.09, emission("Nose", (0.8, 0.5, 0.4)))
     body = add_box(scene, "Body", (0.0, -1.55, -5.3), 1.0, emission("Shirt", (0.15, 0.3, 0.7)))
     body.scale = (1.9, 1.7, 0.7)
-    camera = gray_camera(scene, 50.0, 4.4, 0.05)
-    gray_settings(scene, variant != "REST", shutter_model="ARBITRARY_PLANE", shutter_time=-1.0,
-                  shutter_plane_point=(0.111, 0.0, -1.1), shutter_plane_normal=GRAY_BETA,
-                  use_lorentz_window=variant == "WINDOW")
-    return {"camera": camera}
+    camera = gray_camera(scene, PORTRAIT_LENS_MM, PORTRAIT_FOCUS, 0.05)
+    shutter = {"shutter_model": "ARBITRARY_PLANE", "shutter_time": -1.0}
+    if variant == "WINDOW_DETECTOR":
+        shutter = {"shutter_model": "DETECTOR_PLANE", "shutter_time": fig10_shutter_time(),
+                   "lorentz_window_shutter": "SHUTTER_MODEL", "lorentz_window_time": -1.0}
+    gray_settings(scene, variant != "REST", shutter_plane_point=FIG9_PLANE_POINT, shutter_plane_normal=GRAY_BETA,
+                  use_lorentz_window=variant in ("WINDOW", "WINDOW_DETECTOR"), **shutter)
+    return {"camera": camera, "shutter_time": shutter["shutter_time"], "window_time": -1.0}

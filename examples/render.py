@@ -7,8 +7,10 @@
 Options: --beta=X,Y,Z (world axes, fraction of c), --velocity-from-animation (the active camera's
 keyframed motion; refused with the frame number if it reaches c), --method camera|geometry,
 --samples N, --resolution WxH, --out PATH (.png, or .exr for linear float), --no-doppler,
---no-searchlight, --shutter MODEL, --shutter-time S, --lorentz-window, --speed-of-light C,
---frame N or --frames A-B (several frames: the frame number goes before the extension,
+--no-searchlight, --shutter MODEL, --shutter-time S, --shutter-plane-point X,Y,Z,
+--shutter-plane-normal X,Y,Z (camera-local axes), --lens ideal|phase-hologram, --lorentz-window,
+--window-time T_W (the window in the plane of fixed points for T_W, the shutter model timing the
+rays), --speed-of-light C, --frame N or --frames A-B (several frames: the frame number goes before the extension,
 out/fly_0001.png, or replaces a run of '#' in PATH), --seed N, --reference (render the file's own
 camera unchanged), --proper-time (frame K at the traveller's time K / fps), --threads N, --resume
 (skip frames whose output is already a complete image). Prints one progress line per frame with

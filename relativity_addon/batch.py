@@ -65,6 +65,7 @@ def _frame_range(text):
 
 
 SHUTTER_CHOICES = tuple(model.name.lower() for model in ShutterModel)
+LENS_CHOICES = {"ideal": "IDEAL_LENS", "phase-hologram": "PHASE_HOLOGRAM"}
 
 
 def build_parser(with_blend_file):
@@ -89,6 +90,15 @@ def build_parser(with_blend_file):
     parser.add_argument("--lorentz-window", action="store_true")
     parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
     parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
+    parser.add_argument("--shutter-plane-point", type=_vector3, metavar="X,Y,Z",
+                        help="a point of the arbitrary shutter plane, camera-local axes (the camera looks down -Z)")
+    parser.add_argument("--shutter-plane-normal", type=_vector3, metavar="X,Y,Z",
+                        help="the arbitrary shutter plane's normal, camera-local axes")
+    parser.add_argument("--lens", choices=LENS_CHOICES,
+                        help="the detector-plane shutter's lens: ideal, or its phase hologram (Gray Fig. 6b)")
+    parser.add_argument("--window-time", type=float, metavar="T_W",
+                        help="Lorentz window in the plane of spatial fixed points for T_W (seconds), the shutter "
+                        "model timing the rays (Gray Fig. 10); implies --lorentz-window")
     parser.add_argument("--speed-of-light", type=float, help="scene units per second")
     frames = parser.add_mutually_exclusive_group()
     frames.add_argument("--frame", type=int, help="render this frame (default: the file's current frame)")
@@ -193,6 +203,20 @@ def _apply_options(scene, options):
         settings.use_geometry = False
     if options.lorentz_window:
         settings.use_lorentz_window = True
+    for name in ("shutter_plane_point", "shutter_plane_normal"):
+        value = getattr(options, name)
+        if value is not None:
+            if not all(math.isfinite(v) for v in value):
+                raise BatchError(f"--{name.replace('_', '-')} must be finite")
+            setattr(settings, name, value)
+    if options.lens is not None:
+        settings.imaging_element = LENS_CHOICES[options.lens]
+    if options.window_time is not None:
+        if not math.isfinite(options.window_time):
+            raise BatchError("--window-time must be finite")
+        settings.use_lorentz_window = True
+        settings.lorentz_window_shutter = "SHUTTER_MODEL"
+        settings.lorentz_window_time = options.window_time
 
 
 def animation_fps(scene):

@@ -97,10 +97,16 @@ class RELATIVITY_PT_shutter(_RelativityPanel, Panel):
         _preset_row(layout, "shutter", "Shutter")
         layout.prop(settings, "shutter_model")
         layout.prop(settings, "shutter_time")
+        if settings.shutter_model == "DETECTOR_PLANE":
+            layout.prop(settings, "imaging_element")
         if settings.shutter_model == "ARBITRARY_PLANE":
             layout.prop(settings, "shutter_plane_point")
             layout.prop(settings, "shutter_plane_normal")
         layout.prop(settings, "use_lorentz_window")
+        if settings.use_lorentz_window:
+            layout.prop(settings, "lorentz_window_shutter")
+            if settings.lorentz_window_shutter == "SHUTTER_MODEL":
+                layout.prop(settings, "lorentz_window_time")
 
 
 class RELATIVITY_PT_effects(_RelativityPanel, Panel):

@@ -8,7 +8,7 @@ folder (``presets/relativity/<kind>/``) like any other Blender preset.
 
 Kinds: ``speed`` (|beta| along the current direction, or the camera's view from rest),
 ``speed_of_light`` (real and slow light), ``shutter`` (Gray et al. shutter models) and
-``paper_setups`` (Weiskopf et al. 1999 street and Sun; Gray et al. 2020 beta = (0.1, 0, 0.99), Figs. 9 and 11).
+``paper_setups`` (Weiskopf et al. 1999 street and Sun; Gray et al. 2020 beta = (0.1, 0, 0.99), Figs. 9, 10 and 11).
 """
 
 import os
@@ -99,7 +99,10 @@ class RELATIVITY_OT_shutter_preset_add(AddPresetBase, Operator):
         "settings.shutter_time",
         "settings.shutter_plane_point",
         "settings.shutter_plane_normal",
+        "settings.imaging_element",
         "settings.use_lorentz_window",
+        "settings.lorentz_window_shutter",
+        "settings.lorentz_window_time",
     ]
 
 

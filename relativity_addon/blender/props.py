@@ -47,6 +47,25 @@ _SHUTTER_DESCRIPTIONS = {
 SHUTTER_MODEL_ITEMS = tuple((model.name, *_SHUTTER_DESCRIPTIONS[model.name]) for model in ShutterModel)
 SHUTTER_MODELS = tuple(item[0] for item in SHUTTER_MODEL_ITEMS)
 
+IMAGING_ELEMENT_ITEMS = (
+    ("IDEAL_LENS", "Ideal Lens",
+     "Every ray from an object point to its image takes the same time (equal optical path): the "
+     "detector-plane shutter is stigmatic (Gray Fig. 6a)"),
+    ("PHASE_HOLOGRAM", "Phase Hologram",
+     "A phase hologram of the lens: same ray directions, no time delays, so the detector-plane shutter "
+     "blurs (Gray Fig. 6b)"),
+)
+
+WINDOW_SHUTTER_ITEMS = (
+    ("WINDOW_PLANE", "In the Window",
+     "The shutter sits in the window, the plane of spatial fixed points for the shutter time (Gray eq. 6), "
+     "and opens at the shutter time: the photo equals the photo at rest (Gray Fig. 9); the shutter model "
+     "is not used"),
+    ("SHUTTER_MODEL", "Shutter Model",
+     "The shutter model times the rays; the window stays in the plane of spatial fixed points for the "
+     "Window Time: a residual distortion unless the rays cross it at that time (Gray Fig. 10)"),
+)
+
 
 VELOCITY_SOURCE_ITEMS = (
     ("MANUAL", "Manual", "The observer velocity is the Velocity setting"),
@@ -145,11 +164,32 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         default=(0.0, 0.0, -1.0),
         update=_settings_changed,
     )
+    imaging_element: EnumProperty(
+        name="Lens",
+        description="The detector-plane shutter's imaging element (Gray et al. 2020, Fig. 6)",
+        items=IMAGING_ELEMENT_ITEMS,
+        default="IDEAL_LENS",
+        update=_settings_changed,
+    )
     use_lorentz_window: BoolProperty(
         name="Lorentz Window",
-        description="Shutter and Lorentz-transformation window in the plane of spatial fixed points "
-        "for the shutter time (Gray eq. 6): the photo equals the photo at rest",
+        description="Lorentz-transformation window in a plane of spatial fixed points (Gray eq. 6), "
+        "which undoes the change of ray direction (Gray section 4)",
         default=False,
+        update=_settings_changed,
+    )
+    lorentz_window_shutter: EnumProperty(
+        name="Window Shutter",
+        description="Which shutter times the rays through the Lorentz window",
+        items=WINDOW_SHUTTER_ITEMS,
+        default="WINDOW_PLANE",
+        update=_settings_changed,
+    )
+    lorentz_window_time: FloatProperty(
+        name="Window Time",
+        description="Camera-frame time t_W (seconds) whose plane of spatial fixed points (Gray eq. 6) "
+        "holds the Lorentz window, when the shutter model times the rays",
+        default=0.0,
         update=_settings_changed,
     )
     use_geometry: BoolProperty(

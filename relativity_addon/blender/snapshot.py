@@ -81,6 +81,9 @@ class Snapshot:
     exposure: float  # the one factor the camera multiplies the frame by (1 when FIXED)
     moving_lights: tuple[MovingLight, ...] = ()
     doppler_only_brightness: str = "REST"  # or SPECTRUM: Doppler without searchlight as Weiskopf's Fig. 8
+    imaging_element: str = "IDEAL_LENS"  # or PHASE_HOLOGRAM: the detector-plane shutter's lens (Gray Fig. 6)
+    lorentz_window_shutter: str = "WINDOW_PLANE"  # or SHUTTER_MODEL: what times rays through the window
+    lorentz_window_time: float = 0.0  # camera-frame seconds: the window's plane of fixed points (SHUTTER_MODEL)
 
     @property
     def time(self) -> float:
@@ -373,6 +376,8 @@ def read(scene, depsgraph=None) -> Snapshot:
         raise RelativityError("arbitrary shutter plane needs a non-zero normal")
     if not _finite(settings.shutter_plane_point):
         raise RelativityError("the shutter plane point must be finite")
+    if not math.isfinite(settings.lorentz_window_time):
+        raise RelativityError("the Lorentz window time must be finite")
     matrix = camera_matrix(scene, camera, frame, depsgraph)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
@@ -402,4 +407,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         exposure=frame_exposure(scene, camera, settings, beta, matrix) if settings.use_searchlight else 1.0,
         moving_lights=moving_lights(scene, frame, depsgraph),
         doppler_only_brightness=settings.doppler_only_brightness,
+        imaging_element=settings.imaging_element,
+        lorentz_window_shutter=settings.lorentz_window_shutter,
+        lorentz_window_time=float(settings.lorentz_window_time),
     )

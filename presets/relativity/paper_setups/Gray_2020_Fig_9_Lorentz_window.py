@@ -23,3 +23,4 @@ if scene.camera is not None:
     settings.shutter_plane_point = (0.111, 0.0, -1.1)
     settings.shutter_plane_normal = (0.1, 0.0, -0.99)
     settings.use_lorentz_window = True
+    settings.lorentz_window_shutter = 'WINDOW_PLANE'

@@ -182,7 +182,8 @@ def test_options_reach_the_scene(factory_blender):
         options = parser.parse_args([
             "--out=x.exr", "--beta=0.1,0.2,-0.3", "--method=camera", "--shutter=DETECTOR_PLANE",
             "--shutter-time=-2.5", "--speed-of-light=7", "--no-doppler", "--no-searchlight",
-            "--no-geometry", "--lorentz-window",
+            "--no-geometry", "--lorentz-window", "--lens=phase-hologram", "--shutter-plane-point=0.5,0,-2",
+            "--shutter-plane-normal=0,0.6,-0.8",
         ])
         batch._apply_options(scene, options)
         settings = scene.relativity
@@ -191,7 +192,13 @@ def test_options_reach_the_scene(factory_blender):
         assert settings.shutter_model == "DETECTOR_PLANE" and settings.shutter_time == -2.5
         assert settings.speed_of_light == 7.0
         assert not (settings.use_doppler or settings.use_searchlight or settings.use_geometry)
-        assert settings.use_lorentz_window
+        assert settings.use_lorentz_window and settings.lorentz_window_shutter == "WINDOW_PLANE"
+        assert settings.imaging_element == "PHASE_HOLOGRAM"
+        assert tuple(settings.shutter_plane_point) == pytest.approx((0.5, 0.0, -2.0))
+        assert tuple(settings.shutter_plane_normal) == pytest.approx((0.0, 0.6, -0.8))
+        batch._apply_options(scene, parser.parse_args(["--out=x.exr", "--window-time=-1.5", "--lens=ideal"]))
+        assert settings.lorentz_window_shutter == "SHUTTER_MODEL" and settings.lorentz_window_time == -1.5
+        assert settings.imaging_element == "IDEAL_LENS"
         options = parser.parse_args(["--out=x.png", "--velocity-from-animation", "--method=geometry"])
         batch._apply_options(scene, options)
         assert settings.velocity_source == "CAMERA_ANIMATION" and settings.method == "GEOMETRY"

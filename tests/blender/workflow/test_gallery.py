@@ -6,8 +6,9 @@ two renders that differ only in it is the brightness-weighted mean of D^4 (D^1 f
 al.'s), a blackbody seen at D shows Y(D T) / (D^5 Y(T)) of its rest brightness under the
 paper's "Doppler only" (Y from colour-science here) and Y(D T) / Y(T) with the searchlight,
 Gray's detector-plane shutter images the sphere array sharply at the grid points while the
-aperture-plane one blurs it, the fixed-point-surface shutter keeps the focus plane in place and
-the Lorentz window gives the photo at rest.
+aperture-plane one (and the phase hologram of the lens) blurs it, the fixed-point-surface shutter
+keeps the focus plane in place and the Lorentz window gives the photo at rest (with the detector-plane
+shutter only nearly).
 """
 
 import json
@@ -34,7 +35,7 @@ def _y(temperature):
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
     names = subprocess.run([sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True,
                            timeout=120, env=wh._env()).stdout.split()
-    assert len(names) == 19
+    assert len(names) == 21
     result = subprocess.run([sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48",
                              "--samples=2"], capture_output=True, text=True, timeout=600, env=wh._env())
     assert result.returncode == 0, result.stderr[-2000:]
@@ -74,6 +75,8 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
     assert abs(fig1b["red sphere centroid y (px)"] - fig1b["pinhole aberration formula y (px)"]) < 0.5
     assert numbers["gray_fig5_detector_plane"]["spot centroid to grid pixel, max (px)"] < 1.0
     assert numbers["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] > 1.2
+    # Fig. 6(b): the phase hologram blurs the array the ideal lens (Figs. 5, 6a) keeps sharp
+    assert numbers["gray_fig6b_phase_hologram"]["RMS radius / Fig. 5's (same aperture 0.2), median"] > 1.2
     # Gray Fig. 8: the focus plane stays put; Fig. 9: the Lorentz window gives the photo at rest
     fig8b = numbers["gray_fig8b_fixed_point_surface"]
     assert fig8b["red discs found"] == 4
@@ -81,3 +84,10 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
     assert fig8b["mean |Fig. 8(b) - Fig. 8(a)|, whole image"] > 0.01
     window, moving = numbers["gray_fig9c_lorentz_window"], numbers["gray_fig9b_moving"]
     assert window["mean |image - Fig. 9(a)|"] < 0.05 * moving["mean |image - Fig. 9(a)|"]
+    # Fig. 10: the window with the detector-plane shutter undoes the distortion only imperfectly
+    fig10 = numbers["gray_fig10_window_detector_plane"]
+    assert 10 * window["mean |image - Fig. 9(a)|"] < fig10["mean |image - Fig. 9(a)|"] \
+        < 0.5 * moving["mean |image - Fig. 9(a)|"]
+    # ... where the physics core's window rays put the backdrop
+    assert fig10["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"] \
+        < 0.5 * fig10["strips: mean |Fig. 10 - Fig. 9(a)|"]

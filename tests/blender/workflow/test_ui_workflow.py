@@ -13,6 +13,7 @@ import pytest
 
 import workflow_helpers as wh
 from relativity_addon.blender import compat
+from relativity_addon.physics.shutter import lens_time
 
 
 class RecordingLayout:
@@ -220,7 +221,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
             path = next(os.path.join(d, name) for d in directories if os.path.isfile(os.path.join(d, name)))
             assert bpy.ops.script.execute_preset(filepath=path, menu_idname=menu) == {"FINISHED"}, name
     assert found["speed"] == ["0.5c.py", "0.8c.py", "0.999c.py", "0.99c.py", "0.9c.py"]
-    assert len(found["shutter"]) == 5 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 7
+    assert len(found["shutter"]) == 6 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 8
 
     rotation = np.array(camera.matrix_world.to_quaternion().to_matrix())
 
@@ -244,6 +245,26 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     normal = np.array(settings.shutter_plane_normal)
     np.testing.assert_allclose(normal / np.linalg.norm(normal), beta_local / np.linalg.norm(beta_local), atol=1e-6)
     assert settings.use_lorentz_window and settings.shutter_model == "ARBITRARY_PLANE"
+    assert settings.lorentz_window_shutter == "WINDOW_PLANE"
+    # Fig. 10: the window stays in that plane (the plane of fixed points for t_W = -1), the
+    # detector-plane shutter times the rays; its shutter time gives the axial chief ray Fig. 9's
+    # lens time (Gray's caption), checked with the physics core's lens times.
+    fig9_lens_time = lens_time("ARBITRARY_PLANE", np.zeros(3), np.array([0.0, 0.0, -1e3]), c=1.0,
+                               shutter_time=settings.shutter_time, plane_point=point, plane_normal=normal)
+    load("paper_setups", "Gray_2020_Fig_10_Lorentz_window_detector_plane.py")
+    assert settings.use_lorentz_window and settings.lorentz_window_shutter == "SHUTTER_MODEL"
+    assert settings.lorentz_window_time == -1.0 and settings.shutter_model == "DETECTOR_PLANE"
+    assert settings.imaging_element == "IDEAL_LENS"
+    data = camera.data
+    focus = data.dof.focus_distance if data.dof.use_dof else math.inf
+    image_distance = 1.0 / (1.0 / (data.lens * 1e-3) - 1.0 / focus)
+    fig10_lens_time = lens_time("DETECTOR_PLANE", np.zeros(3), np.array([0.0, 0.0, -1e3]), c=1.0,
+                                shutter_time=settings.shutter_time, detector_point=np.array([0.0, 0.0, image_distance]))
+    assert fig10_lens_time == pytest.approx(fig9_lens_time, abs=1e-6)
+    # The shutter panel shows the lens for the detector plane and the window's settings.
+    shown = [entry[1] for entry in draw_panel(bpy, "RELATIVITY_PT_shutter", scene) if entry[0] == "prop"]
+    assert shown == ["shutter_model", "shutter_time", "imaging_element", "use_lorentz_window",
+                     "lorentz_window_shutter", "lorentz_window_time"]
     # Fig. 11: the same with Blender's stereo pair, eyes 0.4 apart converging at 5, as an anaglyph.
     load("paper_setups", "Gray_2020_Fig_11_stereo_Lorentz_window.py")
     np.testing.assert_allclose(beta_local, rotation.T @ np.array(settings.beta), atol=1e-6)
