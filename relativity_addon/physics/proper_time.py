@@ -38,3 +38,24 @@ def scene_times(tau: ArrayLike, times: ArrayLike, taus: ArrayLike) -> FloatArray
         raise ValueError(f"proper time {tau.min():.6g}..{tau.max():.6g} s outside the sampled "
                          f"{taus[0]:.6g}..{taus[-1]:.6g} s")
     return np.interp(tau, taus, np.asarray(times, dtype=np.float64))
+
+
+def path_proper_times(times: ArrayLike, positions: ArrayLike, c: float, zero_time: float = 0.0) -> FloatArray:
+    """``tau`` at each of ``times`` (increasing, seconds) along the world line through ``positions``
+    (``(K, 3)``, scene units) there, taken straight between samples (the exact integral of
+    ``dt / gamma`` for that piecewise-uniform motion), ``c`` in scene units per second; the clock
+    reads 0 at ``zero_time`` (inside the samples). ValueError for a step at or above c."""
+    times = finite_array(times, "times")
+    positions = finite_array(positions, "positions").reshape(len(times), -1)
+    if times.ndim != 1 or len(times) < 2:
+        raise ValueError("times must be a 1-D array of at least two samples")
+    steps = np.diff(times)
+    if np.any(steps <= 0.0):
+        raise ValueError("times must increase")
+    speeds = np.linalg.norm(np.diff(positions, axis=0), axis=1) / (steps * float(c))
+    if np.any(speeds >= 1.0):
+        raise ValueError(f"the world line moves at {speeds.max():.6g} c between samples: not slower than light")
+    taus = np.concatenate([[0.0], np.cumsum(np.sqrt(1.0 - speeds * speeds) * steps)])
+    if not times[0] <= zero_time <= times[-1]:
+        raise ValueError(f"the clock's zero {zero_time:.6g} s lies outside the samples")
+    return taus - np.interp(zero_time, times, taus)

@@ -35,3 +35,28 @@ def test_outside_the_samples():
     times = np.linspace(0.0, 1.0, 3)
     with pytest.raises(ValueError, match="outside"):
         proper_time.scene_times(2.0, times, proper_time.proper_times(times, np.zeros(3)))
+
+
+def test_path_proper_times_constant_proper_acceleration():
+    """Along the hyperbolic world line x = (c^2 / a)(sqrt(1 + (a t / c)^2) - 1), sampled from its
+    positions alone, tau = (c / a) asinh(a t / c), also before t = 0 (negative there)."""
+    c, a = 10.0, 7.0
+    times = np.linspace(-3.0, 5.0, 8001)
+    at = a * times / c
+    x = c * c / a * (np.sqrt(1.0 + at * at) - 1.0)
+    positions = np.stack([x, 0.5 * x, np.zeros_like(x)], axis=1) / np.sqrt(1.25)  # along a tilted line
+    taus = proper_time.path_proper_times(times, positions, c)
+    exact = c / a * np.arcsinh(at)
+    print(f"largest error {np.abs(taus - exact).max():.2e} s")
+    assert np.abs(taus - exact).max() < 1e-5
+    assert abs(exact[-1] - times[-1]) > 2.0  # the clock really fell behind
+
+
+def test_path_proper_times_uniform_and_zero():
+    times = np.array([1.0, 2.0, 4.0])
+    positions = np.outer(times, [0.0, 8.0, 0.0])  # 0.8 c for c = 10
+    assert np.allclose(proper_time.path_proper_times(times, positions, 10.0, zero_time=2.0), [-0.6, 0.0, 1.2])
+    with pytest.raises(ValueError, match="slower than light"):
+        proper_time.path_proper_times(times, positions, 8.0, zero_time=2.0)
+    with pytest.raises(ValueError, match="outside"):
+        proper_time.path_proper_times(times, positions, 10.0)
