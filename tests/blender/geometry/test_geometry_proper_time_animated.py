@@ -1,0 +1,274 @@
+"""Proper time beyond constant velocity, read off Cycles renders: a keyframed clock (its location keys
+are its world line, its rotation keys its own animation), the same clock's face as a child of a
+keyframed body, and a shape key (the hand's tip slides) on a clock at constant velocity and on a
+keyframed one.
+
+The keyframed world line is constant proper acceleration ``a`` from rest at t = 0 (keys at every
+frame): ``x(t) = (c^2 / a)(sqrt(1 + (a t / c)^2) - 1)`` and ``tau(t) = (c / a) asinh(a t / c)``
+(docs/physics.md); at constant velocity ``tau = t / gamma``. The expected picture is computed here:
+the clock's centre and the hand's tip move on their world lines (the face Lorentz-contracted along
+the velocity of that moment), each is seen at its own retarded time (bisection on the light cone),
+and projected through the camera. The angle of the tip about the centre in the image (centroids
+of the markers' colours) is compared with the render's, within 1 degree; without time dilation
+(the hand at scene time) the expected angle is more than 10 degrees away.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import geometry_helpers as gh
+from geometry_helpers import ch
+
+RESOLUTION = (320, 160)
+FPS = 24
+C = 10.0  # scene units per second
+ACCELERATION = 10.0  # scene units per s^2: 0.77 c at t = 1.2 s, 0.95 c at 3 s
+OMEGA = 2.0  # rad/s of the clock's hand (rotation keys)
+SLIDE = 1.0  # units per second of the shape key's tip (value 1 per second, key offset (0, 1, 0))
+RADIUS = 1.0
+START = 1.0  # the tip's y at shape-key value 0
+FRAME = 48  # t_o = 2 s
+DISTANCE = 8.0
+KEYED_FRAMES = 96
+
+
+def _hyperbolic(t):
+    at = ACCELERATION * np.asarray(t, float) / C
+    return C * C / ACCELERATION * (np.sqrt(1.0 + at * at) - 1.0)
+
+
+def _emission(bpy, name, colour):
+    material = ch.emission_material(bpy, name)
+    material.node_tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
+    return material
+
+
+def _linear(obj):
+    for fcurve in ch.compat.action_fcurves(obj.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+
+
+def _face(bpy, scene):
+    """A red dot at the origin (the centre) and a green dot at (RADIUS, 0, 0) (the tip), tessellation 0."""
+    import bmesh
+
+    mesh = bpy.data.meshes.new("Clock")
+    bm = bmesh.new()
+    for index, offset in enumerate(((0.0, 0.0, 0.0), (RADIUS, 0.0, 0.0))):
+        created = bmesh.ops.create_uvsphere(bm, u_segments=16, v_segments=8, radius=0.09)
+        bmesh.ops.translate(bm, vec=offset, verts=created["verts"])
+        for face in {f for v in created["verts"] for f in v.link_faces}:
+            face.material_index = index
+    bm.to_mesh(mesh)
+    bm.free()
+    mesh.materials.append(_emission(bpy, "Centre", (1.0, 0.0, 0.0)))
+    mesh.materials.append(_emission(bpy, "Tip", (0.0, 1.0, 0.0)))
+    clock = bpy.data.objects.new("Clock", mesh)
+    scene.collection.objects.link(clock)
+    clock.relativity.enabled = True
+    clock.relativity.tessellation = 0
+    return clock
+
+
+def _key_path(obj, offset):
+    """Location keys at every frame: the hyperbolic world line, shifted by ``offset`` along x."""
+    for frame in range(KEYED_FRAMES + 1):
+        obj.location = (float(_hyperbolic(frame / FPS)) + offset, 0.0, -DISTANCE)
+        obj.keyframe_insert("location", frame=frame)
+    _linear(obj)
+
+
+def _key_spin(obj):
+    for frame in (0, 240):
+        obj.rotation_euler = (0.0, 0.0, OMEGA * frame / FPS)
+        obj.keyframe_insert("rotation_euler", index=2, frame=frame)
+    _linear(obj)
+
+
+def _key_slide(bpy, clock):
+    """Shape key "Slide": the tip starts at (RADIUS, -START, 0) and its vertices move by (0, 1, 0) at
+    value 1; the value is t (seconds)."""
+    for vertex in clock.data.vertices:
+        if vertex.co.x > 0.5 * RADIUS:
+            vertex.co.y -= START
+    clock.shape_key_add(name="Basis")
+    slide = clock.shape_key_add(name="Slide")
+    slide.slider_max = 10.0
+    for point in slide.data:
+        if point.co.x > 0.5 * RADIUS:
+            point.co.y += 1.0
+    for frame in (0, 240):
+        slide.value = SLIDE * frame / FPS
+        slide.keyframe_insert("value", frame=frame)
+    for fcurve in ch.compat.action_fcurves(clock.data.shape_keys.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+
+
+def _retarded(position, t_o, camera_position):
+    low, high = t_o - 100.0, t_o
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        ahead = np.linalg.norm(position(middle) - camera_position) - C * (t_o - middle)
+        low, high = (low, middle) if ahead > 0.0 else (middle, high)
+    return 0.5 * (low + high)
+
+
+def _render_angle(bpy, scene, tmp_path):
+    image = ch.render_exr(bpy, scene, tmp_path / "clock.exr")
+
+    def centroid(channel, others):
+        weight = np.where((image[..., channel] > 0.2) & (image[..., others].max(-1) < 0.1), image[..., channel], 0.0)
+        assert weight.sum() > 3.0, "the marker is in the picture"
+        rows, columns = np.indices(weight.shape)
+        return np.array([(weight * (columns + 0.5)).sum(), (weight * (rows + 0.5)).sum()]) / weight.sum()
+
+    return _angle(centroid(0, [1, 2]), centroid(1, [0, 2]))
+
+
+def _angle(centre, tip):
+    return math.degrees(math.atan2(-(tip[1] - centre[1]), tip[0] - centre[0]))  # image y points down
+
+
+def _scene(bpy):
+    scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=8)
+    scene.render.fps = FPS
+    scene.relativity.speed_of_light = C
+    return scene, camera
+
+
+def _render(bpy, scene, tmp_path):
+    scene.frame_set(FRAME)
+    scene.relativity.method = "GEOMETRY"
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    scene.relativity.use_doppler = False
+    scene.relativity.use_searchlight = False
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    return _render_angle(bpy, scene, tmp_path)
+
+
+def _expected(bpy, scene, camera, centre, velocity, tip_offset, clock):
+    """Image angle of the tip about the centre: ``centre(t)`` the world line, ``velocity(t)`` its
+    velocity (the face's contraction), ``tip_offset(tau)`` the tip in the face's rest frame at its
+    proper time ``tau = clock(t)``. Also returns the tip's retarded time and proper time."""
+    def tip(t):
+        beta = velocity(t) / C
+        speed2 = beta @ beta
+        gamma = 1.0 / math.sqrt(1.0 - speed2)
+        contraction = np.eye(3) - (1.0 - 1.0 / gamma) * np.outer(beta, beta) / max(speed2, 1e-30)
+        return centre(t) + contraction @ tip_offset(clock(t))
+
+    model = ch.pinhole_model(bpy, scene, camera)
+    pixels = [model.project_direction(f(_retarded(f, FRAME / FPS, model.location)) - model.location)
+              for f in (centre, tip)]
+    t_tip = _retarded(tip, FRAME / FPS, model.location)
+    return _angle(*pixels), t_tip, clock(t_tip)
+
+
+def _hyperbolic_world_line():
+    """(centre, velocity, proper time) of the keyed clock, shifted so that its light from x = 0 arrives at t_o."""
+    shift = -float(_hyperbolic(FRAME / FPS - DISTANCE / C))
+
+    def centre(t):
+        return np.array([float(_hyperbolic(t)) + shift, 0.0, -DISTANCE])
+
+    def velocity(t):
+        at = ACCELERATION * t / C
+        return np.array([C * at / math.sqrt(1.0 + at * at), 0.0, 0.0])
+
+    def clock(t):
+        return C / ACCELERATION * math.asinh(ACCELERATION * t / C)
+
+    return shift, centre, velocity, clock
+
+
+def _spin(tau):
+    return np.array([RADIUS * math.cos(OMEGA * tau), RADIUS * math.sin(OMEGA * tau), 0.0])
+
+
+def _compare(measured, expected, undilated, label, t_e, tau):
+    print(f"{label}: tip at {measured:.2f} deg in the render, {expected:.2f} deg expected (proper time {tau:.4f} s "
+          f"at the retarded time {t_e:.4f} s); at scene time {undilated:.2f} deg")
+    assert abs(measured - expected) < 1.0
+    assert abs(undilated - expected) > 10.0, "time dilation must be visible in this set-up"
+
+
+@pytest.mark.parametrize("parented", [False, True])
+def test_keyframed_clock_runs_on_proper_time(relativity_addon, tmp_path, parented):
+    """Rotation keys play at tau = integral dt / gamma along the location keys' path; a child's
+    (the face under a keyed body) along the path its parent carries it on."""
+    bpy = __import__("bpy")
+    scene, camera = _scene(bpy)
+    shift, centre, velocity, clock = _hyperbolic_world_line()
+    face = _face(bpy, scene)
+    face.relativity.motion = "ANIMATION"
+    _key_spin(face)
+    if parented:
+        body = bpy.data.objects.new("Body", None)
+        scene.collection.objects.link(body)
+        _key_path(body, shift)
+        face.parent = body  # identity parent inverse: the face sits at the body's origin
+    else:
+        _key_path(face, shift)
+    measured = _render(bpy, scene, tmp_path)
+    expected, t_e, tau = _expected(bpy, scene, camera, centre, velocity, _spin, clock)
+    undilated, _, _ = _expected(bpy, scene, camera, centre, velocity, _spin, lambda t: t)
+    _compare(measured, expected, undilated, "child of a keyed body" if parented else "keyed clock", t_e, tau)
+
+
+@pytest.mark.parametrize("motion", ["CONSTANT", "ANIMATION"])
+def test_shape_keys_run_on_proper_time(relativity_addon, tmp_path, motion):
+    """A keyframed shape key (the tip slides along y at 1 unit per second of its clock) is read at
+    the proper time of each vertex's retarded time."""
+    bpy = __import__("bpy")
+    scene, camera = _scene(bpy)
+    face = _face(bpy, scene)
+    _key_slide(bpy, face)
+    face.relativity.motion = motion
+    if motion == "CONSTANT":
+        speed = 0.9
+        p0 = np.array([speed * DISTANCE, 0.0, -DISTANCE])
+        face.location = p0
+        face.relativity.beta = (speed, 0.0, 0.0)
+        gamma = 1.0 / math.sqrt(1.0 - speed * speed)
+
+        def centre(t):
+            return p0 + np.array([speed * C * (t - FRAME / FPS), 0.0, 0.0])
+
+        def velocity(t):
+            return np.array([speed * C, 0.0, 0.0])
+
+        def clock(t):
+            return t / gamma
+    else:
+        shift, centre, velocity, clock = _hyperbolic_world_line()
+        _key_path(face, shift)
+
+    def slid(tau):
+        return np.array([RADIUS, SLIDE * tau - START, 0.0])
+
+    measured = _render(bpy, scene, tmp_path)
+    expected, t_e, tau = _expected(bpy, scene, camera, centre, velocity, slid, clock)
+    undilated, _, _ = _expected(bpy, scene, camera, centre, velocity, slid, lambda t: t)
+    _compare(measured, expected, undilated, f"shape key, {motion.lower()}", t_e, tau)
+
+
+def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
+    """Tessellated rest points are not the shape keys' vertices: a one-line error naming the fix,
+    and with Proper Time off the old behaviour (the scene frame's shape) is there."""
+    bpy = __import__("bpy")
+    scene, _ = _scene(bpy)
+    face = _face(bpy, scene)
+    _key_slide(bpy, face)
+    face.relativity.motion = "CONSTANT"
+    face.relativity.beta = (0.5, 0.0, 0.0)
+    face.relativity.tessellation = 1
+    scene.frame_set(FRAME)
+    with pytest.raises(gh.geometry_module().RelativityError, match="Tessellation to 0"):
+        gh.apply_geometry(scene)
+    face.relativity.use_proper_time = False
+    gh.apply_geometry(scene)
+    assert gh.geometry_module().scene_errors(scene) == []
