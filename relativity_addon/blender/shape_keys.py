@@ -107,7 +107,8 @@ class ShapeKeyMotion:
         if len(rest) != len(self.base):
             raise RelativityError(f"object {self.name!r}: its animated shape keys are played at proper time only "
                                   "on the mesh's own vertices; set Tessellation to 0 and move modifiers after "
-                                  "the relativity modifier (or turn Proper Time off)")
+                                  "the relativity modifier, or bake the deformation (Animation, Deforming), "
+                                  "or turn Proper Time off")
         blend = self.positions(frame)
         scale = 1.0 + float(np.abs(blend).max(initial=0.0))
         if np.abs(blend - rest).max(initial=0.0) > 1e-5 * scale:

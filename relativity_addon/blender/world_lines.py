@@ -16,6 +16,10 @@ preview they are carried into the observer frame.
 - ANIMATION with ``use_deformation``: per-vertex positions from the deformation bake, contracted
   the same way about the object's origin along the origin's velocity (baked with them).
 
+Proper time (``Object.relativity.use_proper_time``, docs/proper-time.md): an object's own animation
+(rotation and scale keys, shape keys; with a deformation bake everything about the origin's path,
+armatures included) plays at its proper time along its world line.
+
 Every function raises RelativityError (one line) for a motion it cannot show correctly.
 """
 
@@ -219,8 +223,15 @@ def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
         mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
     times = info["start"] + info["step"] * np.arange(info["samples"])
     origins = np.array(info[names.BAKE_ORIGINS_KEY], dtype=np.float64).reshape(-1, 3)
-    result = rest_shape.apparent_positions_deforming_rest_shape(
-        times, positions.reshape(info["samples"], count, 3).astype(np.float64), origins, t_o, x_o, c, beta_o)
+    positions = positions.reshape(info["samples"], count, 3).astype(np.float64)
+    if obj.relativity.use_proper_time:
+        # The origin's path is the world line; the baked shape about it (armature, shape keys,
+        # modifiers, rotation, scale) is the object's own animation, played at its proper time.
+        try:
+            positions = proper_time.own_animation_at_proper_time(times, positions, origins, c)
+        except ValueError as error:
+            raise RelativityError(f"object {obj.name!r}: {error}") from None
+    result = rest_shape.apparent_positions_deforming_rest_shape(times, positions, origins, t_o, x_o, c, beta_o)
     t_e = t_o - result[1]
     if t_e.min() < times[0] or t_e.max() > times[-1]:
         raise RelativityError(

@@ -60,3 +60,27 @@ def test_path_proper_times_uniform_and_zero():
         proper_time.path_proper_times(times, positions, 8.0, zero_time=2.0)
     with pytest.raises(ValueError, match="outside"):
         proper_time.path_proper_times(times, positions, 10.0)
+
+
+def test_own_animation_at_proper_time():
+    """A body moving at 0.8 c (gamma 5/3) whose points turn about its origin at 1 rad/s of scene
+    time in the samples: played at proper time they turn by t / gamma; the origin's path is kept."""
+    c, speed, gamma = 10.0, 0.8, 5.0 / 3.0
+    times = np.linspace(-1.0, 4.0, 2001)
+    origins = np.outer(times, [speed * c, 0.0, 0.0]) + [0.0, 2.0, -5.0]
+    radii = np.array([0.5, 1.0, 2.0])
+
+    def points(angles):
+        return np.stack([np.cos(angles)[:, None] * radii, np.sin(angles)[:, None] * radii,
+                         np.zeros((len(angles), 3))], axis=2)
+
+    result = proper_time.own_animation_at_proper_time(times, origins[:, None, :] + points(times), origins, c)
+    expected = origins[:, None, :] + points(times / gamma)
+    print(f"largest error {np.abs(result - expected).max():.2e}")
+    assert np.abs(result - expected).max() < 1e-5
+    # A bake starting after t = 0: the clock ran at its first rate before (tau = t / gamma still).
+    late = times >= 0.5
+    result = proper_time.own_animation_at_proper_time(times[late], (origins[:, None, :] + points(times))[late],
+                                                      origins[late], c)
+    inside = times[late] / gamma >= 0.5  # arrangements from inside the samples
+    assert np.abs(result - expected[late])[inside].max() < 1e-5

@@ -272,3 +272,53 @@ def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
     face.relativity.use_proper_time = False
     gh.apply_geometry(scene)
     assert gh.geometry_module().scene_errors(scene) == []
+
+
+def test_armature_hand_runs_on_proper_time(relativity_addon, tmp_path):
+    """An armature carries the face along the keyed world line and turns the hand with a keyed bone
+    (Armature modifier, vertex group): with the deformation bake, everything about the origin's path
+    plays at the proper time of each vertex's retarded time."""
+    bpy = __import__("bpy")
+    scene, camera = _scene(bpy)
+    shift, centre, velocity, clock = _hyperbolic_world_line()
+    armature = bpy.data.objects.new("Rig", bpy.data.armatures.new("Rig"))
+    scene.collection.objects.link(armature)
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode="EDIT")
+    bone = armature.data.edit_bones.new("Hand")
+    bone.head, bone.tail = (0.0, 0.0, 0.0), (0.0, 0.0, 0.5)  # its Y axis is the face's normal
+    bpy.ops.object.mode_set(mode="OBJECT")
+    pose_bone = armature.pose.bones["Hand"]
+    pose_bone.rotation_mode = "XYZ"
+    for frame in (0, 240):
+        pose_bone.rotation_euler = (0.0, OMEGA * frame / FPS, 0.0)
+        pose_bone.keyframe_insert("rotation_euler", index=1, frame=frame)
+    _key_path(armature, shift)
+    face = _face(bpy, scene)
+    face.parent = armature
+    group = face.vertex_groups.new(name="Hand")
+    group.add([v.index for v in face.data.vertices if v.co.x > 0.5 * RADIUS], 1.0, "REPLACE")
+    face.modifiers.new("Armature", "ARMATURE").object = armature
+    # Which way the bone turns the hand: Blender's own evaluation at one frame (object space).
+    scene.frame_set(6)
+    bpy.context.view_layer.update()
+    evaluated = face.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
+    tip_now = np.mean([v.co for v in evaluated.vertices if v.co.length > 0.5 * RADIUS], axis=0)
+    face.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh_clear()
+    turn = math.atan2(tip_now[1], tip_now[0])
+    assert abs(abs(turn) - OMEGA * 6 / FPS) < 1e-3
+    sense = math.copysign(1.0, turn)
+    face.relativity.motion = "ANIMATION"
+    face.relativity.use_deformation = True
+    face.relativity.samples_per_frame = 4
+    scene.frame_set(FRAME)
+    scene.relativity.method = "GEOMETRY"
+    gh.addon_module("bakes").bake_deformation(scene, face, 0, FRAME)
+    measured = _render(bpy, scene, tmp_path)
+
+    def spin(tau):
+        return _spin(sense * tau)
+
+    expected, t_e, tau = _expected(bpy, scene, camera, centre, velocity, spin, clock)
+    undilated, _, _ = _expected(bpy, scene, camera, centre, velocity, spin, lambda t: t)
+    _compare(measured, expected, undilated, "armature (deformation bake)", t_e, tau)
