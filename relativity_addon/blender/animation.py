@@ -115,6 +115,25 @@ def world_matrices(obj, frames, own_frames=None):
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
+def keyframes_signature(obj):
+    """Everything of the object's (and its parents') keyframes and transform that moves it, as a
+    cache key; None when an F-curve has modifiers (their settings are not in the key)."""
+    parts = []
+    while obj is not None:
+        animation_data = obj.animation_data
+        if animation_data is not None and animation_data.action is not None:
+            for fcurve in compat.action_fcurves(animation_data):
+                if len(fcurve.modifiers):
+                    return None
+                parts.append((fcurve.data_path, fcurve.array_index, fcurve.mute, fcurve.extrapolation, tuple(
+                    (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
+                    for p in fcurve.keyframe_points)))
+        parts.append((tuple(map(tuple, obj.matrix_parent_inverse)), obj.rotation_mode, obj.parent_type,
+                      *(tuple(getattr(obj, path)) for path in sorted(TRANSFORM_PATHS))))
+        obj = obj.parent
+    return tuple(parts)
+
+
 def has_own_animation(obj, scene=None):
     """Whether keyframes turn or scale the object (or an object parent): its own animation, which a
     CONSTANT object plays at its proper time (``world_lines``). Objects whose keyframes are not

@@ -34,6 +34,7 @@ from .snapshot import check_velocity
 CLOCK_SAMPLES = 200_000
 # Solves with each vertex in the shape of its own retarded time, after the first with the scene frame's.
 SHAPE_PASSES = 2
+_clock_tables = {}  # object name -> the clock table of its last update (see _path_clock)
 
 
 def matrix_array(matrix):
@@ -87,18 +88,43 @@ def plays_own_animation(obj, scene):
 def _path_clock(obj, fps, step, c):
     """``tau(t)`` (seconds to seconds, arrays) of a keyframed object: ``integral dt / gamma`` along
     the path of its origin as its keyframes (all at scene time) draw it, straight between samples
-    ``step`` apart; 0 at scene time 0. The table is kept for the widest range asked so far."""
-    table = {}
+    ``step`` apart (coarser if more than CLOCK_SAMPLES would be needed); 0 at scene time 0. The
+    path is kept between updates while the keyframes stay the same
+    (``animation.keyframes_signature``) and extended by the samples missing when a time falls
+    outside it, so stepping through frames evaluates only the new ones."""
+    signature = animation.keyframes_signature(obj)
+    key = (obj.name, fps, step, c, signature)
+    table = _clock_tables.get(obj.name) if signature is not None else None
+    if table is None or table["key"] != key:
+        table = {"key": key, "spacing": step}
+        _clock_tables[obj.name] = table
+
+    def path(indices):
+        if not len(indices):
+            return np.empty((0, 3))
+        return animation.world_matrices(obj, indices * table["spacing"] * fps)[:, :3, 3]
 
     def clock(times):
         times = np.asarray(times, dtype=np.float64)
         low, high = min(0.0, float(times.min())), max(0.0, float(times.max()))
-        if not table or low < table["grid"][0] or high > table["grid"][-1]:
-            spacing = max(step, (high - low) / CLOCK_SAMPLES)
-            first = np.floor(low / spacing)
-            grid = np.arange(first, max(np.ceil(high / spacing), first + 1) + 1) * spacing
-            path = animation.world_matrices(obj, grid * fps)[:, :3, 3]
-            table.update(grid=grid, taus=proper_time.path_proper_times(grid, path, c))
+        if "grid" not in table or low < table["grid"][0] or high > table["grid"][-1]:
+            first = int(np.floor(low / table["spacing"]))
+            last = max(int(np.ceil(high / table["spacing"])), first + 1)
+            if "grid" in table:
+                old_first, old_last = table["indices"]
+                first, last = min(first, old_first), max(last, old_last)
+            if last - first > CLOCK_SAMPLES:  # coarser samples: start afresh
+                table.pop("grid", None)
+                table["spacing"] = (high - low) / CLOCK_SAMPLES
+                first, last = int(np.floor(low / table["spacing"])), int(np.ceil(high / table["spacing"]))
+            if "grid" in table:
+                points = np.concatenate([path(np.arange(first, old_first)), table["path"],
+                                         path(np.arange(old_last + 1, last + 1))])
+            else:
+                points = path(np.arange(first, last + 1))
+            grid = np.arange(first, last + 1) * table["spacing"]
+            table.update(indices=(first, last), grid=grid, path=points,
+                         taus=proper_time.path_proper_times(grid, points, c))
         return np.interp(times, table["grid"], table["taus"])
 
     return clock

@@ -322,3 +322,26 @@ def test_armature_hand_runs_on_proper_time(relativity_addon, tmp_path):
     expected, t_e, tau = _expected(bpy, scene, camera, centre, velocity, spin, clock)
     undilated, _, _ = _expected(bpy, scene, camera, centre, velocity, spin, lambda t: t)
     _compare(measured, expected, undilated, "armature (deformation bake)", t_e, tau)
+
+
+def test_clock_table_follows_the_keyframes(relativity_addon):
+    """The keyed clock's table (kept between updates) reads (c / a) asinh(a t / c) on the hyperbolic
+    keys, is extended when a later time is asked, and is recomputed when the keys change."""
+    bpy = __import__("bpy")
+    scene, _ = _scene(bpy)
+    face = _face(bpy, scene)
+    _key_path(face, 0.0)
+    world_lines = gh.addon_module("world_lines")
+    step = 1.0 / (8 * FPS)
+
+    def reading(t):
+        return float(world_lines._path_clock(face, FPS, step, C)(np.array([t]))[0])
+
+    for t in (1.0, 3.5, 0.5):  # 3.5 s extends the table
+        assert reading(t) == pytest.approx(C / ACCELERATION * math.asinh(ACCELERATION * t / C), abs=2e-4)
+    for point in ch.compat.action_fcurves(face.animation_data)[0].keyframe_points:
+        point.co.y *= 0.5  # half the path: a slower clock
+    changed = reading(3.5)
+    world_lines._clock_tables.clear()
+    assert changed == reading(3.5)
+    assert changed - C / ACCELERATION * math.asinh(ACCELERATION * 3.5 / C) > 0.1
