@@ -52,6 +52,7 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=Tr
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
     matrix_now = matrix_array(obj_eval.matrix_world)
+    check_parent_motion(obj)
     motion = obj.relativity.motion
     if motion == "ANIMATION" and obj.relativity.use_deformation:
         world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
@@ -74,6 +75,25 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=Tr
         world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
         beta_seen = beta_seen[:1]  # one velocity for every vertex
     return world, beta_seen
+
+
+def check_parent_motion(obj):
+    """RelativityError if the nearest moving mesh among the object's parents (apparent geometry on,
+    Motion not Static) has another motion than the object: a child rides on its parent's world line,
+    and each object's world line comes from its own settings, so they must agree (the child's own
+    keys then play at the proper time of that world line)."""
+    parent = obj.parent
+    while parent is not None:
+        settings = parent.relativity
+        if parent.type == "MESH" and settings.enabled and settings.motion != "STATIC":
+            own = obj.relativity
+            if own.motion != settings.motion or (
+                    own.motion == "CONSTANT" and tuple(own.beta) != tuple(settings.beta)):
+                how = "Constant Velocity with the same velocity" if settings.motion == "CONSTANT" else "Animation"
+                raise RelativityError(f"object {obj.name!r} rides on its moving parent {parent.name!r}: "
+                                      f"set its Motion to {how}")
+            return
+        parent = parent.parent
 
 
 def plays_own_animation(obj, scene):

@@ -345,3 +345,40 @@ def test_clock_table_follows_the_keyframes(relativity_addon):
     world_lines._clock_tables.clear()
     assert changed == reading(3.5)
     assert changed - C / ACCELERATION * math.asinh(ACCELERATION * 3.5 / C) > 0.1
+
+
+def test_child_of_a_constant_velocity_body(relativity_addon, tmp_path):
+    """Hands (the face, with rotation keys) parented to a body at constant velocity 0.9c: a Static
+    child is refused in one line; with the body's motion and velocity it rides on the body's world
+    line and its keys play at t / gamma."""
+    bpy = __import__("bpy")
+    scene, camera = _scene(bpy)
+    speed = 0.9
+    p0 = np.array([speed * DISTANCE, 0.0, -DISTANCE])
+    body_mesh = bpy.data.meshes.new("Body")
+    body_mesh.from_pydata([(0.0, 0.0, 0.0), (0.0, 0.0, 0.01), (0.0, 0.01, 0.0)], [], [])  # renders nothing
+    body = bpy.data.objects.new("Body", body_mesh)
+    scene.collection.objects.link(body)
+    body.location = p0
+    body.relativity.motion = "CONSTANT"
+    body.relativity.beta = (speed, 0.0, 0.0)
+    face = _face(bpy, scene)
+    _key_spin(face)
+    face.parent = body
+    scene.frame_set(FRAME)
+    with pytest.raises(gh.geometry_module().RelativityError, match="rides on its moving parent 'Body'"):
+        gh.apply_geometry(scene)
+    face.relativity.motion = "CONSTANT"
+    face.relativity.beta = (speed, 0.0, 0.0)
+    measured = _render(bpy, scene, tmp_path)
+    gamma = 1.0 / math.sqrt(1.0 - speed * speed)
+
+    def centre(t):
+        return p0 + np.array([speed * C * (t - FRAME / FPS), 0.0, 0.0])
+
+    def velocity(t):
+        return np.array([speed * C, 0.0, 0.0])
+
+    expected, t_e, tau = _expected(bpy, scene, camera, centre, velocity, _spin, lambda t: t / gamma)
+    undilated, _, _ = _expected(bpy, scene, camera, centre, velocity, _spin, lambda t: t)
+    _compare(measured, expected, undilated, "child of a constant-velocity body", t_e, tau)
