@@ -29,6 +29,9 @@ TRANSFORM_PATHS = frozenset((
     "location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale",
     "delta_location", "delta_rotation_euler", "delta_rotation_quaternion", "delta_scale",
 ))
+# The channels that are an object's world line; the others (rotation, scale) are its own animation,
+# which plays at its proper time (``world_lines``).
+LOCATION_PATHS = frozenset(("location", "delta_location"))
 
 
 def _transform_fcurves(obj):
@@ -60,18 +63,21 @@ def _channels(obj, curves, path, size, frames):
     return np.stack(columns, axis=1)
 
 
-def basis_matrices(obj, frames):
+def basis_matrices(obj, frames, own_frames=None):
     """The object's ``matrix_basis`` at each of ``frames`` (float, sub-frames allowed) from its
-    keyframes, deltas included, as float64 ``(K, 4, 4)`` (mathutils is float32).
+    keyframes, deltas included, as float64 ``(K, 4, 4)`` (mathutils is float32). With
+    ``own_frames`` (same shape), the rotation and scale channels (the object's own animation) are
+    read there and the location channels (its world line) at ``frames``.
 
     Blender's composition (``BKE_object_to_mat4``): location + delta location, then
     R = R_delta @ R (Euler deltas in the object's Euler order, quaternion deltas for quaternions;
     axis-angle has no delta in the UI), then scale * delta scale."""
     frames = np.atleast_1d(np.asarray(frames, dtype=np.float64))
+    own_frames = frames if own_frames is None else np.atleast_1d(np.asarray(own_frames, dtype=np.float64))
     curves = _transform_fcurves(obj)
 
     def channels(path, size):
-        return _channels(obj, curves, path, size, frames)
+        return _channels(obj, curves, path, size, frames if path in LOCATION_PATHS else own_frames)
 
     mode = obj.rotation_mode
     if mode == "QUATERNION":
@@ -89,13 +95,14 @@ def basis_matrices(obj, frames):
     )
 
 
-def world_matrices(obj, frames):
+def world_matrices(obj, frames, own_frames=None):
     """``matrix_world`` at each of ``frames`` from keyframes alone, float64 ``(K, 4, 4)``: the
     object's basis under its object-parent chain evaluated at the same frames,
-    ``parent_world @ matrix_parent_inverse @ basis``. Constraints, drivers, NLA and simulations
+    ``parent_world @ matrix_parent_inverse @ basis`` (rotation and scale channels of every link at
+    ``own_frames`` if given, see :func:`basis_matrices`). Constraints, drivers, NLA and simulations
     are not evaluated (see :func:`keyframe_motion_problem`); a bone, vertex or other non-object
     parent raises RelativityError."""
-    matrices = basis_matrices(obj, frames)
+    matrices = basis_matrices(obj, frames, own_frames)
     parent = obj.parent
     if parent is None:
         return matrices
@@ -105,7 +112,26 @@ def world_matrices(obj, frames):
             "its motion from keyframes follows object parents only"
         )
     parent_inverse = np.array(obj.matrix_parent_inverse, dtype=np.float64)
-    return world_matrices(parent, frames) @ parent_inverse @ matrices
+    return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
+
+
+def keyframes_signature(obj):
+    """Everything of the object's (and its parents') keyframes and transform that moves it, as a
+    cache key; None when an F-curve has modifiers (their settings are not in the key)."""
+    parts = []
+    while obj is not None:
+        animation_data = obj.animation_data
+        if animation_data is not None and animation_data.action is not None:
+            for fcurve in compat.action_fcurves(animation_data):
+                if len(fcurve.modifiers):
+                    return None
+                parts.append((fcurve.data_path, fcurve.array_index, fcurve.mute, fcurve.extrapolation, tuple(
+                    (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
+                    for p in fcurve.keyframe_points)))
+        parts.append((tuple(map(tuple, obj.matrix_parent_inverse)), obj.rotation_mode, obj.parent_type,
+                      *(tuple(getattr(obj, path)) for path in sorted(TRANSFORM_PATHS))))
+        obj = obj.parent
+    return tuple(parts)
 
 
 def has_own_animation(obj, scene=None):
@@ -115,7 +141,7 @@ def has_own_animation(obj, scene=None):
     if keyframe_motion_problem(obj, scene) is not None:
         return False
     while obj is not None:
-        if any(path not in ("location", "delta_location") for path, _ in _transform_fcurves(obj)):
+        if any(path not in LOCATION_PATHS for path, _ in _transform_fcurves(obj)):
             return True
         obj = obj.parent
     return False

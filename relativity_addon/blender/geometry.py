@@ -37,7 +37,7 @@ def object_signature(snap, obj, depsgraph=None):
         snap.shutter_time if snap.exact_camera else 0.0,
         tuple(map(tuple, evaluated.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
         relativity.tessellation, relativity.samples_per_frame, snap.fps,
-        relativity.use_deformation,
+        relativity.use_deformation, relativity.use_proper_time,
         len(obj.data.vertices),
     ]
     return repr(parts)

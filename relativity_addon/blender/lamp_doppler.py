@@ -89,7 +89,8 @@ def movers(scene, snap):
             continue
         try:
             centre = _local_centre(obj)[None]
-            world, beta = world_lines.apparent_world_positions(scene, obj, obj, centre, at_rest_observer)
+            world, beta = world_lines.apparent_world_positions(scene, obj, obj, centre, at_rest_observer,
+                                                               shape_keys_too=False)
         except ValueError as error:
             raise RelativityError(f"object {obj.name!r}: {error}") from None
         beta = tuple(float(b) for b in np.asarray(beta)[0])

@@ -64,6 +64,14 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         default=False,
         update=_settings_changed,
     )
+    use_proper_time: BoolProperty(
+        name="Proper Time",
+        description="The object's own animation (rotation and scale keys, keyframed shape keys) plays at its "
+        "proper time, integral of dt / gamma along its world line (location keys or the constant velocity), "
+        "at each vertex's retarded time; off: at the scene's time",
+        default=True,
+        update=_settings_changed,
+    )
     samples_per_frame: IntProperty(
         name="Samples per Frame",
         description="Animation samples per frame used to interpolate the motion at retarded times "

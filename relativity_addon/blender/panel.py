@@ -168,6 +168,8 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         elif settings.motion == "ANIMATION":
             column.prop(settings, "use_deformation")
             column.prop(settings, "samples_per_frame")
+        if settings.motion != "STATIC":
+            column.prop(settings, "use_proper_time")
         column.prop(settings, "tessellation")
         column.prop(settings, "temperature")
         bake = effect.bake_status(context.scene, obj)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import proper_time
-from . import animation, compat, snapshot
+from . import animation, snapshot
 
 SAMPLES_PER_FRAME = 4
 MAX_SAMPLES = 200_000
@@ -26,21 +26,6 @@ def _grid(scene, first_frame, last_frame):
     return frames, proper_time.proper_times(frames / fps, snapshot.observer_speeds(scene, frames))
 
 
-def _keyframes_signature(obj):
-    """Everything of the object's (and its parents') keyframes that moves it."""
-    parts = []
-    while obj is not None:
-        animation_data = obj.animation_data
-        if animation_data is not None and animation_data.action is not None:
-            for fcurve in compat.action_fcurves(animation_data):
-                parts.append((fcurve.data_path, fcurve.array_index, fcurve.mute, tuple(
-                    (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
-                    for p in fcurve.keyframe_points)))
-        parts.append((tuple(map(tuple, obj.matrix_parent_inverse)), tuple(obj.location), tuple(obj.rotation_euler)))
-        obj = obj.parent
-    return tuple(parts)
-
-
 def proper_time_at(scene, frame):
     """The traveller's time (seconds) at ``frame`` (negative before frame 0), interpolated in a
     table of the scene's frame range sampled SAMPLES_PER_FRAME times a frame, which is computed
@@ -52,7 +37,7 @@ def proper_time_at(scene, frame):
     last = max(1.0, float(scene.frame_end), float(frame))
     animated = camera is not None and settings.velocity_source == "CAMERA_ANIMATION"
     key = (scene.name, first, last, settings.velocity_source, tuple(settings.beta), settings.speed_of_light,
-           animation.frames_per_second(scene), _keyframes_signature(camera) if animated else ())
+           animation.frames_per_second(scene), animation.keyframes_signature(camera) if animated else ())
     if _cache.get("key") != key:
         frames, taus = _grid(scene, first, last)
         _cache.update(key=key, frames=frames, taus=taus - np.interp(0.0, frames, taus))

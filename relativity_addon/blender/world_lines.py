@@ -16,15 +16,25 @@ preview they are carried into the observer frame.
 - ANIMATION with ``use_deformation``: per-vertex positions from the deformation bake, contracted
   the same way about the object's origin along the origin's velocity (baked with them).
 
+Proper time (``Object.relativity.use_proper_time``, docs/proper-time.md): an object's own animation
+(rotation and scale keys, shape keys; with a deformation bake everything about the origin's path,
+armatures included) plays at its proper time along its world line.
+
 Every function raises RelativityError (one line) for a motion it cannot show correctly.
 """
 
 import numpy as np
 
 from ..errors import RelativityError
-from ..physics import apparent, rest_shape, sampling
-from . import animation, modifier, names
+from ..physics import apparent, proper_time, rest_shape, sampling
+from . import animation, modifier, names, shape_keys
 from .snapshot import check_velocity
+
+# Most samples of a keyframed object's clock table (its path from scene time 0 to the retarded times).
+CLOCK_SAMPLES = 200_000
+# Solves with each vertex in the shape of its own retarded time, after the first with the scene frame's.
+SHAPE_PASSES = 2
+_clock_tables = {}  # object name -> the clock table of its last update (see _path_clock)
 
 
 def matrix_array(matrix):
@@ -35,20 +45,24 @@ def to_world(matrix, points):
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def apparent_world_positions(scene, obj, obj_eval, rest, snap):
+def apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=True):
     """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
-    points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all)."""
+    points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all).
+    ``shape_keys_too=False``: ``rest`` are not the mesh's points (its centre, say): rigid motion only."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
     matrix_now = matrix_array(obj_eval.matrix_world)
+    check_parent_motion(obj)
     motion = obj.relativity.motion
     if motion == "ANIMATION" and obj.relativity.use_deformation:
         world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
     elif motion == "ANIMATION":
-        world, _, beta_seen = animated_apparent_positions(obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval)
-    elif motion == "CONSTANT" and animation.has_own_animation(obj, scene):
+        world, _, beta_seen = animated_apparent_positions(
+            obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too)
+    elif motion == "CONSTANT" and plays_own_animation(obj, scene):
         beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
-        world, _, beta_seen = proper_time_apparent_positions(obj, scene, rest, matrix_now, beta_u, t_o, x_o, beta_o, c)
+        world, _, beta_seen = proper_time_apparent_positions(
+            obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too)
     else:
         beta_u = np.zeros(3)
         if motion == "CONSTANT":
@@ -63,31 +77,134 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap):
     return world, beta_seen
 
 
-def proper_time_apparent_positions(obj, scene, rest_local, matrix_now, beta_u, t_o, x_o, beta_o, c):
-    """A CONSTANT object with its own animation (a spinning wheel, a clock's hand: rotation and
-    scale keyframes, under its parents): the animation runs at the object's proper time
-    ``tau = t / gamma`` (its clock reads 0 at scene time 0), evaluated at each vertex's retarded
-    time by the sampled solver; the origin moves with ``beta`` through where Blender draws it at
-    ``t_o`` (its keyframed location is not a motion of a CONSTANT object)."""
-    fps = animation.frames_per_second(scene)
-    gamma = 1.0 / np.sqrt(1.0 - beta_u @ beta_u)
-    origin_now = matrix_now[:3, 3].copy()
+def check_parent_motion(obj):
+    """RelativityError if the nearest moving mesh among the object's parents (apparent geometry on,
+    Motion not Static) has another motion than the object: a child rides on its parent's world line,
+    and each object's world line comes from its own settings, so they must agree (the child's own
+    keys then play at the proper time of that world line)."""
+    parent = obj.parent
+    while parent is not None:
+        settings = parent.relativity
+        if parent.type == "MESH" and settings.enabled and settings.motion != "STATIC":
+            own = obj.relativity
+            if own.motion != settings.motion or (
+                    own.motion == "CONSTANT" and tuple(own.beta) != tuple(settings.beta)):
+                how = "Constant Velocity with the same velocity" if settings.motion == "CONSTANT" else "Animation"
+                raise RelativityError(f"object {obj.name!r} rides on its moving parent {parent.name!r}: "
+                                      f"set its Motion to {how}")
+            return
+        parent = parent.parent
 
-    def matrices(times):
+
+def plays_own_animation(obj, scene):
+    """Whether the object has its own animation to play on a clock of its own: keyframes that turn
+    or scale it (or an object parent), or keyframed shape-key values. Objects whose keyframes are
+    not their motion (:func:`animation.keyframe_motion_problem`) are left as Blender shows them."""
+    if animation.keyframe_motion_problem(obj, scene) is not None:
+        return False
+    return animation.has_own_animation(obj, scene) or shape_keys.has_animated_shape_keys(obj)
+
+
+def _path_clock(obj, fps, step, c):
+    """``tau(t)`` (seconds to seconds, arrays) of a keyframed object: ``integral dt / gamma`` along
+    the path of its origin as its keyframes (all at scene time) draw it, straight between samples
+    ``step`` apart (coarser if more than CLOCK_SAMPLES would be needed); 0 at scene time 0. The
+    path is kept between updates while the keyframes stay the same
+    (``animation.keyframes_signature``) and extended by the samples missing when a time falls
+    outside it, so stepping through frames evaluates only the new ones."""
+    signature = animation.keyframes_signature(obj)
+    key = (obj.name, fps, step, c, signature)
+    table = _clock_tables.get(obj.name) if signature is not None else None
+    if table is None or table["key"] != key:
+        table = {"key": key, "spacing": step}
+        _clock_tables[obj.name] = table
+
+    def path(indices):
+        if not len(indices):
+            return np.empty((0, 3))
+        return animation.world_matrices(obj, indices * table["spacing"] * fps)[:, :3, 3]
+
+    def clock(times):
         times = np.asarray(times, dtype=np.float64)
-        own = animation.world_matrices(obj, times / gamma * fps)
-        own[:, :3, 3] = origin_now + (times - t_o)[:, None] * (beta_u * c)
-        return own
+        low, high = min(0.0, float(times.min())), max(0.0, float(times.max()))
+        if "grid" not in table or low < table["grid"][0] or high > table["grid"][-1]:
+            first = int(np.floor(low / table["spacing"]))
+            last = max(int(np.ceil(high / table["spacing"])), first + 1)
+            if "grid" in table:
+                old_first, old_last = table["indices"]
+                first, last = min(first, old_first), max(last, old_last)
+            if last - first > CLOCK_SAMPLES:  # coarser samples: start afresh
+                table.pop("grid", None)
+                table["spacing"] = (high - low) / CLOCK_SAMPLES
+                first, last = int(np.floor(low / table["spacing"])), int(np.ceil(high / table["spacing"]))
+            if "grid" in table:
+                points = np.concatenate([path(np.arange(first, old_first)), table["path"],
+                                         path(np.arange(old_last + 1, last + 1))])
+            else:
+                points = path(np.arange(first, last + 1))
+            grid = np.arange(first, last + 1) * table["spacing"]
+            table.update(indices=(first, last), grid=grid, path=points,
+                         taus=proper_time.path_proper_times(grid, points, c))
+        return np.interp(times, table["grid"], table["taus"])
 
+    return clock
+
+
+def proper_time_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, beta_u=None, matrix_now=None,
+                                   shape_keys_too=True):
+    """An object with its own animation (:func:`plays_own_animation`: a spinning wheel, a clock's
+    hands, shape keys) plays it at its proper time ``tau`` (its clock reads 0 at scene time 0),
+    evaluated at each vertex's retarded time by the sampled solver.
+
+    CONSTANT (``beta_u``): ``tau = t / gamma``; the origin moves with ``beta_u`` through where
+    Blender draws it at ``t_o`` (``matrix_now``; keyframed location is not a motion of a CONSTANT
+    object). ANIMATION: the location keys (under the parents) are the world line, at scene time;
+    rotation and scale keys of the object and its parents are its own animation, at ``tau(t) =
+    integral dt / gamma`` along the origin's path (:func:`_path_clock`). Shape-key values are read at
+    the ``tau`` of each vertex's retarded time (:class:`shape_keys.ShapeKeyMotion`), solving again
+    with the shape each vertex had there (SHAPE_PASSES times). With Proper Time off the clock is
+    the scene's."""
+    fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    dilate = bool(obj.relativity.use_proper_time)
+    if beta_u is not None:
+        gamma = 1.0 / np.sqrt(1.0 - beta_u @ beta_u) if dilate else 1.0
+        origin_now = matrix_now[:3, 3].copy()
+
+        def clock(times):
+            return np.asarray(times, dtype=np.float64) / gamma
+
+        def matrices(times):
+            times = np.asarray(times, dtype=np.float64)
+            own = animation.world_matrices(obj, clock(times) * fps)
+            own[:, :3, 3] = origin_now + (times - t_o)[:, None] * (beta_u * c)
+            return own
+    else:
+        clock = _path_clock(obj, fps, step, c) if dilate else np.asarray
+
+        def matrices(times):
+            times = np.asarray(times, dtype=np.float64)
+            return animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
+
+    shape = None
+    if dilate and shape_keys_too and shape_keys.has_animated_shape_keys(obj):
+        shape = shape_keys.ShapeKeyMotion(obj)
+        shape.check(rest_local, scene.frame_current + scene.frame_subframe)
     try:
-        return sampling.apparent_positions_from_matrix_function(
-            matrices, step, rest_local, t_o, x_o, beta_o, c, world_matrix_now=matrices([t_o])[0])
+        now = matrices(np.array([t_o]))[0]
+        result = sampling.apparent_positions_from_matrix_function(
+            matrices, step, rest_local, t_o, x_o, beta_o, c, world_matrix_now=now)
+        for _ in range(SHAPE_PASSES if shape is not None else 0):
+            shaped = shape.positions(clock(t_o - result[1]) * fps)
+            result = sampling.apparent_positions_from_matrix_function(
+                matrices, step, shaped, t_o, x_o, beta_o, c, world_matrix_now=now)
     except ValueError as error:
         raise RelativityError(f"object {obj.name!r}: {error}") from None
+    return result
 
 
-def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None):
+def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None,
+                                shape_keys_too=True):
     """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
     world matrices when it has a motion bake, else from its keyframes under its parent chain
     (:func:`animation.world_matrices`). An object whose keyframes are not its motion
@@ -102,6 +219,9 @@ def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max
         raise RelativityError(
             f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
             "bake its motion (Bake Motion in the Relativity panel)")
+    if obj.relativity.use_proper_time and plays_own_animation(obj, scene):
+        return proper_time_apparent_positions(
+            obj, scene, rest_local, t_o, x_o, beta_o, c, shape_keys_too=shape_keys_too)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
     try:
         return sampling.apparent_positions_from_matrix_function(
@@ -149,8 +269,15 @@ def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
         mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
     times = info["start"] + info["step"] * np.arange(info["samples"])
     origins = np.array(info[names.BAKE_ORIGINS_KEY], dtype=np.float64).reshape(-1, 3)
-    result = rest_shape.apparent_positions_deforming_rest_shape(
-        times, positions.reshape(info["samples"], count, 3).astype(np.float64), origins, t_o, x_o, c, beta_o)
+    positions = positions.reshape(info["samples"], count, 3).astype(np.float64)
+    if obj.relativity.use_proper_time:
+        # The origin's path is the world line; the baked shape about it (armature, shape keys,
+        # modifiers, rotation, scale) is the object's own animation, played at its proper time.
+        try:
+            positions = proper_time.own_animation_at_proper_time(times, positions, origins, c)
+        except ValueError as error:
+            raise RelativityError(f"object {obj.name!r}: {error}") from None
+    result = rest_shape.apparent_positions_deforming_rest_shape(times, positions, origins, t_o, x_o, c, beta_o)
     t_e = t_o - result[1]
     if t_e.min() < times[0] or t_e.max() > times[-1]:
         raise RelativityError(

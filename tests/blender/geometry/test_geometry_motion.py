@@ -91,6 +91,7 @@ def test_spinning_wheel_on_a_moving_turning_car(relativity_addon, factory_blende
     omega = 6.5  # rad/s: rim at 0.65 c about the hub; up to ~0.9 c in the world
     gh.keyframe_linear(wheel, "rotation_euler", 2, [(0, 0.0), (FPS, omega)])
     wheel.relativity.motion = "ANIMATION"
+    wheel.relativity.use_proper_time = False  # Blender's own matrix_world at t_e (the clock: test_proper_time_*)
     wheel.relativity.tessellation = 0
     wheel.relativity.samples_per_frame = 32
     scene.frame_set(FRAME)
@@ -118,6 +119,7 @@ def test_delta_transforms_count(relativity_addon, factory_blender):
     box.delta_rotation_euler[0] = 0.5
     box.delta_scale = (1.5, 1.0, 0.7)
     box.relativity.motion = "ANIMATION"
+    box.relativity.use_proper_time = False  # Blender's own matrix_world at t_e
     box.relativity.tessellation = 1
     box.relativity.samples_per_frame = 16
     scene.frame_set(FRAME)

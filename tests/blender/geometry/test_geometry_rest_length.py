@@ -129,6 +129,7 @@ def test_moving_deforming_mesh_is_contracted_about_its_origin(relativity_addon, 
     gh.keyframe_linear(blob, "location", 0, [(0, -2.0), (36, -2.0 + 36 * speed)])
     blob.relativity.motion = "ANIMATION"
     blob.relativity.use_deformation = True
+    blob.relativity.use_proper_time = False  # Blender's own shape at t_e (the clock: test_geometry_proper_time_*)
     blob.relativity.tessellation = 0
     blob.relativity.samples_per_frame = 8
     frame = 24
