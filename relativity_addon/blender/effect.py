@@ -29,6 +29,7 @@ from . import (
     metadata,
     modifier,
     moving_lights,
+    shape_keys,
     snapshot,
     traveller,
 )
@@ -289,6 +290,11 @@ def _mesh_warnings(obj, snap):
     return inputs, [coarse] if coarse else []
 
 
+def _shape_key_warnings(obj):
+    warning = shape_keys.scene_time_warning(obj)
+    return [warning] if warning else []
+
+
 def _status(scene):
     """(snapshot or None, warnings) of the scene's last sync; checked now if it has not synced
     since the file was opened."""
@@ -319,7 +325,7 @@ def scene_warnings(scene):
 
 def object_warnings(scene, obj):
     """Warnings for the active object on the apparent-geometry path: its last update error, a bake
-    it needs, a mesh too coarse to curve (as of the last sync)."""
+    it needs, a mesh too coarse to curve (as of the last sync), shape keys left at scene time."""
     if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
         return []
     warnings = list(_object_warnings.get(obj.name, ((), []))[1])
@@ -329,7 +335,7 @@ def object_warnings(scene, obj):
         warnings.append(error)
     elif status is not None and status[1] is None and status[2] is not None:
         warnings.append(status[2])
-    return warnings
+    return warnings + _shape_key_warnings(obj)
 
 
 def bake_status(scene, obj):

@@ -16,7 +16,7 @@ import re
 import numpy as np
 
 from ..errors import RelativityError
-from . import compat
+from . import compat, names
 
 _VALUE_PATH = re.compile(r'^key_blocks\["(.+)"\]\.value$')
 FRAME_SAMPLES_PER_FRAME = 16  # the values' table between the frames asked for (linear in between)
@@ -39,6 +39,44 @@ def has_animated_shape_keys(obj):
     """Whether keyframes change the values of the mesh's shape keys (its own animation)."""
     key = getattr(obj.data, "shape_keys", None)
     return key is not None and bool(_value_fcurves(key))
+
+
+def scene_time_reason(obj):
+    """Why ``obj``'s animated shape keys cannot be blended here at other times (one line), or None.
+    The blend works on the mesh's own vertices with Blender's relative blending; otherwise the keys
+    play at the scene's time (the shape Blender evaluated), which the object's warnings say."""
+    if obj.relativity.tessellation > 0:
+        return "Tessellation is above 0"
+    modifiers = list(obj.modifiers)
+    relativity = next((index for index, m in enumerate(modifiers) if m.type == "NODES" and m.node_group is not None
+                       and m.node_group.name == names.GEOMETRY_GROUP), len(modifiers))
+    before = [m for m in modifiers[:relativity] if m.show_viewport or m.show_render]
+    if before:
+        return f"modifier {before[0].name!r} comes before the relativity modifier"
+    key = obj.data.shape_keys
+    if not key.use_relative:
+        return "its shape keys are absolute (Evaluation Time)"
+    if key.animation_data is not None and any(
+            _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers):
+        return "drivers set its shape keys"
+    for block in key.key_blocks:
+        if block != key.reference_key and not block.mute and block.vertex_group:
+            return f"shape key {block.name!r} has a vertex group"
+    return None
+
+
+def scene_time_warning(obj):
+    """The object's warning when its animated shape keys play at the scene's time although its own
+    animation runs on its proper time, or None."""
+    settings = obj.relativity
+    if not settings.use_proper_time or settings.motion == "STATIC" or settings.use_deformation \
+            or not has_animated_shape_keys(obj):
+        return None
+    reason = scene_time_reason(obj)
+    if reason is None:
+        return None
+    return (f"Object {obj.name!r}: its shape keys play at the scene's time, not at its proper time ({reason}; "
+            "Tessellation 0 with no modifier before the relativity one, or a deformation bake, plays them)")
 
 
 class ShapeKeyMotion:

@@ -187,7 +187,8 @@ def proper_time_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, 
             return animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
 
     shape = None
-    if dilate and shape_keys_too and shape_keys.has_animated_shape_keys(obj):
+    if dilate and shape_keys_too and shape_keys.has_animated_shape_keys(obj) \
+            and shape_keys.scene_time_reason(obj) is None:  # else at the scene's time: the object's warnings
         shape = shape_keys.ShapeKeyMotion(obj)
         shape.check(rest_local, scene.frame_current + scene.frame_subframe)
     try:

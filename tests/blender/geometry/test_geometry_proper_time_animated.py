@@ -257,8 +257,9 @@ def test_shape_keys_run_on_proper_time(relativity_addon, tmp_path, motion):
 
 
 def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
-    """Tessellated rest points are not the shape keys' vertices: a one-line error naming the fix,
-    and with Proper Time off the old behaviour (the scene frame's shape) is there."""
+    """Tessellated rest points are not the shape keys' vertices: the keys play at the scene's time
+    (the shape Blender evaluated, as with Proper Time off), and the object's warning says so and
+    names the fix; at Tessellation 0 the warning goes."""
     bpy = __import__("bpy")
     scene, _ = _scene(bpy)
     face = _face(bpy, scene)
@@ -267,11 +268,19 @@ def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
     face.relativity.beta = (0.5, 0.0, 0.0)
     face.relativity.tessellation = 1
     scene.frame_set(FRAME)
-    with pytest.raises(gh.geometry_module().RelativityError, match="Tessellation to 0"):
-        gh.apply_geometry(scene)
-    face.relativity.use_proper_time = False
+    effect = gh.addon_module("effect")
     gh.apply_geometry(scene)
     assert gh.geometry_module().scene_errors(scene) == []
+    dilated = gh.evaluated_points(bpy, face)[0]
+    (warning,) = [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
+    assert "scene's time" in warning and "Tessellation is above 0" in warning
+    face.relativity.use_proper_time = False
+    scene.frame_set(FRAME)
+    assert np.allclose(gh.evaluated_points(bpy, face)[0], dilated, atol=1e-6), "the scene's time, as without it"
+    assert not [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
+    face.relativity.use_proper_time = True
+    face.relativity.tessellation = 0
+    assert not [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
 
 
 def test_armature_hand_runs_on_proper_time(relativity_addon, tmp_path):
