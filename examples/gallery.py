@@ -42,6 +42,8 @@ FIGURES = {
     "weiskopf_fig9_sun_doppler_searchlight": (gs.suns, ("SEARCHLIGHT",), -0.5),
     "gray_fig1a_rest": (gs.tiles, ("PINHOLE", False), 0.0),
     "gray_fig1b_pinhole": (gs.tiles, ("PINHOLE", True), 0.0),
+    "gray_fig1c_time_of_flight": (gs.tiles, ("PINHOLE", True, True), 0.0),
+    "gray_fig1c_time_of_flight_enlarged": (gs.tiles, ("PINHOLE", True, True, 3000.0), 0.0),
     "gray_fig1_wide_aperture": (gs.tiles, ("APERTURE_PLANE", True), 0.0),
     "gray_fig3b_aperture_plane": (gs.sphere_array, ("APERTURE_PLANE", 0.05), 1.0),
     "gray_fig4_aperture_plane_huge": (gs.sphere_array, ("APERTURE_PLANE", 0.2), 1.0),
@@ -54,6 +56,9 @@ FIGURES = {
     "gray_fig9b_moving": (gs.portrait, ("MOVING",), 0.0),
     "gray_fig9c_lorentz_window": (gs.portrait, ("WINDOW",), 0.0),
     "gray_fig10_window_detector_plane": (gs.portrait, ("WINDOW_DETECTOR",), 0.0),
+    "gray_fig11a_stereo_rest": (gs.stereo_portrait, ("REST",), 0.0),
+    "gray_fig11b_stereo_moving": (gs.stereo_portrait, ("MOVING",), 0.0),
+    "gray_fig11c_stereo_lorentz_window": (gs.stereo_portrait, ("WINDOW",), 0.0),
 }
 
 
@@ -101,16 +106,21 @@ def render_figure(name, out_dir, work_dir, width, height, samples):
     exr = Path(work_dir) / f"{name}.exr"
     settings = scene.render.image_settings
     settings.file_format, settings.color_depth = "OPEN_EXR", "32"
+    if context.get("stereo"):  # Blender's anaglyph of the two views, one EXR (loads on 4.5 and 5.2)
+        settings.views_format = "STEREO_3D"
+        settings.stereo_3d_format.display_mode = "ANAGLYPH"
     scene.render.filepath = str(exr)
     bpy.ops.render.render(write_still=True, scene=scene.name)
     linear = read_image(exr)
     settings.file_format, settings.color_mode, settings.color_depth = "PNG", "RGB", "8"
+    settings.views_format = "INDIVIDUAL"  # the anaglyph is one image now
     image = bpy.data.images.load(str(exr))
     png = Path(out_dir) / f"{name}.png"
     image.save_render(str(png), scene=scene)
     bpy.data.images.remove(image)
     context.update(size=(width, height), window=view_window(scene, context["camera"]))
     context.pop("camera")
+    context.pop("stereo", None)
     return linear, context
 
 

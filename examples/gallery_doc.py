@@ -44,10 +44,28 @@ FIGURES = [
     ("gray_fig1b_pinhole", f"{G20} Fig. 1(b)",
      "The camera moving at 99.5 % of c through the scene, pinhole shutter model: the scene is shrunk "
      "into a small patch around the direction of motion.", GRAY + "; pinhole shutter at t_S = 0; 100 mm lens."),
+    ("gray_fig1c_time_of_flight", f"{G20} Fig. 1(c)",
+     "The same camera and speed with light-travel time alone (*Time of Flight Only*: the Galilean "
+     "transformation instead of the Lorentz one, light at c in the camera frame; no searchlight or "
+     "Doppler, as in Gray's renders): a point is seen where it was when its light left it, "
+     "x_seen = x + beta r in the camera frame. The look is relativity's, more so: directions perpendicular "
+     "to beta are seen acos(beta) = 5.7 degrees from it in both, but what lies ahead is squeezed about ten "
+     "times more, so the wall and the spheres fill a few pixels right of the image centre (the red "
+     "sphere is 1.4 px from the direction of beta here, 11.9 px in (b)). Relativity is this plus the "
+     "Lorentz contraction of the scene by gamma = 10 along beta, which spreads what is ahead. The red "
+     "sphere's centroid is measured against the time-of-flight formula (it covers about one pixel "
+     "here; see the enlargement). Gray's own panel was probably made with light at c in the scene "
+     "frame instead, which squeezes far less (docs/camera.md, \"Time of flight only\").",
+     GRAY + "; pinhole shutter at t_S = 0; 100 mm lens; `use_time_of_flight`."),
+    ("gray_fig1c_time_of_flight_enlarged", f"{G20} Fig. 1(c), enlarged",
+     "The centre of Fig. 1(c) through a 3000 mm lens (30 times the focal length, 0.69 degrees wide), "
+     "shifted to centre the direction of motion: the back wall and the three spheres, whole, in a few "
+     "pixels of Fig. 1(c). The red sphere's centroid against the time-of-flight formula.",
+     "As Fig. 1(c), 3000 mm lens, lens shift x = 0.101 * 3000 / 36 = 8.42."),
     ("gray_fig1_wide_aperture", f"{G20} (Fig. 1 with a wide aperture)",
      "The same moving camera with a wide aperture (radius 0.2) and the aperture-plane shutter, focused at "
      "distance 10: the relativistic blur of Section 3 (not a panel of Fig. 1, whose (c) is the Galilean "
-     "time-of-flight picture: pending, see below).", GRAY + "; aperture-plane shutter, 100 mm lens."),
+     "time-of-flight picture above).", GRAY + "; aperture-plane shutter, 100 mm lens."),
     ("gray_fig3b_aperture_plane", f"{G20} Fig. 3(b)",
      "Aperture-plane shutter, medium aperture (radius 0.05): the spheres, placed to be in focus, come out "
      "blurred, except near the centre and the direction of beta (relativistic coma).",
@@ -126,12 +144,29 @@ FIGURES = [
      "'SHUTTER_MODEL'`, `lorentz_window_time = -1`, and the shutter time Gray's caption gives: the axial "
      "chief ray has Fig. 9's timing (t_S = -1 + 1.1112 + 0.0506 = 0.1618); the preset *Gray 2020 Fig 10 "
      "Lorentz window detector plane*."),
+    ("gray_fig11a_stereo_rest", f"{G20} Fig. 11(a)",
+     "The portrait of Fig. 9 through Blender's stereo camera at rest, as a red-cyan anaglyph (left eye red, "
+     "right eye green and blue): horizontal parallax only, zero for the plane at distance 5. Measured: "
+     "the pupils' parallax between the eyes against the off-axis pair's, 0.4 f (1/z - 1/5) at their "
+     "depth z = 4.31.",
+     "As Fig. 9(a); Stereo 3D, off-axis eyes 0.4 apart converging at 5, Blender's default pivot (left eye "
+     "at the camera) (the preset *Gray 2020 Fig 11 stereo Lorentz window* without motion)."),
+    ("gray_fig11b_stereo_moving", f"{G20} Fig. 11(b)",
+     "The stereo camera moving as in Fig. 9(b), both eyes with one shutter plane and one shutter time: "
+     "each eye's photo is shrunk into a small blurred patch around the direction of motion as in Fig. 9(b); "
+     "the two patches are about as far apart as the off-axis parallax of a point at infinity (the squeezed "
+     "scene is seen far away). The vertical disparity that keeps a moving pair from fusing (Gray section 4) "
+     "is too small to see at this scale; `tests/blender/camera/test_camera_stereo.py` measures it on "
+     "markers (-11.7 to +8.9 px at 200x150).", "As Fig. 9(b), stereo as (a)."),
+    ("gray_fig11c_stereo_lorentz_window", f"{G20} Fig. 11(c)",
+     "As (b) with the Lorentz window in the shared shutter plane (a plane of spatial fixed points for "
+     "t_S): the anaglyph equals the anaglyph at rest (a), pupils' parallax included.",
+     "As Fig. 9(c), stereo as (a)."),
 ]
 
-PENDING = f"""## Pending
+PENDING = """## Pending
 
-- {G20} Fig. 1(c), the time-of-flight-only (Galilean) picture: needs a time-of-flight mode (issue 12).
-- {G20} Fig. 11 (anaglyphs of stereo pairs): issue 12 (stereo).
+- Nothing of the two papers' figures: every panel the add-on can render is above.
 """
 
 

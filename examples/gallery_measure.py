@@ -55,8 +55,17 @@ def aberrate(k, beta):
     return (k + (g - 1.0) * (bhat @ k) * bhat - g * beta) / (g * (1.0 - beta @ k))
 
 
+def time_of_flight_view(view, beta):
+    """Camera-frame viewing direction d of a scene-frame one under the Galilean transformation
+    (Gray Fig. 1c, docs/camera.md): the unit d with d - beta along ``view``."""
+    view, beta = np.asarray(view, float) / np.linalg.norm(view), np.asarray(beta, float)
+    bv = beta @ view
+    return beta + (math.sqrt(bv * bv + 1.0 - beta @ beta) - bv) * view
+
+
 def sphere_image_centroid(context, centre, radius, samples=360):
-    """Area centroid (pixels) of the aberrated cone of rays of a sphere seen from the origin."""
+    """Area centroid (pixels) of the cone of rays of a sphere seen from the origin, aberrated (or
+    mapped by :func:`time_of_flight_view` when the context says ``time_of_flight``)."""
     centre = np.asarray(centre, float)
     axis = centre / np.linalg.norm(centre)
     half = math.asin(radius / np.linalg.norm(centre))
@@ -66,7 +75,10 @@ def sphere_image_centroid(context, centre, radius, samples=360):
     points = []
     for phi in np.linspace(0.0, 2.0 * math.pi, samples, endpoint=False):
         view = math.cos(half) * axis + math.sin(half) * (math.cos(phi) * e1 + math.sin(phi) * e2)
-        points.append(project(context, -aberrate(-view, context["beta_local"])))
+        if context.get("time_of_flight"):
+            points.append(project(context, time_of_flight_view(view, context["beta_local"])))
+        else:
+            points.append(project(context, -aberrate(-view, context["beta_local"])))
     x, y = np.array(points).T
     xn, yn = np.roll(x, -1), np.roll(y, -1)
     cross = x * yn - xn * y
@@ -241,17 +253,21 @@ def sphere_arrays(images, contexts):
 
 def tiles(images, contexts):
     out = {}
-    for name in ("gray_fig1a_rest", "gray_fig1b_pinhole", "gray_fig1_wide_aperture"):
+    for name in ("gray_fig1a_rest", "gray_fig1b_pinhole", "gray_fig1c_time_of_flight",
+                 "gray_fig1c_time_of_flight_enlarged", "gray_fig1_wide_aperture"):
         if name not in images:
             continue
         context, image = contexts[name], images[name]
         red = np.clip(image[..., 0] - image[..., 1], 0.0, None)
         measured = centroid(red)
+        if measured is None:  # Fig. 1(c)'s red sphere is a pixel at 320x240: none at a tiny size
+            continue
         expected = sphere_image_centroid(context, *context["red"])
         y = luminance(image)
         sharp = np.abs(np.diff(y, axis=1)).mean() + np.abs(np.diff(y, axis=0)).mean()
+        formula = "time-of-flight formula" if context.get("time_of_flight") else "pinhole aberration formula"
         out[name] = {"red sphere centroid x (px)": measured[0], "red sphere centroid y (px)": measured[1],
-                     "pinhole aberration formula x (px)": expected[0], "pinhole aberration formula y (px)": expected[1],
+                     f"{formula} x (px)": expected[0], f"{formula} y (px)": expected[1],
                      "mean |luminance gradient| (per px)": sharp}
     return out
 
@@ -312,15 +328,46 @@ def bilinear(image, pixels):
     top = image[y0, x0] * (1 - fx) + image[y0, x0 + 1] * fx
     bottom = image[y0 + 1, x0] * (1 - fx) + image[y0 + 1, x0 + 1] * fx
     return top * (1 - fy) + bottom * fy
+def pupil_parallax(anaglyph, context, eye_separation=0.4, convergence=5.0):
+    """Left-minus-right image offset of the portrait's two pupils (dark discs on the white eyes) in a
+    red-cyan anaglyph (red: the left eye's view, green: the right eye's), against the off-axis pair's
+    parallax of a point at depth z, 2 delta with delta = (e / 2) f (1/z - 1/convergence). The eyes sit
+    about the camera as its stereo pivot says (LEFT: the left eye at the camera, Blender's default)."""
+    from gallery_scenes import PUPILS
+
+    focal_px = context["size"][0] / (context["window"][1] - context["window"][0])
+    half = max(2, round(7 * context["size"][0] / 320))
+    offsets, expected = [], []
+    for pupil in PUPILS:
+        centre = project(context, pupil)
+        delta = eye_separation / 2.0 * focal_px * (1.0 / -pupil[2] - 1.0 / convergence)
+        # where each eye sees it, from the centre of the pair (CENTER pivot) shifted to the pivot's eye
+        middle = centre + np.array([{"LEFT": -delta, "RIGHT": delta}.get(context["pivot"], 0.0), 0.0])
+        left, _ = spot(np.clip(0.9 - anaglyph[..., 0], 0.0, None), middle + (delta, 0.0), half)
+        right, _ = spot(np.clip(0.9 - anaglyph[..., 1], 0.0, None), middle - (delta, 0.0), half)
+        if left is None or right is None:
+            return {}
+        offsets.append(left - right)
+        expected.append(2.0 * delta)
+    offsets = np.array(offsets)
+    return {"pupils' parallax left - right, x (px), mean of two": offsets[:, 0].mean(),
+            "off-axis parallax of the pupils' depth, x (px)": float(np.mean(expected)),
+            "pupils' parallax left - right, y (px), mean of two": offsets[:, 1].mean()}
 
 
 def portrait(images, contexts):
-    rest = images.get("gray_fig9a_rest")
     out = {}
-    for name in ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"):
-        if rest is not None and name in images:
-            out[name] = {"mean |image - Fig. 9(a)|": np.abs(images[name] - rest).mean(),
-                         "mean of Fig. 9(a)": rest.mean()}
+    for rest_name, names, label in (
+            ("gray_fig9a_rest", ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"),
+             "Fig. 9(a)"),
+            ("gray_fig11a_stereo_rest", ("gray_fig11b_stereo_moving", "gray_fig11c_stereo_lorentz_window"),
+             "Fig. 11(a)")):
+        rest = images.get(rest_name)
+        for name in names:
+            if rest is not None and name in images:
+                out[name] = {f"mean |image - {label}|": np.abs(images[name] - rest).mean(),
+                             f"mean of {label}": rest.mean()}
+    rest = images.get("gray_fig9a_rest")
     name = "gray_fig10_window_detector_plane"
     if name in out:
         # The backdrop in the strips beside the portrait (outer 15 % of the width): Fig. 10 against
@@ -344,6 +391,19 @@ def portrait(images, contexts):
         values["backdrop shift by the physics core, right strip, max (px)"] = shift[~left].max()
         values["strips: mean |Fig. 10 - Fig. 9(a)|"] = np.abs(seen - y_rest[strip][inside]).mean()
         values["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"] = np.abs(seen - moved_rest).mean()
+    for name in ("gray_fig11a_stereo_rest", "gray_fig11c_stereo_lorentz_window"):
+        if name in images:
+            out.setdefault(name, {}).update(pupil_parallax(images[name], contexts[name]))
+    moving = images.get("gray_fig11b_stereo_moving")
+    if moving is not None:  # the anaglyph's red is the left eye's, green the right eye's
+        left = centroid(moving[..., 0] - moving[..., 1])
+        right = centroid(moving[..., 1] - moving[..., 0])
+        context = contexts["gray_fig11b_stereo_moving"]
+        focal_px = context["size"][0] / (context["window"][1] - context["window"][0])
+        out.setdefault("gray_fig11b_stereo_moving", {}).update({
+            "left (red) minus right (cyan) patch centroid, x (px)": left[0] - right[0],
+            "left minus right patch centroid, y (px)": left[1] - right[1],
+            "off-axis parallax of a point at infinity, x (px)": -0.4 / 5.0 * focal_px})
     return out
 
 

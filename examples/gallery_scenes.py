@@ -242,8 +242,10 @@ def sphere_array(scene, model, aperture_radius, imaging_element="IDEAL_LENS"):
     return {"camera": camera, "points": points}
 
 
-def tiles(scene, shutter, moving):
-    """Gray's Fig. 1: a tiled floor, a back wall and coloured spheres; pinhole or wide aperture."""
+def tiles(scene, shutter, moving, time_of_flight=False, zoom_lens_mm=None):
+    """Gray's Fig. 1: a tiled floor, a back wall and coloured spheres; pinhole or wide aperture;
+    ``time_of_flight``: Fig. 1(c), light-travel time without the Lorentz transformation;
+    ``zoom_lens_mm``: a long lens, shifted to centre the direction of motion."""
     world(scene, (0.0, 0.0, 0.0), 0.0)
     floor = emission_checker("Tiles", (0.8, 0.8, 0.8), (0.15, 0.15, 0.15), 40.0, 0.6)
     plane(scene, "Floor", [(-20, -1.5, 0), (20, -1.5, 0), (20, -1.5, -40), (-20, -1.5, -40)], floor)
@@ -256,8 +258,12 @@ def tiles(scene, shutter, moving):
     # at rest a wide view (12 mm, 113 degrees); moving, aberration shrinks the scene about
     # 20-fold ahead, so 100 mm (20 degrees), as Gray's Fig. 3 (a) and (b)
     camera = gray_camera(scene, 100.0 if moving else 12.0, GRAY_FOCUS if wide else None, 0.2 if wide else None)
-    gray_settings(scene, moving, shutter_model=shutter, shutter_time=0.0)
-    return {"camera": camera, "red": ((-1.2, -0.7, -8.0), 0.8), "beta_local": GRAY_BETA if moving else (0, 0, 0)}
+    if zoom_lens_mm:
+        camera.data.lens = zoom_lens_mm
+        camera.data.shift_x = GRAY_BETA[0] / -GRAY_BETA[2] * zoom_lens_mm / camera.data.sensor_width
+    gray_settings(scene, moving, shutter_model=shutter, shutter_time=0.0, use_time_of_flight=time_of_flight)
+    return {"camera": camera, "red": ((-1.2, -0.7, -8.0), 0.8), "beta_local": GRAY_BETA if moving else (0, 0, 0),
+            "time_of_flight": time_of_flight}
 
 
 FIXED_PLANE = 8.0
@@ -289,6 +295,7 @@ PORTRAIT_LENS_MM = 50.0
 PORTRAIT_FOCUS = 4.4
 BACKDROP_DEPTH = 10.0
 FIG9_PLANE_POINT = (0.111, 0.0, -1.1)
+PUPILS = ((-0.24, 0.45, -4.31), (0.24, 0.45, -4.31))
 
 
 def fig10_shutter_time(window_time=-1.0):
@@ -315,7 +322,7 @@ def portrait(scene, variant):
     white, pupil = emission("Eye", (0.95, 0.95, 0.95)), emission("Pupil", (0.02, 0.05, 0.12))
     for side in (-1, 1):
         add_sphere(scene, f"Eye {side}", (side * 0.24, 0.45, -4.42), 0.12, white)
-        add_sphere(scene, f"Pupil {side}", (side * 0.24, 0.45, -4.31), 0.045, pupil)
+        add_sphere(scene, f"Pupil {side}", PUPILS[(side + 1) // 2], 0.045, pupil)
     add_sphere(scene, "Nose", (0.0, 0.25, -4.32), 0.09, emission("Nose", (0.8, 0.5, 0.4)))
     body = add_box(scene, "Body", (0.0, -1.55, -5.3), 1.0, emission("Shirt", (0.15, 0.3, 0.7)))
     body.scale = (1.9, 1.7, 0.7)
@@ -327,3 +334,18 @@ def portrait(scene, variant):
     gray_settings(scene, variant != "REST", shutter_plane_point=FIG9_PLANE_POINT, shutter_plane_normal=GRAY_BETA,
                   use_lorentz_window=variant in ("WINDOW", "WINDOW_DETECTOR"), **shutter)
     return {"camera": camera, "shutter_time": shutter["shutter_time"], "window_time": -1.0}
+
+
+def stereo_portrait(scene, variant):
+    """Gray's Fig. 11: the Fig. 9 portrait and shutter through Blender's stereo camera, eyes 0.4 apart
+    (off-axis, converging at distance 5, as the paper's), written as a red-cyan anaglyph. Both eyes
+    share the shutter plane and time (docs/camera.md, Stereo)."""
+    context = portrait(scene, variant)
+    stereo = scene.camera.data.stereo
+    stereo.convergence_mode = "OFFAXIS"
+    stereo.interocular_distance = 0.4
+    stereo.convergence_distance = 5.0
+    scene.render.use_multiview = True
+    scene.render.views_format = "STEREO_3D"
+    context.update(stereo=True, pivot=stereo.pivot)  # Blender's default pivot: the left eye at the camera
+    return context

@@ -10,11 +10,12 @@ keyframed motion; refused with the frame number if it reaches c), --method camer
 --no-searchlight, --shutter MODEL, --shutter-time S, --shutter-plane-point X,Y,Z,
 --shutter-plane-normal X,Y,Z (camera-local axes), --lens ideal|phase-hologram, --lorentz-window,
 --window-time T_W (the window in the plane of fixed points for T_W, the shutter model timing the
-rays), --speed-of-light C, --frame N or --frames A-B (several frames: the frame number goes before the extension,
-out/fly_0001.png, or replaces a run of '#' in PATH), --seed N, --reference (render the file's own
-camera unchanged), --proper-time (frame K at the traveller's time K / fps), --threads N, --resume
-(skip frames whose output is already a complete image). Prints one progress line per frame with
-the time left. Exits non-zero with a one-line reason on any failure.
+rays), --time-of-flight (light delay only, Gray Fig. 1c), --speed-of-light C, --frame N or
+--frames A-B (several frames: the frame number goes before the extension, out/fly_0001.png, or
+replaces a run of '#' in PATH), --seed N, --reference (render the file's own camera unchanged),
+--proper-time (frame K at the traveller's time K / fps), --threads N, --resume (skip frames whose
+output is already a complete image). Prints one progress line per frame with the time left.
+Exits non-zero with a one-line reason on any failure.
 
 On a Dask cluster (docs/farm.md): --workers N (a local cluster of N worker processes) or
 --scheduler tcp://HOST:8786, with --chunk N (frames per task) and --retries N; each task renders

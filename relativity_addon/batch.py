@@ -88,6 +88,8 @@ def build_parser(with_blend_file):
     parser.add_argument("--no-searchlight", action="store_true")
     parser.add_argument("--no-geometry", action="store_true", help="no aberration (testing aid)")
     parser.add_argument("--lorentz-window", action="store_true")
+    parser.add_argument("--time-of-flight", action="store_true",
+                        help="light-travel time only, Galilean (Gray et al. 2020 Fig. 1c; no searchlight or Doppler)")
     parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
     parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
     parser.add_argument("--shutter-plane-point", type=_vector3, metavar="X,Y,Z",
@@ -217,6 +219,8 @@ def _apply_options(scene, options):
         settings.use_lorentz_window = True
         settings.lorentz_window_shutter = "SHUTTER_MODEL"
         settings.lorentz_window_time = options.window_time
+    if options.time_of_flight:
+        settings.use_time_of_flight = True
 
 
 def animation_fps(scene):

@@ -119,16 +119,27 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         layout = _split(self.layout)
         column = layout.column(heading="Effects")
         column.prop(settings, "use_geometry")
-        column.prop(settings, "use_doppler")
-        column.prop(settings, "use_searchlight")
         row = column.row()
-        row.active = settings.use_searchlight
+        row.active = settings.use_geometry and settings.method == "CAMERA"
+        row.prop(settings, "use_time_of_flight")
+        time_of_flight = settings.use_time_of_flight
+        if time_of_flight:
+            column.label(text="Light delay only (Galilean, Gray Fig. 1c): no contraction, searchlight or Doppler",
+                         icon="INFO")
+        elif settings.method != "CAMERA":
+            column.label(text="Time of Flight Only: exact camera only", icon="INFO")
+        colour = column.column()
+        colour.active = not time_of_flight
+        colour.prop(settings, "use_doppler")
+        colour.prop(settings, "use_searchlight")
+        row = colour.row()
+        row.active = settings.use_searchlight and not time_of_flight
         row.prop(settings, "use_chang_searchlight")
-        row = column.row()
-        row.active = settings.use_doppler and not settings.use_searchlight
+        row = colour.row()
+        row.active = settings.use_doppler and not settings.use_searchlight and not time_of_flight
         row.prop(settings, "doppler_only_brightness")
         column = layout.column()
-        column.active = settings.use_searchlight
+        column.active = settings.use_searchlight and not time_of_flight
         column.prop(settings, "exposure_mode")
         snap = effect.last_snapshot(context.scene)
         if settings.exposure_mode == "COMPENSATED" and snap is not None:

@@ -198,6 +198,14 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         default=True,
         update=_settings_changed,
     )
+    use_time_of_flight: BoolProperty(
+        name="Time of Flight Only",
+        description="Teaching aid (Gray et al. 2020, Fig. 1c): light-travel time without the Lorentz "
+        "transformation (Galilean). A point is seen where it was when its light left it, in the camera's "
+        "frame; no length contraction, searchlight or Doppler colour. Exact camera only",
+        default=False,
+        update=_settings_changed,
+    )
     use_doppler: BoolProperty(
         name="Doppler Colour",
         description="Doppler colour shift: blackbodies seen at D T, other colours through the spectral Doppler matrix",

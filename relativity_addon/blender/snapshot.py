@@ -84,6 +84,9 @@ class Snapshot:
     imaging_element: str = "IDEAL_LENS"  # or PHASE_HOLOGRAM: the detector-plane shutter's lens (Gray Fig. 6)
     lorentz_window_shutter: str = "WINDOW_PLANE"  # or SHUTTER_MODEL: what times rays through the window
     lorentz_window_time: float = 0.0  # camera-frame seconds: the window's plane of fixed points (SHUTTER_MODEL)
+    # Gray's Fig. 1c: the Galilean transformation instead of the Lorentz one (use_doppler and
+    # use_searchlight are then False: the mode shows the light-travel delay alone)
+    use_time_of_flight: bool = False
 
     @property
     def time(self) -> float:
@@ -361,6 +364,20 @@ def frame_exposure(scene, camera, settings, beta, camera_matrix):
     return exposure.compensation(beta_camera, view_window(scene, camera), aberration, power)
 
 
+def check_time_of_flight(settings, lights):
+    """RelativityError (one line) for what time-of-flight mode (Gray Fig. 1c) cannot render: it is
+    the exact camera's, for a scene at rest, and has no Lorentz transformation to window or to
+    take spatial fixed points from."""
+    if settings.method != "CAMERA":
+        raise RelativityError("Time of Flight Only is for the exact camera (Method: Exact Camera)")
+    if settings.use_lorentz_window:
+        raise RelativityError("Time of Flight Only has no Lorentz transformation for the Lorentz window to undo")
+    if settings.shutter_model == "FIXED_POINT_SURFACE":
+        raise RelativityError("Time of Flight Only has no spatial fixed points: choose another shutter")
+    if lights:
+        raise RelativityError(f"Time of Flight Only renders a scene at rest: light {lights[0].name!r} moves")
+
+
 def read(scene, depsgraph=None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
     cannot be rendered with correct physics."""
@@ -379,6 +396,10 @@ def read(scene, depsgraph=None) -> Snapshot:
     if not math.isfinite(settings.lorentz_window_time):
         raise RelativityError("the Lorentz window time must be finite")
     matrix = camera_matrix(scene, camera, frame, depsgraph)
+    lights = moving_lights(scene, frame, depsgraph)
+    time_of_flight = bool(settings.use_time_of_flight)
+    if time_of_flight:
+        check_time_of_flight(settings, lights)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
     return Snapshot(
@@ -400,14 +421,16 @@ def read(scene, depsgraph=None) -> Snapshot:
         shutter_plane_normal=tuple(float(v) for v in normal),
         use_lorentz_window=bool(settings.use_lorentz_window),
         use_geometry=bool(settings.use_geometry),
-        use_doppler=bool(settings.use_doppler),
-        use_searchlight=bool(settings.use_searchlight),
+        use_doppler=bool(settings.use_doppler) and not time_of_flight,
+        use_searchlight=bool(settings.use_searchlight) and not time_of_flight,
         use_chang_searchlight=bool(settings.use_chang_searchlight),
         exposure_mode=settings.exposure_mode,
-        exposure=frame_exposure(scene, camera, settings, beta, matrix) if settings.use_searchlight else 1.0,
-        moving_lights=moving_lights(scene, frame, depsgraph),
+        exposure=frame_exposure(scene, camera, settings, beta, matrix)
+        if settings.use_searchlight and not time_of_flight else 1.0,
+        moving_lights=lights,
         doppler_only_brightness=settings.doppler_only_brightness,
         imaging_element=settings.imaging_element,
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
+        use_time_of_flight=time_of_flight,
     )

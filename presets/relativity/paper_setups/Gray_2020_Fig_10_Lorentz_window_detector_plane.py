@@ -17,6 +17,7 @@ if scene.camera is not None:
     settings.velocity_source = 'MANUAL'
     settings.beta = to_world @ beta_local
     settings.method = 'CAMERA'
+    settings.use_time_of_flight = False
     settings.speed_of_light = 1.0
     settings.shutter_plane_point = (0.111, 0.0, -1.1)
     settings.shutter_plane_normal = (0.1, 0.0, -0.99)

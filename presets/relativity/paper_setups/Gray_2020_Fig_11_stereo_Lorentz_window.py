@@ -13,6 +13,7 @@ if scene.camera is not None:
     settings.velocity_source = 'MANUAL'
     settings.beta = to_world @ Vector((0.1, 0.0, -0.99))
     settings.method = 'CAMERA'
+    settings.use_time_of_flight = False
     settings.speed_of_light = 1.0
     settings.shutter_model = 'ARBITRARY_PLANE'
     settings.shutter_time = -1.0

@@ -13,6 +13,7 @@ if scene.camera is not None:
     settings.velocity_source = 'MANUAL'
     settings.beta = to_world @ Vector((0.1, 0.0, -0.99))
     settings.method = 'CAMERA'
+    settings.use_time_of_flight = False
     settings.shutter_model = 'PINHOLE'
     settings.shutter_time = 0.0
     settings.use_lorentz_window = False

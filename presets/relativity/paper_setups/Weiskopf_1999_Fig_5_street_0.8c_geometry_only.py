@@ -9,6 +9,7 @@ if scene.camera is not None:
     settings.velocity_source = 'MANUAL'
     settings.beta = scene.camera.matrix_world.to_quaternion() @ Vector((0.0, 0.0, -0.8))
     settings.method = 'CAMERA'
+    settings.use_time_of_flight = False
     settings.use_geometry = True
     settings.use_doppler = False
     settings.use_searchlight = False

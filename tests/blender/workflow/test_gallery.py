@@ -7,8 +7,9 @@ al.'s), a blackbody seen at D shows Y(D T) / (D^5 Y(T)) of its rest brightness u
 paper's "Doppler only" (Y from colour-science here) and Y(D T) / Y(T) with the searchlight,
 Gray's detector-plane shutter images the sphere array sharply at the grid points while the
 aperture-plane one (and the phase hologram of the lens) blurs it, the fixed-point-surface shutter
-keeps the focus plane in place and the Lorentz window gives the photo at rest (with the detector-plane
-shutter only nearly).
+keeps the focus plane in place, the Lorentz window gives the photo (and the stereo pair) at rest (with
+the detector-plane shutter only nearly), and time of flight alone puts a sphere where the light-delay
+geometry x_seen = x + beta r does.
 """
 
 import json
@@ -35,7 +36,7 @@ def _y(temperature):
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
     names = subprocess.run([sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True,
                            timeout=120, env=wh._env()).stdout.split()
-    assert len(names) == 21
+    assert len(names) == 26
     result = subprocess.run([sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48",
                              "--samples=2"], capture_output=True, text=True, timeout=600, env=wh._env())
     assert result.returncode == 0, result.stderr[-2000:]
@@ -77,6 +78,10 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
     assert numbers["gray_fig4_aperture_plane_huge"]["RMS radius / Fig. 5's (same aperture 0.2), median"] > 1.2
     # Fig. 6(b): the phase hologram blurs the array the ideal lens (Figs. 5, 6a) keeps sharp
     assert numbers["gray_fig6b_phase_hologram"]["RMS radius / Fig. 5's (same aperture 0.2), median"] > 1.2
+    # Gray Fig. 1(c): time of flight only puts the sphere where x_seen = x + beta r does
+    fig1c = numbers["gray_fig1c_time_of_flight_enlarged"]
+    assert abs(fig1c["red sphere centroid x (px)"] - fig1c["time-of-flight formula x (px)"]) < 0.5
+    assert abs(fig1c["red sphere centroid y (px)"] - fig1c["time-of-flight formula y (px)"]) < 0.5
     # Gray Fig. 8: the focus plane stays put; Fig. 9: the Lorentz window gives the photo at rest
     fig8b = numbers["gray_fig8b_fixed_point_surface"]
     assert fig8b["red discs found"] == 4
@@ -91,3 +96,6 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
     # ... where the physics core's window rays put the backdrop
     assert fig10["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"] \
         < 0.5 * fig10["strips: mean |Fig. 10 - Fig. 9(a)|"]
+    # Gray Fig. 11: the stereo pair through the window is the pair at rest
+    window, moving = numbers["gray_fig11c_stereo_lorentz_window"], numbers["gray_fig11b_stereo_moving"]
+    assert window["mean |image - Fig. 11(a)|"] < 0.05 * moving["mean |image - Fig. 11(a)|"]

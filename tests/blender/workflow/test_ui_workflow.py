@@ -203,6 +203,28 @@ def test_coarse_mesh_warning_for_the_geometry_method(relativity_addon, factory_b
     assert not [e for e in log if e[0] == "label" and e[2] == "ERROR"]
 
 
+def test_time_of_flight_says_what_it_leaves_out(relativity_addon, factory_blender):
+    """Time of Flight Only: one line in the Effects panel on what it leaves out, one on where it applies,
+    and with Apparent Geometry the one-line refusal in the main panel."""
+    bpy = factory_blender
+    scene, _, _ = wh.new_scene(bpy)
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    log = draw_panel(bpy, "RELATIVITY_PT_effects", scene)
+    assert ("prop", "use_time_of_flight") in log and not any("Light delay" in e[1] for e in log if e[0] == "label")
+    scene.relativity.use_time_of_flight = True
+    log = draw_panel(bpy, "RELATIVITY_PT_effects", scene)
+    assert any(e[0] == "label" and "no contraction, searchlight or Doppler" in e[1] for e in log)
+    scene.relativity.use_time_of_flight = False
+    scene.relativity.method = "GEOMETRY"
+    log = draw_panel(bpy, "RELATIVITY_PT_effects", scene)
+    assert any(e[0] == "label" and "exact camera only" in e[1] for e in log)
+    scene.relativity.use_time_of_flight = True
+    bpy.context.view_layer.update()
+    log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
+    assert any(e[0] == "label" and e[2] == "ERROR" and "Time of Flight Only is for the exact camera" in e[1]
+               for e in log)
+
+
 def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_addon, factory_blender):
     bpy = factory_blender
     scene, camera, _ = wh.new_scene(bpy)
@@ -221,7 +243,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
             path = next(os.path.join(d, name) for d in directories if os.path.isfile(os.path.join(d, name)))
             assert bpy.ops.script.execute_preset(filepath=path, menu_idname=menu) == {"FINISHED"}, name
     assert found["speed"] == ["0.5c.py", "0.8c.py", "0.999c.py", "0.99c.py", "0.9c.py"]
-    assert len(found["shutter"]) == 6 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 8
+    assert len(found["shutter"]) == 6 and len(found["speed_of_light"]) == 3 and len(found["paper_setups"]) == 9
 
     rotation = np.array(camera.matrix_world.to_quaternion().to_matrix())
 
@@ -234,6 +256,10 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     load("paper_setups", "Gray_2020_beta_0.1_0_0.99_camera.py")
     right, view = rotation[:, 0], -rotation[:, 2]
     np.testing.assert_allclose(tuple(settings.beta), 0.1 * right + 0.99 * view, atol=1e-6)
+    # Fig. 1(c): the same velocity, time of flight only; the next paper set-up switches it off again
+    load("paper_setups", "Gray_2020_Fig_1c_time_of_flight.py")
+    np.testing.assert_allclose(tuple(settings.beta), 0.1 * right + 0.99 * view, atol=1e-6)
+    assert settings.use_time_of_flight and settings.shutter_model == "PINHOLE"
     # Fig. 9: the shutter plane is the plane of spatial fixed points for t_S (docs/physics.md eq. 6:
     # -beta.x = ((gamma + 1) / gamma) c t_S), written in camera-local axes (beta.x is invariant).
     load("paper_setups", "Gray_2020_Fig_9_Lorentz_window.py")
@@ -265,6 +291,7 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     shown = [entry[1] for entry in draw_panel(bpy, "RELATIVITY_PT_shutter", scene) if entry[0] == "prop"]
     assert shown == ["shutter_model", "shutter_time", "imaging_element", "use_lorentz_window",
                      "lorentz_window_shutter", "lorentz_window_time"]
+    assert not settings.use_time_of_flight
     # Fig. 11: the same with Blender's stereo pair, eyes 0.4 apart converging at 5, as an anaglyph.
     load("paper_setups", "Gray_2020_Fig_11_stereo_Lorentz_window.py")
     np.testing.assert_allclose(beta_local, rotation.T @ np.array(settings.beta), atol=1e-6)
