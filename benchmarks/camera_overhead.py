@@ -54,16 +54,15 @@ def timed_render(bpy, scene, path):
 
 
 def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
-    """Renders ``cases`` (label and beta; None for Blender's own camera, "OSL" for it with Cycles'
-    OSL shading system, which the exact camera needs; the first case is the reference) alternately
-    ``repeats`` times after one warm-up round (shader compilation, kernel loading, caches) and
-    prints each case's median time and its median ratio to the reference's time of that round."""
+    """Renders ``cases`` (label and beta, None for Blender's own camera; the first case is the
+    reference) alternately ``repeats`` times after one warm-up round (shader compilation, kernel
+    loading, caches) and prints each case's median time and its median ratio to the reference's
+    time of that round."""
     from relativity_addon.blender import effect
 
     def render(beta, name):
-        if beta is None or beta == "OSL":
+        if beta is None:
             effect.remove(scene)
-            scene.cycles.shading_system = beta == "OSL"
         else:
             scene.relativity.beta = beta
             effect.apply(scene)
@@ -98,8 +97,7 @@ def main():
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
     out = tempfile.mkdtemp(prefix="camera-overhead-")
-    cases = (("perspective", None), ("perspective, OSL shading", "OSL"),
-             ("relativistic beta=0", (0.0, 0.0, 0.0)),
+    cases = (("perspective", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
              ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)))
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
     compare_cameras(bpy, scene, cases, options.repeats, out)
