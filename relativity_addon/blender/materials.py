@@ -313,6 +313,11 @@ def set_spectral_pass(wavelengths_nm):
     _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
 
 
+def in_spectral_pass():
+    """Whether a spectral pass is being rendered (the lamps' colours are then spectral values)."""
+    return _spectral_pass["wavelengths"] is not None
+
+
 def settings_values(snap):
     """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot`` (and the spectral pass)."""
     colour = snap.colour

@@ -80,3 +80,8 @@ REST_NORMAL_GROUP_VERSION = 1
 MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader
 MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and lights): "<prefix> <light> <index>"
 MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}
+
+# --- directly visible lamps (exact camera) ----------------------------------------------------
+LAMP_FACE_PREFIX = "Relativity Lamp Face"  # emitter meshes (objects, meshes, materials): "<prefix> <light>"
+LAMP_FACES_KEY = "relativity_lamp_faces"  # on the scene: {light object name: face object name}
+LAMP_FACE_SAVED_KEY = "relativity_lamp_face_saved"  # on light objects: the user's visible_camera

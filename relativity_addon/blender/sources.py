@@ -259,8 +259,8 @@ def _grey(colour):
     return r == g == b
 
 
-def _light_emission_colour(tree):
-    """The Color input of the Emission node that a light's active Light Output shows, or None."""
+def light_emission_node(tree):
+    """The Emission node that a light's active Light Output shows, or None."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputLight"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
     if output is None:
@@ -268,7 +268,13 @@ def _light_emission_colour(tree):
     found = _feed(output.inputs["Surface"], ())
     if found is None or found[0] is None or found[0].node.bl_idname != "ShaderNodeEmission":
         return None
-    return found[0].node.inputs["Color"]
+    return found[0].node
+
+
+def _light_emission_colour(tree):
+    """The Color input of the Emission node that a light's active Light Output shows, or None."""
+    node = light_emission_node(tree)
+    return None if node is None else node.inputs["Color"]
 
 
 def light_blackbody(light):
