@@ -85,3 +85,5 @@ MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stan
 LAMP_FACE_PREFIX = "Relativity Lamp Face"  # emitter meshes (objects, meshes, materials): "<prefix> <light>"
 LAMP_FACES_KEY = "relativity_lamp_faces"  # on the scene: {light object name: face object name}
 LAMP_FACE_SAVED_KEY = "relativity_lamp_face_saved"  # on light objects: the user's visible_camera
+VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-ray emission of a blackbody volume
+VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material

@@ -27,11 +27,9 @@ a non-constant temperature computed inside a group cannot be linked from the mat
 so that case is None too. Unlinked colours are constants, never blackbodies.
 
 Lights: :func:`light_blackbody` gives the temperature of a light whose spectrum is a blackbody
-(its own temperature setting, or an Emission fed by a Blackbody in its node tree), and
-:func:`volume_blackbody` the Principled Volume's own blackbody emission. Both are recognised for
-the colour code; neither is shifted per ray yet (a light lighting a surface cannot be, and
-volume shaders write no AOVs, so the exact camera's compositor shifts their pixels:
-docs/spectral-model.md).
+(its own temperature setting, or an Emission fed by a Blackbody in its node tree; lamps seen
+directly are drawn by emitter faces, ``lamp_faces.py``), and :func:`volume_blackbody` the
+Principled Volume's own blackbody emission (shifted for camera rays by ``volumes.py``).
 """
 
 from typing import NamedTuple
@@ -323,8 +321,8 @@ def volume_blackbody(node):
     Blender (Cycles and EEVEE alike) adds ``tint sigma mix(1, T^4, intensity) blackbody(T)``
     with ``T`` the Temperature input (times the temperature grid where the volume has one) when
     Blackbody Intensity exceeds 1e-3: a blackbody at ``T`` when the tint is grey. Returned with
-    scale None (it varies with the grid and Stefan-Boltzmann's ``T^4``). Not shifted in the
-    shader: volume shaders write no AOVs, so the exact camera's compositor would shift it again."""
+    scale None (it varies with the grid and Stefan-Boltzmann's ``T^4``). Volume shaders write no
+    AOVs: ``volumes.py`` shifts it for camera rays and marks the pixels on the volume's boundary."""
     if node.bl_idname != "ShaderNodeVolumePrincipled":
         return None
     intensity = _constant(node.inputs["Blackbody Intensity"], ())
