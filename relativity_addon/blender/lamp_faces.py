@@ -233,7 +233,7 @@ def drawable(obj, snap):
 def write(scene, snap):
     """Faces for the lamps seen directly while the exact camera renders (none otherwise). During a
     spectral pass the lamps' colours are spectral values: the faces keep the user's colours."""
-    if materials.in_spectral_pass():
+    if materials.spectral_pass_wavelengths() is not None:
         return
     wanted = {}
     if snap.exact_camera:

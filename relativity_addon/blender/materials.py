@@ -313,9 +313,9 @@ def set_spectral_pass(wavelengths_nm):
     _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
 
 
-def in_spectral_pass():
-    """Whether a spectral pass is being rendered (the lamps' colours are then spectral values)."""
-    return _spectral_pass["wavelengths"] is not None
+def spectral_pass_wavelengths():
+    """The three wavelengths (nm) of the spectral pass being rendered, or None."""
+    return _spectral_pass["wavelengths"]
 
 
 def settings_values(snap):
