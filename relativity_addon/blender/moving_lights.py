@@ -26,7 +26,7 @@ import bpy
 
 from ..errors import RelativityError
 from ..physics import spectral_render
-from . import materials, moving_lamps, names, osl
+from . import emitter_lights, materials, moving_lamps, names, osl
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
@@ -307,6 +307,9 @@ def _scene_materials(scene):
 
 
 def _hide_light(obj):
+    if obj.type == "MESH":  # an emitter lighting the scene: its own light reaches the camera only
+        emitter_lights.hide_from_light_rays(obj)
+        return
     if names.LIGHT_SAVED_KEY not in obj:
         obj[names.LIGHT_SAVED_KEY] = {"hide_render": bool(obj.hide_render)}
     if not obj.hide_render:
@@ -314,6 +317,8 @@ def _hide_light(obj):
 
 
 def _restore_light(obj):
+    if emitter_lights.restore(obj):
+        return True
     saved = obj.get(names.LIGHT_SAVED_KEY)
     if saved is None:
         return False
@@ -354,7 +359,8 @@ def write(scene, snap, attach_new_materials=False, depsgraph=None):
         raise RelativityError(f"OSL unavailable for moving lights: {error}") from error
     light_names = [light.name for light in lights]
     for obj in scene.objects:
-        if obj.type == "LIGHT" and names.LIGHT_SAVED_KEY in obj and obj.name not in light_names:
+        saved = names.LIGHT_SAVED_KEY in obj or names.EMITTER_SAVED_KEY in obj
+        if obj.type in ("LIGHT", "MESH") and saved and obj.name not in light_names:
             _restore_light(obj)
     for name in light_names:
         _hide_light(scene.objects[name])
@@ -384,7 +390,7 @@ def remove(scene):
     for material in bpy.data.materials:
         detach(material)
     for obj in bpy.data.objects:
-        if obj.type == "LIGHT":
+        if obj.type in ("LIGHT", "MESH"):
             _restore_light(obj)
     if names.SHADING_SYSTEM_SAVED_KEY in scene:
         saved = bool(scene[names.SHADING_SYSTEM_SAVED_KEY])

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import RelativityError
 from ..physics import exposure
 from ..physics.shutter import ShutterModel
-from . import animation, names, sources
+from . import animation, emitter_lights, names, sources
 
 Vector3 = tuple[float, float, float]
 
@@ -295,6 +295,9 @@ def moving_lights(scene, frame, depsgraph=None):
     found = []
     for obj in scene.objects:
         motion = obj.relativity.motion
+        if emitter_lights.is_emitter_light(obj) and not obj.hide_render:
+            found += _emitter_light(scene, obj, frame, depsgraph)
+            continue
         if obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
         beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
@@ -313,6 +316,18 @@ def moving_lights(scene, frame, depsgraph=None):
             motion=motion, temperature=float(sources.light_blackbody(light) or 0.0),
         ))
     return tuple(found)
+
+
+def _emitter_light(scene, obj, frame, depsgraph):
+    """A moving emissive mesh as a moving point light at its origin (``emitter_lights``), or none."""
+    beta = check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity beta")
+    matrix = camera_matrix(scene, obj, frame, depsgraph)
+    intensity = emitter_lights.intensity(obj, matrix)
+    if intensity is None:
+        return []
+    return [MovingLight(name=obj.name, kind="POINT", position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
+                        intensity=intensity, axis=(0.0, 0.0, -1.0), spot_size=math.pi, spot_blend=0.0,
+                        temperature=float(obj.relativity.temperature))]
 
 
 # Scenes whose Apparent Geometry final render is running with the exact camera.
