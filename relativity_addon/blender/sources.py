@@ -138,6 +138,11 @@ def _float_feed(input_socket, groups):
     return socket, groups
 
 
+def constant_value(input_socket):
+    """The constant value an input holds (unlinked, or a Value node, also through groups), or None."""
+    return _constant(input_socket, ())
+
+
 def _constant(input_socket, groups):
     value = _float_feed(input_socket, groups)
     return value if isinstance(value, float) else None

@@ -129,7 +129,7 @@ def attach(material):
         return False
     node = source.node
     blackbody = sources.volume_blackbody(node)
-    intensity = sources._constant(node.inputs["Blackbody Intensity"], ())
+    intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
     if blackbody is None or intensity is None:
         return False
     ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
