@@ -10,7 +10,7 @@ group (materials) and the compositor group's flag inputs.
 import bpy
 
 from ..errors import RelativityError
-from . import compositing, luts, materials
+from . import compositing, luts, materials, volumes
 from .compositing import is_applied as compositor_applied
 
 
@@ -21,6 +21,7 @@ def apply(scene, snap):
     try:
         materials.attach_scene(scene, camera_path=snap.colour.camera_path)
         if snap.colour.camera_path:
+            volumes.attach_scene(scene)
             compositing.apply_colour_stage(scene, snap)
         write(scene, snap)
     except (ImportError, ValueError, KeyError, RuntimeError) as error:
@@ -35,6 +36,8 @@ def write(scene, snap, attach_new_materials=False):
     """Write the snapshot's colour factors; before a render also attach materials added since."""
     if attach_new_materials:
         materials.attach_scene(scene, camera_path=snap.colour.camera_path)
+        if snap.colour.camera_path:
+            volumes.attach_scene(scene)
     materials.write_settings(snap)
     compositing.write_colour_stage(scene, snap)
 
@@ -59,7 +62,7 @@ def remove_unused_data():
     """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
     if any(materials.is_attached(material) for material in bpy.data.materials):
         return False
-    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP) + tuple(
+    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP, volumes.GROUP) + tuple(
         builder().name for builder in reversed(materials.GROUP_BUILDERS)
     )
     for name in group_names:

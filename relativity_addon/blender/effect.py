@@ -26,6 +26,7 @@ from . import (
     colour,
     geometry,
     lamp_doppler,
+    lamp_faces,
     metadata,
     modifier,
     moving_lights,
@@ -80,7 +81,9 @@ def apply(scene, frame_range=None, objects=None):
         metadata.write(scene, snap)
         clamping.write(scene, snap)
         lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
+        lamp_faces.write(scene, snap)  # lamps seen directly, drawn by emitters (exact camera)
     except RelativityError:
+        lamp_faces.remove(scene)
         lamp_doppler.remove(scene)
         moving_lights.remove(scene)
         metadata.remove(scene)
@@ -102,6 +105,7 @@ def remove(scene):
     metadata.remove(scene)
     clamping.remove(scene)
     lamp_doppler.remove(scene)
+    lamp_faces.remove(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
@@ -205,6 +209,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
             metadata.write(scene, snap)
             clamping.write(scene, snap)
             lamp_doppler.write(scene, snap)
+            lamp_faces.write(scene, snap)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
             camera.invalidate(scene.camera)
@@ -268,6 +273,7 @@ def _record(scene, snap):
     warnings += geometry.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
     warnings += lamp_doppler.warnings(scene, snap)
+    warnings += lamp_faces.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)

@@ -313,6 +313,11 @@ def set_spectral_pass(wavelengths_nm):
     _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
 
 
+def spectral_pass_wavelengths():
+    """The three wavelengths (nm) of the spectral pass being rendered, or None."""
+    return _spectral_pass["wavelengths"]
+
+
 def settings_values(snap):
     """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot`` (and the spectral pass)."""
     colour = snap.colour

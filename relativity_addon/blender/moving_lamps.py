@@ -25,6 +25,7 @@ import numpy as np
 from mathutils import Vector
 
 from ..errors import RelativityError
+from ..physics import spectral_render
 from ..physics.lorentz import aberrate, camera_to_scene_direction
 from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
 from . import animation, names, snapshot
@@ -34,9 +35,25 @@ MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two li
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 
 
+def _cmf_defines():
+    """The colour matching functions every 10 nm (360-830 nm) and XYZ -> linear Rec.709, as OSL
+    macros (OSL has no global arrays): the shipped tables of the spectral mode."""
+    tables = spectral_render.tables()
+    rows = (tables["cmfs_nm"] % 10.0 == 0.0)
+    cmfs = tables["cmfs"][rows]
+
+    def array(values):
+        return ", ".join(f"{float(v):.7g}" for v in values)
+
+    declare = " ".join(f"float CMF_{axis}[{len(cmfs)}] = {{{array(cmfs[:, index])}}};"
+                       for index, axis in enumerate("XYZ"))
+    declare += f" float XYZ_TO_RGB[9] = {{{array(np.asarray(tables['xyz_to_rgb']).ravel())}}};"
+    return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
+
+
 def _shader_text():
     with open(SHADER_PATH, encoding="utf-8") as handle:
-        source = handle.read()
+        source = handle.read().replace("/* @CMF_TABLES@ */", _cmf_defines())
     text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT) or bpy.data.texts.new(names.MOVING_LAMP_SHADER_TEXT)
     if text.as_string().rstrip("\n") != source.rstrip("\n"):
         text.clear()
@@ -240,7 +257,10 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
         for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
             before, after = max(index - 1, 0), min(index + 1, last)
             inputs = {key: values[key] for key in ("camera_position", "intensity", "light_beta", "spot_axis",
-                                                    "spot_cos_half_angle", "spot_smooth")}
+                                                    "spot_cos_half_angle", "spot_smooth", "temperature",
+                                                    "luminance", "wavelength_0", "wavelength_1", "wavelength_2",
+                                                    "spectral_scale")}
+            inputs["spectral"] = int(values["spectral"])
             inputs["lambert"] = int(values["lambert"])
             inputs.update(lamp_time=float(times[index]), previous_time=float(times[before]),
                           previous_position=tuple(positions[before]), next_time=float(times[after]),

@@ -25,7 +25,8 @@ import os
 import bpy
 
 from ..errors import RelativityError
-from . import moving_lamps, names, osl
+from ..physics import spectral_render
+from . import emitter_lights, materials, moving_lamps, names, osl
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
@@ -120,18 +121,40 @@ def shader_parameters(light, snap):
     cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
     smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0.0 and cos_half < 1.0 else 0.0
     ct, camera_position = reception_event(snap)
+    intensity = tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity
     return {
+        **blackbody_parameters(light.temperature, float(spectral_render.luminance(intensity))),
         "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
         "light_beta": light.beta,
         "camera_position": camera_position,
         # an area light's centre: a Lambertian emitter of power P has I = P / pi along its axis
-        "intensity": tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity,
+        "intensity": intensity,
         "lambert": light.kind == "AREA",
         "light_type": SUPPORTED_KINDS.get(light.kind, 0),
         "spot_axis": light.axis,
         "spot_cos_half_angle": cos_half if light.kind == "SPOT" else -1.0,
         "spot_smooth": smooth,
         "use_shadows": not snap.exact_camera,
+    }
+
+
+def blackbody_parameters(temperature, luminance):
+    """The stand-in lamp shader's blackbody inputs (eq. 18's spectrum, docs/moving-lights.md): the
+    light's temperature and luminance, and in a spectral pass its wavelengths and the scale of
+    ``planck_shape``: ``luminance B(mu, T') / Y_B(T)`` per nm with ``B = C1 / pi (500 nm)^-5
+    planck_shape``, as ``physics.spectral_render.blackbody_samples`` normalises lamps at rest."""
+    wavelengths = materials.spectral_pass_wavelengths()
+    scale = 0.0
+    if temperature > 0.0:
+        constant = spectral_render.PLANCK_C1 / math.pi * (500e-9) ** -5 * 1e-9  # per nm
+        scale = luminance * constant * math.exp(-float(spectral_render.log_blackbody_luminance(temperature)))
+    return {
+        "temperature": float(temperature),
+        "luminance": float(luminance),
+        "spectral": wavelengths is not None and temperature > 0.0,
+        **{f"wavelength_{index}": float(value)
+           for index, value in enumerate(wavelengths if wavelengths is not None else (500.0, 550.0, 600.0))},
+        "spectral_scale": scale,
     }
 
 
@@ -284,6 +307,9 @@ def _scene_materials(scene):
 
 
 def _hide_light(obj):
+    if obj.type == "MESH":  # an emitter lighting the scene: its own light reaches the camera only
+        emitter_lights.hide_from_light_rays(obj)
+        return
     if names.LIGHT_SAVED_KEY not in obj:
         obj[names.LIGHT_SAVED_KEY] = {"hide_render": bool(obj.hide_render)}
     if not obj.hide_render:
@@ -291,6 +317,8 @@ def _hide_light(obj):
 
 
 def _restore_light(obj):
+    if emitter_lights.restore(obj):
+        return True
     saved = obj.get(names.LIGHT_SAVED_KEY)
     if saved is None:
         return False
@@ -331,7 +359,8 @@ def write(scene, snap, attach_new_materials=False, depsgraph=None):
         raise RelativityError(f"OSL unavailable for moving lights: {error}") from error
     light_names = [light.name for light in lights]
     for obj in scene.objects:
-        if obj.type == "LIGHT" and names.LIGHT_SAVED_KEY in obj and obj.name not in light_names:
+        saved = names.LIGHT_SAVED_KEY in obj or names.EMITTER_SAVED_KEY in obj
+        if obj.type in ("LIGHT", "MESH") and saved and obj.name not in light_names:
             _restore_light(obj)
     for name in light_names:
         _hide_light(scene.objects[name])
@@ -361,7 +390,7 @@ def remove(scene):
     for material in bpy.data.materials:
         detach(material)
     for obj in bpy.data.objects:
-        if obj.type == "LIGHT":
+        if obj.type in ("LIGHT", "MESH"):
             _restore_light(obj)
     if names.SHADING_SYSTEM_SAVED_KEY in scene:
         saved = bool(scene[names.SHADING_SYSTEM_SAVED_KEY])

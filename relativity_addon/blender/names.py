@@ -66,6 +66,7 @@ MOVING_LIGHTS_LIGHTS_KEY = "relativity_moving_lights"  # on that group: the ligh
 MOVING_LIGHTS_MATERIAL_KEY = "relativity_moving_lights"  # on materials: the inserted nodes and the old link
 MOVING_LIGHT_NODE_PREFIX = "Relativity Moving Lights"
 LIGHT_SAVED_KEY = "relativity_light_saved"  # on light objects: the user's hide_render while hidden
+EMITTER_SAVED_KEY = "relativity_emitter_saved"  # on emitter meshes lighting the scene: the user's ray visibility
 SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: the user's Open Shading Language
 
 # --- lamps at rest lighting moving objects (eq. 18) -------------------------------------------
@@ -80,3 +81,10 @@ REST_NORMAL_GROUP_VERSION = 1
 MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader
 MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and lights): "<prefix> <light> <index>"
 MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}
+
+# --- directly visible lamps (exact camera) ----------------------------------------------------
+LAMP_FACE_PREFIX = "Relativity Lamp Face"  # emitter meshes (objects, meshes, materials): "<prefix> <light>"
+LAMP_FACES_KEY = "relativity_lamp_faces"  # on the scene: {light object name: face object name}
+LAMP_FACE_SAVED_KEY = "relativity_lamp_face_saved"  # on light objects: the user's visible_camera
+VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-ray emission of a blackbody volume
+VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material

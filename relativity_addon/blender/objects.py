@@ -49,6 +49,14 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         subtype="TEMPERATURE",
         update=_settings_changed,
     )
+    lights_scene: BoolProperty(
+        name="Lights the Scene",
+        description="A moving emitter (Constant Velocity): its light on other surfaces comes from its retarded "
+        "positions with eq. 19's beaming, drawn as a moving point light at its origin with its mean intensity "
+        "(emission times area / 4); its own emission then reaches camera rays only (docs/moving-lights.md)",
+        default=False,
+        update=_settings_changed,
+    )
     tessellation: IntProperty(
         name="Tessellation",
         description="Subdivision levels added before deforming (straight edges can look curved)",

@@ -176,6 +176,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         column.prop(settings, "motion")
         if settings.motion == "CONSTANT":
             column.prop(settings, "beta")
+            column.prop(settings, "lights_scene")
         elif settings.motion == "ANIMATION":
             column.prop(settings, "use_deformation")
             column.prop(settings, "samples_per_frame")

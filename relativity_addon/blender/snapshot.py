@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import RelativityError
 from ..physics import exposure
 from ..physics.shutter import ShutterModel
-from . import animation, names
+from . import animation, emitter_lights, names, sources
 
 Vector3 = tuple[float, float, float]
 
@@ -50,6 +50,7 @@ class MovingLight:
     spot_size: float  # full cone angle, radians
     spot_blend: float
     motion: str = "CONSTANT"  # or ANIMATION: position and beta (at the frame) from its keyframes
+    temperature: float = 0.0  # K, a blackbody light (sources.light_blackbody); 0: an RGB light
 
 
 @dataclass(frozen=True)
@@ -300,6 +301,9 @@ def moving_lights(scene, frame, depsgraph=None):
     found = []
     for obj in scene.objects:
         motion = obj.relativity.motion
+        if emitter_lights.is_emitter_light(obj) and not obj.hide_render:
+            found += _emitter_light(scene, obj, frame, depsgraph)
+            continue
         if obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
         beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
@@ -309,13 +313,27 @@ def moving_lights(scene, frame, depsgraph=None):
         light = obj.data
         power = float(light.energy) / (4.0 * math.pi)
         spot = light.type == "SPOT"
+        colour = np.array(light.color, float) * (np.array(light.temperature_color, float) if light.use_temperature
+                                                 else 1.0)
         found.append(MovingLight(
             name=obj.name, kind=light.type, position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
-            intensity=tuple(power * float(v) for v in light.color), axis=tuple(float(v) for v in axis),
+            intensity=tuple(power * float(v) for v in colour), axis=tuple(float(v) for v in axis),
             spot_size=float(light.spot_size) if spot else math.pi, spot_blend=float(light.spot_blend) if spot else 0.0,
-            motion=motion,
+            motion=motion, temperature=float(sources.light_blackbody(light) or 0.0),
         ))
     return tuple(found)
+
+
+def _emitter_light(scene, obj, frame, depsgraph):
+    """A moving emissive mesh as a moving point light at its origin (``emitter_lights``), or none."""
+    beta = check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity beta")
+    matrix = camera_matrix(scene, obj, frame, depsgraph)
+    intensity = emitter_lights.intensity(obj, matrix)
+    if intensity is None:
+        return []
+    return [MovingLight(name=obj.name, kind="POINT", position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
+                        intensity=intensity, axis=(0.0, 0.0, -1.0), spot_size=math.pi, spot_blend=0.0,
+                        temperature=float(obj.relativity.temperature))]
 
 
 # Scenes whose Apparent Geometry final render is running with the exact camera.

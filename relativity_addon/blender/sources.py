@@ -27,11 +27,9 @@ a non-constant temperature computed inside a group cannot be linked from the mat
 so that case is None too. Unlinked colours are constants, never blackbodies.
 
 Lights: :func:`light_blackbody` gives the temperature of a light whose spectrum is a blackbody
-(its own temperature setting, or an Emission fed by a Blackbody in its node tree), and
-:func:`volume_blackbody` the Principled Volume's own blackbody emission. Both are recognised for
-the colour code; neither is shifted per ray yet (a light lighting a surface cannot be, and
-volume shaders write no AOVs, so the exact camera's compositor shifts their pixels:
-docs/spectral-model.md).
+(its own temperature setting, or an Emission fed by a Blackbody in its node tree; lamps seen
+directly are drawn by emitter faces, ``lamp_faces.py``), and :func:`volume_blackbody` the
+Principled Volume's own blackbody emission (shifted for camera rays by ``volumes.py``).
 """
 
 from typing import NamedTuple
@@ -138,6 +136,11 @@ def _float_feed(input_socket, groups):
     if socket.node.bl_idname == "ShaderNodeValue":
         return float(socket.default_value)
     return socket, groups
+
+
+def constant_value(input_socket):
+    """The constant value an input holds (unlinked, or a Value node, also through groups), or None."""
+    return _constant(input_socket, ())
 
 
 def _constant(input_socket, groups):
@@ -259,8 +262,8 @@ def _grey(colour):
     return r == g == b
 
 
-def _light_emission_colour(tree):
-    """The Color input of the Emission node that a light's active Light Output shows, or None."""
+def light_emission_node(tree):
+    """The Emission node that a light's active Light Output shows, or None."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputLight"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
     if output is None:
@@ -268,7 +271,13 @@ def _light_emission_colour(tree):
     found = _feed(output.inputs["Surface"], ())
     if found is None or found[0] is None or found[0].node.bl_idname != "ShaderNodeEmission":
         return None
-    return found[0].node.inputs["Color"]
+    return found[0].node
+
+
+def _light_emission_colour(tree):
+    """The Color input of the Emission node that a light's active Light Output shows, or None."""
+    node = light_emission_node(tree)
+    return None if node is None else node.inputs["Color"]
 
 
 def light_blackbody(light):
@@ -317,8 +326,8 @@ def volume_blackbody(node):
     Blender (Cycles and EEVEE alike) adds ``tint sigma mix(1, T^4, intensity) blackbody(T)``
     with ``T`` the Temperature input (times the temperature grid where the volume has one) when
     Blackbody Intensity exceeds 1e-3: a blackbody at ``T`` when the tint is grey. Returned with
-    scale None (it varies with the grid and Stefan-Boltzmann's ``T^4``). Not shifted in the
-    shader: volume shaders write no AOVs, so the exact camera's compositor would shift it again."""
+    scale None (it varies with the grid and Stefan-Boltzmann's ``T^4``). Volume shaders write no
+    AOVs: ``volumes.py`` shifts it for camera rays and marks the pixels on the volume's boundary."""
     if node.bl_idname != "ShaderNodeVolumePrincipled":
         return None
     intensity = _constant(node.inputs["Blackbody Intensity"], ())

@@ -65,6 +65,11 @@ def _tables():
     return lut_data.spectral_mode_tables()
 
 
+def tables():
+    """The shipped tables (colour matching functions on their 1 nm grid, XYZ -> RGB, ...)."""
+    return _tables()
+
+
 def planck(wavelengths_nm: ArrayLike, temperature_k: float) -> FloatArray:
     """Planck's law per metre of wavelength (as colour-science's ``planck_law``), 0 deep in the Wien tail."""
     metres = np.asarray(wavelengths_nm, dtype=np.float64) * _NM

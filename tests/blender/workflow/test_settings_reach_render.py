@@ -118,6 +118,8 @@ CASES = [
     case("GEOMETRY", "Mover", "enabled", True, objects={"Mover": {"enabled": False}}),
     case("GEOMETRY", "Mover", "motion", "STATIC"),
     case("GEOMETRY", "Mover", "beta", (-0.3, 0.3, 0.5)),
+    # the moving emitter lights the floor as a moving light (the preview's material shader)
+    case("GEOMETRY", "Mover", "lights_scene", True, base={"geometry_final_render": "PREVIEW"}),
     case("GEOMETRY", "Blackbody", "temperature", 9000.0),
     case("GEOMETRY", "scene", "geometry_final_render", "PREVIEW"),
     # Tessellation shapes the boosted-mesh preview; the exact final render of a mesh at rest

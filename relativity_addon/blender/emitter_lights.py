@@ -1,0 +1,107 @@
+"""Moving emissive meshes that light the scene (``Object.relativity.lights_scene``).
+
+A mesh emitter with Constant Velocity lights other surfaces from where it was when it sent each
+of them its light, beamed by eq. 19 (Weiskopf et al. 1999), like a moving light. The moving-light
+stage draws it as a **point light at the object's origin** with the emitter's mean radiant
+intensity, ``I = L A / 4`` per channel (``L`` the emission's radiance, strength times colour;
+``A`` the mesh's surface area in world units): the mean projected area of a convex body is a
+quarter of its surface (Cauchy), so a sphere is exact in every direction, and any convex emitter
+is exact on average over directions. Its own emission then reaches camera rays only (its diffuse,
+glossy, transmission and volume ray visibility are switched off while applied, which also keeps
+Cycles from sampling it as a light), so the camera still sees it where the apparent geometry puts
+it. Approximations (docs/moving-lights.md): one point at the origin (the emitter's size and shape
+shape neither the light's direction dependence nor its shadows), a constant emission colour and
+strength (the first Emission shader, or Principled BSDF emission, of its materials; textures are
+not followed), and the object's velocity for every part of it.
+"""
+
+import numpy as np
+
+from . import names
+
+RAYS = ("diffuse", "glossy", "transmission", "volume_scatter")
+
+
+def emission_radiance(obj):
+    """``(r, g, b)`` radiance of the emitter's first constant emission, or None."""
+    for slot in obj.material_slots:
+        material = slot.material
+        if material is None or material.node_tree is None:
+            continue
+        for node in material.node_tree.nodes:
+            if node.bl_idname == "ShaderNodeEmission":
+                colour, strength = node.inputs["Color"], node.inputs["Strength"]
+            elif node.bl_idname == "ShaderNodeBsdfPrincipled":
+                colour, strength = node.inputs["Emission Color"], node.inputs["Emission Strength"]
+            else:
+                continue
+            colour = _rest_colour(colour)
+            if colour is None or strength.is_linked or not node.outputs[0].is_linked:
+                continue
+            radiance = tuple(float(strength.default_value) * float(v) for v in tuple(colour.default_value)[:3])
+            if max(radiance) > 0.0:
+                return radiance
+    return None
+
+
+def _rest_colour(socket):
+    """The unlinked socket holding the colour, looking through the Doppler colour stage's group
+    (materials.py inserts it in front of emission colours), or None for a linked colour."""
+    if socket.is_linked:
+        node = socket.links[0].from_node
+        if node.bl_idname != "ShaderNodeGroup" or not node.name.startswith(names.MATERIAL_NODE_PREFIX):
+            return None
+        socket = node.inputs.get("Color")
+        if socket is None or socket.is_linked:
+            return None
+    return socket
+
+
+def surface_area(obj, matrix):
+    """The mesh's surface area in world units (its rest shape under the world matrix ``matrix``)."""
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    count = len(mesh.loop_triangles)
+    if count == 0:
+        return 0.0
+    corners = np.empty(3 * count, dtype=np.int64)
+    mesh.loop_triangles.foreach_get("vertices", corners)
+    local = np.empty(3 * len(mesh.vertices), dtype=np.float64)
+    mesh.vertices.foreach_get("co", local)
+    world = local.reshape(-1, 3) @ np.asarray(matrix)[:3, :3].T
+    a, b, c = (world[corners.reshape(-1, 3)[:, i]] for i in range(3))
+    return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1).sum())
+
+
+def intensity(obj, matrix):
+    """Mean radiant intensity ``L A / 4`` (W/sr per channel) of the emitter, or None."""
+    radiance = emission_radiance(obj)
+    if radiance is None:
+        return None
+    area = surface_area(obj, matrix)
+    return tuple(v * area / 4.0 for v in radiance) if area > 0.0 else None
+
+
+def is_emitter_light(obj):
+    return obj.type == "MESH" and obj.relativity.motion == "CONSTANT" and obj.relativity.lights_scene
+
+
+def hide_from_light_rays(obj):
+    """Camera rays only: the stand-in light carries the emitter's light (the user's values saved)."""
+    if names.EMITTER_SAVED_KEY not in obj:
+        obj[names.EMITTER_SAVED_KEY] = {ray: bool(getattr(obj, f"visible_{ray}")) for ray in RAYS}
+    for ray in RAYS:
+        if getattr(obj, f"visible_{ray}"):
+            setattr(obj, f"visible_{ray}", False)
+
+
+def restore(obj):
+    saved = obj.get(names.EMITTER_SAVED_KEY)
+    if saved is None:
+        return False
+    saved = saved.to_dict()
+    del obj[names.EMITTER_SAVED_KEY]
+    for ray in RAYS:
+        if getattr(obj, f"visible_{ray}") != saved[ray]:
+            setattr(obj, f"visible_{ray}", saved[ray])
+    return True

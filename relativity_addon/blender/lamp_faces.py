@@ -1,0 +1,283 @@
+"""Directly visible lamps on the exact camera's path: drawn by emitter meshes that get the Doppler colour.
+
+A Cycles lamp seen by the camera (a point light with a radius, an area light, ``visible_camera``
+on) writes no shader AOVs: its pixel carries the ``ln D`` of whatever lies behind it and is
+shifted by the compositor as an RGB colour. A blackbody lamp then comes out on the RGB matrix
+(Delta E 2000 of 26 against a blackbody emitter at ``D`` = 1.73, docs/moving-lights.md), and in
+front of a blackbody emitter (which marks its pixels done) or nothing with an AOV it keeps its
+rest colour. So while the exact camera renders, each such lamp at rest is hidden from camera
+rays and an emitter mesh of its shape and radiance (its **face**), visible to camera rays only,
+is drawn in its place with an ordinary material: the materials' Doppler colour (blackbodies
+exactly, RGB through the compositor) and the spectral passes treat it like any emitter.
+
+Radiance, measured against Cycles' own lamps (tests/blender/doppler/test_visible_lamps.py):
+an area light of power ``P`` and area ``A`` (Normalize on) shows ``P / (pi A)`` times its colour,
+a point light of radius ``r`` a disc of ``P / (4 pi^2 r^2)``; ``2^exposure`` multiplies both.
+
+Not covered (the lamp keeps Cycles' own drawing, warned): spot and sun lights, area lights with a
+spread below 180 degrees or Normalize off, portals, lamps whose node tree's emission is textured,
+moving lights (their stand-ins draw nothing for the camera). The face is opaque where Cycles'
+lamps are see-through, and an area light seen from behind gets no face (it shows nothing there).
+"""
+
+import math
+
+import bmesh
+import bpy
+from mathutils import Matrix
+
+from . import compat, materials, names, snapshot, sources
+
+KINDS = ("POINT", "AREA")
+DISC_SEGMENTS = 64
+
+
+def _emission(light):
+    """``(rgb, temperature or None, strength)`` of the face's Emission for ``light``, or None when
+    the lamp's node tree makes a colour a constant face cannot carry."""
+    colour = tuple(light.color)[:3]
+    temperature = sources.light_blackbody(light)
+    tree = compat.light_node_tree(light)
+    node = None if tree is None else sources.light_emission_node(tree)
+    if tree is not None and node is None:
+        return None
+    strength = 1.0
+    if node is not None:
+        if node.inputs["Strength"].is_linked:
+            return None
+        strength = float(node.inputs["Strength"].default_value)
+        if temperature is not None and not light.use_temperature:  # the blackbody is in the node tree
+            source = sources.blackbody_source(node.inputs["Color"])
+            if source is None or source.scale is None:
+                return None
+            return colour, temperature, strength * source.scale
+        if node.inputs["Color"].is_linked:
+            return None
+        colour = tuple(a * b for a, b in zip(colour, tuple(node.inputs["Color"].default_value)[:3], strict=True))
+    if light.use_temperature and temperature is None:  # a tinted blackbody: an RGB colour
+        colour = tuple(a * b for a, b in zip(colour, tuple(light.temperature_color)[:3], strict=True))
+    return colour, temperature if light.use_temperature else None, strength
+
+
+def _radiance_scale(obj):
+    """Radiance of the lamp per unit colour (W m^-2 sr^-1), or None for a lamp without a face."""
+    light = obj.data
+    power = light.energy * 2.0 ** getattr(light, "exposure", 0.0)
+    if light.type == "POINT":
+        radius = light.shadow_soft_size
+        return power / (4.0 * math.pi**2 * radius**2) if radius > 0.0 else None
+    if light.type != "AREA" or light.cycles.is_portal or light.spread < math.pi - 1e-6 or not light.normalize:
+        return None
+    sx, sy, _sz = obj.matrix_world.to_scale()
+    width = light.size
+    height = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size
+    area = width * height * abs(sx * sy) * (math.pi / 4.0 if light.shape in ("DISK", "ELLIPSE") else 1.0)
+    return power / (math.pi * area) if area > 0.0 else None
+
+
+def _candidates(scene, snap):
+    """Lights at rest seen by camera rays, the kind a face can draw or not."""
+    moving = {light.name for light in snap.moving_lights}
+    for obj in scene.objects:
+        if obj.type != "LIGHT" or obj.name in moving or snapshot.light_render_hidden(obj):
+            continue
+        saved = obj.get(names.LAMP_FACE_SAVED_KEY)
+        if (obj.visible_camera if saved is None else bool(saved["visible_camera"])):
+            yield obj
+
+
+def _facing_camera(obj, snap):
+    """An area light is seen from the front (its local -Z side); a point light from everywhere."""
+    if obj.data.type != "AREA":
+        return True
+    camera = Matrix(snap.camera_matrix).translation
+    return (obj.matrix_world.inverted_safe() @ camera).z < 0.0
+
+
+def _mesh(name, light):
+    mesh = bpy.data.meshes.new(name)
+    mesh[names.LAMP_FACES_KEY] = _shape_key(light)
+    if light.type == "POINT":
+        builder = bmesh.new()
+        bmesh.ops.create_uvsphere(builder, u_segments=DISC_SEGMENTS, v_segments=DISC_SEGMENTS // 2,
+                                  radius=light.shadow_soft_size)
+        builder.to_mesh(mesh)
+        builder.free()
+        return mesh
+    width = light.size
+    height = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size
+    if light.shape in ("DISK", "ELLIPSE"):
+        angles = [-2.0 * math.pi * i / DISC_SEGMENTS for i in range(DISC_SEGMENTS)]
+        corners = [(0.5 * width * math.cos(a), 0.5 * height * math.sin(a), 0.0) for a in angles]
+    else:
+        corners = [(-0.5 * width, -0.5 * height, 0.0), (-0.5 * width, 0.5 * height, 0.0),
+                   (0.5 * width, 0.5 * height, 0.0), (0.5 * width, -0.5 * height, 0.0)]
+    mesh.from_pydata(corners, [], [tuple(range(len(corners)))])  # normal along local -Z, like the light
+    return mesh
+
+
+def _shape_key(light):
+    if light.type == "AREA":
+        return f"AREA {light.shape} {light.size:.9g} {light.size_y:.9g}"
+    return f"{light.type} {light.shadow_soft_size:.9g}"
+
+
+def _material(name, colour, temperature, strength):
+    material = bpy.data.materials.new(name)
+    tree = compat.material_node_tree(material)
+    tree.nodes.clear()
+    emission = tree.nodes.new("ShaderNodeEmission")
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs[0], output.inputs["Surface"])
+    _write_material(material, colour, temperature, strength)
+    return material
+
+
+def _write_material(material, colour, temperature, strength):
+    tree = material.node_tree
+    emission = tree.nodes["Emission"]
+    blackbody = tree.nodes.get("Blackbody")
+    if temperature is not None:
+        if blackbody is None:
+            blackbody = tree.nodes.new("ShaderNodeBlackbody")
+            tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+        _set(blackbody.inputs["Temperature"], temperature)
+        strength *= colour[0]  # grey: light_blackbody checked it
+    elif blackbody is not None:
+        tree.nodes.remove(blackbody)
+    _set(emission.inputs["Color"], (*colour, 1.0))
+    _set(emission.inputs["Strength"], strength)
+
+
+def _set(socket, value):
+    current = socket.default_value
+    if isinstance(value, tuple):
+        if all(math.isclose(a, b, rel_tol=1e-7, abs_tol=1e-12) for a, b in zip(current, value, strict=True)):
+            return
+    elif math.isclose(current, value, rel_tol=1e-7, abs_tol=1e-12):
+        return
+    socket.default_value = value
+
+
+def _face(scene, obj):
+    """The face object of light object ``obj``, made (or remade for a new shape) as needed."""
+    record = dict(scene.get(names.LAMP_FACES_KEY, {}))
+    face = bpy.data.objects.get(record.get(obj.name, ""))
+    if face is not None and face.data.get(names.LAMP_FACES_KEY) != _shape_key(obj.data):
+        _delete(face.name)
+        face = None
+    if face is None:
+        name = f"{names.LAMP_FACE_PREFIX} {obj.name}"
+        face = bpy.data.objects.new(name, _mesh(name, obj.data))
+        scene.collection.objects.link(face)
+        for ray in ("diffuse", "glossy", "transmission", "volume_scatter", "shadow"):
+            setattr(face, f"visible_{ray}", False)
+        face.hide_select = True
+        record[obj.name] = face.name
+        scene[names.LAMP_FACES_KEY] = record
+    if face.parent != obj:
+        face.parent = obj
+    # A point light's radius ignores the object's scale; an area light's size follows it.
+    inverse = Matrix.Identity(4)
+    if obj.data.type == "POINT":
+        scale = obj.matrix_world.to_scale()
+        inverse = Matrix.Diagonal((*(1.0 / s if s else 1.0 for s in scale), 1.0))
+    if face.matrix_parent_inverse != inverse:
+        face.matrix_parent_inverse = inverse
+    return face
+
+
+def _delete(face_name):
+    face = bpy.data.objects.get(face_name)
+    if face is None:
+        return
+    mesh = face.data
+    used = [slot.material for slot in face.material_slots if slot.material is not None]
+    bpy.data.objects.remove(face)
+    if mesh is not None and mesh.users == 0:
+        bpy.data.meshes.remove(mesh)
+    for material in used:
+        if material.users == 0:
+            bpy.data.materials.remove(material)
+
+
+def _hide_lamp(obj):
+    if names.LAMP_FACE_SAVED_KEY not in obj:
+        obj[names.LAMP_FACE_SAVED_KEY] = {"visible_camera": bool(obj.visible_camera)}
+    if obj.visible_camera:
+        obj.visible_camera = False
+
+
+def _restore_lamp(obj):
+    saved = obj.get(names.LAMP_FACE_SAVED_KEY)
+    if saved is None:
+        return
+    visible = bool(saved["visible_camera"])
+    del obj[names.LAMP_FACE_SAVED_KEY]
+    if obj.visible_camera != visible:
+        obj.visible_camera = visible
+
+
+def drawable(obj, snap):
+    """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
+    if obj.data.type not in KINDS or not _facing_camera(obj, snap):
+        return None
+    scale = _radiance_scale(obj)
+    emission = _emission(obj.data)
+    if scale is None or emission is None:
+        return None
+    colour, temperature, strength = emission
+    return colour, temperature, scale * strength
+
+
+def write(scene, snap):
+    """Faces for the lamps seen directly while the exact camera renders (none otherwise). During a
+    spectral pass the lamps' colours are spectral values: the faces keep the user's colours."""
+    if materials.spectral_pass_wavelengths() is not None:
+        return
+    wanted = {}
+    if snap.exact_camera:
+        for obj in _candidates(scene, snap):
+            face = drawable(obj, snap)
+            if face is not None:
+                wanted[obj.name] = face
+    record = dict(scene.get(names.LAMP_FACES_KEY, {}))
+    for light_name in [name for name in record if name not in wanted]:
+        _delete(record.pop(light_name))
+        scene[names.LAMP_FACES_KEY] = record
+        obj = bpy.data.objects.get(light_name)
+        if obj is not None:
+            _restore_lamp(obj)
+    for light_name, (colour, temperature, strength) in wanted.items():
+        obj = scene.objects[light_name]
+        _hide_lamp(obj)
+        face = _face(scene, obj)
+        if not face.material_slots or face.material_slots[0].material is None:
+            face.data.materials.append(_material(face.name, colour, temperature, strength))
+            materials.attach(face.material_slots[0].material)
+        else:
+            _write_material(face.material_slots[0].material, colour, temperature, strength)
+    if not record and not wanted and names.LAMP_FACES_KEY in scene:
+        del scene[names.LAMP_FACES_KEY]
+
+
+def remove(scene):
+    """Delete the faces and give the lamps back their camera visibility."""
+    for face_name in dict(scene.get(names.LAMP_FACES_KEY, {})).values():
+        _delete(face_name)
+    if names.LAMP_FACES_KEY in scene:
+        del scene[names.LAMP_FACES_KEY]
+    for obj in bpy.data.objects:
+        if obj.type == "LIGHT":
+            _restore_lamp(obj)
+
+
+def warnings(scene, snap):
+    """Lamps seen directly whose colour the exact camera shifts as the pixel behind them."""
+    if not snap.exact_camera:
+        return []
+    record = scene.get(names.LAMP_FACES_KEY, {})
+    return [f"Light {obj.name!r} is seen directly but not drawn as an emitter: its colour is shifted "
+            "with what lies behind it (docs/moving-lights.md)"
+            for obj in _candidates(scene, snap) if obj.name not in record and obj.data.type != "SUN"
+            and (obj.data.type == "AREA" or obj.data.shadow_soft_size > 0.0) and _facing_camera(obj, snap)]

@@ -1,0 +1,185 @@
+"""Principled Volume blackbodies on the exact camera's path: seen as blackbodies at ``D T``.
+
+Volume shaders write no AOVs in Cycles, so a volume's pixel used to carry the ``ln D`` and done
+mask of what lies behind it, and the compositor shifted the volume's light by the RGB Doppler
+matrix (Delta E 2000 of 27 from the blackbody at ``D T`` = 1.70 x 3000 K). Undoing the matrix
+instead (emitting ``N(D)^-1`` of the wanted colour) is hopeless: ``M(D)`` is nearly rank one away
+from ``D`` = 1 (condition number 1.3e9 at 1.7; docs/spectral-model.md). So, like a blackbody
+emitter, the volume does the exact shift itself and marks its pixels done:
+
+- **volume**: for camera rays, the group below adds ``X - E`` to the Principled Volume's own
+  blackbody emission ``E = tint sigma mix(1, T^4, intensity) B(T)`` (Cycles' formula,
+  ``sigma = 5.670373e-14 / pi``, ``B`` the Blackbody node's colour; measured equal to Cycles' own
+  to 2e-4), where ``X`` is what the materials' Doppler colour group makes of a blackbody colour
+  ``E``: the blackbody at ``D T`` with ``E``'s luminance times ``Y(D T) / Y(T)``, divided by the
+  camera's ``D^4``. ``X - E`` may be negative per channel; Cycles adds volume emission as it is.
+  Other rays (the volume lighting the scene) carry ``E``, the scene-frame light;
+- **boundary**: a Transparent BSDF on the volume's surface (the material had none) writes the
+  ``relativity_colour_done`` AOV where a camera ray enters the volume (front faces), so the
+  compositor keeps those pixels; the material's ``ln D`` writer is muted.
+
+Approximation: the done mask keeps *everything* in the pixel as rendered, so what lies behind the
+volume (seen through it) is not shifted: right against a black background or a blackbody emitter,
+wrong in front of anything else. A camera inside the volume gets no mask (the volume is then
+shifted again by the compositor). ``D`` is the observer's (a volume at rest in the scene frame).
+
+Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
+Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
+Blackbody Intensity and a constant or linked Temperature. Not covered: a temperature grid
+(``Temperature Attribute``, e.g. a fire simulation: the added emission uses the Temperature input
+only), a Principled Volume behind a Mix or Add shader or with a surface shader, the spectral mode
+(volumes stay RGB in every pass), and Apparent Geometry's boosted meshes.
+"""
+
+import math
+
+import bpy
+
+from . import materials, names, sources
+from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
+
+GROUP = names.VOLUME_BLACKBODY_GROUP
+NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX
+SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the Principled Volume
+
+
+def volume_blackbody_group():
+    """``Color``: the emission to add to the volume (``X - E`` for camera rays on the exact camera's
+    path, 0 otherwise); ``Done``: 1 where the boundary marks the pixel as shifted."""
+    nodes = {
+        "settings": group_node(materials.SETTINGS),
+        # the volume's own emission: tint sigma mix(1, T^4, intensity) B(T)
+        "t4": fmath("POWER", "group.Temperature", 4.0),
+        "t4m1": fmath("SUBTRACT", "t4", 1.0),
+        "mixed": fmath("MULTIPLY_ADD", "group.Intensity", "t4m1", 1.0),
+        "sigma": fmath("MULTIPLY", "mixed", SIGMA),
+        "strength": fmath("MULTIPLY", "sigma", "group.Tint"),
+        "planck": Node("ShaderNodeBlackbody", {"Temperature": "group.Temperature"}),
+        "rest": vmath("SCALE", "planck.Color", scale="strength"),
+        # ln D = ln(1 - beta_o . k) - ln(1 - beta_o^2) / 2: the observer's factor only (a volume at
+        # rest; the materials' factor group also reads the emitter's velocity attribute, which a
+        # volume shader does not read as 0 where it is missing: measured ln D != 0 at rest)
+        "geometry": Node("ShaderNodeNewGeometry"),
+        "bo_k": vmath("DOT_PRODUCT", "settings.Observer Beta", "geometry.Incoming"),
+        "bo_bo": vmath("DOT_PRODUCT", "settings.Observer Beta", "settings.Observer Beta"),
+        "ns_bo_k": fmath("SUBTRACT", 1.0, "bo_k.Value"),
+        "one_bo_k": fmath("MAXIMUM", "ns_bo_k", 1e-12),
+        "ns_bo2": fmath("SUBTRACT", 1.0, "bo_bo.Value"),
+        "one_bo2": fmath("MAXIMUM", "ns_bo2", 1e-12),
+        "ln_num": fmath("LOGARITHM", "one_bo_k", math.e),
+        "ln_go2": fmath("LOGARITHM", "one_bo2", math.e),
+        "ln_d": fmath("MULTIPLY_ADD", "ln_go2", -0.5, "ln_num"),
+        # what a blackbody emitter of that colour emits for camera rays (as the materials' Doppler
+        # colour group): the blackbody at D T with the rest luminance times exp(E)
+        "shift": group_node(materials.BLACKBODY_SHIFT, {"Temperature": "group.Temperature", "Log Doppler": "ln_d"}),
+        "luminance": vmath("DOT_PRODUCT", "rest", materials.LUMINANCE_WEIGHTS),
+        "shifted": vmath("SCALE", "shift.Color", scale="luminance.Value"),
+        "base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "rest", 5: "shifted"},
+                     {"data_type": "VECTOR"}),
+        "power": fmath("SUBTRACT", "settings.Power of D", "settings.Camera Power"),
+        "power_term": fmath("MULTIPLY", "power", "ln_d"),
+        "log_gain": fmath("MULTIPLY_ADD", "shift.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
+        "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
+        "gain": fmath("EXPONENT", "safe_log_gain"),
+        "emitter": vmath("SCALE", "base.Result", scale="gain"),
+        "difference": vmath("SUBTRACT", "emitter", "rest"),
+        # only camera rays on the exact camera's path, never in a spectral pass
+        "light_path": Node("ShaderNodeLightPath"),
+        "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
+        "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
+        "switch": fmath("MULTIPLY", "camera_ray", "fast"),
+        "out": vmath("SCALE", "difference", scale="switch"),
+        # the boundary where a camera ray enters the volume
+        "front": fmath("SUBTRACT", 1.0, "geometry.Backfacing"),
+        "done": fmath("MULTIPLY", "switch", "front"),
+    }
+    return Group(
+        GROUP,
+        "ShaderNodeTree",
+        (
+            ("Temperature", "NodeSocketFloat", 1000.0),
+            ("Intensity", "NodeSocketFloat", 1.0),
+            ("Tint", "NodeSocketFloat", 1.0),
+        ),
+        (("Color", "NodeSocketColor", "out"), ("Done", "NodeSocketFloat", "done")),
+        nodes,
+    )
+
+
+def _volume_output(tree):
+    outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial"]
+    output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
+    if output is None or not output.inputs["Volume"].is_linked:
+        return None, None
+    link = output.inputs["Volume"].links[0]
+    return output, link.from_socket
+
+
+def attach(material):
+    """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
+    (after ``materials.attach``, whose records restore it on detach). Returns whether it did."""
+    if not materials.is_attached(material):
+        return False
+    records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
+    if any(record["group_node"].startswith(NODE_PREFIX) for record in records):
+        return False
+    tree = material.node_tree
+    output, source = _volume_output(tree)
+    if output is None or source.node.bl_idname != "ShaderNodeVolumePrincipled" or output.inputs["Surface"].is_linked:
+        return False
+    node = source.node
+    blackbody = sources.volume_blackbody(node)
+    intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+    if blackbody is None or intensity is None:
+        return False
+    ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
+    group = tree.nodes.new("ShaderNodeGroup")
+    group.node_tree = bpy.data.node_groups[GROUP]
+    group.name = group.label = f"{NODE_PREFIX} {node.name}"
+    if isinstance(blackbody.temperature, float):
+        group.inputs["Temperature"].default_value = blackbody.temperature
+    else:
+        tree.links.new(blackbody.temperature, group.inputs["Temperature"])
+    group.inputs["Intensity"].default_value = intensity
+    group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
+    tree.links.new(group.outputs["Color"], emission.inputs["Color"])
+    add = tree.nodes.new("ShaderNodeAddShader")
+    add.name = add.label = f"{NODE_PREFIX} Add {node.name}"
+    tree.links.new(source, add.inputs[0])
+    tree.links.new(emission.outputs[0], add.inputs[1])
+    tree.links.new(add.outputs[0], output.inputs["Volume"])
+    # the boundary: see-through, marks the pixels entered as already shifted; the material's own
+    # ln D writer is muted (the pixel's D is that of what lies behind, the same direction)
+    boundary = tree.nodes.new("ShaderNodeBsdfTransparent")
+    boundary.name = boundary.label = f"{NODE_PREFIX} Boundary {node.name}"
+    tree.links.new(boundary.outputs[0], output.inputs["Surface"])
+    done = tree.nodes.new("ShaderNodeOutputAOV")
+    done.name = done.label = f"{NODE_PREFIX} Done {node.name}"
+    done.aov_name = materials.DONE_AOV
+    tree.links.new(group.outputs["Done"], done.inputs["Value"])
+    log_doppler = tree.nodes.get(f"{materials.NODE_PREFIX} AOV")
+    if log_doppler is not None:
+        log_doppler.mute = True
+    for created in (group, emission, add, boundary, done):
+        created.location = (output.location.x - 200.0, output.location.y - 300.0)
+        created.hide = True
+    blank = {"target": "", "socket": "", "source_node": "", "source_socket": "",
+             "object_temperature": records[0]["object_temperature"] if records else 0.0}
+    records += [
+        {**blank, "group_node": group.name},
+        {**blank, "group_node": emission.name},
+        {**blank, "group_node": boundary.name},
+        {**blank, "group_node": done.name},
+        {**blank, "group_node": add.name, "target": output.name, "socket": output.inputs["Volume"].identifier,
+         "source_node": node.name, "source_socket": source.identifier},
+    ]
+    material[materials.ATTACHED_KEY] = records
+    return True
+
+
+def attach_scene(scene):
+    """The correction for every attached material of ``scene`` with a Principled Volume blackbody."""
+    for material, _temperature in materials.scene_materials(scene):
+        attach(material)

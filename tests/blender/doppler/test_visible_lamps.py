@@ -1,0 +1,92 @@
+"""Lamps seen directly by the exact camera (fast mode): colour-shifted like an emitter mesh.
+
+A 3000 K lamp at rest (an area light, or a point light with a radius, visible to camera rays)
+beside a 3000 K emitter mesh, observer moving toward them at 0.5c. Both are blackbodies at rest
+in the scene frame, so both must be seen as blackbodies at ``D T`` with luminance
+``Y(D T) / Y(T)`` times their rest luminance (Weiskopf et al. 1999 eq. 14, docs/physics.md), ``D``
+from each pixel's viewing direction. References: colour-science's Planck spectra; the rest
+luminances are measured on a render without the effect. Before lamps got emitter faces the lamp
+came out on the RGB matrix: Delta E 2000 of 26 from the blackbody at ``D T``.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import doppler_helpers as dh
+
+TEMPERATURE = 3000.0
+RESOLUTION = (64, 48)
+LAMP = (slice(20, 28), slice(12, 18))  # pixels inside the lamp's image at rest and moving
+MESH = (slice(20, 28), slice(46, 52))
+BETA = (0.0, 0.0, -0.5)
+
+
+def _scene(bpy, kind):
+    scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
+    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
+                         temperature=TEMPERATURE)
+    light = bpy.data.lights.new("Lamp", kind)
+    light.energy = 100.0
+    light.use_temperature = True
+    light.temperature = TEMPERATURE
+    if kind == "AREA":
+        light.size = 2.0
+    else:
+        light.shadow_soft_size = 1.0
+    lamp = bpy.data.objects.new("Lamp", light)
+    lamp.location = (-1.4, 0.0, -5.0)
+    lamp.rotation_euler = (math.pi, 0.0, 0.0)  # an area light emits along its local -Z: toward the camera
+    lamp.visible_camera = True
+    scene.collection.objects.link(lamp)
+    return scene, camera, lamp
+
+
+def _xyz(image, window):
+    return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3)).mean(axis=0)
+
+
+def _expected(doppler, y_rest):
+    """Mean XYZ of blackbodies at ``D T`` scaled to ``y_rest`` times ``Y(D T) / Y(T)``."""
+    y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y_rest for d in doppler], axis=0)
+
+
+@pytest.mark.parametrize("kind", ["AREA", "POINT"])
+def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon, tmp_path, kind):
+    bpy = __import__("bpy")
+    scene, camera, lamp = _scene(bpy, kind)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: _xyz(rest, window)[1] for name, window in (("lamp", LAMP), ("mesh", MESH))}
+    assert y_rest["lamp"] > 1.0 and y_rest["mesh"] > 0.5
+
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert not lamp.visible_camera, "the lamp is drawn by its face while applied"
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
+
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+    measured = {}
+    for name, window in (("lamp", LAMP), ("mesh", MESH)):
+        xyz = _xyz(moving, window)
+        expected = _expected(doppler[window].ravel(), y_rest[name])
+        measured[name] = xyz
+        delta_e = dh.delta_e_2000_normalised(xyz, expected)
+        ratio = xyz[1] / expected[1]
+        print(f"{kind} {name}: D {doppler[window].mean():.3f}, Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
+        assert delta_e < 1.0, name
+        assert ratio == pytest.approx(1.0, abs=0.02), name
+    between = dh.delta_e_2000_normalised(measured["lamp"], measured["mesh"])
+    print(f"{kind}: lamp against emitter mesh, Delta E {between:.3f}")
+    assert between < 1.0
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert lamp.visible_camera
+    assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp Face")]
+    assert not [material for material in bpy.data.materials if material.name.startswith("Relativity Lamp Face")]

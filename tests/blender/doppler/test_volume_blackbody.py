@@ -1,0 +1,107 @@
+"""A Principled Volume blackbody seen by the exact camera (fast mode) is a blackbody at ``D T``.
+
+A cube of emitting gas (Principled Volume, density 0, Blackbody Intensity 1, 3000 K) beside a
+3000 K emitter mesh, both at rest, observer moving toward them at 0.5c. Both must be seen as
+blackbodies at ``D T`` with luminance ``Y(D T) / Y(T)`` times their rest luminance (Weiskopf et
+al. 1999 eq. 14, docs/physics.md), ``D`` from each pixel's viewing direction. References:
+colour-science's Planck spectra; rest luminances measured on a render without the effect. Before
+the volume correction the gas went through the RGB matrix (Delta E 2000 of 26 here).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import doppler_helpers as dh
+from doppler_helpers import ch
+
+TEMPERATURE = 3000.0
+RESOLUTION = (64, 48)
+VOLUME = (slice(20, 28), slice(12, 18))
+MESH = (slice(20, 28), slice(46, 52))
+BETA = (0.0, 0.0, -0.5)
+
+
+def _scene(bpy):
+    scene, camera = dh.emitter_scene(bpy, samples=32, resolution=RESOLUTION)
+    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
+                         temperature=TEMPERATURE)
+    material = bpy.data.materials.new("Gas")
+    from relativity_addon.blender import compat
+
+    tree = compat.material_node_tree(material)
+    tree.nodes.clear()
+    volume = tree.nodes.new("ShaderNodeVolumePrincipled")
+    volume.inputs["Density"].default_value = 0.0
+    volume.inputs["Blackbody Intensity"].default_value = 1.0
+    volume.inputs["Temperature"].default_value = TEMPERATURE
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(volume.outputs[0], output.inputs["Volume"])
+    mesh = bpy.data.meshes.new("Gas")
+    corners = [(x, y, z) for x in (-4.0, -0.2) for y in (-2.0, 2.0) for z in (-6.0, -4.0)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    mesh.from_pydata(corners, [], faces)
+    mesh.materials.append(material)
+    gas = bpy.data.objects.new("Gas", mesh)
+    scene.collection.objects.link(gas)
+    return scene, camera, material
+
+
+def _xyz(image, window):
+    return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3)).mean(axis=0)
+
+
+def _expected(doppler, y_rest):
+    """Mean XYZ of blackbodies at ``D T``, each scaled to its ``y_rest`` times ``Y(D T) / Y(T)``."""
+    y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y
+                    for d, y in zip(doppler, y_rest, strict=True)], axis=0)
+
+
+def _slab_path_ratio(bpy, scene, camera):
+    """Per pixel, the gas slab's path length seen moving over the one seen at rest: the pixel's
+    ray crosses the slab along its scene-frame direction (aberrated, docs/physics.md), ``1/|k_z|``."""
+    rest = dh.pixel_photon_directions(bpy, scene, camera)  # the same pixel's direction at rest
+    scene_k = np.array([ch.aberrate(k, -np.asarray(BETA)) for k in rest.reshape(-1, 3)]).reshape(rest.shape)
+    return np.abs(rest[..., 2]) / np.abs(scene_k[..., 2])
+
+
+def test_principled_volume_blackbody_is_seen_at_d_t(relativity_addon, tmp_path):
+    bpy = __import__("bpy")
+    scene, camera, material = _scene(bpy)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1]
+              for name, window in (("volume", VOLUME), ("mesh", MESH))}
+    assert y_rest["volume"].min() > 0.5 and y_rest["mesh"].min() > 0.5
+    links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
+
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
+
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+    path = {"volume": _slab_path_ratio(bpy, scene, camera)[VOLUME].ravel(), "mesh": 1.0}
+    measured = {}
+    for name, window in (("volume", VOLUME), ("mesh", MESH)):
+        xyz = _xyz(moving, window)
+        expected = _expected(doppler[window].ravel(), y_rest[name] * path[name])
+        measured[name] = xyz
+        delta_e = dh.delta_e_2000_normalised(xyz, expected)
+        ratio = xyz[1] / expected[1]
+        print(f"{name}: D {doppler[window].mean():.3f}, path {np.mean(path[name]):.4f}, Delta E {delta_e:.3f}, "
+              f"Y / expected {ratio:.4f}")
+        assert delta_e < 1.0, name
+        assert ratio == pytest.approx(1.0, abs=0.02), name
+    between = dh.delta_e_2000_normalised(measured["volume"], measured["mesh"])
+    print(f"volume against emitter mesh, Delta E {between:.3f}")
+    assert between < 1.0
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
+    assert len(material.node_tree.nodes) == 2

@@ -1,0 +1,143 @@
+"""A 3000 K point light moving at 0.5c above a white floor, camera at rest (exact camera, stand-in
+lamps): the floor's colour follows eq. 18, ``D^5 B(lambda D, T) = B(lambda, D T)``, with ``D`` the
+lamp-to-floor Doppler factor of each floor point, in the fast mode and in the spectral mode.
+
+Expected values: the retarded positions and ``D`` of ``test_moving_point_light`` (numpy,
+fixed-point iteration) and colour-science's Planck spectra through the CIE 1931 observer: the
+floor's radiance is ``a / pi cos(alpha) / r^2`` times the lamp's luminance in its own frame times
+the blackbody at ``D T`` over ``Y(T)`` (Weiskopf et al. 1999 eqs. 18-19, docs/moving-lights.md).
+Every channel of a pixel shares its light paths, so the chromaticity needs few samples.
+"""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import test_moving_point_light as mp
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
+import doppler_helpers as dh  # noqa: E402
+
+TEMPERATURE = 3000.0
+RESOLUTION = (80, 60)
+ROWS = slice(28, 32)
+SAMPLES = 16
+PASSES = 3
+
+
+def _scene(bpy):
+    scene, camera, lamp = mp._floor_scene(bpy, samples=SAMPLES)
+    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
+    lamp.data.use_temperature = True
+    lamp.data.temperature = TEMPERATURE
+    return scene, camera, lamp
+
+
+def _geometry(points, lamp):
+    """Per pixel ``a / pi cos / r^2`` times the lamp's luminance over ``Y(T)``, and the
+    lamp-to-floor ``D``, from the lamp's retarded positions."""
+    _radiance, source, doppler = mp._expected_radiance(points, mp.BETA)
+    ray = points - source
+    r = np.linalg.norm(ray, axis=-1)
+    cosine = np.maximum(-ray[..., 2] / r, 0.0)
+    colour = np.array(lamp.data.temperature_color)
+    luminance = mp.POWER / (4.0 * math.pi) * float(colour @ (0.2126729, 0.7151522, 0.0721750))
+    y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    return mp.ALBEDO / math.pi * cosine / r**2 * luminance / y_t, doppler
+
+
+def _blackbodies(doppler):
+    """XYZ of the blackbody at ``D T`` for every ``D`` (rounded to 1e-4: one Planck sum each)."""
+    rounded = np.round(doppler, 4)
+    table = {d: dh.blackbody_xyz_colour_science(d * TEMPERATURE) for d in np.unique(rounded)}
+    return np.array([table[d] for d in rounded.ravel()]).reshape(*doppler.shape, 3)
+
+
+def _expected_xyz(points, lamp):
+    """Floor radiance (XYZ) per pixel: a / pi cos / r^2 times the lamp's luminance times B(D T) / Y(T)."""
+    geometry, doppler = _geometry(points, lamp)
+    return geometry[..., None] * _blackbodies(doppler), doppler
+
+
+def _compare(image, expected, doppler, label):
+    """Delta E 2000 and luminance ratio per column band of the lit floor (along the motion)."""
+    measured = dh.linear_rec709_to_xyz(image[ROWS].reshape(-1, 3)).reshape(ROWS.stop - ROWS.start, -1, 3).mean(0)
+    wanted = expected[ROWS].mean(0)
+    lit = wanted[:, 1] > 0.03 * wanted[:, 1].max()
+    results = []
+    for band in np.array_split(np.flatnonzero(lit), 6):
+        got, want = measured[band].sum(0), wanted[band].sum(0)
+        results.append((float(doppler[ROWS][:, band].mean()), dh.delta_e_2000_normalised(got, want), got[1] / want[1]))
+    for d, delta_e, ratio in results:
+        print(f"{label}: D {d:.3f}: Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
+    return results
+
+
+def test_floor_under_a_moving_blackbody_lamp_is_lit_by_the_blackbody_at_d_t(relativity_addon, factory_blender,
+                                                                            tmp_path):
+    bpy = factory_blender
+    scene, camera, lamp = _scene(bpy)
+    mp._effect().apply(scene)
+    points = mp._floor_points(bpy, scene, camera)
+    expected, doppler = _expected_xyz(points, lamp)
+    assert doppler[ROWS].min() < 0.9 and doppler[ROWS].max() > 1.2, "the view must hold red and blue shifts"
+
+    fast = mp._render(bpy, scene, tmp_path / "fast.exr")
+    assert np.all(np.isfinite(fast)) and fast.min() >= 0.0
+    for _d, delta_e, ratio in _compare(fast, expected, doppler, "fast mode"):
+        assert delta_e < 1.0
+        assert ratio == pytest.approx(1.0, abs=0.08)  # noise: 16 samples
+
+    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    pixels, info = spectral_render.render(scene, PASSES)
+    spectral = pixels[::-1, :, :3].astype(float)
+    assert np.all(np.isfinite(spectral))
+    for _d, delta_e, ratio in _compare(spectral, expected, doppler, f"spectral mode, {PASSES} passes"):
+        assert delta_e < 1.0
+        assert ratio == pytest.approx(1.0, abs=0.08)
+    assert tuple(lamp.data.color) == (1.0, 1.0, 1.0) and lamp.data.use_temperature, "the user's lamp is restored"
+
+
+OBSERVER = np.array([-0.3, 0.0, 0.0])  # against the lamp's motion
+
+
+def _observed_floor_points(bpy, scene, camera):
+    """The floor point each pixel centre sees through the moving exact camera, and the pixel's
+    observer Doppler factor ``D_o = 1 / (gamma (1 - beta . d'))`` (``d'`` its direction in the
+    observer's frame, aberrated into the scene frame to find the point: docs/physics.md)."""
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - OBSERVER @ OBSERVER)
+    observer_doppler = 1.0 / (gamma * (1.0 - view @ OBSERVER))
+    scene_photon = np.array([mp.ch.aberrate(k, -OBSERVER) for k in (-view).reshape(-1, 3)]).reshape(view.shape)
+    scene_view = -scene_photon
+    t = -mp.CAMERA[2] / scene_view[..., 2]
+    return mp.CAMERA + t[..., None] * scene_view, observer_doppler
+
+
+def test_moving_blackbody_lamp_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
+    """Lamp at 0.5c, observer at 0.3c against it: each floor pixel is the blackbody at
+    ``D_o D_L T`` (``D_L`` lamp to floor, ``D_o`` floor to observer). The spectral mode carries the
+    lamp's shifted spectrum through the passes; the fast mode shifts the pixel's RGB by ``M(D_o)``
+    as if it were lit by white light (its error is printed, docs/moving-lights.md)."""
+    bpy = factory_blender
+    scene, camera, lamp = _scene(bpy)
+    scene.relativity.beta = tuple(OBSERVER)
+    mp._effect().apply(scene)
+    points, observer_doppler = _observed_floor_points(bpy, scene, camera)
+    geometry, lamp_doppler = _geometry(points, lamp)
+    total = observer_doppler * lamp_doppler
+    expected = geometry[..., None] * _blackbodies(total)  # D_o^5 B(lambda D_o, D_L T) = B(lambda, D_o D_L T)
+
+    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    pixels, info = spectral_render.render(scene, PASSES + 1)
+    spectral = pixels[::-1, :, :3].astype(float)
+    print(f"D_o {observer_doppler[ROWS].min():.3f} .. {observer_doppler[ROWS].max():.3f}; "
+          f"D_L {lamp_doppler[ROWS].min():.3f} .. {lamp_doppler[ROWS].max():.3f}")
+    label = f"moving observer, spectral mode, {PASSES + 1} passes"
+    for _d, delta_e, ratio in _compare(spectral, expected, total, label):
+        assert delta_e < 1.0
+        assert ratio == pytest.approx(1.0, abs=0.08)
+    fast = mp._render(bpy, scene, tmp_path / "fast.exr")
+    _compare(fast, expected, total, "moving observer, fast mode")
