@@ -51,9 +51,27 @@ def _cmf_defines():
     return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
 
 
+def basis_defines():
+    """Mallett & Yuksel's basis on its 5 nm grid over its constrained band (outside it the basis
+    is held at the band's edge values, ``physics.spectral_render.reflectance_matrix``) and the white's
+    temperature, as OSL macros: the table the shader interpolates linearly."""
+    tables = spectral_render.tables()
+    low, high = (float(v) for v in tables["basis_band_nm"])
+    rows = (tables["basis_nm"] >= low) & (tables["basis_nm"] <= high)
+    grid, basis = tables["basis_nm"][rows], tables["basis"][rows]
+    step = float(grid[1] - grid[0])
+    if not (grid[0] == low and grid[-1] == high and np.allclose(np.diff(grid), step)):
+        raise RelativityError("the shipped RGB basis table is not on an even grid over its band")
+    values = ", ".join(f"{float(v):.9g}" for v in basis.ravel())
+    return (f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
+            f"#define WHITE_TEMPERATURE {spectral_render.WHITE_TEMPERATURE_K!r}\n"
+            f"#define BASIS_DECLARE float BASIS[{basis.size}] = {{{values}}};\n")
+
+
 def _shader_text():
     with open(SHADER_PATH, encoding="utf-8") as handle:
         source = handle.read().replace("/* @CMF_TABLES@ */", _cmf_defines())
+        source = source.replace("/* @BASIS_TABLE@ */", basis_defines())
     text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT) or bpy.data.texts.new(names.MOVING_LAMP_SHADER_TEXT)
     if text.as_string().rstrip("\n") != source.rstrip("\n"):
         text.clear()
@@ -259,7 +277,7 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
             inputs = {key: values[key] for key in ("camera_position", "intensity", "light_beta", "spot_axis",
                                                     "spot_cos_half_angle", "spot_smooth", "temperature",
                                                     "luminance", "wavelength_0", "wavelength_1", "wavelength_2",
-                                                    "spectral_scale")}
+                                                    "spectral_scale", "basis_weights")}
             inputs["spectral"] = int(values["spectral"])
             inputs["lambert"] = int(values["lambert"])
             inputs.update(lamp_time=float(times[index]), previous_time=float(times[before]),

@@ -23,6 +23,7 @@ import math
 import os
 
 import bpy
+import numpy as np
 
 from ..errors import RelativityError
 from ..physics import spectral_render
@@ -124,6 +125,7 @@ def shader_parameters(light, snap):
     intensity = tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity
     return {
         **blackbody_parameters(light.temperature, float(spectral_render.luminance(intensity))),
+        **rgb_spectral_parameters(light.temperature, intensity),
         "light_position": tuple(p + b * ct for p, b in zip(light.position, light.beta, strict=True)),
         "light_beta": light.beta,
         "camera_position": camera_position,
@@ -156,6 +158,16 @@ def blackbody_parameters(temperature, luminance):
            for index, value in enumerate(wavelengths if wavelengths is not None else (500.0, 550.0, 600.0))},
         "spectral_scale": scale,
     }
+
+
+def rgb_spectral_parameters(temperature, intensity):
+    """An RGB light's inputs in a spectral pass (eq. 18, docs/moving-lights.md): ``spectral`` and
+    the basis weights of its intensity, ``A(1)^-1 I``, whose up-sampled spectrum the shader shifts
+    by each receiving point's ``D`` (the passes give lamps at rest ``emission_matrix(mu) @ I``)."""
+    if temperature > 0.0 or materials.spectral_pass_wavelengths() is None:
+        return {"basis_weights": (0.0, 0.0, 0.0)}
+    weights = spectral_render.tables()["inverse_rest_matrix"] @ np.asarray(intensity, dtype=np.float64)
+    return {"spectral": True, "basis_weights": tuple(float(v) for v in weights)}
 
 
 def _same(a, b):

@@ -100,12 +100,12 @@ def pixel_log_doppler(scene, snap):
 
 def _scene_lights(scene):
     """The lamps whose colours the passes set. Not the moving lights' stand-in lamps (white: their
-    shaders carry the user's light, whose colour the passes set), nor moving blackbody lights,
-    whose stand-ins compute the shifted spectrum at the pass's wavelengths themselves
-    (``moving_lights.blackbody_parameters``)."""
+    shaders carry the user's light), nor the moving lights themselves (but suns), whose stand-ins
+    compute the shifted spectrum at the pass's wavelengths themselves (blackbodies:
+    ``moving_lights.blackbody_parameters``, RGB lights: ``moving_lights.rgb_spectral_parameters``)."""
     snap = effect.last_snapshot(scene)
     lights = snap.moving_lights if snap is not None else ()
-    shifted = {light.name for light in lights if light.temperature > 0.0 and light.kind != "SUN"}
+    shifted = {light.name for light in lights if light.kind != "SUN"}
     return list({obj.data for obj in scene.objects if obj.type == "LIGHT" and obj.name not in shifted
                  and not (obj.name.startswith(names.MOVING_LAMP_PREFIX) and obj.data.type != "SUN")})
 

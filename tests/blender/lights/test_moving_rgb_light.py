@@ -1,0 +1,134 @@
+"""An orange RGB point light moving at 0.5c above a white floor, camera at rest (exact camera,
+stand-in lamps), spectral mode: each floor point gets the light's up-sampled spectrum shifted by
+its own lamp-to-floor ``D``, ``D^5 S(lambda D)`` (Weiskopf et al. 1999 eq. 18), and the fast mode's
+colour is measured against the same reference (it gives ``D^4`` times the rest colour).
+
+Expected values: the retarded positions and ``D`` of ``test_moving_point_light`` (numpy) and the
+spectrum computed here with colour-science: Mallett & Yuksel's basis (colour-science's table,
+held at the values of its constrained band's edges outside it, ``docs/spectral-model.md``) in the
+6504 K white (colour-science's Planck law), with the weights that give the light's RGB at rest
+through the CIE 1931 observer; shifted and integrated on the observer's 1 nm grid.
+"""
+
+import math
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import test_moving_point_light as mp
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
+import doppler_helpers as dh  # noqa: E402
+
+COLOUR = (1.0, 0.5, 0.1)
+RESOLUTION = (80, 60)
+ROWS = slice(28, 32)
+SAMPLES = 64
+PASSES = 4
+WHITE_K = 6504.0
+
+
+def _basis_extended(wavelengths):
+    """colour-science's Mallett & Yuksel basis, linear between its 5 nm values, held outside the
+    model's constrained band (its edges from the physics core: the model's definition)."""
+    import colour
+
+    from relativity_addon.physics import spectral
+
+    table = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
+    low, high = spectral.basis_constrained_band_nm()
+    clipped = np.clip(wavelengths, low, high)
+    return np.stack([np.interp(clipped, table.wavelengths, table.values[:, i]) for i in range(3)], axis=-1)
+
+
+def _white(wavelengths):
+    import colour
+
+    return colour.colorimetry.planck_law(wavelengths * 1e-9, WHITE_K) / colour.colorimetry.planck_law(560e-9, WHITE_K)
+
+
+def _shifted_basis_xyz(doppler):
+    """``(..., 3, 3)``: XYZ (columns: basis functions) of ``D^5 E(lambda D) basis(lambda D)``."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(colour.SpectralShape(360, 830, 1))
+    grid, bar = np.array(cmfs.wavelengths), np.array(cmfs.values)
+    doppler = np.asarray(doppler, float)
+    emitted = grid * doppler[..., None]
+    spectra = _basis_extended(emitted) * (_white(emitted) * doppler[..., None] ** 5)[..., None]
+    return np.einsum("wc,...wi->...ci", bar, spectra)
+
+
+def _expected_xyz(points):
+    """Floor radiance (XYZ) per pixel: a / pi cos / r^2 times the light's shifted spectrum's XYZ."""
+    _radiance, source, doppler = mp._expected_radiance(points, mp.BETA)
+    ray = points - source
+    r = np.linalg.norm(ray, axis=-1)
+    cosine = np.maximum(-ray[..., 2] / r, 0.0)
+    intensity = mp.POWER / (4.0 * math.pi) * np.array(COLOUR)
+    weights = np.linalg.solve(_shifted_basis_xyz(1.0), dh.linear_rec709_to_xyz(intensity))
+    rounded = np.round(doppler, 4)
+    table = {d: _shifted_basis_xyz(d) @ weights for d in np.unique(rounded)}
+    xyz = np.array([table[d] for d in rounded.ravel()]).reshape(*doppler.shape, 3)
+    return (mp.ALBEDO / math.pi * cosine / r**2)[..., None] * xyz, doppler
+
+
+def _compare(image, expected, doppler, label):
+    """Delta E 2000 and luminance ratio per column band of the lit floor (along the motion)."""
+    measured = dh.linear_rec709_to_xyz(image[ROWS].reshape(-1, 3)).reshape(ROWS.stop - ROWS.start, -1, 3).mean(0)
+    wanted = expected[ROWS].mean(0)
+    lit = wanted[:, 1] > 0.03 * wanted[:, 1].max()
+    results = []
+    for band in np.array_split(np.flatnonzero(lit), 6):
+        got, want = measured[band].sum(0), wanted[band].sum(0)
+        results.append((float(doppler[ROWS][:, band].mean()), dh.delta_e_2000_normalised(got, want), got[1] / want[1]))
+    for d, delta_e, ratio in results:
+        print(f"{label}: D {d:.3f}: Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
+    return results
+
+
+def test_floor_under_a_moving_rgb_lamp_gets_its_shifted_spectrum(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene, camera, lamp = mp._floor_scene(bpy, samples=SAMPLES)
+    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
+    lamp.data.color = COLOUR
+    mp._effect().apply(scene)
+    points = mp._floor_points(bpy, scene, camera)
+    expected, doppler = _expected_xyz(points)
+    assert doppler[ROWS].min() < 0.95 and doppler[ROWS].max() > 1.5, "the view must hold red and blue shifts"
+
+    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    pixels, _info = spectral_render.render(scene, PASSES)
+    spectral = pixels[::-1, :, :3].astype(float)
+    assert np.all(np.isfinite(spectral))
+    results = _compare(spectral, expected, doppler, f"spectral mode, {PASSES} passes")
+    assert len(results) == 6
+    for _d, delta_e, ratio in results:
+        assert delta_e < 2.0
+        assert ratio == pytest.approx(1.0, abs=0.05)
+    assert tuple(lamp.data.color) == pytest.approx(COLOUR), "the user's lamp is restored"
+
+    fast = mp._render(bpy, scene, tmp_path / "fast.exr")  # measured, not asserted: D^4 times the rest colour
+    _compare(fast, expected, doppler, "fast mode")
+
+
+def test_the_shaders_basis_table_is_the_physics_cores(relativity_addon, factory_blender):
+    """The basis the stand-in lamp shader interpolates (written into its text) equals the physics
+    core's extended basis (colour-science's table) at and between its grid points."""
+    from relativity_addon.physics import spectral
+
+    moving_lamps = dh.addon_module(relativity_addon, "moving_lamps")
+    text = moving_lamps.basis_defines()
+    low = float(re.search(r"#define BASIS_LOW (\S+)", text).group(1))
+    step = float(re.search(r"#define BASIS_STEP (\S+)", text).group(1))
+    count = int(re.search(r"#define BASIS_COUNT (\d+)", text).group(1))
+    values = np.array([float(v) for v in re.search(r"\{(.*)\}", text).group(1).split(",")]).reshape(count, 3)
+    assert float(re.search(r"#define WHITE_TEMPERATURE (\S+)", text).group(1)) == WHITE_K
+    wavelengths = np.linspace(300.0, 900.0, 1201)
+    position = np.clip((wavelengths - low) / step, 0.0, count - 1.0)  # as the shader interpolates
+    index = np.minimum(np.floor(position).astype(int), count - 2)
+    f = (position - index)[:, None]
+    shader = (1.0 - f) * values[index] + f * values[index + 1]
+    np.testing.assert_allclose(shader, spectral.reflectance_basis_Mallett2019(wavelengths), atol=1e-7)
