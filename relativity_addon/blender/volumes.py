@@ -25,9 +25,10 @@ shifted again by the compositor). ``D`` is the observer's (a volume at rest in t
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
-Blackbody Intensity and a constant or linked Temperature. Not covered: a temperature grid
-(``Temperature Attribute``, e.g. a fire simulation: the added emission uses the Temperature input
-only), a Principled Volume behind a Mix or Add shader or with a surface shader, the spectral mode
+Blackbody Intensity and a constant or linked Temperature (a node field is followed per point).
+Not covered: a temperature grid (``Temperature Attribute``, e.g. a fire simulation: the added
+emission uses the Temperature input only; following the grid blows up the grid's cool edges,
+docs/spectral-model.md), a Principled Volume behind a Mix or Add shader or with a surface shader, the spectral mode
 (volumes stay RGB in every pass), and Apparent Geometry's boosted meshes.
 """
 
