@@ -33,6 +33,7 @@ from . import (
     shape_keys,
     snapshot,
     traveller,
+    volumes,
 )
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
@@ -274,6 +275,8 @@ def _record(scene, snap):
     warnings += moving_lights.warnings(scene, snap)
     warnings += lamp_doppler.warnings(scene, snap)
     warnings += lamp_faces.warnings(scene, snap)
+    if snap.exact_camera:
+        warnings += volumes.warnings(scene)
     _scene_status[scene.name] = (snap, warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)

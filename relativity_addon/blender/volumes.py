@@ -180,7 +180,42 @@ def attach(material):
     return True
 
 
+def _reads_grids(obj):
+    """Whether Cycles may multiply ``obj``'s volume Temperature by a temperature grid: a Volume
+    object (OpenVDB grids) or a fluid domain (smoke and fire)."""
+    return obj.type == "VOLUME" or any(
+        modifier.type == "FLUID" and modifier.fluid_type == "DOMAIN" for modifier in obj.modifiers)
+
+
+def grid_materials(scene):
+    """``{material: object name}`` of the materials on objects with temperature grids: their
+    emission is ``Temperature x grid``, which the correction does not follow (a grid fades to 0 K
+    at its edges, where Y(D T) / Y(T) of Cycles' sigma T^4 glow explodes: docs/spectral-model.md),
+    so they keep the RGB matrix and a warning."""
+    found = {}
+    for obj in scene.objects:
+        if _reads_grids(obj):
+            for slot in obj.material_slots:
+                if slot.material is not None:
+                    found.setdefault(slot.material, obj.name)
+    return found
+
+
 def attach_scene(scene):
-    """The correction for every attached material of ``scene`` with a Principled Volume blackbody."""
+    """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
+    except those on objects with temperature grids (:func:`grid_materials`)."""
+    skipped = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
-        attach(material)
+        if material not in skipped:
+            attach(material)
+
+
+def warnings(scene):
+    """One line per Principled Volume blackbody on an object with temperature grids."""
+    lines = []
+    for material, name in grid_materials(scene).items():
+        node = _volume_output(material.node_tree)[1] if material.node_tree is not None else None
+        if node is not None and sources.volume_blackbody(node.node) is not None:
+            lines.append(f"Volume {name!r} ({material.name!r}) may read a temperature grid: its blackbody "
+                         "keeps the RGB colour shift (grids are not shifted to D T)")
+    return lines

@@ -105,3 +105,30 @@ def test_principled_volume_blackbody_is_seen_at_d_t(relativity_addon, tmp_path):
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
     assert len(material.node_tree.nodes) == 2
+
+
+def test_volumes_with_temperature_grids_are_left_to_the_rgb_shift_with_a_warning(relativity_addon):
+    """A Volume object (OpenVDB grids) multiplies its Temperature by a temperature grid, which the
+    correction does not follow: its material gets no correction nodes, the scene's warnings name
+    it, and the mesh gas beside it is still corrected."""
+    bpy = __import__("bpy")
+    from relativity_addon.blender import effect, volumes
+
+    scene, _camera, material = _scene(bpy)
+    grid_material = material.copy()
+    grid_material.name = "Fire"
+    volume_object = bpy.data.objects.new("Smoke", bpy.data.volumes.new("Smoke"))
+    volume_object.data.materials.append(grid_material)
+    scene.collection.objects.link(volume_object)
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+
+    def corrected(mat):
+        return any(node.name.startswith(volumes.NODE_PREFIX) for node in mat.node_tree.nodes)
+
+    assert corrected(material) and not corrected(grid_material)
+    (warning,) = [line for line in effect.scene_warnings(scene) if "temperature grid" in line]
+    assert "'Smoke'" in warning and "'Fire'" in warning
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert not corrected(material)
