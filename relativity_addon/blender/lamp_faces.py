@@ -14,21 +14,23 @@ Radiance, measured against Cycles' own lamps (tests/blender/doppler/test_visible
 an area light of power ``P`` and area ``A`` (Normalize on) shows ``P / (pi A)`` times its colour,
 a point light of radius ``r`` a disc of ``P / (4 pi^2 r^2)``; ``2^exposure`` multiplies both.
 
-Not covered (the lamp keeps Cycles' own drawing, warned): spot and sun lights, area lights with a
-spread below 180 degrees or Normalize off, portals, lamps whose node tree's emission is textured,
-moving lights (their stand-ins draw nothing for the camera). The face is opaque where Cycles'
-lamps are see-through, and an area light seen from behind gets no face (it shows nothing there).
+A spot light is drawn as its point light's sphere times Cycles' cone mask toward the camera, taken
+at the lamp's centre for the whole face. Not covered (the lamp keeps Cycles' own drawing, warned):
+sun lights, area lights with a spread below 180 degrees or Normalize off, portals, lamps whose
+node tree's emission is textured, moving lights (their stand-ins draw nothing for the camera).
+The face is opaque where Cycles' lamps are see-through, and an area light seen from behind gets no
+face (it shows nothing there).
 """
 
 import math
 
 import bmesh
 import bpy
-from mathutils import Matrix
+from mathutils import Matrix, Vector
 
 from . import compat, materials, names, snapshot, sources
 
-KINDS = ("POINT", "AREA")
+KINDS = ("POINT", "SPOT", "AREA")
 DISC_SEGMENTS = 64
 
 
@@ -59,13 +61,32 @@ def _emission(light):
     return colour, temperature if light.use_temperature else None, strength
 
 
-def _radiance_scale(obj):
-    """Radiance of the lamp per unit colour (W m^-2 sr^-1), or None for a lamp without a face."""
+def _spot_mask(obj, camera):
+    """Cycles' spot cone toward ``camera`` (its smoothstep blend; 0 outside the cone), taken at the
+    lamp's centre for the whole face."""
+    light = obj.data
+    axis = (obj.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
+    cos_axis = axis.dot((camera - obj.matrix_world.translation).normalized())
+    cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
+    if cos_axis <= cos_half:
+        return 0.0
+    if light.spot_blend <= 0.0 or cos_half >= 1.0:
+        return 1.0
+    x = min((cos_axis - cos_half) / ((1.0 - cos_half) * light.spot_blend), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def _radiance_scale(obj, camera):
+    """Radiance of the lamp per unit colour (W m^-2 sr^-1) seen from ``camera``, or None for a lamp
+    without a face."""
     light = obj.data
     power = light.energy * 2.0 ** getattr(light, "exposure", 0.0)
-    if light.type == "POINT":
+    if light.type in ("POINT", "SPOT"):  # a spot is a point light masked by its cone
         radius = light.shadow_soft_size
-        return power / (4.0 * math.pi**2 * radius**2) if radius > 0.0 else None
+        if radius <= 0.0:
+            return None
+        mask = _spot_mask(obj, camera) if light.type == "SPOT" else 1.0
+        return power / (4.0 * math.pi**2 * radius**2) * mask if mask > 0.0 else None
     if light.type != "AREA" or light.cycles.is_portal or light.spread < math.pi - 1e-6 or not light.normalize:
         return None
     sx, sy, _sz = obj.matrix_world.to_scale()
@@ -97,7 +118,7 @@ def _facing_camera(obj, snap):
 def _mesh(name, light):
     mesh = bpy.data.meshes.new(name)
     mesh[names.LAMP_FACES_KEY] = _shape_key(light)
-    if light.type == "POINT":
+    if light.type in ("POINT", "SPOT"):
         builder = bmesh.new()
         bmesh.ops.create_uvsphere(builder, u_segments=DISC_SEGMENTS, v_segments=DISC_SEGMENTS // 2,
                                   radius=light.shadow_soft_size)
@@ -179,7 +200,7 @@ def _face(scene, obj):
         face.parent = obj
     # A point light's radius ignores the object's scale; an area light's size follows it.
     inverse = Matrix.Identity(4)
-    if obj.data.type == "POINT":
+    if obj.data.type in ("POINT", "SPOT"):
         scale = obj.matrix_world.to_scale()
         inverse = Matrix.Diagonal((*(1.0 / s if s else 1.0 for s in scale), 1.0))
     if face.matrix_parent_inverse != inverse:
@@ -222,7 +243,7 @@ def drawable(obj, snap):
     """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
     if obj.data.type not in KINDS or not _facing_camera(obj, snap):
         return None
-    scale = _radiance_scale(obj)
+    scale = _radiance_scale(obj, Matrix(snap.camera_matrix).translation)
     emission = _emission(obj.data)
     if scale is None or emission is None:
         return None
@@ -280,4 +301,5 @@ def warnings(scene, snap):
     return [f"Light {obj.name!r} is seen directly but not drawn as an emitter: its colour is shifted "
             "with what lies behind it (docs/moving-lights.md)"
             for obj in _candidates(scene, snap) if obj.name not in record and obj.data.type != "SUN"
-            and (obj.data.type == "AREA" or obj.data.shadow_soft_size > 0.0) and _facing_camera(obj, snap)]
+            and (obj.data.type == "AREA" or obj.data.shadow_soft_size > 0.0) and _facing_camera(obj, snap)
+            and (obj.data.type != "SPOT" or _spot_mask(obj, Matrix(snap.camera_matrix).translation) > 0.0)]

@@ -37,7 +37,7 @@ def _scene(bpy, kind):
         light.shadow_soft_size = 1.0
     lamp = bpy.data.objects.new("Lamp", light)
     lamp.location = (-1.4, 0.0, -5.0)
-    lamp.rotation_euler = (math.pi, 0.0, 0.0)  # an area light emits along its local -Z: toward the camera
+    lamp.rotation_euler = (math.pi, 0.0, 0.0)  # area and spot lights emit along local -Z: toward the camera
     lamp.visible_camera = True
     scene.collection.objects.link(lamp)
     return scene, camera, lamp
@@ -53,7 +53,7 @@ def _expected(doppler, y_rest):
     return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y_rest for d in doppler], axis=0)
 
 
-@pytest.mark.parametrize("kind", ["AREA", "POINT"])
+@pytest.mark.parametrize("kind", ["AREA", "POINT", "SPOT"])
 def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon, tmp_path, kind):
     bpy = __import__("bpy")
     scene, camera, lamp = _scene(bpy, kind)
