@@ -28,7 +28,7 @@ from ..errors import RelativityError
 from ..physics import spectral_render
 from ..physics.lorentz import aberrate, camera_to_scene_direction
 from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
-from . import animation, names, snapshot
+from . import animation, materials, names, snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
@@ -301,14 +301,20 @@ def sun_in_scene_frame(axis, beta):
 
 
 def _write_sun(scene, light, obj):
-    """The stand-in sun: the user's sun aberrated, ``D^2`` its strength, ``1 / D`` its angle."""
+    """The stand-in sun: the user's sun aberrated, ``D^2`` its strength, ``1 / D`` its angle, its
+    ``D`` stored for the spectral passes (which set its colour to ``D S(mu D)``)."""
     user = scene.objects[light.name].data
     direction, doppler = sun_in_scene_frame(light.axis, light.beta)
     stand_in = obj.data
     _set(stand_in, "energy", float(user.energy) * doppler * doppler)
+    if stand_in.get(names.SUN_DOPPLER_KEY) != float(doppler):  # for the spectral passes' shift
+        stand_in[names.SUN_DOPPLER_KEY] = float(doppler)
     _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
-    _set(stand_in, "color", tuple(user.color))
-    for key in ("use_shadow", "use_temperature", "temperature"):
+    keys = ("use_shadow",)
+    if materials.spectral_pass_wavelengths() is None:  # in a pass: the shifted spectral values stay
+        _set(stand_in, "color", tuple(user.color))
+        keys += ("use_temperature", "temperature")
+    for key in keys:
         if hasattr(user, key) and getattr(stand_in, key) != getattr(user, key):
             setattr(stand_in, key, getattr(user, key))
     rotation = Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y")

@@ -100,8 +100,9 @@ def pixel_log_doppler(scene, snap):
 
 def _scene_lights(scene):
     """The lamps whose colours the passes set. Not the moving lights' stand-in lamps (white: their
-    shaders carry the user's light), nor the moving lights themselves (but suns), whose stand-ins
-    compute the shifted spectrum at the pass's wavelengths themselves (blackbodies:
+    shaders carry the user's light), nor the moving lights themselves (but suns: a moving sun's
+    stand-in, ``D^2`` its strength, gets ``D S(mu D)``, its spectrum shifted by its one ``D``),
+    whose stand-ins compute the shifted spectrum at the pass's wavelengths themselves (blackbodies:
     ``moving_lights.blackbody_parameters``, RGB lights: ``moving_lights.rgb_spectral_parameters``)."""
     snap = effect.last_snapshot(scene)
     lights = snap.moving_lights if snap is not None else ()
@@ -158,6 +159,9 @@ def render(scene, passes, progress=None):
                     light = bpy.data.lights[name]
                     light.color, light.use_temperature = colour, use_temperature
                     spectrum = _light_spectrum(light, trio)
+                    doppler = float(light.get(names.SUN_DOPPLER_KEY, 1.0))
+                    if doppler != 1.0:  # a moving sun's stand-in (energy D^2): D S(mu D), eq. 18
+                        spectrum = doppler * _light_spectrum(light, tuple(doppler * w for w in trio))
                     light.use_temperature, light.color = False, tuple(spectrum)
                 rendered = _render_exr(scene, os.path.join(folder, f"pass{index}.exr"))
                 samples.append(rendered[..., :3])

@@ -99,3 +99,36 @@ def test_moving_area_light_follows_eq_19_with_its_cosine(relativity_addon, facto
     print(f"area light at 0.5c: max error {error:.4f} of the peak (its cosine unaberrated: {unaberrated:.3f})")
     assert error < 0.05
     assert unaberrated > 3.0 * error
+
+
+def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativity_addon, factory_blender):
+    """Spectral mode: a 5000 K sun moving at 0.5c lights the floor with its spectrum shifted by its
+    one D (eq. 18: irradiance ``D^3 S(lambda D) = D^-2 B(lambda, D T)`` per unit of ``B / Y(T)``),
+    so the floor is the blackbody at ``D T`` (colour-science) with luminance
+    ``a / pi E cos D^-2 Y(D T) / Y(T)``. Without the shift it kept its 5000 K colour at ``D^2``."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
+    import doppler_helpers as dh
+
+    bpy = factory_blender
+    temperature = 5000.0
+    scene, _camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, kind="SUN", samples=8)
+    scene.render.resolution_x, scene.render.resolution_y = 40, 30
+    sun.data.energy = SUN_STRENGTH
+    sun.data.use_temperature = True
+    sun.data.temperature = temperature
+    floor._effect().apply(scene)
+    k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)
+    d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
+    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    pixels, _info = spectral_render.render(scene, 3)
+    floor_xyz = dh.linear_rec709_to_xyz(pixels[:, :, :3].reshape(-1, 3).astype(float)).mean(axis=0)
+    blackbody = dh.blackbody_xyz_colour_science(d * temperature)
+    y_ratio = blackbody[1] / dh.blackbody_xyz_colour_science(temperature)[1]
+    expected_y = floor.ALBEDO / math.pi * SUN_STRENGTH * (-k[2]) * y_ratio / (d * d)
+    delta_e = dh.delta_e_2000_normalised(floor_xyz, blackbody)
+    print(f"sun at 0.5c, D = {d:.4f}: floor Delta E {delta_e:.3f} from the blackbody at D T, "
+          f"Y / expected {floor_xyz[1] / expected_y:.4f}; at T: Delta E "
+          f"{dh.delta_e_2000_normalised(floor_xyz, dh.blackbody_xyz_colour_science(temperature)):.2f}")
+    assert delta_e < 1.0
+    assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
+    assert tuple(sun.data.color) == (1.0, 1.0, 1.0) and sun.data.use_temperature, "the user's sun is restored"
