@@ -18,13 +18,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import test_moving_point_light as mp
+from test_moving_blackbody_light import ROWS, _compare
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
 import doppler_helpers as dh  # noqa: E402
 
 COLOUR = (1.0, 0.5, 0.1)
 RESOLUTION = (80, 60)
-ROWS = slice(28, 32)
 SAMPLES = 64
 PASSES = 4
 WHITE_K = 6504.0
@@ -73,20 +73,6 @@ def _expected_xyz(points):
     table = {d: _shifted_basis_xyz(d) @ weights for d in np.unique(rounded)}
     xyz = np.array([table[d] for d in rounded.ravel()]).reshape(*doppler.shape, 3)
     return (mp.ALBEDO / math.pi * cosine / r**2)[..., None] * xyz, doppler
-
-
-def _compare(image, expected, doppler, label):
-    """Delta E 2000 and luminance ratio per column band of the lit floor (along the motion)."""
-    measured = dh.linear_rec709_to_xyz(image[ROWS].reshape(-1, 3)).reshape(ROWS.stop - ROWS.start, -1, 3).mean(0)
-    wanted = expected[ROWS].mean(0)
-    lit = wanted[:, 1] > 0.03 * wanted[:, 1].max()
-    results = []
-    for band in np.array_split(np.flatnonzero(lit), 6):
-        got, want = measured[band].sum(0), wanted[band].sum(0)
-        results.append((float(doppler[ROWS][:, band].mean()), dh.delta_e_2000_normalised(got, want), got[1] / want[1]))
-    for d, delta_e, ratio in results:
-        print(f"{label}: D {d:.3f}: Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
-    return results
 
 
 def test_floor_under_a_moving_rgb_lamp_gets_its_shifted_spectrum(relativity_addon, factory_blender, tmp_path):
