@@ -28,7 +28,7 @@ import bmesh
 import bpy
 from mathutils import Matrix, Vector
 
-from . import compat, materials, names, snapshot, sources
+from . import compat, materials, moving_lights, names, snapshot, sources
 
 KINDS = ("POINT", "SPOT", "AREA")
 DISC_SEGMENTS = 64
@@ -67,12 +67,12 @@ def _spot_mask(obj, camera):
     light = obj.data
     axis = (obj.matrix_world.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
     cos_axis = axis.dot((camera - obj.matrix_world.translation).normalized())
-    cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
+    cos_half, smooth = moving_lights.spot_cone(light.spot_size, light.spot_blend)
     if cos_axis <= cos_half:
         return 0.0
-    if light.spot_blend <= 0.0 or cos_half >= 1.0:
+    if smooth == 0.0:
         return 1.0
-    x = min((cos_axis - cos_half) / ((1.0 - cos_half) * light.spot_blend), 1.0)
+    x = min((cos_axis - cos_half) * smooth, 1.0)
     return x * x * (3.0 - 2.0 * x)
 
 

@@ -116,11 +116,18 @@ def reception_event(snap):
     return snap.speed_of_light * (t - snap.time), tuple(float(v) for v in x)
 
 
+def spot_cone(spot_size, spot_blend):
+    """Cycles' spot cone: ``(cos of the half angle, 1 / width of the blend in cos)``; the mask is
+    ``smoothstep(0, 1, (cos - cos_half) * smooth)`` (no blend: smooth 0, a hard edge)."""
+    cos_half = math.cos(min(spot_size, math.pi) * 0.5)
+    smooth = 1.0 / ((1.0 - cos_half) * spot_blend) if spot_blend > 0.0 and cos_half < 1.0 else 0.0
+    return cos_half, smooth
+
+
 def shader_parameters(light, snap):
     """The script node's inputs for one light (world axes; intensity in W/sr per channel): the
     light's position at the reception event's time and that event's position."""
-    cos_half = math.cos(min(light.spot_size, math.pi) * 0.5)
-    smooth = 1.0 / ((1.0 - cos_half) * light.spot_blend) if light.spot_blend > 0.0 and cos_half < 1.0 else 0.0
+    cos_half, smooth = spot_cone(light.spot_size, light.spot_blend)
     ct, camera_position = reception_event(snap)
     intensity = tuple(4.0 * v for v in light.intensity) if light.kind == "AREA" else light.intensity
     return {

@@ -16,7 +16,7 @@ import re
 import numpy as np
 
 from ..errors import RelativityError
-from . import compat, names
+from . import compat, modifier
 
 _VALUE_PATH = re.compile(r'^key_blocks\["(.+)"\]\.value$')
 FRAME_SAMPLES_PER_FRAME = 16  # the values' table between the frames asked for (linear in between)
@@ -48,9 +48,9 @@ def scene_time_reason(obj):
     if obj.relativity.tessellation > 0:
         return "Tessellation is above 0"
     modifiers = list(obj.modifiers)
-    relativity = next((index for index, m in enumerate(modifiers) if m.type == "NODES" and m.node_group is not None
-                       and m.node_group.name == names.GEOMETRY_GROUP), len(modifiers))
-    before = [m for m in modifiers[:relativity] if m.show_viewport or m.show_render]
+    own = modifier.find_modifier(obj)
+    before = [m for m in modifiers[:modifiers.index(own) if own is not None else len(modifiers)]
+              if m.show_viewport or m.show_render]
     if before:
         return f"modifier {before[0].name!r} comes before the relativity modifier"
     key = obj.data.shape_keys
