@@ -17,7 +17,7 @@ not followed), and the object's velocity for every part of it.
 
 import numpy as np
 
-from . import names
+from . import names, sources
 
 RAYS = ("diffuse", "glossy", "transmission", "volume_scatter")
 
@@ -45,16 +45,10 @@ def emission_radiance(obj):
 
 
 def _rest_colour(socket):
-    """The unlinked socket holding the colour, looking through the Doppler colour stage's group
-    (materials.py inserts it in front of emission colours), or None for a linked colour."""
-    if socket.is_linked:
-        node = socket.links[0].from_node
-        if node.bl_idname != "ShaderNodeGroup" or not node.name.startswith(names.MATERIAL_NODE_PREFIX):
-            return None
-        socket = node.inputs.get("Color")
-        if socket is None or socket.is_linked:
-            return None
-    return socket
+    """The unlinked socket holding the colour, looking through the Doppler colour stage's group,
+    or None for a linked colour."""
+    socket = sources.rest_colour_input(socket)
+    return None if socket is None or socket.is_linked else socket
 
 
 def surface_area(obj, matrix):

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import spectral_render
-from . import emitter_lights, materials, moving_lamps, names, osl
+from . import emitter_lights, materials, moving_lamps, names, osl, sources
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
@@ -246,14 +246,8 @@ def _albedo_socket(tree, surface):
 def _albedo_source(socket):
     """The socket feeding the albedo, looking through the Doppler colour stage's group (the
     rest-frame colour is what the light reflects from), or None for the socket's own value."""
-    if not socket.is_linked:
-        return None
-    source = socket.links[0].from_socket
-    node = source.node
-    if node.bl_idname == "ShaderNodeGroup" and node.name.startswith(names.MATERIAL_NODE_PREFIX):
-        colour = node.inputs.get("Color")
-        return colour.links[0].from_socket if colour is not None and colour.is_linked else None
-    return source
+    socket = sources.rest_colour_input(socket)
+    return socket.links[0].from_socket if socket is not None and socket.is_linked else None
 
 
 def attach(material, group):

@@ -34,7 +34,7 @@ Principled Volume's own blackbody emission (shifted for camera rays by ``volumes
 
 from typing import NamedTuple
 
-from . import compat
+from . import compat, names
 
 MIX_NODES = ("ShaderNodeMix", "ShaderNodeMixRGB")
 BLACKBODY_INTENSITY_CUTOFF = 1e-3  # below this Blender's Principled Volume emits no blackbody
@@ -365,3 +365,14 @@ def mark_blackbody(tree, node, blackbody):
         node.inputs["Temperature"].default_value = blackbody.temperature
     else:
         tree.links.new(blackbody.temperature, node.inputs["Temperature"])
+
+
+def rest_colour_input(socket):
+    """The input socket holding the user's rest-frame colour of a colour input: the socket itself,
+    or, where the Doppler colour stage's group (``materials.py``) feeds it, that group's Color
+    input; None for a group without one."""
+    if socket.is_linked:
+        node = socket.links[0].from_node
+        if node.bl_idname == "ShaderNodeGroup" and node.name.startswith(names.MATERIAL_NODE_PREFIX):
+            return node.inputs.get("Color")
+    return socket
