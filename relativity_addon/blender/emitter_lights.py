@@ -17,9 +17,9 @@ not followed), and the object's velocity for every part of it.
 
 import numpy as np
 
-from . import names, sources
+from . import names, sources, visibility
 
-RAYS = ("diffuse", "glossy", "transmission", "volume_scatter")
+RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 
 
 def emission_radiance(obj):
@@ -82,20 +82,8 @@ def is_emitter_light(obj):
 
 def hide_from_light_rays(obj):
     """Camera rays only: the stand-in light carries the emitter's light (the user's values saved)."""
-    if names.EMITTER_SAVED_KEY not in obj:
-        obj[names.EMITTER_SAVED_KEY] = {ray: bool(getattr(obj, f"visible_{ray}")) for ray in RAYS}
-    for ray in RAYS:
-        if getattr(obj, f"visible_{ray}"):
-            setattr(obj, f"visible_{ray}", False)
+    visibility.hide(obj, names.EMITTER_SAVED_KEY, RAYS)
 
 
 def restore(obj):
-    saved = obj.get(names.EMITTER_SAVED_KEY)
-    if saved is None:
-        return False
-    saved = saved.to_dict()
-    del obj[names.EMITTER_SAVED_KEY]
-    for ray in RAYS:
-        if getattr(obj, f"visible_{ray}") != saved[ray]:
-            setattr(obj, f"visible_{ray}", saved[ray])
-    return True
+    return visibility.restore(obj, names.EMITTER_SAVED_KEY)

@@ -28,7 +28,7 @@ import bmesh
 import bpy
 from mathutils import Matrix, Vector
 
-from . import compat, materials, moving_lights, names, snapshot, sources
+from . import compat, materials, moving_lights, names, snapshot, sources, visibility
 
 KINDS = ("POINT", "SPOT", "AREA")
 DISC_SEGMENTS = 64
@@ -102,8 +102,7 @@ def _candidates(scene, snap):
     for obj in scene.objects:
         if obj.type != "LIGHT" or obj.name in moving or snapshot.light_render_hidden(obj):
             continue
-        saved = obj.get(names.LAMP_FACE_SAVED_KEY)
-        if (obj.visible_camera if saved is None else bool(saved["visible_camera"])):
+        if visibility.saved(obj, names.LAMP_FACE_SAVED_KEY, "visible_camera"):
             yield obj
 
 
@@ -222,23 +221,6 @@ def _delete(face_name):
             bpy.data.materials.remove(material)
 
 
-def _hide_lamp(obj):
-    if names.LAMP_FACE_SAVED_KEY not in obj:
-        obj[names.LAMP_FACE_SAVED_KEY] = {"visible_camera": bool(obj.visible_camera)}
-    if obj.visible_camera:
-        obj.visible_camera = False
-
-
-def _restore_lamp(obj):
-    saved = obj.get(names.LAMP_FACE_SAVED_KEY)
-    if saved is None:
-        return
-    visible = bool(saved["visible_camera"])
-    del obj[names.LAMP_FACE_SAVED_KEY]
-    if obj.visible_camera != visible:
-        obj.visible_camera = visible
-
-
 def drawable(obj, snap):
     """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
     if obj.data.type not in KINDS or not _facing_camera(obj, snap):
@@ -268,10 +250,10 @@ def write(scene, snap):
         scene[names.LAMP_FACES_KEY] = record
         obj = bpy.data.objects.get(light_name)
         if obj is not None:
-            _restore_lamp(obj)
+            visibility.restore(obj, names.LAMP_FACE_SAVED_KEY)
     for light_name, (colour, temperature, strength) in wanted.items():
         obj = scene.objects[light_name]
-        _hide_lamp(obj)
+        visibility.hide(obj, names.LAMP_FACE_SAVED_KEY, ("visible_camera",))
         face = _face(scene, obj)
         if not face.material_slots or face.material_slots[0].material is None:
             face.data.materials.append(_material(face.name, colour, temperature, strength))
@@ -290,7 +272,7 @@ def remove(scene):
         del scene[names.LAMP_FACES_KEY]
     for obj in bpy.data.objects:
         if obj.type == "LIGHT":
-            _restore_lamp(obj)
+            visibility.restore(obj, names.LAMP_FACE_SAVED_KEY)
 
 
 def warnings(scene, snap):
