@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import camera_helpers as ch
+from relativity_addon.physics.shutter import fixed_point_plane
 
 ROTATION = (math.radians(90.0), 0.0, 0.0)  # looks down world +Y: local (x, y, -z) = world (x, z, y)
 GRAY_BETA = np.array([0.1, 0.99, 0.0])  # Gray's (0.1, 0, 0.99) in their axes, world axes here
@@ -119,6 +120,17 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
         pairs.append([_read_png(bpy, tmp_path / f"{name}_{eye}.png") for eye in "LR"])
         ch.run_render_script(blend, tmp_path / f"{name}-anaglyph.png", *common, *options, "--stereo=anaglyph")
         anaglyphs.append(_read_png(bpy, tmp_path / f"{name}-anaglyph.png"))
+    # The window with a shutter model (Fig. 10's set-up): both eyes' arbitrary-plane shutter in the
+    # window plane (eq. 6 for t_W = t_S, camera-local axes), opening at t_W; every ray of either eye
+    # then crosses the window at a spatial fixed point of the shared frame, so the pair is the rest
+    # pair too. An eye with its own plane (through its own pinhole) would not be.
+    rotation = np.array(camera_object.matrix_world.to_3x3())
+    point, normal = fixed_point_plane(-1.0, rotation.T @ GRAY_BETA, 1.0)
+    plane = (f"--shutter-plane-point={','.join(repr(float(v)) for v in point)}",
+             f"--shutter-plane-normal={','.join(repr(float(v)) for v in normal)}")
+    ch.run_render_script(blend, tmp_path / "shutter.png", *common, f"--beta={beta}", "--window-time=-1",
+                         "--shutter=arbitrary_plane", *plane, "--stereo=views")
+    shutter_pair = [_read_png(bpy, tmp_path / f"shutter_{eye}.png") for eye in "LR"]
     (rest_l, rest_r), (window_l, window_r) = pairs
     # Side by side (not squeezed): the left view, then the right one, in one image twice as wide.
     ch.run_render_script(blend, tmp_path / "window-sbs.png", *common, *cases[1][1:], "--stereo=side-by-side")
@@ -129,7 +141,10 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
     differences = [np.abs(window_l - rest_l).mean(), np.abs(window_r - rest_r).mean()]
     anaglyph_difference = np.abs(anaglyphs[1] - anaglyphs[0]).mean()
     parallax = np.abs(rest_l - rest_r).mean()
-    print(f"|window - rest| per eye {differences}, anaglyph {anaglyph_difference:.2g}; |L - R| at rest {parallax:.3f}")
+    shutter_differences = [np.abs(shutter_pair[0] - rest_l).mean(), np.abs(shutter_pair[1] - rest_r).mean()]
+    print(f"|window - rest| per eye {differences}, anaglyph {anaglyph_difference:.2g}; |L - R| at rest {parallax:.3f}; "
+          f"window with the plane shutter: |pair - rest| per eye {shutter_differences}")
+    assert max(shutter_differences) < 1e-3
     assert rest_l.mean() > 0.005 and rest_r.mean() > 0.005
     assert parallax > 0.01, "the eyes must see different images"
     assert max(differences) < 1e-3
