@@ -15,9 +15,12 @@ an area light of power ``P`` and area ``A`` (Normalize on) shows ``P / (pi A)`` 
 a point light of radius ``r`` a disc of ``P / (4 pi^2 r^2)``; ``2^exposure`` multiplies both.
 
 A spot light is drawn as its point light's sphere times Cycles' cone mask toward the camera, taken
-at the lamp's centre for the whole face. Not covered (the lamp keeps Cycles' own drawing, warned):
-sun lights, area lights with a spread below 180 degrees or Normalize off, portals, lamps whose
-node tree's emission is textured, moving lights (their stand-ins draw nothing for the camera).
+at the lamp's centre for the whole face. A sun with an angle ``theta`` is a disc of radiance
+``E / (pi sin^2(theta / 2))`` in Cycles (measured); its face is a disc of that angular radius at
+``SUN_DISTANCE`` of the camera's clip end, centred on the camera's rays' origin (the aperture centre
+at the shutter time, where the exact camera's rays start). Not covered (the lamp keeps Cycles' own
+drawing, warned): area lights with a spread below 180 degrees or Normalize off, portals, lamps
+whose node tree's emission is textured, moving lights (their stand-ins draw nothing for the camera).
 The face is opaque where Cycles' lamps are see-through, and an area light seen from behind gets no
 face (it shows nothing there).
 """
@@ -30,7 +33,10 @@ from mathutils import Matrix, Vector
 
 from . import compat, materials, moving_lights, names, snapshot, sources, visibility
 
-KINDS = ("POINT", "SPOT", "AREA")
+KINDS = ("POINT", "SPOT", "AREA", "SUN")
+# A sun's face sits this far out, as a fraction of the camera's clip end: behind everything but
+# what lies in the last 2 % before the clip end (the sun itself is behind everything).
+SUN_DISTANCE = 0.98
 DISC_SEGMENTS = 64
 
 
@@ -81,6 +87,8 @@ def _radiance_scale(obj, camera):
     without a face."""
     light = obj.data
     power = light.energy * 2.0 ** getattr(light, "exposure", 0.0)
+    if light.type == "SUN":  # a disc of half-angle theta / 2 (none for a sun without an angle)
+        return power / (math.pi * math.sin(0.5 * light.angle) ** 2) if light.angle > 1e-6 else None
     if light.type in ("POINT", "SPOT"):  # a spot is a point light masked by its cone
         radius = light.shadow_soft_size
         if radius <= 0.0:
@@ -114,15 +122,25 @@ def _facing_camera(obj, snap):
     return (obj.matrix_world.inverted_safe() @ camera).z < 0.0
 
 
-def _mesh(name, light):
+def _sun_distance(scene, snap):
+    return SUN_DISTANCE * scene.objects[snap.camera].data.clip_end
+
+
+def _mesh(name, light, sun_distance):
     mesh = bpy.data.meshes.new(name)
-    mesh[names.LAMP_FACES_KEY] = _shape_key(light)
+    mesh[names.LAMP_FACES_KEY] = _shape_key(light, sun_distance)
     if light.type in ("POINT", "SPOT"):
         builder = bmesh.new()
         bmesh.ops.create_uvsphere(builder, u_segments=DISC_SEGMENTS, v_segments=DISC_SEGMENTS // 2,
                                   radius=light.shadow_soft_size)
         builder.to_mesh(mesh)
         builder.free()
+        return mesh
+    if light.type == "SUN":  # toward the sun (local +Z), facing back along its light
+        radius = sun_distance * math.tan(0.5 * light.angle)
+        angles = [-2.0 * math.pi * i / DISC_SEGMENTS for i in range(DISC_SEGMENTS)]
+        mesh.from_pydata([(radius * math.cos(a), radius * math.sin(a), sun_distance) for a in angles], [],
+                         [tuple(range(DISC_SEGMENTS))])
         return mesh
     width = light.size
     height = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size
@@ -136,7 +154,9 @@ def _mesh(name, light):
     return mesh
 
 
-def _shape_key(light):
+def _shape_key(light, sun_distance):
+    if light.type == "SUN":
+        return f"SUN {light.angle:.9g} {sun_distance:.9g}"
     if light.type == "AREA":
         return f"AREA {light.shape} {light.size:.9g} {light.size_y:.9g}"
     return f"{light.type} {light.shadow_soft_size:.9g}"
@@ -179,22 +199,29 @@ def _set(socket, value):
     socket.default_value = value
 
 
-def _face(scene, obj):
+def _face(scene, obj, snap):
     """The face object of light object ``obj``, made (or remade for a new shape) as needed."""
     record = dict(scene.get(names.LAMP_FACES_KEY, {}))
     face = bpy.data.objects.get(record.get(obj.name, ""))
-    if face is not None and face.data.get(names.LAMP_FACES_KEY) != _shape_key(obj.data):
+    sun_distance = _sun_distance(scene, snap)
+    if face is not None and face.data.get(names.LAMP_FACES_KEY) != _shape_key(obj.data, sun_distance):
         _delete(face.name)
         face = None
     if face is None:
         name = f"{names.LAMP_FACE_PREFIX} {obj.name}"
-        face = bpy.data.objects.new(name, _mesh(name, obj.data))
+        face = bpy.data.objects.new(name, _mesh(name, obj.data, sun_distance))
         scene.collection.objects.link(face)
         for ray in ("diffuse", "glossy", "transmission", "volume_scatter", "shadow"):
             setattr(face, f"visible_{ray}", False)
         face.hide_select = True
         record[obj.name] = face.name
         scene[names.LAMP_FACES_KEY] = record
+    if obj.data.type == "SUN":  # at infinity: turned with the sun, centred where the rays start
+        turn = obj.matrix_world.to_quaternion().to_matrix().to_4x4()
+        matrix = Matrix.Translation(Vector(snap.mesh_observer[1])) @ turn
+        if face.matrix_world != matrix:
+            face.matrix_world = matrix
+        return face
     if face.parent != obj:
         face.parent = obj
     # A point light's radius ignores the object's scale; an area light's size follows it.
@@ -254,7 +281,7 @@ def write(scene, snap):
     for light_name, (colour, temperature, strength) in wanted.items():
         obj = scene.objects[light_name]
         visibility.hide(obj, names.LAMP_FACE_SAVED_KEY, ("visible_camera",))
-        face = _face(scene, obj)
+        face = _face(scene, obj, snap)
         if not face.material_slots or face.material_slots[0].material is None:
             face.data.materials.append(_material(face.name, colour, temperature, strength))
             materials.attach(face.material_slots[0].material)
@@ -275,6 +302,14 @@ def remove(scene):
             visibility.restore(obj, names.LAMP_FACE_SAVED_KEY)
 
 
+def _has_extent(light):
+    """Whether Cycles draws the lamp for camera rays at all (a point, spot or sun without a size
+    is a delta light, invisible)."""
+    if light.type == "SUN":
+        return light.angle > 1e-6
+    return light.type == "AREA" or light.shadow_soft_size > 0.0
+
+
 def warnings(scene, snap):
     """Lamps seen directly whose colour the exact camera shifts as the pixel behind them."""
     if not snap.exact_camera:
@@ -282,6 +317,6 @@ def warnings(scene, snap):
     record = scene.get(names.LAMP_FACES_KEY, {})
     return [f"Light {obj.name!r} is seen directly but not drawn as an emitter: its colour is shifted "
             "with what lies behind it (docs/moving-lights.md)"
-            for obj in _candidates(scene, snap) if obj.name not in record and obj.data.type != "SUN"
-            and (obj.data.type == "AREA" or obj.data.shadow_soft_size > 0.0) and _facing_camera(obj, snap)
+            for obj in _candidates(scene, snap) if obj.name not in record and _has_extent(obj.data)
+            and _facing_camera(obj, snap)
             and (obj.data.type != "SPOT" or _spot_mask(obj, Matrix(snap.camera_matrix).translation) > 0.0)]

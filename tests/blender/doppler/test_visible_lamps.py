@@ -90,3 +90,56 @@ def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon,
     assert lamp.visible_camera
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp Face")]
     assert not [material for material in bpy.data.materials if material.name.startswith("Relativity Lamp Face")]
+
+
+
+def test_visible_sun_disc_is_seen_at_d_t(relativity_addon, tmp_path):
+    """A 5762 K sun with a 20 degree disc straight ahead (Cycles draws it for camera rays, with
+    radiance ``E / (pi sin^2(theta/2))``), observer at 0.5c toward it: the disc's centre is the
+    blackbody at ``D T`` with ``Y(D T) / Y(T)`` times its luminance at rest in Cycles' own drawing."""
+    bpy = __import__("bpy")
+    scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
+    scene.world = None
+    light = bpy.data.lights.new("Sun", "SUN")
+    light.energy = 5.0
+    light.angle = math.radians(20.0)
+    light.use_temperature = True
+    light.temperature = 5762.0
+    sun = bpy.data.objects.new("Sun", light)
+    sun.rotation_euler = (math.pi, 0.0, 0.0)  # shining along +Z, into the camera looking down -Z
+    sun.visible_camera = True
+    scene.collection.objects.link(sun)
+    centre = (slice(20, 28), slice(28, 36))
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = _xyz(rest, centre)[1]
+    disc = 5.0 / (math.pi * math.sin(math.radians(10.0)) ** 2)
+    print(f"sun at rest: Y {y_rest:.2f}, E / (pi sin^2) {disc:.2f}")
+    assert y_rest == pytest.approx(disc, rel=0.01)
+
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert not sun.visible_camera, "the sun is drawn by its face while applied"
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    doppler = (1.0 / (gamma * (1.0 - view @ np.asarray(BETA))))[centre].ravel()
+    y_t = dh.blackbody_xyz_colour_science(5762.0)[1]
+    expected = np.mean([dh.blackbody_xyz_colour_science(d * 5762.0) / y_t * y_rest for d in doppler], axis=0)
+    xyz = _xyz(moving, centre)
+    delta_e = dh.delta_e_2000_normalised(xyz, expected)
+    print(f"sun at 0.5c: D {doppler.mean():.3f}, Delta E {delta_e:.3f}, Y / expected {xyz[1] / expected[1]:.4f}")
+    assert delta_e < 1.0
+    assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.02)
+    # The aberrated disc: half-angle 10 degrees seen at 0.5c head-on shrinks to
+    # atan(sin / (gamma (cos + beta))), so its width in pixels shrinks by about that ratio.
+    lit = [int((image[24, :, :3].sum(axis=1) > 0.5 * image[24, 32, :3].sum()).sum()) for image in (rest, moving)]
+    half = math.radians(10.0)
+    shrink = math.atan(math.sin(half) / (gamma * (math.cos(half) + 0.5))) / half
+    print(f"disc width {lit[0]} px at rest, {lit[1]} px moving (expected about {lit[0] * shrink:.1f})")
+    assert abs(lit[1] - lit[0] * shrink) <= 2.0
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sun.visible_camera
+    assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp Face")]
