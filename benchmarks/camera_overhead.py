@@ -54,19 +54,25 @@ def timed_render(bpy, scene, path):
 
 
 def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
-    """Renders ``cases`` (label and beta, None for Blender's own camera; the first case is the
+    """Renders ``cases`` (label and beta: None for Blender's own camera, or a function of the scene
+    that sets up another camera and returns the function undoing it; the first case is the
     reference) alternately ``repeats`` times after one warm-up round (shader compilation, kernel
     loading, caches) and prints each case's median time and its median ratio to the reference's
     time of that round."""
     from relativity_addon.blender import effect
 
     def render(beta, name):
-        if beta is None:
+        undo = None
+        if beta is None or callable(beta):
             effect.remove(scene)
+            undo = beta(scene) if beta is not None else None
         else:
             scene.relativity.beta = beta
             effect.apply(scene)
-        return timed_render(bpy, scene, os.path.join(out, prefix + name))
+        seconds = timed_render(bpy, scene, os.path.join(out, prefix + name))
+        if undo is not None:
+            undo()
+        return seconds
 
     for _, beta in cases:
         render(beta, "warmup.png")
