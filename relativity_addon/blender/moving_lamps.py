@@ -274,7 +274,7 @@ def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
         last = len(times) - 1
         for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
             before, after = max(index - 1, 0), min(index + 1, last)
-            inputs = {key: values[key] for key in ("camera_position", "intensity", "light_beta", "spot_axis",
+            inputs = {key: values[key] for key in ("camera_position", "light_beta", "spot_axis",
                                                     "spot_cos_half_angle", "spot_smooth", "temperature",
                                                     "luminance", "wavelength_0", "wavelength_1", "wavelength_2",
                                                     "spectral_scale", "basis_weights")}

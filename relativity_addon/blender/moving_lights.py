@@ -168,13 +168,17 @@ def blackbody_parameters(temperature, luminance):
 
 
 def rgb_spectral_parameters(temperature, intensity):
-    """An RGB light's inputs in a spectral pass (eq. 18, docs/moving-lights.md): ``spectral`` and
-    the basis weights of its intensity, ``A(1)^-1 I``, whose up-sampled spectrum the shader shifts
-    by each receiving point's ``D`` (the passes give lamps at rest ``emission_matrix(mu) @ I``)."""
-    if temperature > 0.0 or materials.spectral_pass_wavelengths() is None:
+    """An RGB light's stand-in lamp inputs (eq. 18, docs/moving-lights.md): the basis weights of
+    its intensity, ``A(1)^-1 I``, whose up-sampled spectrum the shader shifts by each receiving
+    point's ``D`` (the passes give lamps at rest ``emission_matrix(mu) @ I``), and ``spectral`` in
+    a spectral pass; in the fast mode the shader takes the shifted spectrum's CIE integral."""
+    if temperature > 0.0:
         return {"basis_weights": (0.0, 0.0, 0.0)}
     weights = spectral_render.tables()["inverse_rest_matrix"] @ np.asarray(intensity, dtype=np.float64)
-    return {"spectral": True, "basis_weights": tuple(float(v) for v in weights)}
+    parameters = {"basis_weights": tuple(float(v) for v in weights)}
+    if materials.spectral_pass_wavelengths() is not None:
+        parameters["spectral"] = True
+    return parameters
 
 
 def _same(a, b):
