@@ -28,7 +28,7 @@ from ..errors import RelativityError
 from ..physics import spectral_render
 from ..physics.lorentz import aberrate, camera_to_scene_direction
 from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
-from . import animation, materials, names, snapshot
+from . import animation, materials, names, snapshot, sources
 
 SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
@@ -300,23 +300,54 @@ def sun_in_scene_frame(axis, beta):
     return k, 1.0 / (gamma * (1.0 - float(beta @ k)))
 
 
+def fast_sun(user, doppler):
+    """``(colour, temperature or None, strength factor)`` of the stand-in for sun ``user`` seen at
+    ``D`` in the fast mode (eq. 18 for a plane wave: irradiance ``D^3 S(lambda D)``): a blackbody
+    sun is the blackbody at ``D T`` with ``D^-2 Y(D T)/Y(T)`` its strength (the spectral passes'
+    brightness); an RGB sun keeps the ``D^2`` of its total with the colour of its shifted spectrum
+    (``M(D) c`` at ``c``'s luminance), as moving RGB lamps keep eq. 19's ``D^4``."""
+    colour = np.array(user.color[:3], dtype=np.float64)
+    temperature = sources.light_blackbody(user) if user.use_temperature else None
+    if temperature is not None:
+        log_ratio = spectral_render.log_blackbody_luminance(doppler * temperature) \
+            - spectral_render.log_blackbody_luminance(temperature)
+        return tuple(colour), doppler * temperature, float(np.exp(log_ratio)) / doppler**2
+    if user.use_temperature:  # a tinted blackbody: an RGB colour
+        colour = colour * np.array(user.temperature_color[:3])
+    shifted = spectral_render.gamut_map(spectral_render.doppler_rgb_matrix(doppler) @ colour)
+    y, y_shifted = float(spectral_render.luminance(colour)), float(spectral_render.luminance(shifted))
+    if y_shifted > 0.0:
+        colour = shifted * (y / y_shifted)
+    return tuple(float(v) for v in colour), None, doppler**2
+
+
 def _write_sun(scene, light, obj):
-    """The stand-in sun: the user's sun aberrated, ``D^2`` its strength, ``1 / D`` its angle, its
-    ``D`` stored for the spectral passes (which set its colour to ``D S(mu D)``)."""
+    """The stand-in sun: the user's sun aberrated, ``1 / D`` its angle, its ``D`` stored for the
+    spectral passes (which set its colour to ``D S(mu D)`` at strength ``D^2``); outside them the
+    colour and strength of :func:`fast_sun`."""
     user = scene.objects[light.name].data
     direction, doppler = sun_in_scene_frame(light.axis, light.beta)
     stand_in = obj.data
-    _set(stand_in, "energy", float(user.energy) * doppler * doppler)
     if stand_in.get(names.SUN_DOPPLER_KEY) != float(doppler):  # for the spectral passes' shift
         stand_in[names.SUN_DOPPLER_KEY] = float(doppler)
     _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
-    keys = ("use_shadow",)
-    if materials.spectral_pass_wavelengths() is None:  # in a pass: the shifted spectral values stay
-        _set(stand_in, "color", tuple(user.color))
-        keys += ("use_temperature", "temperature")
-    for key in keys:
-        if hasattr(user, key) and getattr(stand_in, key) != getattr(user, key):
-            setattr(stand_in, key, getattr(user, key))
+    if materials.spectral_pass_wavelengths() is None:  # in a pass (the user's sun spectral too): they stay
+        rest = {"color": [float(v) for v in user.color[:3]], "use_temperature": bool(user.use_temperature),
+                "temperature": float(user.temperature)}
+        saved = stand_in.get(names.SUN_REST_KEY)
+        if saved is None or saved.to_dict() != rest:  # the spectrum the passes shift
+            stand_in[names.SUN_REST_KEY] = rest
+        colour, temperature, strength = fast_sun(user, doppler)
+        _set(stand_in, "energy", float(user.energy) * strength)
+        _set(stand_in, "color", colour)
+        if stand_in.use_temperature != (temperature is not None):
+            stand_in.use_temperature = temperature is not None
+        if temperature is not None:
+            _set(stand_in, "temperature", float(temperature))
+    else:
+        _set(stand_in, "energy", float(user.energy) * doppler * doppler)
+    if stand_in.use_shadow != user.use_shadow:
+        stand_in.use_shadow = user.use_shadow
     rotation = Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y")
     _set(obj, "rotation_quaternion", tuple(rotation))
 

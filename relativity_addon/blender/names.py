@@ -81,6 +81,7 @@ REST_NORMAL_GROUP_VERSION = 1
 MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader
 MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and lights): "<prefix> <light> <index>"
 SUN_DOPPLER_KEY = "relativity_sun_doppler"  # on a stand-in sun's light: D of the moving sun's light
+SUN_REST_KEY = "relativity_sun_rest"  # on it too: the user's sun's colour, use_temperature, temperature
 MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}
 
 # --- directly visible lamps (exact camera) ----------------------------------------------------

@@ -159,8 +159,11 @@ def render(scene, passes, progress=None):
                     light = bpy.data.lights[name]
                     light.color, light.use_temperature = colour, use_temperature
                     spectrum = _light_spectrum(light, trio)
-                    doppler = float(light.get(names.SUN_DOPPLER_KEY, 1.0))
-                    if doppler != 1.0:  # a moving sun's stand-in (energy D^2): D S(mu D), eq. 18
+                    if names.SUN_DOPPLER_KEY in light:  # a moving sun's stand-in (energy D^2): D S(mu D), eq. 18
+                        doppler = float(light[names.SUN_DOPPLER_KEY])
+                        rest = light[names.SUN_REST_KEY]  # of the user's sun (the stand-in has the fast mode's)
+                        light.color, light.use_temperature = tuple(rest["color"]), bool(rest["use_temperature"])
+                        light.temperature = float(rest["temperature"])
                         spectrum = doppler * _light_spectrum(light, tuple(doppler * w for w in trio))
                     light.use_temperature, light.color = False, tuple(spectrum)
                 rendered = _render_exr(scene, os.path.join(folder, f"pass{index}.exr"))

@@ -53,6 +53,20 @@ def _expected(doppler, y_rest):
     return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y_rest for d in doppler], axis=0)
 
 
+def _render_moving(bpy, scene, camera, lamp, tmp_path):
+    """The exact camera at ``BETA`` (c = 1): its render and each pixel's ``D``."""
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert not lamp.visible_camera, "the lamp is drawn by its face while applied"
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    return moving, 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+
+
 @pytest.mark.parametrize("kind", ["AREA", "POINT", "SPOT"])
 def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon, tmp_path, kind):
     bpy = __import__("bpy")
@@ -61,17 +75,7 @@ def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon,
     y_rest = {name: _xyz(rest, window)[1] for name, window in (("lamp", LAMP), ("mesh", MESH))}
     assert y_rest["lamp"] > 1.0 and y_rest["mesh"] > 0.5
 
-    scene.relativity.method = "CAMERA"
-    scene.relativity.beta = BETA
-    scene.relativity.speed_of_light = 1.0
-    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
-    assert not lamp.visible_camera, "the lamp is drawn by its face while applied"
-    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
-    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
-
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
-    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
-    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+    moving, doppler = _render_moving(bpy, scene, camera, lamp, tmp_path)
     measured = {}
     for name, window in (("lamp", LAMP), ("mesh", MESH)):
         xyz = _xyz(moving, window)
@@ -116,15 +120,9 @@ def test_visible_sun_disc_is_seen_at_d_t(relativity_addon, tmp_path):
     print(f"sun at rest: Y {y_rest:.2f}, E / (pi sin^2) {disc:.2f}")
     assert y_rest == pytest.approx(disc, rel=0.01)
 
-    scene.relativity.method = "CAMERA"
-    scene.relativity.beta = BETA
-    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
-    assert not sun.visible_camera, "the sun is drawn by its face while applied"
-    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
-    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    moving, doppler = _render_moving(bpy, scene, camera, sun, tmp_path)
+    doppler = doppler[centre].ravel()
     gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
-    doppler = (1.0 / (gamma * (1.0 - view @ np.asarray(BETA))))[centre].ravel()
     y_t = dh.blackbody_xyz_colour_science(5762.0)[1]
     expected = np.mean([dh.blackbody_xyz_colour_science(d * 5762.0) / y_t * y_rest for d in doppler], axis=0)
     xyz = _xyz(moving, centre)

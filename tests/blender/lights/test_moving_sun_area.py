@@ -33,7 +33,8 @@ def test_moving_sun_is_aberrated_and_d_squared_brighter(relativity_addon, factor
     sun.data.angle = 0.0  # hard shadows
     floor._effect().apply(scene)  # the sun points down its local -Z: straight down
     assert sun.hide_render
-    image = floor._render(bpy, scene, tmp_path / "sun.exr")[..., 1]
+    rendered = floor._render(bpy, scene, tmp_path / "sun.exr")
+    image = ch.luminance(rendered)  # the colour shifts (eq. 18), the brightness follows D^2
     points = floor._floor_points(bpy, scene, camera)
     k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)  # photon direction, scene frame
     d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
@@ -53,6 +54,14 @@ def test_moving_sun_is_aberrated_and_d_squared_brighter(relativity_addon, factor
           f"an unaberrated shadow shares {(shadow & at_rest_shadow).sum()} px")
     assert brightness == pytest.approx(1.0, abs=0.01)
     assert wrong.sum() <= 0.02 * shadow.sum()
+    # Its colour: the white's spectrum shifted by D (the physics core's colour-science model).
+    from relativity_addon.physics.spectral import doppler_shift_rgb, linear_rec709_to_XYZ
+
+    lit_rgb = rendered[..., :3][judged & ~shadow].mean(axis=0)
+    colour_error = np.abs(lit_rgb / lit_rgb.sum() - (shifted := doppler_shift_rgb((1.0, 1.0, 1.0), d)) / shifted.sum())
+    print(f"floor colour {np.round(lit_rgb / lit_rgb.sum(), 4)}, white shifted {np.round(shifted / shifted.sum(), 4)}"
+          f" (XYZ {np.round(linear_rec709_to_XYZ(shifted), 3)})")
+    assert colour_error.max() < 0.01
     assert (shadow & at_rest_shadow).sum() < 0.7 * shadow.sum()
 
 
@@ -101,11 +110,12 @@ def test_moving_area_light_follows_eq_19_with_its_cosine(relativity_addon, facto
     assert unaberrated > 3.0 * error
 
 
-def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativity_addon, factory_blender):
+def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativity_addon, factory_blender, tmp_path):
     """Spectral mode: a 5000 K sun moving at 0.5c lights the floor with its spectrum shifted by its
     one D (eq. 18: irradiance ``D^3 S(lambda D) = D^-2 B(lambda, D T)`` per unit of ``B / Y(T)``),
     so the floor is the blackbody at ``D T`` (colour-science) with luminance
-    ``a / pi E cos D^-2 Y(D T) / Y(T)``. Without the shift it kept its 5000 K colour at ``D^2``."""
+    ``a / pi E cos D^-2 Y(D T) / Y(T)``, in the fast mode too. Without the shift it kept its
+    5000 K colour at ``D^2``."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
     import doppler_helpers as dh
 
@@ -132,3 +142,10 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     assert delta_e < 1.0
     assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
     assert tuple(sun.data.color) == (1.0, 1.0, 1.0) and sun.data.use_temperature, "the user's sun is restored"
+    # The fast mode: the same blackbody at D T and brightness (the stand-in at D T, D^-2 Y(D T)/Y(T)).
+    fast = floor._render(bpy, scene, tmp_path / "fast.exr")[..., :3]
+    fast_xyz = dh.linear_rec709_to_xyz(fast.reshape(-1, 3).astype(float)).mean(axis=0)
+    fast_delta_e = dh.delta_e_2000_normalised(fast_xyz, blackbody)
+    print(f"fast mode: Delta E {fast_delta_e:.3f}, Y / expected {fast_xyz[1] / expected_y:.4f}")
+    assert fast_delta_e < 1.0
+    assert fast_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
