@@ -90,7 +90,9 @@ def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     world = local @ np.array(snap.camera_matrix)[:3, :3].T
     world /= np.linalg.norm(world, axis=-1, keepdims=True)
     if snap.exact_camera and snap.use_geometry and any(snap.beta):
-        world = camera_to_scene_direction(world, snap.beta)
+        # Gray eq. (2) carries photon directions: the photon arriving along a view direction
+        # travels the other way (as the camera shader's scene_ray_direction does)
+        world = -camera_to_scene_direction(-world, snap.beta)
     return world
 
 

@@ -1,0 +1,98 @@
+"""Moving lights seen by a MOVING observer on the exact camera path (stand-in lamps): a point lamp
+and a glowing sphere that Lights the Scene, both at 0.5c along +X above a white floor, the camera
+moving at 0.5c against the light and toward the floor.
+
+The floor is at rest in the scene frame and its light reaches the camera at the reception event
+``(t_o, x_cam)`` whatever the observer's velocity, so its scene-frame radiance is eq. 19 from the
+light's retarded positions exactly as for an observer at rest (``test_moving_point_light``'s numpy
+fixed-point solution, not the add-on's). The moving observer sees it through aberration (each
+pixel's direction in its frame aberrated into the scene frame finds the floor point:
+``test_moving_blackbody_light._observed_floor_points``) and the searchlight ``D_o^4`` (Weiskopf et
+al. eq. 14). Doppler colour is off here (white light, white floor): each pixel is ``D_o^4`` times
+the floor's scene-frame radiance, averaged over the pixel (a 3 x 3 grid in it: the box filter; the
+pool is a few pixels wide).
+"""
+
+import numpy as np
+import test_moving_blackbody_light as bb
+import test_moving_emitter_lights as em
+import test_moving_point_light as mp
+
+OBSERVER = np.array([-0.26, 0.21, -0.37])  # 0.5c: against the light, sideways and toward the floor
+RESOLUTION = (80, 60)
+SAMPLES = 64  # 32: up to 3.8 % of the peak (noise)
+SUBPIXELS = (1.0 / 6.0, 0.5, 5.0 / 6.0)
+BAND = 4  # pixels
+
+
+def _observe(bpy, scene, camera, tmp_path, name):
+    """Render the scene seen by the moving observer (searchlight on, Doppler colour off); the
+    reference (``D_o^4`` times the floor's scene-frame radiance for a point lamp of power
+    ``mp.POWER``) and ``D_o``, both averaged over each pixel."""
+    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
+    scene.cycles.samples = SAMPLES
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = tuple(OBSERVER)
+    scene.relativity.use_doppler = False
+    mp._effect().apply(scene)
+    image = mp._render(bpy, scene, tmp_path / f"{name}.exr")[..., 1]
+    assert np.all(np.isfinite(image)) and image.min() >= 0.0
+    seen, doppler = [], []
+    for offset in ((x, y) for y in SUBPIXELS for x in SUBPIXELS):
+        points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER, offset)
+        seen.append(observer_doppler**4 * mp._expected_radiance(points, mp.BETA)[0])
+        doppler.append(observer_doppler)
+    return image, np.mean(seen, axis=0), np.mean(doppler, axis=0)
+
+
+def _compare(image, expected, label):
+    """The largest error of the profiles along and across the light's motion (``BAND``-pixel bands
+    through the expected peak) as a fraction of the peak, and the pool's peak (column, row) in them."""
+    row, column = np.unravel_index(np.argmax(expected), expected.shape)
+    rows, columns = (slice(centre - BAND // 2, centre + BAND - BAND // 2) for centre in (row, column))
+    profile, wanted = image[rows].mean(0), expected[rows].mean(0)
+    across, across_wanted = image[:, columns].mean(1), expected[:, columns].mean(1)
+    error = max(np.abs(profile - wanted).max(), np.abs(across - across_wanted).max()) / wanted.max()
+    peak = np.array([int(np.argmax(profile)), int(np.argmax(across))])
+    expected_peak = np.array([int(np.argmax(wanted)), int(np.argmax(across_wanted))])
+    print(f"{label}: peak {wanted.max():.3f} (rendered {profile.max():.3f}); profile error {error:.4f} of the "
+          f"peak; pool at {peak} (expected {expected_peak})")
+    return error, np.abs(peak - expected_peak).max()
+
+
+def _check(image, expected, observer_doppler, label):
+    error, offset = _compare(image, expected, label)
+    assert error < 0.05
+    assert offset <= 2
+    # the test tells the searchlight applied once from none or twice
+    for power, wrong in ((0, "no searchlight"), (8, "D_o^8")):
+        assert _compare(image, expected * observer_doppler**(power - 4), f"{label}, {wrong}")[0] > 0.5
+
+
+def test_moving_lamp_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene, camera, _lamp = mp._floor_scene(bpy)
+    image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "lamp")
+    # The stand-ins span the retarded positions of what the camera sees: the floor points (pixel
+    # centres, aberrated) that get at least 1 % of the brightest one's D^4 / r^2 (moving_lamps.py).
+    points, _ = bb._observed_floor_points(bpy, scene, camera, OBSERVER)
+    _radiance, source, lamp_doppler = mp._expected_radiance(points, mp.BETA)
+    irradiance = lamp_doppler**4 / np.sum((points - source) ** 2, axis=-1)
+    wanted = source[irradiance >= 0.01 * irradiance.max()][:, 0]
+    placed = [obj.location.x for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")]
+    print(f"stand-ins from x = {min(placed):.2f} to {max(placed):.2f}; the seen floor's retarded positions "
+          f"{wanted.min():.2f} .. {wanted.max():.2f}")
+    assert min(placed) < wanted.min() + 0.1 and max(placed) > wanted.max() - 0.1
+
+    print(f"D_o over the view {observer_doppler.min():.3f} .. {observer_doppler.max():.3f}")
+    _check(image, expected, observer_doppler, "lamp")
+
+
+def test_moving_emitter_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
+    """A sphere of radius R and radiance L that Lights the Scene: a point light of intensity
+    ``L pi R^2`` (test_moving_emitter_lights), here seen by the moving observer."""
+    bpy = factory_blender
+    scene, camera, _sphere = em._scene(bpy, lights_scene=True)
+    image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "emitter")
+    _check(image, expected * em.RADIANCE * np.pi * em.RADIUS**2 / (mp.POWER / (4.0 * np.pi)), observer_doppler,
+           "emitter")
