@@ -23,26 +23,43 @@ RESOLUTION = (80, 60)
 SAMPLES = 64  # 32: up to 3.8 % of the peak (noise)
 SUBPIXELS = (1.0 / 6.0, 0.5, 5.0 / 6.0)
 BAND = 4  # pixels
+SHUTTER_TIME = 0.2  # s: c t_S = 2
 
 
-def _observe(bpy, scene, camera, tmp_path, name):
+def _reception_event(shutter_time):
+    """Gray eq. (1): the pinhole's event (t_S, 0) in the camera frame is (gamma t_S,
+    x_cam + gamma beta c t_S) in the scene frame (scene seconds after t_o, position)."""
+    gamma = 1.0 / np.sqrt(1.0 - OBSERVER @ OBSERVER)
+    return gamma * shutter_time, mp.CAMERA + gamma * OBSERVER * mp.C * shutter_time
+
+
+def _observe(bpy, scene, camera, tmp_path, name, shutter_time=0.0):
     """Render the scene seen by the moving observer (searchlight on, Doppler colour off); the
     reference (``D_o^4`` times the floor's scene-frame radiance for a point lamp of power
-    ``mp.POWER``) and ``D_o``, both averaged over each pixel."""
+    ``mp.POWER``, the light received at :func:`_reception_event`) and ``D_o``, both averaged over
+    each pixel."""
     scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
     scene.cycles.samples = SAMPLES
     scene.relativity.method = "CAMERA"
     scene.relativity.beta = tuple(OBSERVER)
     scene.relativity.use_doppler = False
+    scene.relativity.shutter_time = shutter_time
     mp._effect().apply(scene)
     image = mp._render(bpy, scene, tmp_path / f"{name}.exr")[..., 1]
     assert np.all(np.isfinite(image)) and image.min() >= 0.0
+    return (image, *_reference(bpy, scene, camera, *_reception_event(shutter_time)))
+
+
+def _reference(bpy, scene, camera, time, position):
+    """``D_o^4`` times the floor's radiance (the light received at ``(time, position)``) and
+    ``D_o``, averaged over each pixel."""
     seen, doppler = [], []
     for offset in ((x, y) for y in SUBPIXELS for x in SUBPIXELS):
-        points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER, offset)
-        seen.append(observer_doppler**4 * mp._expected_radiance(points, mp.BETA)[0])
+        points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER, offset, position)
+        seen.append(observer_doppler**4 * mp._expected_radiance(points, mp.BETA, reception_time=time,
+                                                                camera=position)[0])
         doppler.append(observer_doppler)
-    return image, np.mean(seen, axis=0), np.mean(doppler, axis=0)
+    return np.mean(seen, axis=0), np.mean(doppler, axis=0)
 
 
 def _compare(image, expected, label):
@@ -96,3 +113,16 @@ def test_moving_emitter_seen_by_a_moving_observer(relativity_addon, factory_blen
     image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "emitter")
     _check(image, expected * em.RADIANCE * np.pi * em.RADIUS**2 / (mp.POWER / (4.0 * np.pi)), observer_doppler,
            "emitter")
+
+
+def test_shutter_time_with_a_moving_observer(relativity_addon, factory_blender, tmp_path):
+    """With shutter time t_S the moving camera receives the light at Gray eq. (1)'s event: later
+    (gamma t_S) and elsewhere (gamma beta c t_S on); the pool is where that event says."""
+    bpy = factory_blender
+    scene, camera, _lamp = mp._floor_scene(bpy)
+    image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "shutter", SHUTTER_TIME)
+    _check(image, expected, observer_doppler, "shutter time")
+    time, position = _reception_event(SHUTTER_TIME)
+    for label, when, where in (("at t_o", 0.0, position), ("from x_cam", time, mp.CAMERA)):
+        wrong, _ = _reference(bpy, scene, camera, when, where)
+        assert _compare(image, wrong, f"shutter time, the light received {label}")[0] > 0.3
