@@ -20,7 +20,7 @@ import test_moving_point_light as mp
 
 OBSERVER = np.array([-0.26, 0.21, -0.37])  # 0.5c: against the light, sideways and toward the floor
 RESOLUTION = (80, 60)
-SAMPLES = 64  # 32: up to 3.8 % of the peak (noise)
+SAMPLES = 64  # 32: up to 4.5 % of the peak (noise)
 SUBPIXELS = (1.0 / 6.0, 0.5, 5.0 / 6.0)
 BAND = 4  # pixels
 SHUTTER_TIME = 0.2  # s: c t_S = 2
