@@ -14,6 +14,7 @@ pool is a few pixels wide).
 """
 
 import numpy as np
+import pytest
 import test_moving_blackbody_light as bb
 import test_moving_emitter_lights as em
 import test_moving_point_light as mp
@@ -90,19 +91,34 @@ def test_moving_lamp_seen_by_a_moving_observer(relativity_addon, factory_blender
     bpy = factory_blender
     scene, camera, _lamp = mp._floor_scene(bpy)
     image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "lamp")
-    # The stand-ins span the retarded positions of what the camera sees: the floor points (pixel
-    # centres, aberrated) that get at least 1 % of the brightest one's D^4 / r^2 (moving_lamps.py).
-    points, _ = bb._observed_floor_points(bpy, scene, camera, OBSERVER)
+    print(f"D_o over the view {observer_doppler.min():.3f} .. {observer_doppler.max():.3f}")
+    _check(image, expected, observer_doppler, "lamp")
+
+
+@pytest.mark.parametrize("window", [False, True])
+def test_stand_ins_span_what_the_moving_camera_sees(relativity_addon, factory_blender, window):
+    """The stand-ins span the retarded positions of the floor points the camera sees (those that get
+    at least 1 % of the brightest one's ``D^4 / r^2``, as moving_lamps.py chooses): its pixels'
+    directions aberrated into the scene frame, or kept as they are behind a Lorentz window at
+    ``t_W = 0`` (Gray eq. 6: a plane through the camera whose rays keep their camera-frame
+    directions). Before the fix the stand-ins were placed for the view aberrated the wrong way
+    (x -4.63 .. -1.61 where the camera sees -15.13 .. -1.61) and aberrated behind the window
+    (-15.11 .. -1.62 where it sees -7.60 .. -1.61)."""
+    bpy = factory_blender
+    scene, camera, _lamp = mp._floor_scene(bpy)
+    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
+    scene.relativity.beta = tuple(OBSERVER)
+    scene.relativity.use_lorentz_window = window
+    mp._effect().apply(scene)
+    points, _ = bb._observed_floor_points(bpy, scene, camera, np.zeros(3) if window else OBSERVER)
     _radiance, source, lamp_doppler = mp._expected_radiance(points, mp.BETA)
     irradiance = lamp_doppler**4 / np.sum((points - source) ** 2, axis=-1)
     wanted = source[irradiance >= 0.01 * irradiance.max()][:, 0]
     placed = [obj.location.x for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")]
-    print(f"stand-ins from x = {min(placed):.2f} to {max(placed):.2f}; the seen floor's retarded positions "
-          f"{wanted.min():.2f} .. {wanted.max():.2f}")
+    print(f"window {window}: stand-ins from x = {min(placed):.2f} to {max(placed):.2f}; the seen floor's retarded "
+          f"positions {wanted.min():.2f} .. {wanted.max():.2f}")
     assert min(placed) < wanted.min() + 0.1 and max(placed) > wanted.max() - 0.1
-
-    print(f"D_o over the view {observer_doppler.min():.3f} .. {observer_doppler.max():.3f}")
-    _check(image, expected, observer_doppler, "lamp")
+    assert min(placed) > wanted.min() - 1.0 and max(placed) < wanted.max() + 1.0  # the grid is 5 % wider
 
 
 def test_moving_emitter_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
