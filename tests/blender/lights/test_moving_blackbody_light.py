@@ -111,7 +111,7 @@ def _observed_floor_points(bpy, scene, camera, observer=OBSERVER, offset=(0.5, 0
     view = -dh.pixel_photon_directions(bpy, scene, camera, offset)
     gamma = 1.0 / math.sqrt(1.0 - observer @ observer)
     observer_doppler = 1.0 / (gamma * (1.0 - view @ observer))
-    scene_photon = np.array([mp.ch.aberrate(k, -observer) for k in (-view).reshape(-1, 3)]).reshape(view.shape)
+    scene_photon = mp.ch.aberrate(-view, -observer)
     scene_view = -scene_photon
     t = -origin[2] / scene_view[..., 2]
     return origin + t[..., None] * scene_view, observer_doppler

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import test_moving_blackbody_light as bb
 import test_moving_emitter_lights as em
+import test_moving_light_shadows as sh
 import test_moving_point_light as mp
 
 OBSERVER = np.array([-0.26, 0.21, -0.37])  # 0.5c: against the light, sideways and toward the floor
@@ -25,6 +26,7 @@ SAMPLES = 64  # 32: up to 4.5 % of the peak (noise)
 SUBPIXELS = (1.0 / 6.0, 0.5, 5.0 / 6.0)
 BAND = 4  # pixels
 SHUTTER_TIME = 0.2  # s: c t_S = 2
+SHADOW_SAMPLES = 64  # 32: the noise breaks the dark runs (edges 21 px off)
 
 
 def _reception_event(shutter_time):
@@ -142,3 +144,29 @@ def test_shutter_time_with_a_moving_observer(relativity_addon, factory_blender, 
     for label, when, where in (("at t_o", 0.0, position), ("from x_cam", time, mp.CAMERA)):
         wrong, _ = _reference(bpy, scene, camera, when, where)
         assert _compare(image, wrong, f"shutter time, the light received {label}")[0] > 0.3
+
+
+def test_shadow_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
+    """test_moving_light_shadows' black square 0.5 above the floor, seen by the moving observer
+    (160 x 120): the exact shadow is where the segment from each floor point's retarded lamp position
+    crosses the square, at the floor points the aberrated pixels see."""
+    bpy = factory_blender
+    scene, camera, _lamp = mp._floor_scene(bpy, occluder=True, samples=SHADOW_SAMPLES)
+    scene.relativity.beta = tuple(OBSERVER)
+    scene.relativity.use_doppler = False
+    mp._effect().apply(scene)
+    image = mp._render(bpy, scene, tmp_path / "shadow.exr")[..., 1]
+    assert np.all(np.isfinite(image)) and image.min() >= 0.0
+    points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER)
+    lit, source, _d = mp._expected_radiance(points, mp.BETA)
+    clear_error, deficit, edge_error, one_lamp_error, wrong, size = sh.measure(
+        image, points, observer_doppler**4 * lit, source, "moving observer")
+    assert clear_error < 0.02
+    assert abs(deficit - 1.0) < 0.4
+    assert edge_error < 0.5 * one_lamp_error
+    assert wrong < 0.3 * size
+    # the pixels' floor points without aberration put the shadow elsewhere
+    points, _ = bb._observed_floor_points(bpy, scene, camera, np.zeros(3))
+    lit, source, _d = mp._expected_radiance(points, mp.BETA)
+    unaberrated = sh.measure(image, points, observer_doppler**4 * lit, source, "the view not aberrated")
+    assert wrong < 0.3 * unaberrated[4]
