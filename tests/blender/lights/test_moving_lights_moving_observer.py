@@ -1,6 +1,6 @@
 """Moving lights seen by a MOVING observer on the exact camera path (stand-in lamps): a point lamp
 and a glowing sphere that Lights the Scene, both at 0.5c along +X above a white floor, the camera
-moving at 0.5c against the light and toward the floor.
+moving at 0.5c against the light, sideways and toward the floor.
 
 The floor is at rest in the scene frame and its light reaches the camera at the reception event
 ``(t_o, x_cam)`` whatever the observer's velocity, so its scene-frame radiance is eq. 19 from the
@@ -8,9 +8,11 @@ light's retarded positions exactly as for an observer at rest (``test_moving_poi
 fixed-point solution, not the add-on's). The moving observer sees it through aberration (each
 pixel's direction in its frame aberrated into the scene frame finds the floor point:
 ``test_moving_blackbody_light._observed_floor_points``) and the searchlight ``D_o^4`` (Weiskopf et
-al. eq. 14). Doppler colour is off here (white light, white floor): each pixel is ``D_o^4`` times
-the floor's scene-frame radiance, averaged over the pixel (a 3 x 3 grid in it: the box filter; the
-pool is a few pixels wide).
+al. eq. 14). The observer's Doppler colour is off here (white light, white floor) and the pixels'
+luminance is compared (a moving light's colour shifts with its own ``D``, eq. 18; its brightness
+follows eq. 19): each pixel is ``D_o^4`` times the floor's scene-frame radiance, averaged over
+the pixel (a 3 x 3 grid in it: the box filter; the pool is a few pixels wide). Also checked: a
+shutter time (Gray eq. 1's reception event), the stand-ins' span and a shadow.
 """
 
 import numpy as np
@@ -48,7 +50,7 @@ def _observe(bpy, scene, camera, tmp_path, name, shutter_time=0.0):
     scene.relativity.use_doppler = False
     scene.relativity.shutter_time = shutter_time
     mp._effect().apply(scene)
-    image = mp._render(bpy, scene, tmp_path / f"{name}.exr")[..., 1]
+    image = mp.ch.luminance(mp._render(bpy, scene, tmp_path / f"{name}.exr"))
     assert np.all(np.isfinite(image)) and image.min() >= 0.0
     return (image, *_reference(bpy, scene, camera, *_reception_event(shutter_time)))
 
@@ -155,7 +157,7 @@ def test_shadow_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp
     scene.relativity.beta = tuple(OBSERVER)
     scene.relativity.use_doppler = False
     mp._effect().apply(scene)
-    image = mp._render(bpy, scene, tmp_path / "shadow.exr")[..., 1]
+    image = mp.ch.luminance(mp._render(bpy, scene, tmp_path / "shadow.exr"))
     assert np.all(np.isfinite(image)) and image.min() >= 0.0
     points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER)
     lit, source, _d = mp._expected_radiance(points, mp.BETA)
