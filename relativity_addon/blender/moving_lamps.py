@@ -81,7 +81,8 @@ def _shader_text():
 
 def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
-    camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame)."""
+    camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame unless
+    a Lorentz window keeps it, Gray eq. 6)."""
     left, right, bottom, top = snapshot.view_window(scene, scene.objects[snap.camera])
     widen_x, widen_y = margin * (right - left), margin * (top - bottom)
     x = np.linspace(left - widen_x, right + widen_x, columns)
@@ -89,8 +90,10 @@ def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     local = np.stack(np.broadcast_arrays(x[None, :], y[:, None], -1.0), axis=-1).reshape(-1, 3)
     world = local @ np.array(snap.camera_matrix)[:3, :3].T
     world /= np.linalg.norm(world, axis=-1, keepdims=True)
-    if snap.exact_camera and snap.use_geometry and any(snap.beta):
-        world = camera_to_scene_direction(world, snap.beta)
+    if snap.exact_camera and snap.use_geometry and not snap.use_lorentz_window and any(snap.beta):
+        # Gray eq. (2) carries photon directions: the photon arriving along a view direction
+        # travels the other way (as the camera shader's scene_ray_direction does)
+        world = -camera_to_scene_direction(-world, snap.beta)
     return world
 
 

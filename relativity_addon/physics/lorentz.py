@@ -79,11 +79,12 @@ def _aberrate(k, beta):
 
 
 def camera_to_scene_direction(d: ArrayLike, beta: ArrayLike) -> FloatArray:
-    """Gray et al. eq. (2): a ray's forward (propagation) direction ``d`` in the camera frame seen
+    """Gray et al. eq. (2): a photon's propagation direction ``d`` in the camera frame seen
     in the scene frame, for a camera moving with ``beta`` (in camera coordinates) through the scene.
 
     d_scene ∝ d + (gamma - 1)(bhat·d) bhat + gamma beta, returned normalised. This is
-    :func:`aberrate` with ``-beta``.
+    :func:`aberrate` with ``-beta``. A viewing direction ``v`` (out of the camera) is the reverse
+    of the photon's: its scene-frame direction is ``-camera_to_scene_direction(-v, beta)``.
     """
     return _aberrate(unit_vectors(d, "d"), -velocity_array(beta))
 

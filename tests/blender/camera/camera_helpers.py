@@ -30,7 +30,8 @@ def gamma_of(beta):
 
 
 def aberrate(k, beta):
-    """Photon propagation direction k (scene frame) -> k' in the frame moving with beta."""
+    """Photon propagation direction k (scene frame; or an array of them, (..., 3)) -> k' in the
+    frame moving with beta."""
     k = np.asarray(k, float)
     beta = np.asarray(beta, float)
     b2 = beta @ beta
@@ -38,7 +39,8 @@ def aberrate(k, beta):
         return k.copy()
     g = gamma_of(beta)
     bhat = beta / math.sqrt(b2)
-    return (k + (g - 1.0) * (bhat @ k) * bhat - g * beta) / (g * (1.0 - beta @ k))
+    bk = np.asarray(k @ bhat)[..., None]
+    return (k + (g - 1.0) * bk * bhat - g * beta) / (g * (1.0 - np.asarray(k @ beta)[..., None]))
 
 
 def doppler_factor(k, beta):

@@ -62,11 +62,12 @@ def render(bpy, scene, path):
     return ch.render_exr(bpy, scene, path)
 
 
-def pixel_photon_directions(bpy, scene, camera):
-    """Photon propagation direction (toward the camera, world axes) at every pixel centre."""
+def pixel_photon_directions(bpy, scene, camera, offset=(0.5, 0.5)):
+    """Photon propagation direction (toward the camera, world axes) at every pixel's centre, or
+    at ``offset`` (pixels) from its top-left corner."""
     model = ch.pinhole_model(bpy, scene, camera)
     width, height = model.size
-    px, py = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
+    px, py = np.meshgrid(np.arange(width) + offset[0], np.arange(height) + offset[1])
     view = model.pixel_direction(px, py) @ model.rotation.T
     return -view
 

@@ -103,17 +103,18 @@ def test_floor_under_a_moving_blackbody_lamp_is_lit_by_the_blackbody_at_d_t(rela
 OBSERVER = np.array([-0.3, 0.0, 0.0])  # against the lamp's motion
 
 
-def _observed_floor_points(bpy, scene, camera):
-    """The floor point each pixel centre sees through the moving exact camera, and the pixel's
-    observer Doppler factor ``D_o = 1 / (gamma (1 - beta . d'))`` (``d'`` its direction in the
-    observer's frame, aberrated into the scene frame to find the point: docs/physics.md)."""
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
-    gamma = 1.0 / math.sqrt(1.0 - OBSERVER @ OBSERVER)
-    observer_doppler = 1.0 / (gamma * (1.0 - view @ OBSERVER))
-    scene_photon = np.array([mp.ch.aberrate(k, -OBSERVER) for k in (-view).reshape(-1, 3)]).reshape(view.shape)
+def _observed_floor_points(bpy, scene, camera, observer=OBSERVER, offset=(0.5, 0.5), origin=mp.CAMERA):
+    """The floor point each pixel centre (or the point ``offset`` from its corner) sees through the
+    exact camera moving with ``observer`` (its rays leave ``origin`` in the scene frame), and the
+    pixel's observer Doppler factor ``D_o = 1 / (gamma (1 - beta . d'))`` (``d'`` its direction in
+    the observer's frame, aberrated into the scene frame to find the point: docs/physics.md)."""
+    view = -dh.pixel_photon_directions(bpy, scene, camera, offset)
+    gamma = 1.0 / math.sqrt(1.0 - observer @ observer)
+    observer_doppler = 1.0 / (gamma * (1.0 - view @ observer))
+    scene_photon = mp.ch.aberrate(-view, -observer)
     scene_view = -scene_photon
-    t = -mp.CAMERA[2] / scene_view[..., 2]
-    return mp.CAMERA + t[..., None] * scene_view, observer_doppler
+    t = -origin[2] / scene_view[..., 2]
+    return origin + t[..., None] * scene_view, observer_doppler
 
 
 def test_moving_blackbody_lamp_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):

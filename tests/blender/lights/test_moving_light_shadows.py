@@ -27,15 +27,13 @@ def _dark_span(dark):
     return first, last
 
 
-def test_shadow_behind_the_exact_camera(relativity_addon, factory_blender, tmp_path):
-    bpy = factory_blender
-    scene, camera, _lamp = floor._floor_scene(bpy, occluder=True, samples=floor.SAMPLES_LAMPS)
-    floor._effect().apply(scene)
-    stand_ins = [obj for obj in scene.objects if obj.type == "LIGHT" and not obj.hide_render]
-    image = floor._render(bpy, scene, tmp_path / "shadow.exr")[..., 1]
-    assert np.all(np.isfinite(image)) and image.min() >= 0.0
-    points = floor._floor_points(bpy, scene, camera)
-    lit, source, _ = floor._expected_radiance(points, floor.BETA)
+def measure(image, points, lit, source, label):
+    """Compare a render's floor (``image``, one channel) with the exact shadow of eq. 19: ``points``
+    the floor point of each pixel, ``lit`` its radiance without the occluder, ``source`` the lamp's
+    retarded position for it. Returns the mean error away from the shadow (fraction of the peak),
+    the light the shadow takes away over the exact, the mean offset of the shadow's edges along the
+    rows (px), the same for one lamp at one retarded position per frame, the pixels judged dark/lit
+    wrong and the exact shadow's size (px)."""
     exact = np.where(floor._blocked(source, points), 0.0, lit)
     seen = floor._blocked(np.broadcast_to(floor.CAMERA, points.shape), points)  # pixels showing the occluder
     floor_px = ~seen
@@ -52,7 +50,7 @@ def test_shadow_behind_the_exact_camera(relativity_addon, factory_blender, tmp_p
     clear_error = np.abs(image - exact)[clear].mean() / peak
     # the light the shadow takes away, in total
     deficit = (lit - image)[floor_px].sum() / (lit - exact)[floor_px].sum()
-    # the shadow's edges along the motion, row by row (dark: below half the unshadowed light)
+    # the shadow's edges along the rows (dark: below half the unshadowed light)
     rows = shadowed.any(1)
     first, last = _dark_span((image < 0.5 * lit) & floor_px)
     first_exact, last_exact = _dark_span(shadowed & floor_px)
@@ -63,11 +61,24 @@ def test_shadow_behind_the_exact_camera(relativity_addon, factory_blender, tmp_p
     first_one, last_one = _dark_span(one_lamp & floor_px)
     one_lamp_offsets = np.concatenate([first_one - first_exact, last_one - last_exact])
     one_lamp_error = np.nanmean(np.abs(one_lamp_offsets[np.r_[rows, rows]]))
-    wrong = ((image < 0.5 * lit) != shadowed) & floor_px & (lit > 0.05 * peak)
-    print(f"{len(stand_ins)} stand-in lamps; away from the shadow: mean error {clear_error:.4f} of the peak; "
-          f"shadow deficit {deficit:.3f} of the exact; edges along the motion: mean {edge_error:.1f} px off "
-          f"(one lamp per frame: {one_lamp_error:.1f} px); {wrong.sum()} px dark/lit wrong of {shadowed.sum()} "
-          f"in the exact shadow")
+    wrong = int((((image < 0.5 * lit) != shadowed) & floor_px & (lit > 0.05 * peak)).sum())
+    print(f"{label}: away from the shadow: mean error {clear_error:.4f} of the peak; shadow deficit {deficit:.3f} "
+          f"of the exact; edges along the rows: mean {edge_error:.1f} px off (one lamp per frame: "
+          f"{one_lamp_error:.1f} px); {wrong} px dark/lit wrong of {shadowed.sum()} in the exact shadow")
+    return clear_error, deficit, edge_error, one_lamp_error, wrong, int(shadowed.sum())
+
+
+def test_shadow_behind_the_exact_camera(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene, camera, _lamp = floor._floor_scene(bpy, occluder=True, samples=floor.SAMPLES_LAMPS)
+    floor._effect().apply(scene)
+    stand_ins = [obj for obj in scene.objects if obj.type == "LIGHT" and not obj.hide_render]
+    image = floor._render(bpy, scene, tmp_path / "shadow.exr")[..., 1]
+    assert np.all(np.isfinite(image)) and image.min() >= 0.0
+    points = floor._floor_points(bpy, scene, camera)
+    lit, source, _ = floor._expected_radiance(points, floor.BETA)
+    clear_error, deficit, edge_error, one_lamp_error, _wrong, _size = measure(
+        image, points, lit, source, f"{len(stand_ins)} stand-in lamps")
     assert 2 <= len(stand_ins) <= 16
     assert clear_error < 0.02
     assert abs(deficit - 1.0) < 0.2

@@ -102,20 +102,21 @@ def _floor_points(bpy, scene, camera):
     return CAMERA + t[..., None] * view
 
 
-def _retarded_lamp(points, beta, reception_time=0.0):
-    """The lamp's position when it emitted the light each floor point sends the camera at
-    ``reception_time`` (scene seconds after t_o = 0), by fixed-point iteration in scene time."""
-    t_x = reception_time - np.linalg.norm(points - CAMERA, axis=-1) / C
+def _retarded_lamp(points, beta, reception_time=0.0, camera=CAMERA):
+    """The lamp's position when it emitted the light each floor point sends the camera (at
+    ``camera``) at ``reception_time`` (scene seconds after t_o = 0), by fixed-point iteration in
+    scene time."""
+    t_x = reception_time - np.linalg.norm(points - camera, axis=-1) / C
     t_e = t_x.copy()
     for _ in range(80):  # contracts by |beta| = 0.5 per step
         t_e = t_x - np.linalg.norm(points - (LAMP + beta * C * t_e[..., None]), axis=-1) / C
     return LAMP + beta * C * t_e[..., None]
 
 
-def _expected_radiance(points, beta, occluder=False, reception_time=0.0):
+def _expected_radiance(points, beta, occluder=False, reception_time=0.0, camera=CAMERA):
     """a / pi * D^4 cos(alpha) I / r^2 at floor points, zero where the occluder blocks the segment
-    from the retarded lamp."""
-    source = _retarded_lamp(points, beta, reception_time)
+    from the retarded lamp (the reception event ``(reception_time, camera)``)."""
+    source = _retarded_lamp(points, beta, reception_time, camera)
     ray = points - source
     r = np.linalg.norm(ray, axis=-1)
     n = ray / r[..., None]
