@@ -39,11 +39,11 @@ ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffus
 
 
 def supported(snap):
-    """The snapshot's moving lights this stage renders: point and spot lights, with constant
-    velocity, or keyframed (ANIMATION) where stand-in lamps draw them (:func:`uses_lamps`)."""
+    """The snapshot's moving lights this stage renders: point and spot lights with constant
+    velocity, and every kind, constant or keyframed (ANIMATION), where stand-in lamps draw them
+    (:func:`uses_lamps`; a keyframed sun moves with its keyframes' velocity at the frame)."""
     if uses_lamps(snap):
-        return [light for light in snap.moving_lights if light.kind in LAMP_KINDS
-                and (light.motion == "CONSTANT" or light.kind != "SUN")]
+        return [light for light in snap.moving_lights if light.kind in LAMP_KINDS]
     return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
 
 

@@ -197,7 +197,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
 def _draw_light(layout, obj):
     """Lights: the same motion settings as meshes (blender/moving_lights.py: point and spot lights
     with constant velocity on both paths; with the exact camera also sun and area lights and
-    keyframed point, spot and area lights)."""
+    keyframed lights)."""
     settings = obj.relativity
     layout.prop(settings, "motion")
     kind = obj.data.type
@@ -207,11 +207,10 @@ def _draw_light(layout, obj):
             layout.label(text=f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent "
                               "Geometry)", icon="INFO")
     elif settings.motion == "ANIMATION":
+        layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)",
+                     icon="INFO")
         if kind == "SUN":
-            layout.label(text="Animated sun lights are rendered at rest", icon="ERROR")
-        else:
-            layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)",
-                         icon="INFO")
+            layout.label(text="A sun moves with its keyframes' velocity at the frame", icon="INFO")
 
 
 classes = (

@@ -94,13 +94,20 @@ def test_unsupported_lights_are_reported(relativity_addon, factory_blender):
     scene, _camera, lamp = _floor_scene(bpy)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     scene.collection.objects.link(sun)
-    sun.relativity.motion = "ANIMATION"  # a keyframed sun is not drawn moving (a constant-velocity one is)
+    sun.relativity.motion = "CONSTANT"  # Apparent Geometry's preview draws no moving sun (the exact camera does)
+    sun.relativity.beta = (0.3, 0.0, 0.0)
+    scene.relativity.method = "GEOMETRY"
     effect.apply(scene)
     warnings = effect.scene_warnings(scene)
     print(warnings)
     assert any("'Sun'" in warning and "at rest" in warning for warning in warnings)
-    assert any("stand-in lamps" in warning for warning in warnings)  # the exact camera
     assert not sun.hide_render  # rendered at rest, as the warning says
+    effect.remove(scene)
+    scene.relativity.method = "CAMERA"
+    effect.apply(scene)
+    assert any("stand-in lamps" in warning for warning in effect.scene_warnings(scene))
+    assert not any("'Sun'" in warning for warning in effect.scene_warnings(scene))
+    assert sun.hide_render  # drawn by its stand-in
     effect.remove(scene)
 
 

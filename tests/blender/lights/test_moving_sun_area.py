@@ -149,3 +149,31 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     print(f"fast mode: Delta E {fast_delta_e:.3f}, Y / expected {fast_xyz[1] / expected_y:.4f}")
     assert fast_delta_e < 1.0
     assert fast_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
+
+
+def test_keyframed_sun_moves_with_its_keyframes_velocity(relativity_addon, factory_blender):
+    """A sun keyframed to move at 0.5c along x gets, at the frame, the stand-in of a sun moving at
+    that velocity: the photon direction aberrated and the strength ``D^2`` written out here."""
+    bpy = factory_blender
+    scene, _camera, sun = floor._floor_scene(bpy, beta=None, kind="SUN")
+    sun.data.energy = SUN_STRENGTH
+    fps = scene.render.fps
+    for frame in (1, 21):
+        sun.location = (SUN_BETA[0] * floor.C * (frame - 11) / fps, 0.0, 3.0)
+        sun.keyframe_insert("location", frame=frame)
+    for curve in ch.compat.action_fcurves(sun.animation_data):
+        for point in curve.keyframe_points:
+            point.interpolation = "LINEAR"
+    sun.relativity.motion = "ANIMATION"
+    scene.frame_set(11)
+    floor._effect().apply(scene)
+    assert sun.hide_render
+    (stand_in,) = [obj for obj in scene.objects if obj.type == "LIGHT" and obj is not sun and not obj.hide_render]
+    k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)
+    d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
+    bpy.context.view_layer.update()
+    direction = -np.array(stand_in.matrix_world.to_3x3().col[2])
+    print(f"keyframed sun: stand-in direction {np.round(direction, 4)} (k {np.round(k, 4)}), "
+          f"strength {stand_in.data.energy:.4f} (D^2 E {d * d * SUN_STRENGTH:.4f})")
+    assert np.allclose(direction, k, atol=1e-4)
+    assert stand_in.data.energy == pytest.approx(d * d * SUN_STRENGTH, rel=1e-4)
