@@ -10,7 +10,7 @@ group (materials) and the compositor group's flag inputs.
 import bpy
 
 from ..errors import RelativityError
-from . import compositing, luts, materials, volumes
+from . import compositing, luts, materials, volumes, world_sampling
 from .compositing import is_applied as compositor_applied
 
 
@@ -19,9 +19,8 @@ def apply(scene, snap):
     exact camera, the world and the compositor stage). RelativityError (one line) after undoing
     any partial change."""
     try:
-        materials.attach_scene(scene, camera_path=snap.colour.camera_path)
+        _attach(scene, snap)
         if snap.colour.camera_path:
-            volumes.attach_scene(scene)
             compositing.apply_colour_stage(scene, snap)
         write(scene, snap)
     except (ImportError, ValueError, KeyError, RuntimeError) as error:
@@ -35,11 +34,18 @@ def apply(scene, snap):
 def write(scene, snap, attach_new_materials=False):
     """Write the snapshot's colour factors; before a render also attach materials added since."""
     if attach_new_materials:
-        materials.attach_scene(scene, camera_path=snap.colour.camera_path)
-        if snap.colour.camera_path:
-            volumes.attach_scene(scene)
+        _attach(scene, snap)
     materials.write_settings(snap)
     compositing.write_colour_stage(scene, snap)
+
+
+def _attach(scene, snap):
+    """The colour groups in every material (and on the exact camera's path the world and volumes)."""
+    if snap.colour.camera_path and not materials.is_attached(scene.world):
+        world_sampling.hold(scene.world)  # before the groups make the world look varying
+    materials.attach_scene(scene, camera_path=snap.colour.camera_path)
+    if snap.colour.camera_path:
+        volumes.attach_scene(scene)
 
 
 def remove_camera_stage(scene):
@@ -47,6 +53,7 @@ def remove_camera_stage(scene):
     Doppler AOV), after an Apparent Geometry final render; the materials stay attached."""
     compositing.remove_colour_stage(scene)
     materials.detach_world(scene.world)
+    world_sampling.release(scene.world)
 
 
 def remove(scene):
@@ -54,6 +61,8 @@ def remove(scene):
     groups and lookup tables once no scene uses them."""
     compositing.remove_colour_stage(scene)
     materials.detach_all()
+    for world in bpy.data.worlds:
+        world_sampling.release(world)
     if not any(compositor_applied(other) for other in bpy.data.scenes):
         remove_unused_data()
 

@@ -67,6 +67,7 @@ MOVING_LIGHTS_MATERIAL_KEY = "relativity_moving_lights"  # on materials: the ins
 MOVING_LIGHT_NODE_PREFIX = "Relativity Moving Lights"
 LIGHT_SAVED_KEY = "relativity_light_saved"  # on light objects: the user's hide_render while hidden
 EMITTER_SAVED_KEY = "relativity_emitter_saved"  # on emitter meshes lighting the scene: the user's ray visibility
+WORLD_SAMPLING_SAVED_KEY = "relativity_world_sampling_saved"  # on worlds: the user's Cycles light-sampling map
 SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: the user's Open Shading Language
 
 # --- lamps at rest lighting moving objects (eq. 18) -------------------------------------------

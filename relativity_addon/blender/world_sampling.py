@@ -1,0 +1,50 @@
+"""The world's light-sampling map while the exact camera's Doppler groups are in a constant world.
+
+Before every render Cycles builds an importance map of a world whose colour may vary with the
+direction, by evaluating its shader over the map (1024 x 512 under the default Automatic
+sampling); a constant world (a Background of constant colour and strength) needs none. Once the
+exact camera's Doppler AOV and colour groups are in its node tree Cycles can no longer tell that
+it is constant and builds the map: 1.9 s of every render, measured on a world-only 192 x 96
+panorama at 1 sample (2.1 s against 0.08 s without the map). The groups change the colour for
+camera rays only, so the map of the world's light is uniform anyway: while they are in a
+constant world its Sampling is Manual at resolution ``MAP_RESOLUTION`` (a uniform map, cheap), and
+the user's settings come back when they go. Worlds that vary (textures, sky) keep theirs.
+"""
+
+from . import names
+
+MAP_RESOLUTION = 16
+SAVED = names.WORLD_SAMPLING_SAVED_KEY
+
+
+def _constant(world):
+    """Whether the world's surface is one Background of unlinked colour and strength."""
+    tree = world.node_tree
+    if tree is None:
+        return False
+    outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputWorld" and node.is_active_output]
+    if len(outputs) != 1 or outputs[0].inputs["Volume"].is_linked or not outputs[0].inputs["Surface"].is_linked:
+        return False
+    background = outputs[0].inputs["Surface"].links[0].from_node
+    return background.bl_idname == "ShaderNodeBackground" and not any(socket.is_linked for socket in background.inputs)
+
+
+def hold(world):
+    """Before the Doppler groups go into ``world``: a uniform map if the world is constant."""
+    if world is None or SAVED in world or not _constant(world):
+        return
+    settings = world.cycles
+    world[SAVED] = {"sampling_method": settings.sampling_method,
+                    "sample_map_resolution": settings.sample_map_resolution}
+    settings.sampling_method = "MANUAL"
+    settings.sample_map_resolution = MAP_RESOLUTION
+
+
+def release(world):
+    """Give the world back its sampling settings."""
+    if world is None or SAVED not in world:
+        return
+    saved = world[SAVED].to_dict()
+    world.cycles.sampling_method = saved["sampling_method"]
+    world.cycles.sample_map_resolution = saved["sample_map_resolution"]
+    del world[SAVED]
