@@ -2,7 +2,7 @@
 
     python benchmarks/camera_overhead.py [--samples 128] [--resolution 160x120] [--repeats 5]
 
-Same lit scene, same seed, Cycles on the CPU. The cameras are rendered alternately (perspective,
+Same lit scene (with Blender's default constant world), same seed, Cycles on the CPU. The cameras are rendered alternately (perspective,
 relativistic at rest, relativistic at speed, then again) so that load from other processes hits
 all of them alike; each round's times are divided by that round's perspective time and the
 median ratio over the rounds is printed, next to the median times.
@@ -31,6 +31,10 @@ def build_scene(bpy, resolution, samples):
     scene.cycles.use_adaptive_sampling = False
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
+    from relativity_addon.blender import compat
+
+    scene.world = bpy.data.worlds.new("World")  # Blender's default: a constant grey Background
+    compat.world_node_tree(scene.world).nodes["Background"].inputs["Color"].default_value = (0.05, 0.05, 0.05, 1.0)
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     camera.location = (1.5, -6.0, 2.0)
     camera.rotation_euler = (math.radians(75.0), 0.0, math.radians(20.0))
