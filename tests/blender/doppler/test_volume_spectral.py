@@ -1,0 +1,194 @@
+"""Volumes in the spectral mode (observer at 0.5c toward them, scene at rest).
+
+The passes give volume shaders their spectral values like surfaces: a Principled Volume's own
+blackbody emission becomes the Planck spectrum with the luminance Blender gives it, its colours
+(scattering albedo, Absorption Color) and a Volume Absorption's colour are up-sampled like
+reflectances and enter Cycles' own per-channel formulas, now per wavelength. References:
+colour-science (Planck spectra, the CIE 1931 functions, Mallett & Yuksel's basis), integrated here
+on a 1 nm grid; Beer-Lambert per wavelength with Cycles' absorption coefficients
+
+    Principled Volume: sigma_a = density max(1 - C, 0) max(1 - sqrt(A), 0)   (C Color, A Absorption Color)
+    Volume Absorption: sigma_a = density (1 - C)
+
+(``svm_node_principled_volume``; checked at rest on an RGB render first), along each pixel's
+scene-frame ray through the slab. The one number taken from a render is the gas's luminance at rest.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import doppler_helpers as dh
+
+TEMPERATURE = 3000.0
+RESOLUTION = (64, 48)
+LEFT = (slice(20, 28), slice(12, 18))
+RIGHT = (slice(20, 28), slice(46, 52))
+BETA = (0.0, 0.0, -0.5)
+THROUGH_BETA = (0.0, 0.0, -0.25)  # D = 1.29: the rest band the picture sees keeps the colours' structure
+PASSES = 4
+SLAB = (-5.0, -3.0)  # the absorbing slabs' z range: 2 m thick
+EMITTER = (0.9, 0.45, 0.15)
+PRINCIPLED_ABSORPTION = (0.85, 0.35, 0.1)  # Absorption Color, Color black (no scattering)
+ABSORPTION_COLOUR = (0.2, 0.55, 0.9)  # Volume Absorption's Color
+DENSITY = 1.5
+
+
+def _xyz(image, window):
+    return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3)).mean(axis=0)
+
+
+def _set_up(bpy, scene, beta=BETA):
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = beta
+    scene.relativity.speed_of_light = 1.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+
+
+def _spectral(addon, scene, passes=PASSES):
+    pixels, _info = dh.addon_module(addon, "spectral_render").render(scene, passes)
+    return pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
+
+
+def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path):
+    """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh: both the blackbody at
+    ``D T`` with luminance ``Y(D T) / Y(T)`` times the rest luminance (times the slab's path-length
+    change under aberration)."""
+    bpy = __import__("bpy")
+    scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
+    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
+                         temperature=TEMPERATURE)
+    gas = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
+    dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), gas)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1]
+              for name, window in (("volume", LEFT), ("mesh", RIGHT))}
+    assert y_rest["volume"].min() > 0.5 and y_rest["mesh"].min() > 0.5
+
+    _set_up(bpy, scene)
+    doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
+    scene_k = dh.scene_frame_directions(bpy, scene, camera, BETA)
+    rest_k = dh.pixel_photon_directions(bpy, scene, camera)
+    path = {"volume": (np.abs(rest_k[..., 2]) / np.abs(scene_k[..., 2]))[LEFT].ravel(), "mesh": 1.0}
+    spectral = _spectral(relativity_addon, scene, passes=3)
+    fast = dh.render(bpy, scene, tmp_path / "fast.exr")
+    assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
+    y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    measured = {}
+    for name, window in (("volume", LEFT), ("mesh", RIGHT)):
+        expected = np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in
+                            zip(doppler[window].ravel(), y_rest[name] * path[name], strict=True)], axis=0)
+        measured[name] = xyz = _xyz(spectral, window)
+        fast_xyz = _xyz(fast, window)
+        delta_e = dh.delta_e_2000_normalised(xyz, expected)
+        print(f"{name}: D {doppler[window].mean():.3f}, spectral Delta E {delta_e:.3f}, Y/expected "
+              f"{xyz[1] / expected[1]:.4f}; fast Delta E {dh.delta_e_2000_normalised(fast_xyz, expected):.3f}, "
+              f"Y/expected {fast_xyz[1] / expected[1]:.4f}")
+        assert delta_e < 2.0, name
+        assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05), name
+    assert dh.delta_e_2000_normalised(measured["volume"], measured["mesh"]) < 2.0
+
+
+def _absorbing_scene(bpy):
+    """An orange emitter wall behind two 2 m slabs of non-emitting, non-scattering gas: a Principled
+    Volume (left) and a Volume Absorption (right)."""
+    scene, camera = dh.emitter_scene(bpy, samples=4, resolution=RESOLUTION)  # no noise: no scattering
+    dh.add_emitter_plane(bpy, scene, "Wall", (-6.0, 6.0), (-4.0, 4.0), colour=EMITTER, beta=None, depth=7.0)
+    principled = dh.volume_material(bpy, "Principled", Color=(0.0, 0.0, 0.0), Density=DENSITY,
+                                    Absorption_Color=PRINCIPLED_ABSORPTION)
+    absorption = dh.volume_material(bpy, "Absorption", "ShaderNodeVolumeAbsorption", Color=ABSORPTION_COLOUR,
+                                    Density=DENSITY)
+    dh.add_box(bpy, scene, "Left", (-6.0, -0.1), (-4.0, 4.0), SLAB, principled)
+    dh.add_box(bpy, scene, "Right", (0.1, 6.0), (-4.0, 4.0), SLAB, absorption)
+    return scene, camera
+
+
+def _coefficients(mu):
+    """Cycles' absorption coefficients per metre at wavelengths ``mu`` for the up-sampled colours."""
+    principled = DENSITY * np.maximum(1.0 - np.sqrt(dh.mallett_reflectance(PRINCIPLED_ABSORPTION, mu)), 0.0)
+    return {"left": principled, "right": DENSITY * (1.0 - dh.mallett_reflectance(ABSORPTION_COLOUR, mu))}
+
+
+def test_emitter_seen_through_absorbing_volumes_in_spectral_mode(relativity_addon, tmp_path):
+    """The wall's up-sampled spectrum times Beer-Lambert's transmittance per wavelength, shifted:
+    ``D^5 S(lambda D) exp(-sigma_a(lambda D) l)``, ``l`` the slab's thickness over the pixel's
+    scene-frame ``|k_z|``."""
+    bpy = __import__("bpy")
+    scene, camera = _absorbing_scene(bpy)
+    thickness = SLAB[1] - SLAB[0]
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    rest_k = dh.pixel_photon_directions(bpy, scene, camera)
+    rgb_coefficients = {"left": DENSITY * (1.0 - np.sqrt(PRINCIPLED_ABSORPTION)),
+                        "right": DENSITY * (1.0 - np.asarray(ABSORPTION_COLOUR))}
+    for side, window in (("left", LEFT), ("right", RIGHT)):  # Cycles' RGB formula, per channel at rest
+        length = thickness / np.abs(rest_k[window][..., 2])
+        expected = np.asarray(EMITTER) * np.exp(-rgb_coefficients[side] * length[..., None])
+        ratio = rest[window].mean(axis=(0, 1)) / expected.mean(axis=(0, 1))
+        print(f"rest {side}: rendered / Beer-Lambert per channel {np.round(ratio, 4)}")
+        assert ratio == pytest.approx(np.ones(3), abs=0.01)
+
+    _set_up(bpy, scene, THROUGH_BETA)
+    doppler = dh.pixel_doppler(bpy, scene, camera, THROUGH_BETA)
+    length = thickness / np.abs(dh.scene_frame_directions(bpy, scene, camera, THROUGH_BETA)[..., 2])
+    spectral = _spectral(relativity_addon, scene)
+    fast = dh.render(bpy, scene, tmp_path / "fast.exr")
+    wall = dh.emitted_spectrum(EMITTER)
+    for side, window in (("left", LEFT), ("right", RIGHT)):
+        def transmitted(mu, side=side, path=0.0):
+            return wall(mu) * np.exp(-_coefficients(mu)[side] * path)
+
+        expected = np.mean([dh.observed_xyz(lambda mu, path=path: transmitted(mu, path=path), d)
+                            for d, path in zip(doppler[window].ravel(), length[window].ravel(), strict=True)], axis=0)
+        xyz, fast_xyz = _xyz(spectral, window), _xyz(fast, window)
+        delta_e = dh.delta_e_2000_normalised(xyz, expected)
+        print(f"{side}: D {doppler[window].mean():.3f}, spectral Delta E {delta_e:.3f}, Y/expected "
+              f"{xyz[1] / expected[1]:.4f}; fast Delta E {dh.delta_e_2000_normalised(fast_xyz, expected):.3f}, "
+              f"Y/expected {fast_xyz[1] / expected[1]:.4f}")
+        assert delta_e < 2.0, side
+        assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05), side
+    assert math.isfinite(float(spectral.sum()))
+
+
+def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
+    """A blackbody on an object that may read a temperature grid (a Volume object), one behind a
+    Mix shader, and a world volume: one-line RelativityError before any pass, never a picture with
+    RGB volumes; without the blackbody the grid object is accepted (its density grid only scales
+    every wavelength alike)."""
+    bpy = __import__("bpy")
+    from importlib import import_module
+
+    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    relativity_error = import_module(f"{relativity_addon}.errors").RelativityError
+    scene, _camera = dh.emitter_scene(bpy, samples=1, resolution=(16, 12))
+    fire = dh.volume_material(bpy, "Fire", Density=1.0, Blackbody_Intensity=1.0, Temperature=1500.0)
+    smoke = bpy.data.objects.new("Smoke", bpy.data.volumes.new("Smoke"))
+    smoke.data.materials.append(fire)
+    scene.collection.objects.link(smoke)
+    _set_up(bpy, scene)
+
+    def refusal():
+        with pytest.raises(relativity_error) as caught:
+            spectral_render.render(scene, 2)
+        return str(caught.value)
+
+    message = refusal()
+    assert "temperature grid" in message and "'Fire'" in message and "'Smoke'" in message and "\n" not in message
+    fire.node_tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
+    spectral_render.check(scene)  # accepted
+
+    mixed = dh.volume_material(bpy, "Mixed", Density=0.0, Blackbody_Intensity=1.0, Temperature=2000.0)
+    tree = mixed.node_tree
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(tree.nodes["Principled Volume"].outputs[0], mix.inputs[1])
+    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Volume"])
+    dh.add_box(bpy, scene, "Mixed", (-1.0, 1.0), (-1.0, 1.0), (-6.0, -4.0), mixed)
+    assert "cannot make the blackbody of 'Principled Volume' in material 'Mixed'" in refusal()
+    tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
+
+    world_tree = scene.world.node_tree
+    world_volume = world_tree.nodes.new("ShaderNodeVolumeScatter")
+    output = next(node for node in world_tree.nodes if node.bl_idname == "ShaderNodeOutputWorld")
+    world_tree.links.new(world_volume.outputs[0], output.inputs["Volume"])
+    assert "world volumes" in refusal()
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
