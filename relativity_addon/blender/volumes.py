@@ -18,18 +18,35 @@ emitter, the volume does the exact shift itself and marks its pixels done:
   ``relativity_colour_done`` AOV where a camera ray enters the volume (front faces), so the
   compositor keeps those pixels; the material's ``ln D`` writer is muted.
 
-Approximation: the done mask keeps *everything* in the pixel as rendered, so what lies behind the
-volume (seen through it) is not shifted: right against a black background or a blackbody emitter,
-wrong in front of anything else. A camera inside the volume gets no mask (the volume is then
-shifted again by the compositor). ``D`` is the observer's (a volume at rest in the scene frame).
+Approximation (fast mode): the done mask keeps *everything* in the pixel as rendered, so what lies
+behind the volume (seen through it) is not shifted: right against a black background or a
+blackbody emitter, wrong in front of anything else. A camera inside the volume gets no mask (the
+volume is then shifted again by the compositor). ``D`` is the observer's (a volume at rest in the
+scene frame).
+
+**Spectral mode** (``spectral_render``): the passes carry volumes like surfaces, so nothing above is
+needed and what is seen through a volume is right too. In a pass the group's fast part and done
+mask are 0 (the compositor passes through), its ``Intensity`` output (linked into the Principled
+Volume's Blackbody Intensity) switches Cycles' RGB blackbody off, and its ``Color`` is ``E``'s
+spectral values: the blackbody at ``T`` with ``E``'s luminance (``spectral_nodes``, the surfaces'
+group; adding the spectral-minus-RGB difference instead was tried: 18 % off at 400 nm, where ``E``'s
+RGB is ~1e3 times the Planck value). :func:`attach_colours` puts ``spectral_nodes.volume_colour_group``
+(the colour unchanged outside the passes) in front of the volume colours (:data:`VOLUME_COLOURS`):
+Principled Volume Color and Absorption Color and the Volume Absorption / Scatter colours up-sampled
+as reflectances, which Cycles' per-channel formulas (``sigma_a = density max(1 - C, 0)
+max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wavelength; the
+Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
+Emission node in a volume has the materials' own group already. What cannot be made spectral is
+refused in one line (:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
 Blackbody Intensity and a constant or linked Temperature (a node field is followed per point).
 Not covered: a temperature grid (``Temperature Attribute``, e.g. a fire simulation: the added
 emission uses the Temperature input only; following the grid blows up the grid's cool edges,
-docs/spectral-model.md), a Principled Volume behind a Mix or Add shader or with a surface shader, the spectral mode
-(volumes stay RGB in every pass), and Apparent Geometry's boosted meshes.
+docs/spectral-model.md; refused by the spectral mode, whose passes cannot give a grid a spectrum), a
+Principled Volume behind a Mix or Add shader or with a surface shader (also refused by the spectral
+mode when it emits a blackbody), and Apparent Geometry's boosted meshes.
 """
 
 import math

@@ -25,6 +25,9 @@ TEMPERATURE = 3000.0
 RESOLUTION = (64, 48)
 LEFT = (slice(20, 28), slice(12, 18))
 RIGHT = (slice(20, 28), slice(46, 52))
+GAS = (slice(12, 18), slice(12, 18))  # the gas's upper half
+GAS_THROUGH = (slice(32, 38), slice(12, 18))  # its lower half, the blue emitter behind
+BEHIND = (0.5, 1.25, 4.5)  # bright, so that it counts beside the 7x brighter gas
 BETA = (0.0, 0.0, -0.5)
 THROUGH_BETA = (0.0, 0.0, -0.25)  # D = 1.29: the rest band the picture sees keeps the colours' structure
 PASSES = 4
@@ -52,33 +55,42 @@ def _spectral(addon, scene, passes=PASSES):
 
 
 def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path):
-    """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh: both the blackbody at
-    ``D T`` with luminance ``Y(D T) / Y(T)`` times the rest luminance (times the slab's path-length
-    change under aberration)."""
+    """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh, a blue emitter behind
+    the slab's lower half: the gas and the mesh are the blackbody at ``D T`` with luminance
+    ``Y(D T) / Y(T)`` times the rest luminance (times the slab's path-length change under
+    aberration); through the gas the blue emitter's up-sampled spectrum, shifted, is added (the
+    fast mode's done mask keeps it at its rest colour)."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
     dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
                          temperature=TEMPERATURE)
+    dh.add_emitter_plane(bpy, scene, "Behind", (-5.0, -0.5), (-3.0, -0.5), colour=BEHIND, beta=None, depth=7.0)
     gas = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
     dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), gas)
+    windows = {"volume": GAS, "volume + blue emitter": GAS_THROUGH, "mesh": RIGHT}
+    behind_xyz = dh.linear_rec709_to_xyz(BEHIND)
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
-    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1]
-              for name, window in (("volume", LEFT), ("mesh", RIGHT))}
-    assert y_rest["volume"].min() > 0.5 and y_rest["mesh"].min() > 0.5
+    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1] for name, window in windows.items()}
+    y_rest["volume + blue emitter"] -= behind_xyz[1]  # the gas's own part (density 0: the emitter is unabsorbed)
+    assert min(y.min() for y in y_rest.values()) > 0.5
 
     _set_up(bpy, scene)
     doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
     scene_k = dh.scene_frame_directions(bpy, scene, camera, BETA)
     rest_k = dh.pixel_photon_directions(bpy, scene, camera)
-    path = {"volume": (np.abs(rest_k[..., 2]) / np.abs(scene_k[..., 2]))[LEFT].ravel(), "mesh": 1.0}
+    path = np.abs(rest_k[..., 2]) / np.abs(scene_k[..., 2])
     spectral = _spectral(relativity_addon, scene, passes=3)
     fast = dh.render(bpy, scene, tmp_path / "fast.exr")
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
     y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    blue = dh.emitted_spectrum(BEHIND)
     measured = {}
-    for name, window in (("volume", LEFT), ("mesh", RIGHT)):
+    for name, window in windows.items():
+        gas_path = path[window].ravel() if name != "mesh" else 1.0
         expected = np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in
-                            zip(doppler[window].ravel(), y_rest[name] * path[name], strict=True)], axis=0)
+                            zip(doppler[window].ravel(), y_rest[name] * gas_path, strict=True)], axis=0)
+        if name == "volume + blue emitter":
+            expected += np.mean([dh.observed_xyz(blue, d) for d in doppler[window].ravel()], axis=0)
         measured[name] = xyz = _xyz(spectral, window)
         fast_xyz = _xyz(fast, window)
         delta_e = dh.delta_e_2000_normalised(xyz, expected)
@@ -117,6 +129,14 @@ def test_emitter_seen_through_absorbing_volumes_in_spectral_mode(relativity_addo
     bpy = __import__("bpy")
     scene, camera = _absorbing_scene(bpy)
     thickness = SLAB[1] - SLAB[0]
+    trees = [bpy.data.materials[name].node_tree for name in ("Principled", "Absorption")]
+
+    def state():
+        return [(sorted((link.from_node.name, link.to_node.name) for link in tree.links), len(tree.nodes),
+                 [tuple(socket.default_value) for node in tree.nodes for socket in node.inputs
+                  if socket.type == "RGBA"]) for tree in trees]
+
+    before = state()
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
     rest_k = dh.pixel_photon_directions(bpy, scene, camera)
     rgb_coefficients = {"left": DENSITY * (1.0 - np.sqrt(PRINCIPLED_ABSORPTION)),
@@ -148,6 +168,8 @@ def test_emitter_seen_through_absorbing_volumes_in_spectral_mode(relativity_addo
         assert delta_e < 2.0, side
         assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05), side
     assert math.isfinite(float(spectral.sum()))
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert state() == before
 
 
 def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
