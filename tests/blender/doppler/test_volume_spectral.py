@@ -35,6 +35,7 @@ SLAB = (-5.0, -3.0)  # the absorbing slabs' z range: 2 m thick
 EMITTER = (0.9, 0.45, 0.15)
 PRINCIPLED_ABSORPTION = (0.85, 0.35, 0.1)  # Absorption Color, Color black (no scattering)
 ABSORPTION_COLOUR = (0.2, 0.55, 0.9)  # Volume Absorption's Color
+GLOW = (0.1, 0.3, 0.05)  # emission per metre of an Emission node beside the Volume Absorption
 SCATTER_COLOUR = (0.3, 0.6, 0.8)  # the scattering case's Principled Volume Color and Volume Scatter Color
 DENSITY = 1.5
 
@@ -113,8 +114,8 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
 
 
 def _slab_scene(bpy, scattering):
-    """An orange emitter wall behind two 2 m slabs of non-emitting gas: a Principled Volume (left)
-    and a Volume Absorption (right), or, ``scattering``, a Principled Volume that also scatters and
+    """An orange emitter wall behind two 2 m slabs of gas: a Principled Volume (left) and a Volume
+    Absorption with a green Emission beside it (right), or, ``scattering``, a Principled Volume that also scatters and
     a Volume Scatter. The wall is hidden from scatter rays and the camera sees it straight through
     (no in-scattering): what reaches the camera is the wall's light times the transmittance. The
     scattering volumes' transmittance is estimated stochastically by Cycles: many samples, on the
@@ -129,9 +130,23 @@ def _slab_scene(bpy, scattering):
     kind = "ShaderNodeVolumeScatter" if scattering else "ShaderNodeVolumeAbsorption"
     other = dh.volume_material(bpy, "Other", kind, Color=SCATTER_COLOUR if scattering else ABSORPTION_COLOUR,
                                Density=DENSITY)
+    if not scattering:  # the Volume Absorption also glows: an Emission node beside it (Add Shader)
+        tree = other.node_tree
+        glow, add = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeAddShader")
+        glow.inputs["Color"].default_value = (*GLOW, 1.0)
+        tree.links.new(tree.nodes["Volume Absorption"].outputs[0], add.inputs[0])
+        tree.links.new(glow.outputs[0], add.inputs[1])
+        tree.links.new(add.outputs[0], tree.nodes["Material Output"].inputs["Volume"])
     dh.add_box(bpy, scene, "Left", (-6.0, -0.1), (-4.0, 4.0), SLAB, principled)
     dh.add_box(bpy, scene, "Right", (0.1, 6.0), (-4.0, 4.0), SLAB, other)
     return scene, camera
+
+
+def _through(wall, glow, extinction, length):
+    """Radiance leaving a slab of ``length`` with this extinction and emission per metre ``glow``,
+    the wall's ``wall`` behind it: ``wall T + glow (1 - T) / sigma``, ``T = exp(-sigma length)``."""
+    transmitted = np.exp(-extinction * length)
+    return wall * transmitted + glow * (1.0 - transmitted) / extinction
 
 
 def _extinction(colour, scattering):
@@ -165,7 +180,8 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
     rgb = _extinction(np.asarray, scattering)
     for side, window in (("left", LEFT), ("right", RIGHT)):  # Cycles' RGB formula, per channel at rest
         length = thickness / np.abs(rest_k[window][..., 2])
-        expected = np.asarray(EMITTER) * np.exp(-rgb[side] * length[..., None])
+        glow = np.asarray(GLOW) if side == "right" and not scattering else np.zeros(3)
+        expected = _through(np.asarray(EMITTER), glow, rgb[side], length[..., None])
         ratio = rest[window].mean(axis=(0, 1)) / expected.mean(axis=(0, 1))
         print(f"rest {side}: rendered / Beer-Lambert per channel {np.round(ratio, 4)}")
         assert ratio == pytest.approx(np.ones(3), abs=0.03 if scattering else 0.01)
@@ -175,10 +191,13 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
     length = thickness / np.abs(dh.scene_frame_directions(bpy, scene, camera, THROUGH_BETA)[..., 2])
     spectral = _spectral(relativity_addon, scene)
     fast = dh.render(bpy, scene, tmp_path / "fast.exr")
-    wall = dh.emitted_spectrum(EMITTER)
+    wall, glow = dh.emitted_spectrum(EMITTER), dh.emitted_spectrum(GLOW)
     for side, window in (("left", LEFT), ("right", RIGHT)):
-        def transmitted(mu, side=side, path=0.0):
-            return wall(mu) * np.exp(-_extinction(lambda rgb: dh.mallett_reflectance(rgb, mu), scattering)[side] * path)
+        glows = side == "right" and not scattering
+
+        def transmitted(mu, side=side, glows=glows, path=0.0):
+            extinction = _extinction(lambda rgb: dh.mallett_reflectance(rgb, mu), scattering)[side]
+            return _through(wall(mu), glow(mu) if glows else 0.0, extinction, path)
 
         expected = np.mean([dh.observed_xyz(lambda mu, path=path: transmitted(mu, path=path), d)
                             for d, path in zip(doppler[window].ravel(), length[window].ravel(), strict=True)], axis=0)
