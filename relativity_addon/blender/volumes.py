@@ -309,11 +309,21 @@ def _emits_blackbody(node):
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
 
 
+def _volume_nodes_inside(tree, seen=()):
+    """Whether node group ``tree`` (or a group inside it) holds volume shader nodes."""
+    if tree is None or tree.name in seen:
+        return False
+    kinds = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
+    return any(node.bl_idname in kinds or (node.bl_idname == "ShaderNodeGroup"
+               and _volume_nodes_inside(node.node_tree, (*seen, tree.name))) for node in tree.nodes)
+
+
 def spectral_problem(scene):
     """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
     that may read a temperature grid (its emission varies with the grid, which has no spectrum in
     the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
-    would stay RGB), a Volume Coefficients node, or a world volume."""
+    would stay RGB), a Volume Coefficients node, volume shaders inside a node group (only the
+    material's own nodes get the colour group), or a world volume."""
     grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
@@ -322,6 +332,8 @@ def spectral_problem(scene):
         corrected = correctable[1].node if correctable is not None else None
         for node in material.node_tree.nodes:
             where = f"{node.name!r} in material {material.name!r}"
+            if node.bl_idname == "ShaderNodeGroup" and _volume_nodes_inside(node.node_tree):
+                return f"Spectral colour cannot make the volume shaders inside the node group {where} spectral"
             if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
                 return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
             if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:

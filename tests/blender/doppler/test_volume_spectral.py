@@ -215,9 +215,9 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
 
 def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     """A blackbody on an object that may read a temperature grid (a Volume object), one behind a
-    Mix shader, and a world volume: one-line RelativityError before any pass, never a picture with
-    RGB volumes; without the blackbody the grid object is accepted (its density grid only scales
-    every wavelength alike)."""
+    Mix shader, volume shaders inside a node group, and a world volume: one-line RelativityError
+    before any pass, never a picture with RGB volumes; without the blackbody the grid object is
+    accepted (its density grid only scales every wavelength alike)."""
     bpy = __import__("bpy")
     from importlib import import_module
 
@@ -248,6 +248,13 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     dh.add_box(bpy, scene, "Mixed", (-1.0, 1.0), (-1.0, 1.0), (-6.0, -4.0), mixed)
     assert "cannot make the blackbody of 'Principled Volume' in material 'Mixed'" in refusal()
     tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
+
+    inner = bpy.data.node_groups.new("Smoke Shader", "ShaderNodeTree")
+    inner.nodes.new("ShaderNodeVolumeAbsorption")
+    grouped = tree.nodes.new("ShaderNodeGroup")
+    grouped.node_tree = inner
+    assert "volume shaders inside the node group" in refusal()
+    tree.nodes.remove(grouped)
 
     world_tree = scene.world.node_tree
     world_volume = world_tree.nodes.new("ShaderNodeVolumeScatter")
