@@ -71,7 +71,8 @@ def remove_unused_data():
     """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
     if any(materials.is_attached(material) for material in bpy.data.materials):
         return False
-    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP, volumes.GROUP) + tuple(
+    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP, volumes.GROUP,
+                   volumes.COLOUR_GROUP) + tuple(
         builder().name for builder in reversed(materials.GROUP_BUILDERS)
     )
     for name in group_names:

@@ -38,7 +38,8 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 4  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4
+SHADER_GROUPS_VERSION = 5  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+# 5: volumes in spectral passes
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
@@ -91,3 +92,5 @@ LAMP_FACES_KEY = "relativity_lamp_faces"  # on the scene: {light object name: fa
 LAMP_FACE_SAVED_KEY = "relativity_lamp_face_saved"  # on light objects: the user's visible_camera
 VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-ray emission of a blackbody volume
 VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material
+VOLUME_COLOUR_GROUP = "Relativity Spectral Volume Colour"  # shader group: a volume colour, spectral in the passes
+VOLUME_COLOUR_NODE_PREFIX = "Relativity Spectral Volume"  # its nodes in front of volume colour inputs

@@ -113,3 +113,28 @@ def spectral_colour_group():
         (("Color", "NodeSocketColor", "out.Result"),),
         nodes,
     )
+
+
+def volume_colour_group():
+    """A volume shader's colour (``volumes.attach_colours``): unchanged outside the spectral passes
+    (volumes write no AOVs: the compositor shifts their pixels), its spectral values in them."""
+    nodes = {
+        "settings": group_node(names.SETTINGS_GROUP),
+        "spectral": group_node(SPECTRAL_COLOUR, {
+            "Color": "group.Color", "Temperature": "group.Temperature",
+            "Is Blackbody": "group.Is Blackbody", "Is Emission": "group.Is Emission"}),
+        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "group.Color", 5: "spectral"},
+                    {"data_type": "VECTOR"}),
+    }
+    return Group(
+        names.VOLUME_COLOUR_GROUP,
+        "ShaderNodeTree",
+        (
+            ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
+            ("Temperature", "NodeSocketFloat", 5762.0),
+            ("Is Blackbody", "NodeSocketFloat", 0.0),
+            ("Is Emission", "NodeSocketFloat", 0.0),
+        ),
+        (("Color", "NodeSocketColor", "out.Result"),),
+        nodes,
+    )

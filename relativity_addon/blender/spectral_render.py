@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import exposure, spectral_render
-from . import compositing, effect, materials, modifier, names, snapshot
+from . import compositing, effect, materials, modifier, names, snapshot, volumes
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
@@ -48,6 +48,9 @@ def check(scene):
         if moving:
             raise RelativityError(f"Spectral colour with Apparent Geometry: object {moving[0]!r} moves; each "
                                   "pixel's D is the observer's (use the fast colour for moving objects)")
+    problem = volumes.spectral_problem(scene)
+    if problem is not None:
+        raise RelativityError(problem)
     settings = scene.relativity
     if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
         raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "

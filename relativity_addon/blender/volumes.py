@@ -18,35 +18,65 @@ emitter, the volume does the exact shift itself and marks its pixels done:
   ``relativity_colour_done`` AOV where a camera ray enters the volume (front faces), so the
   compositor keeps those pixels; the material's ``ln D`` writer is muted.
 
-Approximation: the done mask keeps *everything* in the pixel as rendered, so what lies behind the
-volume (seen through it) is not shifted: right against a black background or a blackbody emitter,
-wrong in front of anything else. A camera inside the volume gets no mask (the volume is then
-shifted again by the compositor). ``D`` is the observer's (a volume at rest in the scene frame).
+Approximation (fast mode): the done mask keeps *everything* in the pixel as rendered, so what lies
+behind the volume (seen through it) is not shifted: right against a black background or a
+blackbody emitter, wrong in front of anything else. A camera inside the volume gets no mask (the
+volume is then shifted again by the compositor). ``D`` is the observer's (a volume at rest in the
+scene frame).
+
+**Spectral mode** (``spectral_render``): the passes carry volumes like surfaces, so nothing above is
+needed and what is seen through a volume is right too. In a pass the group's fast part and done
+mask are 0 (the compositor passes through), its ``Intensity`` output (linked into the Principled
+Volume's Blackbody Intensity) switches Cycles' RGB blackbody off, and its ``Color`` is ``E``'s
+spectral values: the blackbody at ``T`` with ``E``'s luminance (``spectral_nodes``, the surfaces'
+group; adding the spectral-minus-RGB difference instead was tried: 18 % off at 400 nm, where ``E``'s
+RGB is ~1e3 times the Planck value). :func:`attach_colours` puts ``spectral_nodes.volume_colour_group``
+(the colour unchanged outside the passes) in front of the volume colours (:data:`VOLUME_COLOURS`):
+Principled Volume Color and Absorption Color and the Volume Absorption / Scatter colours up-sampled
+as reflectances, which Cycles' per-channel formulas (``sigma_a = density max(1 - C, 0)
+max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wavelength; the
+Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
+Emission node in a volume has the materials' own group already. What cannot be made spectral is
+refused in one line (:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
 Blackbody Intensity and a constant or linked Temperature (a node field is followed per point).
 Not covered: a temperature grid (``Temperature Attribute``, e.g. a fire simulation: the added
 emission uses the Temperature input only; following the grid blows up the grid's cool edges,
-docs/spectral-model.md), a Principled Volume behind a Mix or Add shader or with a surface shader, the spectral mode
-(volumes stay RGB in every pass), and Apparent Geometry's boosted meshes.
+docs/spectral-model.md; refused by the spectral mode, whose passes cannot give a grid a spectrum), a
+Principled Volume behind a Mix or Add shader or with a surface shader (also refused by the spectral
+mode when it emits a blackbody), and Apparent Geometry's boosted meshes.
 """
 
 import math
 
 import bpy
 
-from . import materials, names, sources
+from . import materials, names, sources, spectral_nodes
 from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
 GROUP = names.VOLUME_BLACKBODY_GROUP
 NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX
+COLOUR_GROUP = names.VOLUME_COLOUR_GROUP
+COLOUR_PREFIX = names.VOLUME_COLOUR_NODE_PREFIX
+# (node type, input names) of volume colours made spectral in the passes (an Emission node in a
+# volume already has the materials' colour group); True: an emitted colour, else a reflectance-like
+# coefficient (scattering albedo, absorption colour), up-sampled as a reflectance.
+VOLUME_COLOURS = (
+    ("ShaderNodeVolumePrincipled", (("Color", False), ("Absorption Color", False), ("Emission Color", True))),
+    ("ShaderNodeVolumeAbsorption", (("Color", False),)),
+    ("ShaderNodeVolumeScatter", (("Color", False),)),
+)
+UNSUPPORTED_VOLUME_NODES = ("ShaderNodeVolumeCoefficients",)  # RGB coefficients: no spectrum to give them
 SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the Principled Volume
 
 
 def volume_blackbody_group():
     """``Color``: the emission to add to the volume (``X - E`` for camera rays on the exact camera's
-    path, 0 otherwise); ``Done``: 1 where the boundary marks the pixel as shifted."""
+    path, 0 otherwise; in a spectral pass ``E``'s spectral values); ``Done``: 1 where the boundary
+    marks the pixel as shifted; ``Intensity``: the Principled Volume's Blackbody Intensity (0 in a
+    spectral pass)."""
     nodes = {
         "settings": group_node(materials.SETTINGS),
         # the volume's own emission: tint sigma mix(1, T^4, intensity) B(T)
@@ -89,7 +119,15 @@ def volume_blackbody_group():
         "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
         "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
         "switch": fmath("MULTIPLY", "camera_ray", "fast"),
-        "out": vmath("SCALE", "difference", scale="switch"),
+        "fast_out": vmath("SCALE", "difference", scale="switch"),
+        # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
+        # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
+        # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
+        "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, {
+            "Color": "rest", "Temperature": "group.Temperature", "Is Blackbody": 1.0, "Is Emission": 1.0}),
+        "spectral_out": vmath("SCALE", "spectral", scale="settings.Spectral Pass"),
+        "out": vmath("ADD", "fast_out", "spectral_out"),
+        "intensity": fmath("MULTIPLY", "group.Intensity", "fast"),
         # the boundary where a camera ray enters the volume
         "front": fmath("SUBTRACT", 1.0, "geometry.Backfacing"),
         "done": fmath("MULTIPLY", "switch", "front"),
@@ -102,7 +140,8 @@ def volume_blackbody_group():
             ("Intensity", "NodeSocketFloat", 1.0),
             ("Tint", "NodeSocketFloat", 1.0),
         ),
-        (("Color", "NodeSocketColor", "out"), ("Done", "NodeSocketFloat", "done")),
+        (("Color", "NodeSocketColor", "out"), ("Done", "NodeSocketFloat", "done"),
+         ("Intensity", "NodeSocketFloat", "intensity")),
         nodes,
     )
 
@@ -116,6 +155,21 @@ def _volume_output(tree):
     return output, link.from_socket
 
 
+def _correctable(material):
+    """``(output, Principled Volume output socket, blackbody, intensity)`` where ``material``'s
+    volume is a Principled Volume blackbody the correction handles, else None."""
+    if material.node_tree is None:
+        return None
+    output, source = _volume_output(material.node_tree)
+    if output is None or source.node.bl_idname != "ShaderNodeVolumePrincipled" or output.inputs["Surface"].is_linked:
+        return None
+    blackbody = sources.volume_blackbody(source.node)
+    intensity = sources.constant_value(source.node.inputs["Blackbody Intensity"])
+    if blackbody is None or intensity is None:
+        return None
+    return output, source, blackbody, intensity
+
+
 def attach(material):
     """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
     (after ``materials.attach``, whose records restore it on detach). Returns whether it did."""
@@ -124,15 +178,12 @@ def attach(material):
     records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
     if any(record["group_node"].startswith(NODE_PREFIX) for record in records):
         return False
+    found = _correctable(material)
+    if found is None:
+        return False
     tree = material.node_tree
-    output, source = _volume_output(tree)
-    if output is None or source.node.bl_idname != "ShaderNodeVolumePrincipled" or output.inputs["Surface"].is_linked:
-        return False
+    output, source, blackbody, intensity = found
     node = source.node
-    blackbody = sources.volume_blackbody(node)
-    intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
-    if blackbody is None or intensity is None:
-        return False
     ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
     group = tree.nodes.new("ShaderNodeGroup")
     group.node_tree = bpy.data.node_groups[GROUP]
@@ -143,6 +194,7 @@ def attach(material):
         tree.links.new(blackbody.temperature, group.inputs["Temperature"])
     group.inputs["Intensity"].default_value = intensity
     group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+    tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
     tree.links.new(group.outputs["Color"], emission.inputs["Color"])
@@ -201,13 +253,106 @@ def grid_materials(scene):
     return found
 
 
+def attach_colours(material):
+    """Put the volume colour group (``spectral_nodes.volume_colour_group``: unchanged outside the
+    spectral passes) in front of every volume colour input of an attached ``material``
+    (:data:`VOLUME_COLOURS`), recorded like ``materials.attach``'s groups. Returns whether it did."""
+    if not materials.is_attached(material):
+        return False
+    records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
+    if any(record["group_node"].startswith(COLOUR_PREFIX) for record in records):
+        return False
+    tree = material.node_tree
+    targets = [(node, node.inputs[name], emitted) for node in list(tree.nodes) for kind, inputs in VOLUME_COLOURS
+               if node.bl_idname == kind for name, emitted in inputs]
+    if not targets:
+        return False
+    group_tree = ensure_group(spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY,
+                              names.SHADER_GROUPS_VERSION)
+    for target, socket, emitted in targets:
+        source = socket.links[0].from_socket if socket.is_linked else None
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = group_tree
+        node.name = node.label = f"{COLOUR_PREFIX} {target.name} {socket.identifier}"
+        node.location, node.hide = (target.location.x - 220.0, target.location.y), True
+        if source is not None:
+            tree.links.new(source, node.inputs["Color"])
+            blackbody = sources.blackbody_source(socket)
+            if blackbody is not None:
+                sources.mark_blackbody(tree, node, blackbody)
+        else:
+            node.inputs["Color"].default_value = socket.default_value
+        node.inputs["Is Emission"].default_value = 1.0 if emitted else 0.0
+        tree.links.new(node.outputs["Color"], socket)
+        records.append({"group_node": node.name, "target": target.name, "socket": socket.identifier,
+                        "source_node": source.node.name if source is not None else "",
+                        "source_socket": source.identifier if source is not None else "",
+                        "object_temperature": records[0]["object_temperature"] if records else 0.0})
+    material[materials.ATTACHED_KEY] = records
+    return True
+
+
 def attach_scene(scene):
     """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
-    except those on objects with temperature grids (:func:`grid_materials`)."""
+    except those on objects with temperature grids (:func:`grid_materials`); every volume colour
+    made spectral for the spectral passes (:func:`attach_colours`)."""
     skipped = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         if material not in skipped:
             attach(material)
+        attach_colours(material)
+
+
+def _emits_blackbody(node):
+    """Whether a Principled Volume may add its blackbody emission (intensity linked or above the cutoff)."""
+    intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+    return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
+
+
+def _volume_nodes_inside(tree, seen=()):
+    """Whether node group ``tree`` (or a group inside it) holds volume shader nodes."""
+    if tree is None or tree.name in seen:
+        return False
+    kinds = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
+    return any(node.bl_idname in kinds or (node.bl_idname == "ShaderNodeGroup"
+               and _volume_nodes_inside(node.node_tree, (*seen, tree.name))) for node in tree.nodes)
+
+
+def spectral_problem(scene):
+    """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
+    that may read a temperature grid (its emission varies with the grid, which has no spectrum in
+    the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
+    would stay RGB), a Volume Coefficients node, volume shaders inside a node group (only the
+    material's own nodes get the colour group), or a world volume."""
+    grids = grid_materials(scene)
+    for material, _temperature in materials.scene_materials(scene):
+        if material.node_tree is None:
+            continue
+        correctable = _correctable(material)
+        corrected = correctable[1].node if correctable is not None else None
+        for node in material.node_tree.nodes:
+            where = f"{node.name!r} in material {material.name!r}"
+            if node.bl_idname == "ShaderNodeGroup" and _volume_nodes_inside(node.node_tree):
+                return f"Spectral colour cannot make the volume shaders inside the node group {where} spectral"
+            if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
+                return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
+            if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:
+                continue
+            if material in grids and _emits_blackbody(node):
+                return (f"Spectral colour cannot follow temperature grids: the blackbody of {where} on "
+                        f"{grids[material]!r} varies with its grid (set Blackbody Intensity to 0)")
+            if material in grids and node.inputs["Color Attribute"].default_value:
+                return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
+            attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
+            if _emits_blackbody(node) and node != corrected and not attached:
+                return (f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint, a "
+                        "constant intensity and the Principled Volume alone on the Volume output")
+    world = scene.world
+    tree = world.node_tree if world is not None else None
+    if tree is not None and any(node.bl_idname == "ShaderNodeOutputWorld" and node.inputs["Volume"].is_linked
+                                for node in tree.nodes):
+        return f"Spectral colour does not cover world volumes (world {world.name!r})"
+    return None
 
 
 def warnings(scene):

@@ -112,3 +112,97 @@ def delta_e_2000_normalised(xyz_a, xyz_b):
     lab_a = colour.XYZ_to_Lab(np.asarray(xyz_a) / xyz_a[1], white)
     lab_b = colour.XYZ_to_Lab(np.asarray(xyz_b) / xyz_b[1], white)
     return float(colour.delta_E(lab_a, lab_b, method="CIE 2000"))
+
+
+# --- volumes and spectra (shared by the volume and lit-scene tests) -------------------------------
+
+
+def volume_material(bpy, name, kind="ShaderNodeVolumePrincipled", **inputs):
+    """A material whose Volume output is one ``kind`` node with these input values (colours as RGB)."""
+    from relativity_addon.blender import compat
+
+    material = bpy.data.materials.new(name)
+    tree = compat.material_node_tree(material)
+    tree.nodes.clear()
+    volume = tree.nodes.new(kind)
+    for socket, value in inputs.items():
+        socket = socket.replace("_", " ")
+        volume.inputs[socket].default_value = (*value, 1.0) if isinstance(value, tuple) else value
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(volume.outputs[0], output.inputs["Volume"])
+    return material
+
+
+def add_box(bpy, scene, name, x_range, y_range, z_range, material):
+    """An axis-aligned closed box (outward faces) with ``material``."""
+    mesh = bpy.data.meshes.new(name)
+    corners = [(x, y, z) for x in x_range for y in y_range for z in z_range]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    mesh.from_pydata(corners, [], faces)
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def scene_frame_directions(bpy, scene, camera, beta):
+    """Per pixel, the photon's propagation direction in the scene frame: the pixel's direction in
+    the moving camera's frame aberrated back (docs/physics.md)."""
+    seen = pixel_photon_directions(bpy, scene, camera)
+    beta = -np.asarray(beta, float)
+    return np.array([ch.aberrate(k, beta) for k in seen.reshape(-1, 3)]).reshape(seen.shape)
+
+
+def pixel_doppler(bpy, scene, camera, beta):
+    """``D = 1 / (gamma (1 - beta.d))`` at every pixel centre, ``d`` its viewing direction."""
+    view = -pixel_photon_directions(bpy, scene, camera)
+    beta = np.asarray(beta, float)
+    gamma = 1.0 / math.sqrt(1.0 - beta @ beta)
+    return 1.0 / (gamma * (1.0 - view @ beta))
+
+
+def cmfs_1nm():
+    """CIE 1931 2 degree functions on 360-830 nm at 1 nm: (wavelengths, (W, 3) values)."""
+    import colour
+
+    shape = colour.SpectralShape(360, 830, 1)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    return cmfs.wavelengths, cmfs.values
+
+
+def planck(wavelength_nm, temperature):
+    from colour.colorimetry import planck_law
+
+    with np.errstate(over="ignore"):
+        return planck_law(np.asarray(wavelength_nm) * 1e-9, temperature)
+
+
+def mallett_reflectance(rgb, wavelength_nm):
+    """Mallett & Yuksel's sRGB basis with weights ``rgb``, held at the 420-655 nm band's edge values
+    outside it (the add-on's documented extension, docs/spectral-model.md)."""
+    import colour
+
+    basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
+    clipped = np.clip(wavelength_nm, 420.0, 655.0)
+    values = np.stack([np.interp(clipped, basis.wavelengths, basis.values[:, i]) for i in range(3)], -1)
+    return values @ np.asarray(rgb, float)
+
+
+def emitted_spectrum(rgb):
+    """``S(mu)`` of an emitted linear Rec.709 colour as docs/spectral-model.md defines it: the basis
+    in 6504 K white light, weighted so that its CIE integral (1 nm sum) at rest is ``rgb``'s XYZ."""
+    wavelengths, cmfs = cmfs_1nm()
+    white = planck(wavelengths, 6504.0)
+    columns = np.stack([cmfs.T @ (white * mallett_reflectance(np.eye(3)[i], wavelengths)) for i in range(3)], -1)
+    weights = np.linalg.solve(columns, linear_rec709_to_xyz(rgb))
+
+    def spectrum(mu):
+        return planck(mu, 6504.0) * mallett_reflectance(weights, mu)
+
+    return spectrum
+
+
+def observed_xyz(spectrum, doppler):
+    """XYZ of ``D^5 L(lambda D)`` for a scene-frame spectral radiance ``spectrum(mu)`` (per nm)."""
+    wavelengths, cmfs = cmfs_1nm()
+    return doppler**5 * spectrum(wavelengths * doppler) @ cmfs

@@ -27,48 +27,12 @@ PASSES = 4
 # --- references (colour-science, 1 nm) ------------------------------------------------------------
 
 
-def _cmfs():
-    import colour
-
-    shape = colour.SpectralShape(360, 830, 1)
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
-    return cmfs.wavelengths, cmfs.values
-
-
-def _planck(wavelength_nm, temperature):
-    from colour.colorimetry import planck_law
-
-    with np.errstate(over="ignore"):
-        return planck_law(np.asarray(wavelength_nm) * 1e-9, temperature)
-
-
-def _mallett_reflectance(rgb, wavelength_nm):
-    """Mallett & Yuksel's sRGB basis with weights ``rgb``, held at the 420-655 nm band's edge values
-    outside it (the add-on's documented extension, docs/spectral-model.md)."""
-    import colour
-
-    basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
-    clipped = np.clip(wavelength_nm, 420.0, 655.0)
-    values = np.stack([np.interp(clipped, basis.wavelengths, basis.values[:, i]) for i in range(3)], -1)
-    return values @ np.asarray(rgb, float)
-
-
-def _observed_xyz(spectrum, doppler):
-    """XYZ of ``D^5 L(lambda D)`` for a scene-frame spectral radiance ``spectrum(mu)``."""
-    wavelengths, cmfs = _cmfs()
-    observed = doppler**5 * spectrum(wavelengths * doppler)
-    return observed @ cmfs
-
-
-def _xyz(rgb):
-    return dh.linear_rec709_to_xyz(rgb)
-
-
-def _pixel_doppler(bpy, scene, camera, beta):
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
-    beta = np.asarray(beta, float)
-    gamma = 1.0 / math.sqrt(1.0 - beta @ beta)
-    return 1.0 / (gamma * (1.0 - view @ beta))
+_cmfs = dh.cmfs_1nm
+_planck = dh.planck
+_mallett_reflectance = dh.mallett_reflectance  # held at the 420-655 nm band's edge values outside it
+_observed_xyz = dh.observed_xyz  # XYZ of D^5 L(lambda D)
+_xyz = dh.linear_rec709_to_xyz
+_pixel_doppler = dh.pixel_doppler
 
 
 # --- scenes ---------------------------------------------------------------------------------------
