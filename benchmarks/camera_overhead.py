@@ -2,10 +2,11 @@
 
     python benchmarks/camera_overhead.py [--samples 128] [--resolution 160x120] [--repeats 5]
 
-Same lit scene (with Blender's default constant world), same seed, Cycles on the CPU. The cameras are rendered alternately (perspective,
-relativistic at rest, relativistic at speed, then again) so that load from other processes hits
-all of them alike; each round's times are divided by that round's perspective time and the
-median ratio over the rounds is printed, next to the median times.
+Same lit scene (with Blender's default constant world), same seed, Cycles on the CPU. The
+cameras are rendered alternately (perspective, relativistic at rest, relativistic at speed, then
+again) so that load from other processes hits all of them alike; each round's times are divided
+by that round's perspective time and the median ratio over the rounds is printed, next to the
+median times.
 At beta = 0 both cameras trace the same rays, so the ratio is the camera's own cost; at speed
 the view itself changes (more or less geometry in frame), which is not camera overhead.
 """
