@@ -230,9 +230,7 @@ def doppler_colour_group():
         "bb_select": fmath("MULTIPLY", "group.Is Blackbody", "shifted_ray"),
         "fast": Node("ShaderNodeMix", {"Factor": "bb_select", 4: "rgb_out.Result", 5: "bb_out"},
                      {"data_type": "VECTOR"}),
-        "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, {
-            "Color": "group.Color", "Temperature": "group.Temperature",
-            "Is Blackbody": "group.Is Blackbody", "Is Emission": "group.Is Emission"}),
+        "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, spectral_nodes.COLOUR_LINKS),
         # A moving emitter behind the exact camera (Apparent Geometry's final render): the camera
         # applies the observer's D_o^4 only, the compositor divides by the whole D^4; the rest, D_s^4
         "emitter_power": fmath("MULTIPLY", "settings.Camera Power", "light_path.Is Camera Ray"),
@@ -249,12 +247,7 @@ def doppler_colour_group():
     return Group(
         DOPPLER_EMISSION,
         "ShaderNodeTree",
-        (
-            ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
-            ("Temperature", "NodeSocketFloat", 5762.0),
-            ("Is Blackbody", "NodeSocketFloat", 0.0),
-            ("Is Emission", "NodeSocketFloat", 0.0),
-        ),
+        spectral_nodes.COLOUR_INPUTS,
         (("Color", "NodeSocketColor", "out.Result"),),
         nodes,
     )

@@ -32,6 +32,16 @@ ROWS = tuple(f"Reflectance {i}" for i in range(3)) + tuple(f"Emission {i}" for i
 VECTORS = ROWS + ("Planck Prefactors", "Planck Numerators")
 
 
+# The inputs of every colour group: a colour, its blackbody temperature and what it is; and the
+# links that hand a group's own inputs on to an inner colour group.
+COLOUR_INPUTS = (
+    ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
+    ("Temperature", "NodeSocketFloat", 5762.0),
+    ("Is Blackbody", "NodeSocketFloat", 0.0),
+    ("Is Emission", "NodeSocketFloat", 0.0),
+)
+COLOUR_LINKS = {name: f"group.{name}" for name, _kind, _default in COLOUR_INPUTS}
+
 def settings_nodes():
     """Nodes of the settings group for the spectral pass (outputs named like the nodes)."""
     nodes = {"Spectral Pass": Node("ShaderNodeValue")}
@@ -104,12 +114,7 @@ def spectral_colour_group():
     return Group(
         SPECTRAL_COLOUR,
         "ShaderNodeTree",
-        (
-            ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
-            ("Temperature", "NodeSocketFloat", 5762.0),
-            ("Is Blackbody", "NodeSocketFloat", 0.0),
-            ("Is Emission", "NodeSocketFloat", 0.0),
-        ),
+        COLOUR_INPUTS,
         (("Color", "NodeSocketColor", "out.Result"),),
         nodes,
     )
@@ -120,21 +125,14 @@ def volume_colour_group():
     (volumes write no AOVs: the compositor shifts their pixels), its spectral values in them."""
     nodes = {
         "settings": group_node(names.SETTINGS_GROUP),
-        "spectral": group_node(SPECTRAL_COLOUR, {
-            "Color": "group.Color", "Temperature": "group.Temperature",
-            "Is Blackbody": "group.Is Blackbody", "Is Emission": "group.Is Emission"}),
+        "spectral": group_node(SPECTRAL_COLOUR, COLOUR_LINKS),
         "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "group.Color", 5: "spectral"},
                     {"data_type": "VECTOR"}),
     }
     return Group(
         names.VOLUME_COLOUR_GROUP,
         "ShaderNodeTree",
-        (
-            ("Color", "NodeSocketColor", (1.0, 1.0, 1.0, 1.0)),
-            ("Temperature", "NodeSocketFloat", 5762.0),
-            ("Is Blackbody", "NodeSocketFloat", 0.0),
-            ("Is Emission", "NodeSocketFloat", 0.0),
-        ),
+        COLOUR_INPUTS,
         (("Color", "NodeSocketColor", "out.Result"),),
         nodes,
     )
