@@ -39,8 +39,10 @@ def compositor_group():
     scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
     nodes = {}
     nodes.update({
-        # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group)
-        "ln_d": fmath("ADD", "group.Log Doppler", 0.0),
+        # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group), the mean
+        # over the samples that wrote it (a camera ray scattered in a volume writes none)
+        "coverage": fmath("MAXIMUM", "group.Coverage", 1e-3),
+        "ln_d": fmath("DIVIDE", "group.Log Doppler", "coverage"),
         # Linear interpolation between the two nearest texels, done here with two nearest-texel
         # reads (Blender 4.5's Map UV has no bilinear mode nor an Extend border): x is the texel
         # coordinate, clamped to the table (= Extend), i0 the left texel, at most size - 2.
@@ -95,6 +97,7 @@ def compositor_group():
             ("Image", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
             ("Log Doppler", "NodeSocketFloat", 0.0),
             ("Done", "NodeSocketFloat", 0.0),
+            ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
         (("Image", "NodeSocketColor", "out"),),
@@ -177,7 +180,7 @@ def apply_colour_stage(scene, snap):
             tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
         for view_layer in scene.view_layers:
-            for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV):
+            for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
                     aov = view_layer.aovs.add()
                     aov.name = aov_name
@@ -191,7 +194,8 @@ def apply_colour_stage(scene, snap):
             node.name = node.label = f"{COMPOSITOR_GROUP} {layers.name}"
             node.location = (layers.location.x + 250.0, layers.location.y)
             tree.links.new(image, node.inputs["Image"])
-            for aov_name, socket_name in ((materials.DONE_AOV, "Done"), (materials.LOG_DOPPLER_AOV, "Log Doppler")):
+            for aov_name, socket_name in ((materials.DONE_AOV, "Done"), (materials.LOG_DOPPLER_AOV, "Log Doppler"),
+                                          (materials.COVERAGE_AOV, "Coverage")):
                 aov_output = layers.outputs.get(aov_name)
                 if aov_output is not None:
                     tree.links.new(aov_output, node.inputs[socket_name])

@@ -45,6 +45,7 @@ BLACKBODY_SHIFT = names.BLACKBODY_SHIFT_GROUP
 DOPPLER_EMISSION = names.DOPPLER_COLOUR_GROUP
 DOPPLER_AOV = names.DOPPLER_AOV_GROUP
 LOG_DOPPLER_AOV = names.LOG_DOPPLER_AOV
+COVERAGE_AOV = names.COVERAGE_AOV
 
 LN10 = math.log(10.0)
 E = math.e
@@ -254,7 +255,9 @@ def doppler_colour_group():
 
 
 def doppler_aov_group():
-    """Writes ``ln D`` of the first camera hit to the ``relativity_log_doppler`` AOV.
+    """Writes ``ln D`` of the first camera hit to the ``relativity_log_doppler`` AOV, and 1 to the
+    ``relativity_coverage`` AOV: samples that write neither (a camera ray scattered in a volume)
+    would otherwise dilute the pixel's mean ``ln D``; the compositor divides by the coverage.
 
     The exact camera's compositor stage reads ``D`` from it: computed by Cycles per sample from
     the scene-frame photon direction, so it is right for every shutter model, depth of field and
@@ -264,6 +267,7 @@ def doppler_aov_group():
         "settings": group_node(SETTINGS),
         "doppler": group_node(DOPPLER_FACTOR, {"Observer Beta": "settings.Observer Beta"}),
         "aov": Node("ShaderNodeOutputAOV", {"Value": "doppler"}, {"aov_name": LOG_DOPPLER_AOV}),
+        "coverage": Node("ShaderNodeOutputAOV", {"Value": 1.0}, {"aov_name": COVERAGE_AOV}),
     }
     return Group(DOPPLER_AOV, "ShaderNodeTree", (), (), nodes)
 

@@ -38,17 +38,19 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 5  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
-# 5: volumes in spectral passes
+SHADER_GROUPS_VERSION = 6  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+# 5: volumes in spectral passes; 6: the coverage AOV
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
 COMPOSITOR_GROUP = "Relativity Doppler Compositor"
 COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
-COMPOSITOR_GROUPS_VERSION = 4  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear)
+COMPOSITOR_GROUPS_VERSION = 5  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
+# 5: ln D over the coverage AOV
 COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
 COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
 LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit
+COVERAGE_AOV = "relativity_coverage"  # 1 with it: the pixel's share of samples that wrote ln D
 COLOUR_DONE_AOV = "relativity_colour_done"  # 1 where a material already shifted the colour
 
 # --- spectral mode -------------------------------------------------------------------------

@@ -208,6 +208,9 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
               f"Y/expected {fast_xyz[1] / expected[1]:.4f}")
         assert delta_e < 2.0, side
         assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05), side
+        # The fast mode: the RGB model's error only. Before the coverage AOV the samples scattered in
+        # the volume diluted the pixel's ln D (Delta E 13 on 5.2, 38-44 on 4.5, Y 0.68).
+        assert dh.delta_e_2000_normalised(fast_xyz, expected) < 2.5, side
     assert math.isfinite(float(spectral.sum()))
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert state() == before
