@@ -9,7 +9,9 @@ spectral Doppler matrix per pixel after the render, with no second render:
   ``D = gamma (1 - beta . k)`` with ``k`` the scene-frame photon direction (the Incoming vector)
   and ``beta`` the observer velocity (docs/physics.md). Computed by Cycles per sample, so it holds
   for every shutter model, depth of field and the Lorentz window, and it follows the velocity
-  frame by frame in animation renders.
+  frame by frame in animation renders. It is divided by the ``relativity_coverage`` AOV (1 from
+  every writer): a camera ray scattered in a volume writes neither, and would otherwise pull the
+  pixel's mean ``ln D`` toward 0.
 - ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),
   and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
   (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
