@@ -358,6 +358,26 @@ def colour_targets(material):
                         yield node, socket
 
 
+def grouped_colour_node(tree, seen=()):
+    """``(group node, inner node)``: the first node of a kind in :data:`COLOUR_INPUTS` inside a
+    node group of ``tree`` (at any depth; the add-on's own groups aside), or None. The colour
+    group goes in front of a material's own nodes only, so such a colour stays RGB."""
+    if tree is None or tree.name in seen:
+        return None
+    kinds = {kind for kind, _inputs in COLOUR_INPUTS}
+    for node in tree.nodes:
+        if node.bl_idname != "ShaderNodeGroup" or node.node_tree is None \
+                or node.name.startswith(names.MATERIAL_NODE_PREFIX):
+            continue
+        inner = next((n for n in node.node_tree.nodes if n.bl_idname in kinds), None)
+        if inner is None:
+            found = grouped_colour_node(node.node_tree, (*seen, tree.name))
+            inner = found[1] if found is not None else None
+        if inner is not None:
+            return node, inner
+    return None
+
+
 def mark_blackbody(tree, node, blackbody):
     """Colour group ``node`` shifts its colour as a blackbody (``sources.Blackbody``)."""
     node.inputs["Is Blackbody"].default_value = 1.0

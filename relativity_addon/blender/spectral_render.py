@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import exposure, spectral_render
-from . import compositing, effect, materials, modifier, names, snapshot, volumes
+from . import compositing, effect, materials, modifier, names, snapshot, sources, volumes
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
@@ -51,6 +51,11 @@ def check(scene):
     problem = volumes.spectral_problem(scene)
     if problem is not None:
         raise RelativityError(problem)
+    for material, _temperature in materials.scene_materials(scene):
+        found = sources.grouped_colour_node(material.node_tree)
+        if found is not None:
+            raise RelativityError(f"Spectral colour cannot make {found[1].name!r} inside the node group "
+                                  f"{found[0].name!r} of material {material.name!r} spectral: ungroup it")
     settings = scene.relativity
     if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
         raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "
