@@ -27,24 +27,8 @@ def _scene(bpy):
     scene, camera = dh.emitter_scene(bpy, samples=32, resolution=RESOLUTION)
     dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
                          temperature=TEMPERATURE)
-    material = bpy.data.materials.new("Gas")
-    from relativity_addon.blender import compat
-
-    tree = compat.material_node_tree(material)
-    tree.nodes.clear()
-    volume = tree.nodes.new("ShaderNodeVolumePrincipled")
-    volume.inputs["Density"].default_value = 0.0
-    volume.inputs["Blackbody Intensity"].default_value = 1.0
-    volume.inputs["Temperature"].default_value = TEMPERATURE
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(volume.outputs[0], output.inputs["Volume"])
-    mesh = bpy.data.meshes.new("Gas")
-    corners = [(x, y, z) for x in (-4.0, -0.2) for y in (-2.0, 2.0) for z in (-6.0, -4.0)]
-    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    mesh.from_pydata(corners, [], faces)
-    mesh.materials.append(material)
-    gas = bpy.data.objects.new("Gas", mesh)
-    scene.collection.objects.link(gas)
+    material = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
+    dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), material)
     return scene, camera, material
 
 

@@ -25,14 +25,9 @@ HALVES = {"cool": (2500.0, (slice(20, 28), slice(18, 26))), "hot": (4000.0, (sli
 
 def _scene(bpy):
     scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
-    from relativity_addon.blender import compat
-
-    material = bpy.data.materials.new("Field")
-    tree = compat.material_node_tree(material)
-    tree.nodes.clear()
-    volume = tree.nodes.new("ShaderNodeVolumePrincipled")
-    volume.inputs["Density"].default_value = 0.0
-    volume.inputs["Blackbody Intensity"].default_value = 1.0
+    material = dh.volume_material(bpy, "Field", Density=0.0, Blackbody_Intensity=1.0)
+    tree = material.node_tree
+    volume = tree.nodes["Principled Volume"]
     # T = 2500 K + 1500 K (x > 0)
     position = tree.nodes.new("ShaderNodeNewGeometry")
     split = tree.nodes.new("ShaderNodeSeparateXYZ")
@@ -47,14 +42,7 @@ def _scene(bpy):
     temperature.inputs[2].default_value = HALVES["cool"][0]
     tree.links.new(side.outputs[0], temperature.inputs[0])
     tree.links.new(temperature.outputs[0], volume.inputs["Temperature"])
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    tree.links.new(volume.outputs[0], output.inputs["Volume"])
-    mesh = bpy.data.meshes.new("Field")
-    corners = [(x, y, z) for x in (-3.0, 3.0) for y in (-2.0, 2.0) for z in (-6.0, -4.0)]
-    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    mesh.from_pydata(corners, [], faces)
-    mesh.materials.append(material)
-    scene.collection.objects.link(bpy.data.objects.new("Field", mesh))
+    dh.add_box(bpy, scene, "Field", (-3.0, 3.0), (-2.0, 2.0), (-6.0, -4.0), material)
     return scene, camera, material
 
 
