@@ -365,44 +365,50 @@ def attach(material, temperature=None):
     tree = material.node_tree
     records = []
     for target_node, socket in list(sources.colour_targets(material)):
-        source = socket.links[0].from_socket if socket.is_linked else None
-        blackbody = sources.blackbody_source(socket)  # through reroutes, mixes, groups
-        node = tree.nodes.new("ShaderNodeGroup")
-        node.node_tree = group
-        node.name = node.label = f"{NODE_PREFIX} {target_node.name} {socket.identifier}"
-        node.location = (target_node.location.x - 220.0, target_node.location.y)
-        node.hide = True
-        if source is not None:
-            tree.links.new(source, node.inputs["Color"])
-            if blackbody is not None:
-                sources.mark_blackbody(tree, node, blackbody)
-        else:
-            node.inputs["Color"].default_value = socket.default_value
         is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
-        node.inputs["Is Emission"].default_value = 1.0 if is_emission else 0.0
+        node, record = insert_colour_group(tree, group, NODE_PREFIX, target_node, socket, is_emission)
         if temperature and is_emission and not node.inputs["Is Blackbody"].default_value:
             node.inputs["Is Blackbody"].default_value = 1.0
             node.inputs["Temperature"].default_value = temperature
-        tree.links.new(node.outputs["Color"], socket)
-        records.append(
-            {
-                "group_node": node.name,
-                "target": target_node.name,
-                "socket": socket.identifier,
-                "source_node": source.node.name if source is not None else "",
-                "source_socket": source.identifier if source is not None else "",
-            }
-        )
+        records.append(record)
     object_temperature = float(temperature or 0.0)
-    aov = tree.nodes.new("ShaderNodeGroup")
-    aov.node_tree = bpy.data.node_groups[DOPPLER_AOV]
-    aov.name = aov.label = f"{NODE_PREFIX} AOV"
-    aov.hide = True
-    records.append({"group_node": aov.name, "target": "", "socket": "", "source_node": "", "source_socket": ""})
+    records.append(_insert_aov_writer(tree))
     for record in records:
         record["object_temperature"] = object_temperature  # what attach_scene compares to re-attach
     material[ATTACHED_KEY] = records
     return True
+
+
+def insert_colour_group(tree, group_tree, prefix, target_node, socket, is_emission):
+    """Put colour group ``group_tree`` (inputs ``spectral_nodes.COLOUR_INPUTS``) in front of
+    ``socket`` of ``target_node``, a colour fed by a Blackbody (through reroutes, mixes, groups)
+    marked as one; returns the group node and the record :func:`detach` undoes it by."""
+    source = socket.links[0].from_socket if socket.is_linked else None
+    blackbody = sources.blackbody_source(socket)
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group_tree
+    node.name = node.label = f"{prefix} {target_node.name} {socket.identifier}"
+    node.location, node.hide = (target_node.location.x - 220.0, target_node.location.y), True
+    if source is not None:
+        tree.links.new(source, node.inputs["Color"])
+    else:
+        node.inputs["Color"].default_value = socket.default_value
+    if blackbody is not None:
+        sources.mark_blackbody(tree, node, blackbody)
+    node.inputs["Is Emission"].default_value = 1.0 if is_emission else 0.0
+    tree.links.new(node.outputs["Color"], socket)
+    return node, {"group_node": node.name, "target": target_node.name, "socket": socket.identifier,
+                  "source_node": source.node.name if source is not None else "",
+                  "source_socket": source.identifier if source is not None else ""}
+
+
+def _insert_aov_writer(tree):
+    """The Doppler AOV group in ``tree`` (it writes the pixel's ``ln D``); its record."""
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = bpy.data.node_groups[DOPPLER_AOV]
+    node.name = node.label = f"{NODE_PREFIX} AOV"
+    node.hide = True
+    return {"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
 
 
 def detach(material):
@@ -463,32 +469,12 @@ def attach_world(world):
     if world is None or world.node_tree is None or ATTACHED_KEY in world:
         return False
     tree = world.node_tree
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = bpy.data.node_groups[DOPPLER_AOV]
-    node.name = node.label = f"{NODE_PREFIX} AOV"
-    node.hide = True
-    records = [{"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}]
+    records = [_insert_aov_writer(tree)]
     for background in [n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground"]:
         # every background colour: the fast mode shifts only blackbodies here (the compositor the
         # rest), a spectral pass needs all of them as emitted spectra
-        socket = background.inputs["Color"]
-        source = socket.links[0].from_socket if socket.is_linked else None
-        group = tree.nodes.new("ShaderNodeGroup")
-        group.node_tree = bpy.data.node_groups[DOPPLER_EMISSION]
-        group.name = group.label = f"{NODE_PREFIX} {background.name} {socket.identifier}"
-        group.location, group.hide = (background.location.x - 220.0, background.location.y), True
-        if source is not None:
-            tree.links.new(source, group.inputs["Color"])
-        else:
-            group.inputs["Color"].default_value = socket.default_value
-        blackbody = sources.blackbody_source(socket)
-        if blackbody is not None:
-            sources.mark_blackbody(tree, group, blackbody)
-        group.inputs["Is Emission"].default_value = 1.0
-        tree.links.new(group.outputs["Color"], socket)
-        records.append({"group_node": group.name, "target": background.name, "socket": socket.identifier,
-                        "source_node": source.node.name if source else "", "source_socket": source.identifier
-                        if source else ""})
+        group = bpy.data.node_groups[DOPPLER_EMISSION]
+        records.append(insert_colour_group(tree, group, NODE_PREFIX, background, background.inputs["Color"], True)[1])
     world[ATTACHED_KEY] = records
     return True
 

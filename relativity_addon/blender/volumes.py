@@ -69,6 +69,7 @@ VOLUME_COLOURS = (
     ("ShaderNodeVolumeScatter", (("Color", False),)),
 )
 UNSUPPORTED_VOLUME_NODES = ("ShaderNodeVolumeCoefficients",)  # RGB coefficients: no spectrum to give them
+VOLUME_KINDS = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
 SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the Principled Volume
 
 
@@ -270,24 +271,9 @@ def attach_colours(material):
     group_tree = ensure_group(spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY,
                               names.SHADER_GROUPS_VERSION)
     for target, socket, emitted in targets:
-        source = socket.links[0].from_socket if socket.is_linked else None
-        node = tree.nodes.new("ShaderNodeGroup")
-        node.node_tree = group_tree
-        node.name = node.label = f"{COLOUR_PREFIX} {target.name} {socket.identifier}"
-        node.location, node.hide = (target.location.x - 220.0, target.location.y), True
-        if source is not None:
-            tree.links.new(source, node.inputs["Color"])
-            blackbody = sources.blackbody_source(socket)
-            if blackbody is not None:
-                sources.mark_blackbody(tree, node, blackbody)
-        else:
-            node.inputs["Color"].default_value = socket.default_value
-        node.inputs["Is Emission"].default_value = 1.0 if emitted else 0.0
-        tree.links.new(node.outputs["Color"], socket)
-        records.append({"group_node": node.name, "target": target.name, "socket": socket.identifier,
-                        "source_node": source.node.name if source is not None else "",
-                        "source_socket": source.identifier if source is not None else "",
-                        "object_temperature": records[0]["object_temperature"] if records else 0.0})
+        _node, record = materials.insert_colour_group(tree, group_tree, COLOUR_PREFIX, target, socket, emitted)
+        record["object_temperature"] = records[0]["object_temperature"] if records else 0.0
+        records.append(record)
     material[materials.ATTACHED_KEY] = records
     return True
 
@@ -309,15 +295,6 @@ def _emits_blackbody(node):
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
 
 
-def _volume_nodes_inside(tree, seen=()):
-    """Whether node group ``tree`` (or a group inside it) holds volume shader nodes."""
-    if tree is None or tree.name in seen:
-        return False
-    kinds = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
-    return any(node.bl_idname in kinds or (node.bl_idname == "ShaderNodeGroup"
-               and _volume_nodes_inside(node.node_tree, (*seen, tree.name))) for node in tree.nodes)
-
-
 def spectral_problem(scene):
     """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
     that may read a temperature grid (its emission varies with the grid, which has no spectrum in
@@ -328,12 +305,14 @@ def spectral_problem(scene):
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
             continue
+        grouped = sources.grouped_node(material.node_tree, VOLUME_KINDS)
+        if grouped is not None:
+            return (f"Spectral colour cannot make the volume shaders inside the node group {grouped[0].name!r} "
+                    f"in material {material.name!r} spectral")
         correctable = _correctable(material)
         corrected = correctable[1].node if correctable is not None else None
         for node in material.node_tree.nodes:
             where = f"{node.name!r} in material {material.name!r}"
-            if node.bl_idname == "ShaderNodeGroup" and _volume_nodes_inside(node.node_tree):
-                return f"Spectral colour cannot make the volume shaders inside the node group {where} spectral"
             if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
                 return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
             if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:
