@@ -118,8 +118,7 @@ def _facing_camera(obj, snap):
     """An area light is seen from the front (its local -Z side); a point light from everywhere."""
     if obj.data.type != "AREA":
         return True
-    camera = Matrix(snap.camera_matrix).translation
-    return (obj.matrix_world.inverted_safe() @ camera).z < 0.0
+    return (obj.matrix_world.inverted_safe() @ Vector(snap.camera_position)).z < 0.0
 
 
 def _sun_distance(scene, snap):
@@ -252,7 +251,7 @@ def drawable(obj, snap):
     """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
     if obj.data.type not in KINDS or not _facing_camera(obj, snap):
         return None
-    scale = _radiance_scale(obj, Matrix(snap.camera_matrix).translation)
+    scale = _radiance_scale(obj, Vector(snap.camera_position))
     emission = _emission(obj.data)
     if scale is None or emission is None:
         return None
@@ -319,4 +318,4 @@ def warnings(scene, snap):
             "with what lies behind it (docs/moving-lights.md)"
             for obj in _candidates(scene, snap) if obj.name not in record and _has_extent(obj.data)
             and _facing_camera(obj, snap)
-            and (obj.data.type != "SPOT" or _spot_mask(obj, Matrix(snap.camera_matrix).translation) > 0.0)]
+            and (obj.data.type != "SPOT" or _spot_mask(obj, Vector(snap.camera_position)) > 0.0)]

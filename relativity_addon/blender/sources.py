@@ -358,20 +358,25 @@ def colour_targets(material):
                         yield node, socket
 
 
-def grouped_colour_node(tree, seen=()):
+def grouped_colour_node(tree):
     """``(group node, inner node)``: the first node of a kind in :data:`COLOUR_INPUTS` inside a
-    node group of ``tree`` (at any depth; the add-on's own groups aside), or None. The colour
-    group goes in front of a material's own nodes only, so such a colour stays RGB."""
+    node group of ``tree``, or None (:func:`grouped_node`). The colour group goes in front of a
+    material's own nodes only, so such a colour stays RGB."""
+    return grouped_node(tree, {kind for kind, _inputs in COLOUR_INPUTS})
+
+
+def grouped_node(tree, kinds, seen=()):
+    """``(group node, inner node)``: the first node whose type is in ``kinds`` inside a node
+    group of ``tree`` (at any depth; the add-on's own groups aside), or None."""
     if tree is None or tree.name in seen:
         return None
-    kinds = {kind for kind, _inputs in COLOUR_INPUTS}
     for node in tree.nodes:
         if node.bl_idname != "ShaderNodeGroup" or node.node_tree is None \
                 or node.name.startswith(names.MATERIAL_NODE_PREFIX):
             continue
         inner = next((n for n in node.node_tree.nodes if n.bl_idname in kinds), None)
         if inner is None:
-            found = grouped_colour_node(node.node_tree, (*seen, tree.name))
+            found = grouped_node(node.node_tree, kinds, (*seen, tree.name))
             inner = found[1] if found is not None else None
         if inner is not None:
             return node, inner
