@@ -25,7 +25,7 @@ import math
 
 import bpy
 
-from . import luts, names, sources, spectral_nodes
+from . import grouped_colours, luts, names, sources, spectral_nodes
 from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
@@ -364,8 +364,7 @@ def attach(material, temperature=None):
     group = bpy.data.node_groups.get(DOPPLER_EMISSION) or ensure_node_groups()
     tree = material.node_tree
     records = []
-    for target_node, socket in list(sources.colour_targets(material)):
-        is_emission = target_node.bl_idname == "ShaderNodeEmission" or socket.name == "Emission Color"
+    for target_node, socket, is_emission in list(grouped_colours.targets(tree)):
         node, record = insert_colour_group(tree, group, NODE_PREFIX, target_node, socket, is_emission)
         if temperature and is_emission and not node.inputs["Is Blackbody"].default_value:
             node.inputs["Is Blackbody"].default_value = 1.0
@@ -376,6 +375,8 @@ def attach(material, temperature=None):
     for record in records:
         record["object_temperature"] = object_temperature  # what attach_scene compares to re-attach
     material[ATTACHED_KEY] = records
+    grouped_colours.attach_groups(tree, lambda inner, target, socket, is_emission: insert_colour_group(
+        inner, group, NODE_PREFIX, target, socket, is_emission)[1])
     return True
 
 
@@ -415,8 +416,12 @@ def detach(material):
     """Remove the inserted groups and restore the original links exactly."""
     if not is_attached(material):
         return False
-    tree = material.node_tree
-    for record in list(material[ATTACHED_KEY]):
+    return _detach_records(material, material.node_tree)
+
+
+def _detach_records(owner, tree):
+    """Undo the insertions recorded on ``owner`` (a material, world or node group) in ``tree``."""
+    for record in list(owner[ATTACHED_KEY]):
         record = record.to_dict()
         node = tree.nodes.get(record["group_node"])
         if node is not None:
@@ -430,7 +435,7 @@ def detach(material):
             source = next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
             if source is not None:
                 tree.links.new(source, socket)
-    del material[ATTACHED_KEY]
+    del owner[ATTACHED_KEY]
     return True
 
 
@@ -497,3 +502,4 @@ def detach_all():
         detach(material)
     for world in bpy.data.worlds:
         detach_world(world)
+    grouped_colours.detach_all(_detach_records)

@@ -115,7 +115,7 @@ class RELATIVITY_OT_render_spectral(Operator):
         if not _poll_scene(cls, context):
             return False
         try:
-            spectral_render.check(context.scene)
+            spectral_render.ready(context.scene)  # the rest of the check: when pressed (execute)
         except RelativityError as error:
             cls.poll_message_set(str(error))
             return False

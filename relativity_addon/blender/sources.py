@@ -347,24 +347,6 @@ COLOUR_INPUTS = (
 )
 
 
-def colour_targets(material):
-    """``(node, socket)`` of every colour input of ``material`` that the colour group goes in front of."""
-    for node in list(material.node_tree.nodes):
-        for kind, socket_names in COLOUR_INPUTS:
-            if node.bl_idname == kind:
-                for name in socket_names:
-                    socket = node.inputs.get(name)
-                    if socket is not None:
-                        yield node, socket
-
-
-def grouped_colour_node(tree):
-    """``(group node, inner node)``: the first node of a kind in :data:`COLOUR_INPUTS` inside a
-    node group of ``tree``, or None (:func:`grouped_node`). The colour group goes in front of a
-    material's own nodes only, so such a colour stays RGB."""
-    return grouped_node(tree, {kind for kind, _inputs in COLOUR_INPUTS})
-
-
 def grouped_node(tree, kinds, seen=()):
     """``(group node, inner node)``: the first node whose type is in ``kinds`` inside a node
     group of ``tree`` (at any depth; the add-on's own groups aside), or None."""

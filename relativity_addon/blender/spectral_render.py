@@ -28,17 +28,27 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import exposure, spectral_render
-from . import compositing, effect, materials, modifier, names, snapshot, sources, volumes
+from . import compositing, effect, materials, modifier, names, snapshot, volumes
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
 
-def check(scene):
-    """RelativityError unless the scene is set up for a spectral render."""
-    method = effect.applied_method(scene)
-    if method is None:
+def ready(scene):
+    """RelativityError unless the effect is set up with the physical colour settings: the cheap
+    part of :func:`check`, for the button's poll (which runs on every redraw of the panel)."""
+    if effect.applied_method(scene) is None:
         raise RelativityError("Spectral colour needs the effect: set it up first (Set Up Relativistic Render)")
-    if method == "GEOMETRY":
+    settings = scene.relativity
+    if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
+        raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "
+                              "Searchlight on (and Chang's searchlight off)")
+
+
+def check(scene):
+    """RelativityError unless the scene is set up for a spectral render (walks the scene's
+    objects and materials: :func:`render` runs it, the button's poll only :func:`ready`)."""
+    ready(scene)
+    if effect.applied_method(scene) == "GEOMETRY":
         # Its passes are exact-camera renders (effect.begin_final_render); each pixel's D is the
         # observer's, so every mesh must be at rest in the scene.
         problem = effect.final_render_problem(scene, snapshot.read(scene))
@@ -51,15 +61,6 @@ def check(scene):
     problem = volumes.spectral_problem(scene)
     if problem is not None:
         raise RelativityError(problem)
-    for material, _temperature in materials.scene_materials(scene):
-        found = sources.grouped_colour_node(material.node_tree)
-        if found is not None:
-            raise RelativityError(f"Spectral colour cannot make {found[1].name!r} inside the node group "
-                                  f"{found[0].name!r} of material {material.name!r} spectral: ungroup it")
-    settings = scene.relativity
-    if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
-        raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "
-                              "Searchlight on (and Chang's searchlight off)")
 
 
 def _light_spectrum(light, wavelengths):

@@ -58,6 +58,39 @@ def add_emitter_plane(bpy, scene, name, x_range, y_range, colour=(0.5, 0.5, 0.5)
     return obj
 
 
+def emission_in_group(bpy, material, kind, temperature):
+    """Replace the material's Emission by one inside a node group (shared by every material given
+    the same ``kind``), its colour a Blackbody at ``temperature``: inside the group, through a
+    reroute (``inner group``), or outside, through the group's Color input (``passed group``)."""
+    tree = material.node_tree
+    for node in [n for n in tree.nodes if n.bl_idname in ("ShaderNodeEmission", "ShaderNodeBlackbody")]:
+        tree.nodes.remove(node)
+    group = bpy.data.node_groups.get(kind)
+    if group is None:
+        group = bpy.data.node_groups.new(kind, "ShaderNodeTree")
+        group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+        emission = group.nodes.new("ShaderNodeEmission")
+        group.links.new(emission.outputs[0], group.nodes.new("NodeGroupOutput").inputs["Shader"])
+        reroute = group.nodes.new("NodeReroute")
+        group.links.new(reroute.outputs[0], emission.inputs["Color"])
+        if kind == "inner group":
+            inner = group.nodes.new("ShaderNodeBlackbody")
+            inner.inputs["Temperature"].default_value = temperature
+            group.links.new(inner.outputs[0], reroute.inputs[0])
+        else:
+            group.interface.new_socket("Color", in_out="INPUT", socket_type="NodeSocketColor")
+            group.links.new(group.nodes.new("NodeGroupInput").outputs["Color"], reroute.inputs[0])
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    tree.links.new(node.outputs["Shader"], output.inputs["Surface"])
+    if kind == "passed group":
+        outside = tree.nodes.new("ShaderNodeBlackbody")
+        outside.inputs["Temperature"].default_value = temperature
+        tree.links.new(outside.outputs[0], node.inputs["Color"])
+    return node
+
+
 def render(bpy, scene, path):
     return ch.render_exr(bpy, scene, path)
 

@@ -100,11 +100,16 @@ def test_searchlight_ratio_without_doppler_colour(relativity_addon, factory_blen
     assert grey_spread < 1e-4 * image.max()
 
 
-@pytest.mark.parametrize("beta_z", [-0.5, 0.5])
-def test_blackbody_seen_at_dt_by_moving_observer(factory_blender, tmp_path, beta_z):
+@pytest.mark.parametrize("beta_z, grouped", [(-0.5, None), (0.5, None), (0.5, "inner group"), (0.5, "passed group")])
+def test_blackbody_seen_at_dt_by_moving_observer(factory_blender, tmp_path, beta_z, grouped):
+    """Also with the Emission inside a node group (grouped_colours.py): its colour group, inside
+    the group or in front of it, shifts the blackbody for camera rays and marks the pixel done."""
     bpy = factory_blender
     temperature = 5762.0
     scene, camera, blend = _wall_scene(bpy, tmp_path, temperature=temperature)
+    if grouped:
+        dh.emission_in_group(bpy, bpy.data.materials["Wall"], grouped, temperature)
+        blend = ch.save_blend(bpy, tmp_path / "grouped.blend")
     beta = (0.0, 0.0, beta_z)
     rest = _render(bpy, blend, tmp_path / "sun_rest.exr", (0.0, 0.0, 0.0))
     image = _render(bpy, blend, tmp_path / "sun.exr", beta)

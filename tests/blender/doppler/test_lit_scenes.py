@@ -151,15 +151,66 @@ def _patch_windows(bpy, scene, camera, beta, half=2):
     return windows
 
 
-@pytest.mark.parametrize("speed", [0.3, 0.6])
-def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed):
+def _grouped_diffuse(bpy, name, colour, style):
+    """A Diffuse BSDF material whose BSDF sits in a node group: its colour set inside (``inner``),
+    the group inside another (``nested``), or an RGB node outside feeding the group's Color input
+    through a reroute (``passed``)."""
+    material = _diffuse(bpy, name, colour)
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Diffuse BSDF"])
+    group = bpy.data.node_groups.new(f"{name} paint", "ShaderNodeTree")
+    group.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    diffuse = group.nodes.new("ShaderNodeBsdfDiffuse")
+    group.links.new(diffuse.outputs[0], group.nodes.new("NodeGroupOutput").inputs["Shader"])
+    diffuse.inputs["Color"].default_value = (*colour, 1.0)
+    if style == "nested":
+        outer = bpy.data.node_groups.new(f"{name} outer", "ShaderNodeTree")
+        outer.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+        inner = outer.nodes.new("ShaderNodeGroup")
+        inner.node_tree = group
+        outer.links.new(inner.outputs[0], outer.nodes.new("NodeGroupOutput").inputs["Shader"])
+        group = outer
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    tree.links.new(node.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    if style == "passed":
+        group.interface.new_socket("Color", in_out="INPUT", socket_type="NodeSocketColor")
+        reroute = group.nodes.new("NodeReroute")
+        group.links.new(group.nodes.new("NodeGroupInput").outputs["Color"], reroute.inputs[0])
+        group.links.new(reroute.outputs[0], diffuse.inputs["Color"])
+        rgb = tree.nodes.new("ShaderNodeRGB")
+        rgb.outputs[0].default_value = (*colour, 1.0)
+        tree.links.new(rgb.outputs[0], node.inputs["Color"])
+    return material
+
+
+def _node_group_state(bpy):
+    """Every user node group's nodes and links, to compare before and after the effect."""
+    return {group.name: (sorted(node.name for node in group.nodes),
+                         sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name,
+                                 link.to_socket.identifier) for link in group.links))
+            for group in bpy.data.node_groups if not group.name.startswith("Relativity")}
+
+
+# Patches whose Diffuse BSDF sits in a node group (the white one stays ungrouped).
+GROUPED = {"Red": "inner", "Green": "nested", "Blue": "passed"}
+
+
+@pytest.mark.parametrize("speed, grouped", [(0.3, False), (0.6, False), (0.6, True)],
+                         ids=["0.3c", "0.6c", "0.6c-grouped"])
+def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed, grouped):
     """Up-sampled RGB patches under a sun with its own temperature: spectral mode within Delta E 2
-    of the same spectra (reflectance basis times Planck) shifted and integrated here."""
+    of the same spectra (reflectance basis times Planck) shifted and integrated here. Grouped:
+    three of the BSDFs inside node groups (grouped_colours.py), which must be made spectral too,
+    and left exactly as they were when the effect is removed."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
     for name, (colour, (x, y)) in PATCHES.items():
         corners = [(x - 1, y - 1, -5), (x + 1, y - 1, -5), (x + 1, y + 1, -5), (x - 1, y + 1, -5)]
-        _quad(bpy, scene, name, corners, _diffuse(bpy, name, colour))
+        style = GROUPED.get(name) if grouped else None
+        _quad(bpy, scene, name, corners,
+              _grouped_diffuse(bpy, name, colour, style) if style else _diffuse(bpy, name, colour))
+    groups_before = _node_group_state(bpy)
     _sun(bpy, scene)
     rest_windows = _patch_windows(bpy, scene, camera, (0.0, 0.0, 0.0))
     rest = _render_f12(bpy, scene, tmp_path, "rest")
@@ -188,6 +239,8 @@ def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed):
               f"{dh.delta_e_2000_normalised(fast_xyz, expected):.2f}, Y/expected {fast_xyz[1] / expected[1]:.3f}")
         assert delta_e < 2.0
         assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert _node_group_state(bpy) == groups_before
 
 
 def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):

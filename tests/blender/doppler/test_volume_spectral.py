@@ -238,6 +238,10 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
 
     message = refusal()
     assert "temperature grid" in message and "'Fire'" in message and "'Smoke'" in message and "\n" not in message
+    # the button: enabled (its poll runs only the cheap checks), the refusal reported when pressed
+    assert bpy.ops.relativity.render_spectral.poll()
+    with pytest.raises(RuntimeError, match="temperature grid"):
+        bpy.ops.relativity.render_spectral()
     fire.node_tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
     spectral_render.check(scene)  # accepted
 
@@ -256,15 +260,6 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     grouped.node_tree = inner
     assert "volume shaders inside the node group" in refusal()
     tree.nodes.remove(grouped)
-    # Surfaces too: a Diffuse BSDF inside a group (two deep) would stay RGB in the passes.
-    outer, deeper = (bpy.data.node_groups.new(name, "ShaderNodeTree") for name in ("Paint", "Base"))
-    deeper.nodes.new("ShaderNodeBsdfDiffuse")
-    outer.nodes.new("ShaderNodeGroup").node_tree = deeper
-    painted = tree.nodes.new("ShaderNodeGroup")
-    painted.node_tree = outer
-    message = refusal()
-    assert "'Diffuse BSDF' inside the node group" in message and "'Mixed'" in message
-    tree.nodes.remove(painted)
 
     world_tree = scene.world.node_tree
     world_volume = world_tree.nodes.new("ShaderNodeVolumeScatter")
