@@ -34,13 +34,49 @@ COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
 COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
 SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
-VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
+# The Render Layers outputs of Cycles' Emission and Environment passes (Blender 4.5's names, then 5.x's).
+EMITTED_PASSES = {"Emission": ("Emit", "Emission"), "Environment": ("Env", "Environment")}
+VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Use Environment")
+
+
+def _matrix_nodes(key, image_name, colour):
+    """Nodes for ``gamut_map(N(D) colour)`` (``{key}_mapped``) and ``a(D)`` (``{key}_alpha``) read
+    from a packed matrix table (``luts``) at the texel position the shared nodes computed."""
+    nodes = {f"{key}_lut": Node("CompositorNodeImage", props={"image": image_name})}
+    map_inputs, map_props = compat.map_uv_nearest()
+    for row in range(3):
+        for side in "01":
+            texel = f"{key}_row{row}_{side}"
+            # z: UV alpha
+            nodes[f"{texel}_uv"] = Node("ShaderNodeCombineXYZ", {0: f"u{side}", 1: (row + 0.5) / 3.0, 2: 1.0})
+            nodes[texel] = Node("CompositorNodeMapUV", {
+                "Image": f"{key}_lut.Image", "UV": f"{texel}_uv",
+                **{name: Menu(value) for name, value in map_inputs.items()},
+            }, map_props)
+            nodes[f"{texel}_dot"] = vmath("DOT_PRODUCT", texel, colour)
+        nodes[f"{key}_step{row}"] = fmath("SUBTRACT", f"{key}_row{row}_1_dot.Value", f"{key}_row{row}_0_dot.Value")
+        nodes[f"{key}_dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"{key}_step{row}", f"{key}_row{row}_0_dot.Value")
+    nodes.update({
+        f"{key}_split0": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_0"}),
+        f"{key}_split1": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_1"}),
+        f"{key}_alpha_step": fmath("SUBTRACT", f"{key}_split1.Alpha", f"{key}_split0.Alpha"),
+        f"{key}_alpha": fmath("MULTIPLY_ADD", "frac", f"{key}_alpha_step", f"{key}_split0.Alpha"),
+        f"{key}_product": Node("ShaderNodeCombineXYZ", {0: f"{key}_dot0", 1: f"{key}_dot1", 2: f"{key}_dot2"}),
+        f"{key}_mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: f"{key}_product"}, kind="CompositorNodeGroup"),
+        # exp(E) with E = a(D) with the searchlight and Doppler, + (p - p_cam) ln D
+        f"{key}_base": Node("ShaderNodeMix", {"Factor": "group.Use Doppler", 4: colour, 5: f"{key}_mapped"},
+                            {"data_type": "VECTOR"}),
+        f"{key}_log_gain": fmath("MULTIPLY_ADD", f"{key}_alpha", "group.Spectral Searchlight", "power_term"),
+        f"{key}_safe_log_gain": fmath("MINIMUM", f"{key}_log_gain", materials.EXP_LIMIT),
+        f"{key}_gain": fmath("EXPONENT", f"{key}_safe_log_gain"),
+        f"{key}_shifted": vmath("SCALE", f"{key}_base.Result", scale=f"{key}_gain"),
+    })
+    return nodes
 
 
 def compositor_group():
     scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
-    nodes = {}
-    nodes.update({
+    nodes = {
         # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group), the mean
         # over the samples that wrote it (a camera ray scattered in a volume writes none)
         "coverage": fmath("MAXIMUM", "group.Coverage", 1e-3),
@@ -56,35 +92,20 @@ def compositor_group():
         "frac": fmath("SUBTRACT", "x", "i0"),
         "u0": fmath("MULTIPLY_ADD", "i0", 1.0 / luts.LUT_SIZE, 0.5 / luts.LUT_SIZE),
         "u1": fmath("ADD", "u0", 1.0 / luts.LUT_SIZE),
-        "lut": Node("CompositorNodeImage", props={"image": luts.DOPPLER_LUT_NAME}),
-    })
-    map_inputs, map_props = compat.map_uv_nearest()
-    for row in range(3):
-        for side in "01":
-            texel = f"row{row}_{side}"
-            # z: UV alpha
-            nodes[f"uv{texel}"] = Node("ShaderNodeCombineXYZ", {0: f"u{side}", 1: (row + 0.5) / 3.0, 2: 1.0})
-            nodes[texel] = Node("CompositorNodeMapUV", {
-                "Image": "lut.Image", "UV": f"uv{texel}", **{key: Menu(value) for key, value in map_inputs.items()},
-            }, map_props)
-            nodes[f"dot{texel}"] = vmath("DOT_PRODUCT", texel, "group.Image")
-        nodes[f"step{row}"] = fmath("SUBTRACT", f"dotrow{row}_1.Value", f"dotrow{row}_0.Value")
-        nodes[f"dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"step{row}", f"dotrow{row}_0.Value")
-    nodes.update({
-        "row0_split0": Node("CompositorNodeSeparateColor", {0: "row0_0"}),
-        "row0_split1": Node("CompositorNodeSeparateColor", {0: "row0_1"}),
-        "alpha_step": fmath("SUBTRACT", "row0_split1.Alpha", "row0_split0.Alpha"),
-        "alpha": fmath("MULTIPLY_ADD", "frac", "alpha_step", "row0_split0.Alpha"),
-        "product": Node("ShaderNodeCombineXYZ", {0: "dot0.Value", 1: "dot1.Value", 2: "dot2.Value"}),
-        "mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: "product"}, kind="CompositorNodeGroup"),
-        "base": Node("ShaderNodeMix", {"Factor": "group.Use Doppler", 4: "group.Image", 5: "mapped"},
-                     {"data_type": "VECTOR"}),
         "power": fmath("SUBTRACT", "group.Power of D", "group.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
-        "log_gain": fmath("MULTIPLY_ADD", "alpha", "group.Spectral Searchlight", "power_term"),
-        "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
-        "gain": fmath("EXPONENT", "safe_log_gain"),
-        "shifted": vmath("SCALE", "base.Result", scale="gain"),
+        # Emitted light (what the camera sees of emitters and the world: Cycles' Emission and
+        # Environment passes) is read by the emitters' table, the rest (reflected) by the table of
+        # the scene's illuminant (illuminants.py; the same table for white light).
+        "environment": vmath("SCALE", "group.Environment", scale="group.Use Environment"),
+        "emitted": vmath("ADD", "group.Emission", "environment"),
+        "rest": vmath("SUBTRACT", "group.Image", "emitted"),
+        "reflected": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # denoising may push it below 0
+    }
+    nodes.update(_matrix_nodes("emit", luts.DOPPLER_LUT_NAME, "emitted"))
+    nodes.update(_matrix_nodes("refl", luts.ILLUMINANT_LUT_NAME, "reflected"))
+    nodes.update({
+        "shifted": vmath("ADD", "emit_shifted", "refl_shifted"),
         "kept": Node("ShaderNodeMix", {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
                      {"data_type": "VECTOR", "clamp_factor": True}),
         "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
@@ -100,6 +121,8 @@ def compositor_group():
             ("Log Doppler", "NodeSocketFloat", 0.0),
             ("Done", "NodeSocketFloat", 0.0),
             ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
+            ("Emission", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("Environment", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
         (("Image", "NodeSocketColor", "out"),),
@@ -109,6 +132,8 @@ def compositor_group():
 
 def ensure_compositor_group():
     luts.ensure_doppler_matrix_lut()
+    if bpy.data.images.get(luts.ILLUMINANT_LUT_NAME) is None:
+        luts.ensure_illuminant_lut(0.0)
     version = (names.GROUP_VERSION_KEY, names.COMPOSITOR_GROUPS_VERSION)
     ensure_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"), *version)
     return ensure_group(compositor_group(), *version)
@@ -154,7 +179,10 @@ def write_colour_stage(scene, snap):
     _tree, nodes = _inserted_nodes(scene)
     if not nodes:
         return False
+    luts.ensure_illuminant_lut(snap.illuminant_k)
     values = colour_stage_values(snap)
+    # with a transparent film the Environment pass holds a background the picture does not show
+    values["Use Environment"] = 0.0 if scene.render.film_transparent else 1.0
     for node in nodes:
         for name, value in values.items():
             if node.inputs[name].default_value != value:
@@ -174,6 +202,7 @@ def apply_colour_stage(scene, snap):
             "tree": compat.compositor_tree(scene).name if compat.compositor_tree(scene) else "",
             "use_compositing": scene.render.use_compositing,
             "added_aovs": [],
+            "passes": {layer.name: [layer.use_pass_emit, layer.use_pass_environment] for layer in scene.view_layers},
             "inserted": [],
             "created_tree": "",
         }
@@ -182,6 +211,7 @@ def apply_colour_stage(scene, snap):
             tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
         for view_layer in scene.view_layers:
+            view_layer.use_pass_emit = view_layer.use_pass_environment = True  # emitted light: EMITTED_PASSES
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
                     aov = view_layer.aovs.add()
@@ -201,6 +231,10 @@ def apply_colour_stage(scene, snap):
                 aov_output = layers.outputs.get(aov_name)
                 if aov_output is not None:
                     tree.links.new(aov_output, node.inputs[socket_name])
+            for socket_name, pass_names in EMITTED_PASSES.items():
+                output = next((layers.outputs[n] for n in pass_names if n in layers.outputs), None)
+                if output is not None:
+                    tree.links.new(output, node.inputs[socket_name])
             for to_node, to_socket in targets:
                 socket = next(s for s in tree.nodes[to_node].inputs if s.identifier == to_socket)
                 tree.links.new(node.outputs["Image"], socket)
@@ -229,6 +263,10 @@ def remove_colour_stage(scene):
                 socket = next((s for s in target.inputs if s.identifier == to_socket), None)
                 if socket is not None:
                     tree.links.new(layers.outputs["Image"], socket)
+    for view_layer_name, (emission, environment) in saved.get("passes", {}).items():
+        view_layer = scene.view_layers.get(view_layer_name)
+        if view_layer is not None:
+            view_layer.use_pass_emit, view_layer.use_pass_environment = emission, environment
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:

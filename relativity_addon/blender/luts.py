@@ -12,10 +12,12 @@ import bpy
 import numpy as np
 
 from .. import lut_data
+from ..physics import illuminant
 from . import names
 
 DOPPLER_LUT_NAME = names.DOPPLER_LUT_IMAGE
 BLACKBODY_LUT_NAME = names.BLACKBODY_LUT_IMAGE
+ILLUMINANT_LUT_NAME = names.ILLUMINANT_LUT_IMAGE
 LUT_SIZE = 2048
 # ID property on a LUT image: the layout version, so an outdated table is rebuilt.
 LAYOUT_KEY = names.LUT_LAYOUT_KEY
@@ -75,6 +77,25 @@ def ensure_blackbody_lut():
     """The packed ``N x 1`` blackbody table (``spectral_luts.blackbody_rgb_lut``)."""
 
     return _ensure_lut(BLACKBODY_LUT_NAME, lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
+
+
+def ensure_illuminant_lut(temperature_k):
+    """The packed ``N x 3`` table for light reflected under a blackbody at ``temperature_k``
+    (0: white), laid out as the Doppler matrix table (``physics/illuminant.py``); rebuilt (0.1-0.5 s)
+    only when the illuminant changes, and packed so that the file renders alone."""
+    image = bpy.data.images.get(ILLUMINANT_LUT_NAME)
+    stamp = round(float(temperature_k), 3)
+    if image is not None and image.get(names.ILLUMINANT_KEY) == stamp and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
+        return image
+    pixels = illuminant.doppler_lut(np.linspace(*DOPPLER_LOG10_RANGE, LUT_SIZE), stamp or None)
+    if image is not None and tuple(image.size) == (LUT_SIZE, 3) and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
+        image.pixels.foreach_set(pixels)  # in place: the compositor's Image node keeps pointing at it
+        image.update()
+        image.pack()
+    else:
+        image = _packed_float_image(ILLUMINANT_LUT_NAME, LUT_SIZE, 3, pixels)
+    image[names.ILLUMINANT_KEY] = stamp
+    return image
 
 
 def texture_u_scale_offset(log10_range, size=LUT_SIZE):

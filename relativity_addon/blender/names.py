@@ -45,8 +45,8 @@ GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor group
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
 COMPOSITOR_GROUP = "Relativity Doppler Compositor"
 COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
-COMPOSITOR_GROUPS_VERSION = 5  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
-# 5: ln D over the coverage AOV
+COMPOSITOR_GROUPS_VERSION = 6  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
+# 5: ln D over the coverage AOV; 6: emitted and reflected light through their own tables
 COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
 COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
 LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit
@@ -59,6 +59,8 @@ SPECTRAL_IMAGE = "Relativity Spectral Render"  # the picture the spectral render
 # --- lookup tables --------------------------------------------------------------------------
 DOPPLER_LUT_IMAGE = "Relativity Doppler Matrix LUT"
 BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
+ILLUMINANT_LUT_IMAGE = "Relativity Illuminant LUT"  # the fast mode's matrix for reflected light
+ILLUMINANT_KEY = "relativity_illuminant_k"  # on that image: the illuminant it holds (K, 0 = white)
 LUT_LAYOUT_KEY = "relativity_lut_layout"
 LUT_LAYOUT_VERSION = 1
 

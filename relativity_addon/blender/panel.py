@@ -138,6 +138,16 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row = colour.row()
         row.active = settings.use_doppler and not settings.use_searchlight and not time_of_flight
         row.prop(settings, "doppler_only_brightness")
+        if settings.method == "CAMERA":
+            row = colour.row(align=True)
+            row.active = settings.use_doppler and not time_of_flight
+            row.prop(settings, "fast_illuminant")
+            if settings.fast_illuminant == "BLACKBODY":
+                row.prop(settings, "fast_illuminant_temperature", text="")
+            elif settings.fast_illuminant == "AUTO":
+                snap = effect.last_snapshot(context.scene)
+                if snap is not None and snap.illuminant_k:
+                    colour.label(text=f"Lit by a {snap.illuminant_k:.0f} K blackbody", icon="LIGHT")
         column = layout.column()
         column.active = settings.use_searchlight and not time_of_flight
         column.prop(settings, "exposure_mode")

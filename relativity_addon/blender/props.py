@@ -250,6 +250,28 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         default="FIXED",
         update=_settings_changed,
     )
+    fast_illuminant: EnumProperty(
+        name="Lit By",
+        description="Fast colour (F12): the light that lit what the camera sees reflected, whose spectrum the "
+        "Doppler shift moves into view (self-luminous surfaces and the world are read as emitters either way)",
+        items=(
+            ("AUTO", "Automatic", "The scene's lamps' blackbody temperature when every lamp (lights and "
+             "blackbody emitters; the world only if it is a blackbody) is a blackbody at one temperature, "
+             "else white"),
+            ("WHITE", "White", "6504 K white light, as for emitters"),
+            ("BLACKBODY", "Blackbody", "A blackbody at the temperature below"),
+        ),
+        default="AUTO",
+        update=_settings_changed,
+    )
+    fast_illuminant_temperature: FloatProperty(
+        name="Temperature",
+        description="Blackbody temperature of the light (K) for Lit By: Blackbody",
+        default=5762.0,
+        min=1000.0,
+        max=40000.0,
+        update=_settings_changed,
+    )
     spectral_passes: IntProperty(
         name="Spectral Passes",
         description="Colour passes of Render Spectral (three wavelengths each): "

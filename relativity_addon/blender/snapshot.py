@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import RelativityError
 from ..physics import exposure
 from ..physics.shutter import ShutterModel
-from . import animation, emitter_lights, names, sources
+from . import animation, emitter_lights, illuminants, names, sources
 
 Vector3 = tuple[float, float, float]
 
@@ -88,6 +88,8 @@ class Snapshot:
     # Gray's Fig. 1c: the Galilean transformation instead of the Lorentz one (use_doppler and
     # use_searchlight are then False: the mode shows the light-travel delay alone)
     use_time_of_flight: bool = False
+    # the fast mode's illuminant of reflected light (illuminants.py): a blackbody's K, 0 for white
+    illuminant_k: float = 0.0
 
     @property
     def time(self) -> float:
@@ -420,6 +422,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         check_time_of_flight(settings, lights)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
+    exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     return Snapshot(
         scene=scene.name,
         frame=frame,
@@ -428,7 +431,7 @@ def read(scene, depsgraph=None) -> Snapshot:
         beta=beta,
         velocity_source=settings.velocity_source,
         method=settings.method,
-        exact_camera=settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene)),
+        exact_camera=exact_camera,
         geometry_final_render=settings.geometry_final_render,
         engine=scene.render.engine,
         camera=camera.name,
@@ -451,4 +454,6 @@ def read(scene, depsgraph=None) -> Snapshot:
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
+        illuminant_k=illuminants.fast_illuminant(scene) if exact_camera and settings.use_doppler
+        and not time_of_flight else 0.0,
     )

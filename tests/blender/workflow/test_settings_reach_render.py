@@ -62,6 +62,8 @@ BASE_SCENE = {
     "use_searchlight": True,
     "use_chang_searchlight": False,
     "velocity_source": "MANUAL",
+    "fast_illuminant": "AUTO",  # a white lamp and a blackbody emitter: white
+    "fast_illuminant_temperature": 5762.0,
 }
 BASE_OBJECTS = {
     "Mover": {"enabled": True, "motion": "CONSTANT", "beta": (0.5, 0.0, 0.0)},
@@ -103,6 +105,8 @@ CASES = [
     case("CAMERA", "scene", "doppler_only_brightness", "SPECTRUM", base={"use_searchlight": False}),
     case("CAMERA", "scene", "velocity_source", "CAMERA_ANIMATION"),
     case("CAMERA", "Blackbody", "temperature", 9000.0),
+    case("CAMERA", "scene", "fast_illuminant", "BLACKBODY", base={"fast_illuminant_temperature": 2500.0}),
+    case("CAMERA", "scene", "fast_illuminant_temperature", 2500.0, base={"fast_illuminant": "BLACKBODY"}),
     case("CAMERA", "scene", "method", "GEOMETRY"),  # switching the method after Set Up
     # Apparent geometry: the scene settings that apply there, and every object setting.
     case("GEOMETRY", "scene", "speed_of_light", 15.0, base=FROM_ANIMATION),
