@@ -79,7 +79,7 @@ def remove_unused_data():
         tree = bpy.data.node_groups.get(name)
         if tree is not None:
             bpy.data.node_groups.remove(tree)
-    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, luts.ILLUMINANT_LUT_NAME):
+    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, *luts.ILLUMINANT_LUT_NAMES):
         image = bpy.data.images.get(name)
         if image is not None:
             bpy.data.images.remove(image)

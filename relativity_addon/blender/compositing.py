@@ -27,16 +27,14 @@ created if the scene has none); :func:`remove_colour_stage` restores the composi
 
 import bpy
 
-from . import compat, luts, materials, names
+from . import compat, light_groups, luts, materials, names
 from .nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
 
 COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
 COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
 SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
-# The Render Layers outputs of Cycles' Emission and Environment passes (Blender 4.5's names, then 5.x's).
-EMITTED_PASSES = {"Emission": ("Emit", "Emission"), "Environment": ("Env", "Environment")}
-VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Use Environment")
+VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
 
 
 def _matrix_nodes(key, image_name, colour):
@@ -94,18 +92,18 @@ def compositor_group():
         "u1": fmath("ADD", "u0", 1.0 / luts.LUT_SIZE),
         "power": fmath("SUBTRACT", "group.Power of D", "group.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
-        # Emitted light (what the camera sees of emitters and the world: Cycles' Emission and
-        # Environment passes) is read by the emitters' table, the rest (reflected) by the table of
-        # the scene's illuminant (illuminants.py; the same table for white light).
-        "environment": vmath("SCALE", "group.Environment", scale="group.Use Environment"),
-        "emitted": vmath("ADD", "group.Emission", "environment"),
-        "rest": vmath("SUBTRACT", "group.Image", "emitted"),
-        "reflected": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # denoising may push it below 0
+        # The light of blackbody lamps (light_groups.py: one light group per temperature) is read
+        # through its temperature's table, the rest of the pixel through the emitters' table.
+        "lit": vmath("ADD", "group.Lit 1", "group.Lit 2"),
+        "rest": vmath("SUBTRACT", "group.Image", "lit"),
+        "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # denoising may push it below 0
     }
-    nodes.update(_matrix_nodes("emit", luts.DOPPLER_LUT_NAME, "emitted"))
-    nodes.update(_matrix_nodes("refl", luts.ILLUMINANT_LUT_NAME, "reflected"))
+    nodes.update(_matrix_nodes("emit", luts.DOPPLER_LUT_NAME, "other"))
+    for slot, image_name in enumerate(luts.ILLUMINANT_LUT_NAMES, start=1):
+        nodes.update(_matrix_nodes(f"lit{slot}", image_name, f"group.Lit {slot}"))
     nodes.update({
-        "shifted": vmath("ADD", "emit_shifted", "refl_shifted"),
+        "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
+        "shifted": vmath("ADD", "emit_shifted", "lit_shifted"),
         "kept": Node("ShaderNodeMix", {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
                      {"data_type": "VECTOR", "clamp_factor": True}),
         "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
@@ -121,8 +119,8 @@ def compositor_group():
             ("Log Doppler", "NodeSocketFloat", 0.0),
             ("Done", "NodeSocketFloat", 0.0),
             ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
-            ("Emission", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
-            ("Environment", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("Lit 1", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the light groups' passes
+            ("Lit 2", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
         (("Image", "NodeSocketColor", "out"),),
@@ -132,8 +130,9 @@ def compositor_group():
 
 def ensure_compositor_group():
     luts.ensure_doppler_matrix_lut()
-    if bpy.data.images.get(luts.ILLUMINANT_LUT_NAME) is None:
-        luts.ensure_illuminant_lut(0.0)
+    for name in luts.ILLUMINANT_LUT_NAMES:
+        if bpy.data.images.get(name) is None:
+            luts.ensure_illuminant_lut(name, 0.0)
     version = (names.GROUP_VERSION_KEY, names.COMPOSITOR_GROUPS_VERSION)
     ensure_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"), *version)
     return ensure_group(compositor_group(), *version)
@@ -179,10 +178,10 @@ def write_colour_stage(scene, snap):
     _tree, nodes = _inserted_nodes(scene)
     if not nodes:
         return False
-    luts.ensure_illuminant_lut(snap.illuminant_k)
+    temperatures = light_groups.assign(scene, snap.lit_groups)
+    for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
+        luts.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
-    # with a transparent film the Environment pass holds a background the picture does not show
-    values["Use Environment"] = 0.0 if scene.render.film_transparent else 1.0
     for node in nodes:
         for name, value in values.items():
             if node.inputs[name].default_value != value:
@@ -202,7 +201,6 @@ def apply_colour_stage(scene, snap):
             "tree": compat.compositor_tree(scene).name if compat.compositor_tree(scene) else "",
             "use_compositing": scene.render.use_compositing,
             "added_aovs": [],
-            "passes": {layer.name: [layer.use_pass_emit, layer.use_pass_environment] for layer in scene.view_layers},
             "inserted": [],
             "created_tree": "",
         }
@@ -210,8 +208,8 @@ def apply_colour_stage(scene, snap):
         if tree is None:
             tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
+        light_groups.hold(scene)
         for view_layer in scene.view_layers:
-            view_layer.use_pass_emit = view_layer.use_pass_environment = True  # emitted light: EMITTED_PASSES
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
                     aov = view_layer.aovs.add()
@@ -231,10 +229,10 @@ def apply_colour_stage(scene, snap):
                 aov_output = layers.outputs.get(aov_name)
                 if aov_output is not None:
                     tree.links.new(aov_output, node.inputs[socket_name])
-            for socket_name, pass_names in EMITTED_PASSES.items():
-                output = next((layers.outputs[n] for n in pass_names if n in layers.outputs), None)
+            for slot, group_name in enumerate(light_groups.SLOTS, start=1):
+                output = layers.outputs.get(f"Combined_{group_name}")
                 if output is not None:
-                    tree.links.new(output, node.inputs[socket_name])
+                    tree.links.new(output, node.inputs[f"Lit {slot}"])
             for to_node, to_socket in targets:
                 socket = next(s for s in tree.nodes[to_node].inputs if s.identifier == to_socket)
                 tree.links.new(node.outputs["Image"], socket)
@@ -263,10 +261,7 @@ def remove_colour_stage(scene):
                 socket = next((s for s in target.inputs if s.identifier == to_socket), None)
                 if socket is not None:
                     tree.links.new(layers.outputs["Image"], socket)
-    for view_layer_name, (emission, environment) in saved.get("passes", {}).items():
-        view_layer = scene.view_layers.get(view_layer_name)
-        if view_layer is not None:
-            view_layer.use_pass_emit, view_layer.use_pass_environment = emission, environment
+    light_groups.release(scene)
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:

@@ -1,24 +1,42 @@
-"""Which light lit the scene, for the fast mode's reflected light (``physics/illuminant.py``).
+"""Which lamps lit the scene, for the fast mode's reflected light (``physics/illuminant.py``).
 
-The fast mode reads a reflected pixel as a reflectance under one illuminant. ``Lit By`` chooses
-it (``Scene.relativity.fast_illuminant``); Automatic takes the scene's lamps: a blackbody at
-``T`` when every lamp is a blackbody at that one temperature, else white (6504 K, the emitters'
-white). Lamps are the scene's lights with power (``sources.light_blackbody``: their own
-temperature or a Blackbody in their node tree; any other light is "not a blackbody"), meshes
-whose emission colour is a blackbody (``sources.blackbody_source``, through node groups, or the
-object's blackbody temperature) and a world whose background is one. Meshes that emit RGB colours
-and an RGB world do not count: they are usually what is seen, not what lights (a grey world's
-ambient fill, a glowing screen); Lit By: White or Blackbody overrides the choice.
+The fast mode reads a pixel's colour as a spectrum and shifts that. Light that a blackbody lamp
+at ``T`` sent onto surfaces is a reflectance times ``B(lambda, T)``; everything else (emitters
+and the world seen directly, light of white or RGB lamps and of the world) is read as an RGB
+colour in 6504 K white, the emitters' reading. So the lamps are sorted by temperature into light
+groups (``light_groups.py``), whose passes the compositor reads through their own tables.
+
+*Lit By* (``Scene.relativity.fast_illuminant``) chooses the lamps:
+
+- **Automatic**: every blackbody lamp by its own temperature. Blackbody lamps are lights with
+  power whose spectrum is a blackbody (``sources.light_blackbody``: their own temperature or a
+  Blackbody in their node tree), meshes whose emission colours are one blackbody (a Blackbody node,
+  also inside node groups, or the object's blackbody temperature) and a world whose background is
+  one. At most ``len(names.LIT_GROUPS)`` temperatures get a group, the most frequent ones; the
+  others' light is read in white.
+- **White**: no groups: every pixel in white, as emitters (the reading before light groups).
+- **Blackbody**: every light object (not emitting meshes nor the world) as a blackbody at the
+  temperature given.
 """
 
-from . import grouped_colours, sources
+from typing import NamedTuple
+
+from . import grouped_colours, names, sources
 
 OWN_PREFIX = "Relativity"  # the add-on's stand-in lamps, copies and lamp faces
 STRENGTHS = {"ShaderNodeEmission": "Strength", "ShaderNodeBsdfPrincipled": "Emission Strength"}
+WORLD = ""  # the world's entry in a group's members
+
+
+class LitGroup(NamedTuple):
+    """Lamps of one blackbody temperature: their object names, and :data:`WORLD` for the world."""
+
+    temperature: float
+    members: tuple
 
 
 def _blackbody_emission(tree):
-    """Temperatures of the blackbody emission colours of a material or world tree with strength."""
+    """Temperatures of the blackbody emission colours with strength of a material's tree."""
     found = set()
     for node, socket, is_emission in grouped_colours.targets(tree):
         strength = node.inputs.get(STRENGTHS.get(node.bl_idname, ""))
@@ -30,42 +48,50 @@ def _blackbody_emission(tree):
     return found
 
 
-def scene_blackbody_temperature(scene):
-    """Temperature (K) of the one blackbody that lights ``scene``, or None (white, mixed or none)."""
-    temperatures, other = set(), False
-    for obj in scene.objects:
-        if obj.hide_render or obj.name.startswith(OWN_PREFIX):
-            continue
-        if obj.type == "LIGHT":
-            if obj.data.energy > 0.0:
-                temperature = sources.light_blackbody(obj.data)
-                other |= temperature is None
-                temperatures |= {temperature} - {None}
-            continue
-        for slot in obj.material_slots:
-            material = slot.material
-            if material is None or material.node_tree is None:
-                continue
-            emitted = _blackbody_emission(material.node_tree)
-            if obj.relativity.temperature and any(is_emission for *_, is_emission in
-                                                  grouped_colours.targets(material.node_tree)):
-                emitted.add(float(obj.relativity.temperature))
-            temperatures |= emitted
-    world = scene.world
-    if world is not None and world.node_tree is not None:
-        backgrounds = [node for node in world.node_tree.nodes if node.bl_idname == "ShaderNodeBackground"]
-        for background in backgrounds:
-            blackbody = sources.blackbody_source(sources.rest_colour_input(background.inputs["Color"]))
-            if blackbody is not None and isinstance(blackbody.temperature, float):
-                temperatures.add(blackbody.temperature)
-    return next(iter(temperatures)) if len(temperatures) == 1 and not other else None
+def _lamp_temperature(obj):
+    """The blackbody temperature of a lamp object (a light or an emitting mesh), or None."""
+    if obj.type == "LIGHT":
+        return sources.light_blackbody(obj.data) if obj.data.energy > 0.0 else None
+    found = set()
+    for slot in obj.material_slots:
+        material = slot.material
+        if material is not None and material.node_tree is not None:
+            found |= _blackbody_emission(material.node_tree)
+            if obj.relativity.temperature and any(emits for *_, emits in grouped_colours.targets(material.node_tree)):
+                found.add(float(obj.relativity.temperature))
+    return found.pop() if len(found) == 1 else None
 
 
-def fast_illuminant(scene):
-    """The fast mode's illuminant from the settings: a temperature (K), or 0.0 for white."""
+def _world_temperature(world):
+    if world is None or world.node_tree is None:
+        return None
+    found = set()
+    for background in [node for node in world.node_tree.nodes if node.bl_idname == "ShaderNodeBackground"]:
+        blackbody = sources.blackbody_source(sources.rest_colour_input(background.inputs["Color"]))
+        found.add(blackbody.temperature if blackbody is not None and isinstance(blackbody.temperature, float) else None)
+    return found.pop() if len(found) == 1 else None
+
+
+def _candidates(scene):
+    return [obj for obj in scene.objects if not obj.hide_render and not obj.name.startswith(OWN_PREFIX)]
+
+
+def lit_groups(scene):
+    """The light groups of the fast mode's blackbody lamps, by *Lit By* (tuple of :class:`LitGroup`)."""
     settings = scene.relativity
+    if settings.fast_illuminant == "WHITE":
+        return ()
     if settings.fast_illuminant == "BLACKBODY":
-        return float(settings.fast_illuminant_temperature)
-    if settings.fast_illuminant == "AUTO":
-        return float(scene_blackbody_temperature(scene) or 0.0)
-    return 0.0
+        members = tuple(sorted(obj.name for obj in _candidates(scene) if obj.type == "LIGHT"))
+        return (LitGroup(float(settings.fast_illuminant_temperature), members),) if members else ()
+    by_temperature = {}
+    for obj in _candidates(scene):
+        if obj.type in ("LIGHT", "MESH", "CURVE", "SURFACE", "META", "FONT"):
+            temperature = _lamp_temperature(obj)
+            if temperature is not None:
+                by_temperature.setdefault(temperature, []).append(obj.name)
+    world_temperature = _world_temperature(scene.world)
+    if world_temperature is not None:
+        by_temperature.setdefault(world_temperature, []).append(WORLD)
+    ranked = sorted(by_temperature.items(), key=lambda item: (-len(item[1]), item[0]))[:len(names.LIT_GROUPS)]
+    return tuple(LitGroup(temperature, tuple(sorted(members))) for temperature, members in ranked)

@@ -17,7 +17,7 @@ from . import names
 
 DOPPLER_LUT_NAME = names.DOPPLER_LUT_IMAGE
 BLACKBODY_LUT_NAME = names.BLACKBODY_LUT_IMAGE
-ILLUMINANT_LUT_NAME = names.ILLUMINANT_LUT_IMAGE
+ILLUMINANT_LUT_NAMES = names.ILLUMINANT_LUT_IMAGES
 LUT_SIZE = 2048
 # ID property on a LUT image: the layout version, so an outdated table is rebuilt.
 LAYOUT_KEY = names.LUT_LAYOUT_KEY
@@ -79,11 +79,11 @@ def ensure_blackbody_lut():
     return _ensure_lut(BLACKBODY_LUT_NAME, lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 
 
-def ensure_illuminant_lut(temperature_k):
-    """The packed ``N x 3`` table for light reflected under a blackbody at ``temperature_k``
-    (0: white), laid out as the Doppler matrix table (``physics/illuminant.py``); rebuilt (0.1-0.5 s)
-    only when the illuminant changes, and packed so that the file renders alone."""
-    image = bpy.data.images.get(ILLUMINANT_LUT_NAME)
+def ensure_illuminant_lut(name, temperature_k):
+    """The packed ``N x 3`` table ``name`` for light reflected under a blackbody at
+    ``temperature_k`` (0: white), laid out as the Doppler matrix table (``physics/illuminant.py``);
+    rebuilt in place (0.1-0.5 s) only when the illuminant changes, packed so that the file renders alone."""
+    image = bpy.data.images.get(name)
     stamp = round(float(temperature_k), 3)
     if image is not None and image.get(names.ILLUMINANT_KEY) == stamp and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
@@ -93,7 +93,7 @@ def ensure_illuminant_lut(temperature_k):
         image.update()
         image.pack()
     else:
-        image = _packed_float_image(ILLUMINANT_LUT_NAME, LUT_SIZE, 3, pixels)
+        image = _packed_float_image(name, LUT_SIZE, 3, pixels)
     image[names.ILLUMINANT_KEY] = stamp
     return image
 

@@ -59,8 +59,12 @@ SPECTRAL_IMAGE = "Relativity Spectral Render"  # the picture the spectral render
 # --- lookup tables --------------------------------------------------------------------------
 DOPPLER_LUT_IMAGE = "Relativity Doppler Matrix LUT"
 BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
-ILLUMINANT_LUT_IMAGE = "Relativity Illuminant LUT"  # the fast mode's matrix for reflected light
-ILLUMINANT_KEY = "relativity_illuminant_k"  # on that image: the illuminant it holds (K, 0 = white)
+# The fast mode's light of blackbody lamps: one view-layer light group per lamp temperature (slot),
+# its pass read through its own matrix table (light_groups.py, physics/illuminant.py).
+LIT_GROUPS = ("Relativity Lit 1", "Relativity Lit 2")
+ILLUMINANT_LUT_IMAGES = ("Relativity Illuminant LUT 1", "Relativity Illuminant LUT 2")
+ILLUMINANT_KEY = "relativity_illuminant_k"  # on such an image: the illuminant it holds (K, 0 = white)
+LIGHT_GROUPS_KEY = "relativity_light_groups"  # on the scene: the light groups it set, to give back
 LUT_LAYOUT_KEY = "relativity_lut_layout"
 LUT_LAYOUT_VERSION = 1
 

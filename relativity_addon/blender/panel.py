@@ -144,10 +144,10 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
             row.prop(settings, "fast_illuminant")
             if settings.fast_illuminant == "BLACKBODY":
                 row.prop(settings, "fast_illuminant_temperature", text="")
-            elif settings.fast_illuminant == "AUTO":
-                snap = effect.last_snapshot(context.scene)
-                if snap is not None and snap.illuminant_k:
-                    colour.label(text=f"Lit by a {snap.illuminant_k:.0f} K blackbody", icon="LIGHT")
+            snap = effect.last_snapshot(context.scene)
+            if snap is not None and snap.lit_groups and settings.fast_illuminant == "AUTO":
+                kelvins = ", ".join(f"{group.temperature:.0f} K" for group in snap.lit_groups)
+                colour.label(text=f"Blackbody lamps: {kelvins}", icon="LIGHT")
         column = layout.column()
         column.active = settings.use_searchlight and not time_of_flight
         column.prop(settings, "exposure_mode")

@@ -252,14 +252,14 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
     )
     fast_illuminant: EnumProperty(
         name="Lit By",
-        description="Fast colour (F12): the light that lit what the camera sees reflected, whose spectrum the "
-        "Doppler shift moves into view (self-luminous surfaces and the world are read as emitters either way)",
+        description="Fast colour (F12): how the light that lamps sent onto surfaces is read as a spectrum, "
+        "which the Doppler shift moves into view (emitters and the world seen directly are read as RGB "
+        "colours in white light)",
         items=(
-            ("AUTO", "Automatic", "The scene's lamps' blackbody temperature when every lamp (lights and "
-             "blackbody emitters; the world only if it is a blackbody) is a blackbody at one temperature, "
-             "else white"),
-            ("WHITE", "White", "6504 K white light, as for emitters"),
-            ("BLACKBODY", "Blackbody", "A blackbody at the temperature below"),
+            ("AUTO", "Automatic", "Each blackbody lamp (lights, blackbody emitters, a blackbody world) by its "
+             "temperature, through Cycles' light groups (two temperatures at most); other lamps in white"),
+            ("WHITE", "White", "Every lamp as 6504 K white light"),
+            ("BLACKBODY", "Blackbody", "Every light object as a blackbody at the temperature below"),
         ),
         default="AUTO",
         update=_settings_changed,

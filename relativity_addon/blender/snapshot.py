@@ -88,8 +88,9 @@ class Snapshot:
     # Gray's Fig. 1c: the Galilean transformation instead of the Lorentz one (use_doppler and
     # use_searchlight are then False: the mode shows the light-travel delay alone)
     use_time_of_flight: bool = False
-    # the fast mode's illuminant of reflected light (illuminants.py): a blackbody's K, 0 for white
-    illuminant_k: float = 0.0
+    # the fast mode's blackbody lamps by temperature (illuminants.LitGroup): their light groups'
+    # passes are read through their own tables (light_groups.py)
+    lit_groups: tuple = ()
 
     @property
     def time(self) -> float:
@@ -454,6 +455,6 @@ def read(scene, depsgraph=None) -> Snapshot:
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
-        illuminant_k=illuminants.fast_illuminant(scene) if exact_camera and settings.use_doppler
-        and not time_of_flight else 0.0,
+        lit_groups=illuminants.lit_groups(scene) if exact_camera and settings.use_doppler and not time_of_flight
+        else (),
     )

@@ -297,29 +297,98 @@ def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):
     assert dh.delta_e_2000_normalised(fast, expected) < 2.0  # read as lit by the sun's 4000 K
 
 
-def test_lit_by_automatic_takes_one_blackbody_temperature(relativity_addon):
-    """Lit By: Automatic is the lamps' blackbody temperature only when they all share one."""
+def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp_path):
+    """A white wall lit by two area lights of 2700 K and 5000 K and a grey sky, observer at 0.6c:
+    the fast mode (Lit By: Automatic, a light group per temperature, the sky's light in white) gives
+    the sum of the three shifted spectra, each at the luminance it has at rest (measured on rest
+    renders with one lamp on): Delta E 2000 < 2, luminance within 5 %."""
+    bpy = __import__("bpy")
+    scene, camera = dh.emitter_scene(bpy, samples=32, resolution=RESOLUTION)
+    _quad(bpy, scene, "Wall", [(-40, -40, -5), (40, -40, -5), (40, 40, -5), (-40, 40, -5)],
+          _diffuse(bpy, "White", (1.0, 1.0, 1.0)))
+    lamps = {}
+    for name, temperature, x in (("Warm", 2700.0, -3.0), ("Cool", 5000.0, 3.0)):
+        light = bpy.data.lights.new(name, "AREA")
+        light.size, light.energy = 4.0, 400.0
+        light.use_temperature, light.temperature = True, temperature
+        lamp = bpy.data.objects.new(name, light)
+        lamp.location = (x, 0.0, 0.5)
+        lamp.visible_camera = False
+        scene.collection.objects.link(lamp)
+        lamps[name] = (lamp, temperature)
+    background = scene.world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+    sky = background.inputs["Strength"]
+    sky.default_value = 1.0
+
+    def rest_luminance(name):
+        for other, (lamp, _t) in lamps.items():
+            lamp.data.energy = 400.0 if other == name else 0.0
+        sky.default_value = 1.0 if name == "Sky" else 0.0
+        rest = _render_f12(bpy, scene, tmp_path, f"rest_{name}")[CENTRE].reshape(-1, 3)
+        return _xyz(rest).mean(axis=0)[1]
+
+    parts = {name: rest_luminance(name) for name in ("Warm", "Cool", "Sky")}
+    for lamp, _t in lamps.values():
+        lamp.data.energy = 400.0
+    sky.default_value = 1.0
+    print("rest luminance by lamp:", {name: round(float(y), 4) for name, y in parts.items()})
+    assert min(parts.values()) > 0.1 * max(parts.values()), "each lamp must light the wall"
+
+    beta = (0.0, 0.0, -0.6)
+    _set_up(bpy, scene, beta)
+    doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
+    spectra = {"Warm": 2700.0, "Cool": 5000.0, "Sky": 6504.0}  # the sky's grey: the emitters' 6504 K white
+    expected = np.mean([sum(parts[name] * dh.blackbody_xyz_colour_science(d * t)
+                            / dh.blackbody_xyz_colour_science(t)[1] for name, t in spectra.items())
+                        for d in doppler], axis=0)
+    fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
+    delta_e = dh.delta_e_2000_normalised(fast, expected)
+    print(f"two lamps and a sky, fast mode: Delta E {delta_e:.2f}, Y / expected {fast[1] / expected[1]:.4f}")
+    assert delta_e < 2.0
+    assert fast[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    scene.relativity.fast_illuminant = "WHITE"
+    white = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)
+    print(f"read in white: Delta E {dh.delta_e_2000_normalised(white, expected):.2f}, "
+          f"Y / expected {white[1] / expected[1]:.4f}")
+    assert dh.delta_e_2000_normalised(white, expected) > 5.0
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert all(lamp.lightgroup == "" for lamp, _t in lamps.values()) and scene.world.lightgroup == ""
+    assert not any(layer.lightgroups for layer in scene.view_layers)
+
+
+def test_lit_by_sorts_blackbody_lamps_by_temperature(relativity_addon):
+    """Lit By: Automatic groups the blackbody lamps by temperature (two at most, the most frequent);
+    RGB emitters and white lamps stay out; Blackbody and White override it."""
     bpy = __import__("bpy")
     illuminants = dh.addon_module(relativity_addon, "illuminants")
     scene, _camera = dh.emitter_scene(bpy)
-    assert illuminants.scene_blackbody_temperature(scene) is None  # no lamp: white
+
+    def groups():
+        return [(group.temperature, group.members) for group in illuminants.lit_groups(scene)]
+
+    assert groups() == []  # no lamp
     sun = _sun(bpy, scene, temperature=4000.0)
-    assert illuminants.scene_blackbody_temperature(scene) == 4000.0
+    assert groups() == [(4000.0, ("Sun",))]
     panel = dh.add_emitter_plane(bpy, scene, "Panel", (-1, 1), (-1, 1), temperature=4000.0)
-    assert illuminants.scene_blackbody_temperature(scene) == 4000.0  # a blackbody emitter at the same T
+    assert groups() == [(4000.0, ("Panel", "Sun"))]  # a blackbody emitter at the same T
     panel.data.materials[0].node_tree.nodes["Blackbody"].inputs["Temperature"].default_value = 3000.0
-    assert illuminants.scene_blackbody_temperature(scene) is None  # two temperatures
-    bpy.data.objects.remove(panel)
+    assert groups() == [(3000.0, ("Panel",)), (4000.0, ("Sun",))]
+    dh.add_emitter_plane(bpy, scene, "Panel2", (-1, 1), (-1, 1), temperature=2000.0)
+    dh.add_emitter_plane(bpy, scene, "Panel3", (-1, 1), (-1, 1), temperature=2000.0)
+    assert groups() == [(2000.0, ("Panel2", "Panel3")), (3000.0, ("Panel",))]  # two slots
+    for name in ("Panel", "Panel2", "Panel3"):
+        bpy.data.objects.remove(bpy.data.objects[name])
     dh.add_emitter_plane(bpy, scene, "Screen", (-1, 1), (-1, 1), colour=(0.2, 0.9, 0.1))
-    assert illuminants.scene_blackbody_temperature(scene) == 4000.0  # RGB emitters do not light
+    assert groups() == [(4000.0, ("Sun",))]  # RGB emitters are read in white
     sun.data.use_temperature = False
-    assert illuminants.scene_blackbody_temperature(scene) is None  # a white lamp
+    assert groups() == []  # a white lamp
     scene.relativity.fast_illuminant = "BLACKBODY"
     scene.relativity.fast_illuminant_temperature = 3200.0
-    assert illuminants.fast_illuminant(scene) == 3200.0
+    assert groups() == [(3200.0, ("Sun",))]
     scene.relativity.fast_illuminant = "WHITE"
     sun.data.use_temperature = True
-    assert illuminants.fast_illuminant(scene) == 0.0
+    assert groups() == []
 
 
 def test_batch_script_spectral_option(relativity_addon, tmp_path):
