@@ -94,9 +94,10 @@ def compositor_group():
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
         # The light of blackbody lamps (light_groups.py: one light group per temperature) is read
         # through its temperature's table, the rest of the pixel through the emitters' table.
+        # (the light groups' passes denoised like the Image where Cycles' denoiser is on: _add_denoisers)
         "lit": vmath("ADD", "group.Lit 1", "group.Lit 2"),
         "rest": vmath("SUBTRACT", "group.Image", "lit"),
-        "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # denoising may push it below 0
+        "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # the passes' noise may push it below 0
     }
     nodes.update(_matrix_nodes("emit", luts.DOPPLER_LUT_NAME, "other"))
     for slot, image_name in enumerate(luts.ILLUMINANT_LUT_NAMES, start=1):
@@ -182,11 +183,41 @@ def write_colour_stage(scene, snap):
     for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
         luts.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
-    for node in nodes:
+    tree = compat.compositor_tree(scene)
+    for record in scene[SAVED_KEY]["inserted"]:
+        node, layers = tree.nodes.get(record["group_node"]), tree.nodes.get(record["layers"])
+        if node is None:
+            continue
         for name, value in values.items():
             if node.inputs[name].default_value != value:
                 node.inputs[name].default_value = value
+        view_layer = scene.view_layers.get(layers.layer) if layers is not None else None
+        denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
+        for name, temperature in zip(record.get("denoisers", ()), temperatures, strict=False):
+            denoiser = tree.nodes.get(name)
+            if denoiser is not None and denoiser.mute != (not denoised or not temperature):
+                denoiser.mute = not denoised or not temperature  # muted: the pass as rendered
     return True
+
+
+def _add_denoisers(tree, layers, node):
+    """Per light group, a Denoise node between its pass and the stage (``node``), guided by the
+    denoising data passes: Cycles' denoiser denoises the Image but not the light groups' passes,
+    whose noise would come back with the rest of the pixel. Muted where not needed."""
+    outputs = layers.outputs
+    added = []
+    for slot, group_name in enumerate(light_groups.SLOTS, start=1):
+        denoiser = tree.nodes.new("CompositorNodeDenoise")
+        denoiser.name = denoiser.label = f"{node.name} Denoise {slot}"
+        denoiser.location = (node.location.x - 200.0, node.location.y - 150.0 * slot)
+        denoiser.mute = True
+        for output_name, input_name in ((f"Combined_{group_name}", "Image"), ("Denoising Normal", "Normal"),
+                                        ("Denoising Albedo", "Albedo")):
+            if output_name in outputs:
+                tree.links.new(outputs[output_name], denoiser.inputs[input_name])
+        tree.links.new(denoiser.outputs["Image"], node.inputs[f"Lit {slot}"])
+        added.append(denoiser.name)
+    return added
 
 
 def is_applied(scene):
@@ -209,7 +240,9 @@ def apply_colour_stage(scene, snap):
             tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
         light_groups.hold(scene)
+        saved["denoising_passes"] = {layer.name: layer.cycles.denoising_store_passes for layer in scene.view_layers}
         for view_layer in scene.view_layers:
+            view_layer.cycles.denoising_store_passes = True  # guides for the light groups' denoisers
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
                     aov = view_layer.aovs.add()
@@ -229,14 +262,11 @@ def apply_colour_stage(scene, snap):
                 aov_output = layers.outputs.get(aov_name)
                 if aov_output is not None:
                     tree.links.new(aov_output, node.inputs[socket_name])
-            for slot, group_name in enumerate(light_groups.SLOTS, start=1):
-                output = layers.outputs.get(f"Combined_{group_name}")
-                if output is not None:
-                    tree.links.new(output, node.inputs[f"Lit {slot}"])
             for to_node, to_socket in targets:
                 socket = next(s for s in tree.nodes[to_node].inputs if s.identifier == to_socket)
                 tree.links.new(node.outputs["Image"], socket)
-            saved["inserted"].append({"group_node": node.name, "layers": layers.name, "targets": targets})
+            saved["inserted"].append({"group_node": node.name, "layers": layers.name, "targets": targets,
+                                      "denoisers": _add_denoisers(tree, layers, node)})
         scene.render.use_compositing = True
         scene[SAVED_KEY] = saved
     write_colour_stage(scene, snap)
@@ -250,9 +280,10 @@ def remove_colour_stage(scene):
     tree = compat.compositor_tree(scene)
     if tree is not None:
         for record in saved["inserted"]:
-            node = tree.nodes.get(record["group_node"])
-            if node is not None:
-                tree.nodes.remove(node)
+            for name in [record["group_node"], *record.get("denoisers", ())]:
+                node = tree.nodes.get(name)
+                if node is not None:
+                    tree.nodes.remove(node)
             layers = tree.nodes.get(record["layers"])
             for to_node, to_socket in record["targets"]:
                 target = tree.nodes.get(to_node)
@@ -262,6 +293,10 @@ def remove_colour_stage(scene):
                 if socket is not None:
                     tree.links.new(layers.outputs["Image"], socket)
     light_groups.release(scene)
+    for name, stored in saved.get("denoising_passes", {}).items():
+        view_layer = scene.view_layers.get(name)
+        if view_layer is not None:
+            view_layer.cycles.denoising_store_passes = stored
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:

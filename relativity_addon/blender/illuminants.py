@@ -48,17 +48,23 @@ def _blackbody_emission(tree):
     return found
 
 
-def _lamp_temperature(obj):
-    """The blackbody temperature of a lamp object (a light or an emitting mesh), or None."""
+def _lamp_temperature(obj, seen):
+    """The blackbody temperature of a lamp object (a light or an emitting mesh), or None;
+    ``seen`` caches each material's ``(blackbody temperatures, whether it emits)``."""
     if obj.type == "LIGHT":
         return sources.light_blackbody(obj.data) if obj.data.energy > 0.0 else None
     found = set()
     for slot in obj.material_slots:
         material = slot.material
-        if material is not None and material.node_tree is not None:
-            found |= _blackbody_emission(material.node_tree)
-            if obj.relativity.temperature and any(emits for *_, emits in grouped_colours.targets(material.node_tree)):
-                found.add(float(obj.relativity.temperature))
+        if material is None or material.node_tree is None:
+            continue
+        if material.name not in seen:
+            tree = material.node_tree
+            seen[material.name] = (_blackbody_emission(tree), any(emits for *_, emits in grouped_colours.targets(tree)))
+        temperatures, emits = seen[material.name]
+        found |= temperatures
+        if obj.relativity.temperature and emits:
+            found.add(float(obj.relativity.temperature))
     return found.pop() if len(found) == 1 else None
 
 
@@ -84,10 +90,10 @@ def lit_groups(scene):
     if settings.fast_illuminant == "BLACKBODY":
         members = tuple(sorted(obj.name for obj in _candidates(scene) if obj.type == "LIGHT"))
         return (LitGroup(float(settings.fast_illuminant_temperature), members),) if members else ()
-    by_temperature = {}
+    by_temperature, seen = {}, {}
     for obj in _candidates(scene):
         if obj.type in ("LIGHT", "MESH", "CURVE", "SURFACE", "META", "FONT"):
-            temperature = _lamp_temperature(obj)
+            temperature = _lamp_temperature(obj, seen)
             if temperature is not None:
                 by_temperature.setdefault(temperature, []).append(obj.name)
     world_temperature = _world_temperature(scene.world)

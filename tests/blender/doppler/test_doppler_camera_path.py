@@ -127,14 +127,23 @@ def test_blackbody_seen_at_dt_by_moving_observer(factory_blender, tmp_path, beta
     assert measured_ratio == pytest.approx(expected_ratio, rel=0.02)
 
 
+@pytest.mark.parametrize("lit", [False, True], ids=["emitters", "lit"])
 @pytest.mark.parametrize("beta_z", [-0.9998, 0.9998])
-def test_deep_shift_is_finite(factory_blender, tmp_path, beta_z):
-    """D reaches ~100 (toward the wall) or ~0.01 (away) at the image centre."""
+def test_deep_shift_is_finite(factory_blender, tmp_path, beta_z, lit):
+    """D reaches ~100 (toward the wall) or ~0.01 (away) at the image centre. Lit: one wall is
+    diffuse, lit by a 1500 K area light and a grey world (the fast mode's light-group tables)."""
     bpy = factory_blender
     scene, camera = dh.emitter_scene(bpy, samples=2)
     for i, colour in enumerate(((1.0, 1.0, 1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))):
-        dh.add_emitter_plane(bpy, scene, f"Wall{i}", (-400.0 + 266.0 * i, -134.0 + 266.0 * i), (-400.0, 400.0),
-                             colour, beta=None)
+        wall = dh.add_emitter_plane(bpy, scene, f"Wall{i}", (-400.0 + 266.0 * i, -134.0 + 266.0 * i),
+                                    (-400.0, 400.0), colour, beta=None)
+        if lit and i == 1:
+            wall.data.materials[0] = ch.diffuse_material(bpy, "Diffuse", (0.8, 0.5, 0.2))
+    if lit:
+        light = bpy.data.lights.new("Lamp", "AREA")
+        light.size, light.energy, light.use_temperature, light.temperature = 20.0, 2000.0, True, 1500.0
+        scene.collection.objects.link(bpy.data.objects.new("Lamp", light))
+        scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.2, 0.2, 0.2, 1.0)
     dh.add_emitter_plane(bpy, scene, "Sun", (-0.2, 0.2), (-0.2, 0.2), beta=None, temperature=5762.0,
                          depth=4.0)
     blend = ch.save_blend(bpy, tmp_path / "deep.blend")

@@ -347,6 +347,18 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     print(f"two lamps and a sky, fast mode: Delta E {delta_e:.2f}, Y / expected {fast[1] / expected[1]:.4f}")
     assert delta_e < 2.0
     assert fast[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    # Cycles' denoiser (on by default) denoises the Image but not the light groups' passes: the
+    # stage denoises those too (muted Denoise nodes otherwise), or their noise would come back
+    scene.cycles.use_denoising, scene.cycles.samples = True, 4
+    denoised = _xyz(_render_f12(bpy, scene, tmp_path, "denoised")[CENTRE].reshape(-1, 3))
+    scene.cycles.use_denoising = False
+    raw = _xyz(_render_f12(bpy, scene, tmp_path, "raw")[CENTRE].reshape(-1, 3))
+    spreads = [pixels[:, 1].std() / pixels[:, 1].mean() for pixels in (denoised, raw)]
+    print(f"4 samples, denoised: Delta E {dh.delta_e_2000_normalised(denoised.mean(axis=0), expected):.2f}, "
+          f"Y / expected {denoised.mean(axis=0)[1] / expected[1]:.4f}; pixel spread {spreads[0]:.4f} "
+          f"against {spreads[1]:.4f} not denoised")
+    assert dh.delta_e_2000_normalised(denoised.mean(axis=0), expected) < 2.0
+    assert spreads[0] < 0.5 * spreads[1]
     scene.relativity.fast_illuminant = "WHITE"
     white = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)
     print(f"read in white: Delta E {dh.delta_e_2000_normalised(white, expected):.2f}, "
