@@ -27,6 +27,7 @@ from . import (
     geometry,
     lamp_doppler,
     lamp_faces,
+    light_groups,
     metadata,
     modifier,
     moving_lights,
@@ -277,6 +278,7 @@ def _record(scene, snap):
     warnings += lamp_faces.warnings(scene, snap)
     if snap.exact_camera:
         warnings += volumes.warnings(scene)
+        warnings += light_groups.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)

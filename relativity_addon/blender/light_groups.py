@@ -24,6 +24,14 @@ def user_groups(scene):
     return sorted({group.name for layer in scene.view_layers for group in layer.lightgroups} - set(SLOTS))
 
 
+def warnings(scene, snap):
+    """One line when blackbody lamps are read in white because the scene has its own light groups."""
+    if snap.lit_groups and user_groups(scene):
+        return [f"Fast colour reads the lamps in white light: the scene has its own light groups "
+                f"({', '.join(user_groups(scene))}); Render Spectral is exact"]
+    return []
+
+
 def hold(scene):
     """Add the slots' light groups to every view layer (before the compositor stage links their passes)."""
     if KEY in scene or user_groups(scene):

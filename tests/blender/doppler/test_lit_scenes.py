@@ -367,6 +367,14 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert all(lamp.lightgroup == "" for lamp, _t in lamps.values()) and scene.world.lightgroup == ""
     assert not any(layer.lightgroups for layer in scene.view_layers)
+    # the user's own light groups are left alone, and the panel says what that costs
+    scene.view_layers[0].lightgroups.add(name="Key")
+    scene.relativity.fast_illuminant = "AUTO"
+    _set_up(bpy, scene, beta)
+    warnings = dh.addon_module(relativity_addon, "effect").scene_warnings(scene)
+    assert any("own light groups (Key)" in line for line in warnings), warnings
+    assert [group.name for group in scene.view_layers[0].lightgroups] == ["Key"]
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
 
 
 def test_lit_by_sorts_blackbody_lamps_by_temperature(relativity_addon):
