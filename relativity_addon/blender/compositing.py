@@ -20,6 +20,10 @@ spectral Doppler matrix per pixel after the render, with no second render:
   comparison). All exponents are added before one ``exp`` so that nothing overflows float32.
 - Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
   written by ``materials``) keep their rendered colour.
+- The light of blackbody lamps (Cycles light groups per temperature, ``light_groups.py``) goes
+  through the table of its blackbody (``physics/illuminant.py``): a surface it lit sends a
+  reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
+  Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
 
 The group is inserted after every Render Layers node of the scene's compositor (a tree is
 created if the scene has none); :func:`remove_colour_stage` restores the compositor exactly.
