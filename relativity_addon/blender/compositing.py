@@ -197,8 +197,10 @@ def write_colour_stage(scene, snap):
                 node.inputs[name].default_value = value
         view_layer = scene.view_layers.get(layers.layer) if layers is not None else None
         denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
-        for name, temperature in zip(record.get("denoisers", ()), temperatures, strict=False):
+        for slot, (name, temperature) in enumerate(zip(record.get("denoisers", ()), temperatures, strict=False), 1):
             denoiser = tree.nodes.get(name)
+            if denoiser is not None and layers is not None:
+                _link_light_group_pass(tree, layers, denoiser, slot)
             if denoiser is not None and denoiser.mute != (not denoised or not temperature):
                 denoiser.mute = not denoised or not temperature  # muted: the pass as rendered
     return True
@@ -208,20 +210,29 @@ def _add_denoisers(tree, layers, node):
     """Per light group, a Denoise node between its pass and the stage (``node``), guided by the
     denoising data passes: Cycles' denoiser denoises the Image but not the light groups' passes,
     whose noise would come back with the rest of the pixel. Muted where not needed."""
-    outputs = layers.outputs
     added = []
-    for slot, group_name in enumerate(light_groups.SLOTS, start=1):
+    for slot in range(1, len(light_groups.SLOTS) + 1):
         denoiser = tree.nodes.new("CompositorNodeDenoise")
         denoiser.name = denoiser.label = f"{node.name} Denoise {slot}"
         denoiser.location = (node.location.x - 200.0, node.location.y - 150.0 * slot)
         denoiser.mute = True
-        for output_name, input_name in ((f"Combined_{group_name}", "Image"), ("Denoising Normal", "Normal"),
-                                        ("Denoising Albedo", "Albedo")):
-            if output_name in outputs:
-                tree.links.new(outputs[output_name], denoiser.inputs[input_name])
         tree.links.new(denoiser.outputs["Image"], node.inputs[f"Lit {slot}"])
+        _link_light_group_pass(tree, layers, denoiser, slot)
         added.append(denoiser.name)
     return added
+
+
+def _link_light_group_pass(tree, layers, denoiser, slot):
+    """Link light group ``slot``'s pass and the denoising guides into ``denoiser`` (the Render
+    Layers node shows a new light group's output only once it is updated)."""
+    if denoiser.inputs["Image"].is_linked:
+        return
+    layers.update()
+    outputs = layers.outputs
+    for output_name, input_name in ((f"Combined_{light_groups.SLOTS[slot - 1]}", "Image"),
+                                    ("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")):
+        if output_name in outputs:
+            tree.links.new(outputs[output_name], denoiser.inputs[input_name])
 
 
 def is_applied(scene):

@@ -342,6 +342,9 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     expected = np.mean([sum(parts[name] * dh.blackbody_xyz_colour_science(d * t)
                             / dh.blackbody_xyz_colour_science(t)[1] for name, t in spectra.items())
                         for d in doppler], axis=0)
+    tree = dh.addon_module(relativity_addon, "compat").compositor_tree(scene)
+    denoisers = [node for node in tree.nodes if node.bl_idname == "CompositorNodeDenoise"]
+    assert len(denoisers) == 2 and all(node.inputs["Image"].is_linked for node in denoisers)
     fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
     delta_e = dh.delta_e_2000_normalised(fast, expected)
     print(f"two lamps and a sky, fast mode: Delta E {delta_e:.2f}, Y / expected {fast[1] / expected[1]:.4f}")
