@@ -1,0 +1,160 @@
+"""The world seen by a moving exact camera: its colour Doppler-shifted at every pixel.
+
+Nothing but a world of constant colour: every pixel's expected colour is the world's colour through
+the Doppler matrix at that pixel's ``D = 1 / (gamma (1 - beta . d'))``, ``d'`` its camera-frame
+viewing direction (docs/physics.md), for the perspective camera and the equirectangular panorama
+(Blender's projection: longitude -pi to pi left to right, latitude -pi/2 to pi/2 bottom to top),
+up to D about 4; in a spectral render, the XYZ of ``D^5 S(lambda D)`` of the colour's spectrum
+(docs/spectral-model.md). The world's Doppler colour group feeds its Background only where it
+changes the colour (spectral passes, blackbodies: ``world_colour``), and removing the effect gives
+the world back exactly.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import doppler_helpers as dh
+
+COLOUR = (0.3, 0.6, 0.2)
+RESOLUTION = (48, 32)
+
+
+def _world_scene(bpy, colour=COLOUR, resolution=RESOLUTION):
+    """No objects; the camera at the origin looks down -Z (world axes = camera axes)."""
+    scene, camera = dh.emitter_scene(bpy, samples=4, resolution=resolution)
+    background = scene.world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (*colour, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    return scene, camera, background
+
+
+def _set_up(bpy, scene, beta):
+    scene.relativity.beta = beta
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+
+
+def _equirectangular_directions(width, height):
+    """Camera-local viewing directions (+X right, +Y up, -Z forward) of the pixel centres, top row first."""
+    longitude = -math.pi + (np.arange(width) + 0.5) / width * 2.0 * math.pi
+    latitude = math.pi / 2 - (np.arange(height) + 0.5) / height * math.pi
+    lon, lat = np.meshgrid(longitude, latitude)
+    return np.stack([np.cos(lat) * np.sin(lon), np.sin(lat), -np.cos(lat) * np.cos(lon)], axis=-1)
+
+
+def _doppler(view, beta):
+    beta = np.asarray(beta, float)
+    return math.sqrt(1.0 - beta @ beta) / (1.0 - view @ beta)  # 1 / (gamma (1 - beta . d))
+
+
+def _assert_shifted(image, d, colour=COLOUR, tolerance=0.01):
+    from relativity_addon.physics import spectral
+
+    expected = spectral.doppler_shift_rgb(colour, d)
+    error = np.abs(image - expected) / expected.sum(-1, keepdims=True)
+    print(f"D {d.min():.3f}-{d.max():.3f}: max relative error {error.max():.4f}, mean {error.mean():.5f}")
+    assert np.all(np.isfinite(image))
+    assert error.mean() < 0.005
+    assert error.max() < tolerance
+
+
+def _signature(tree):
+    links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+                   for link in tree.links)
+    return sorted(node.name for node in tree.nodes), links
+
+
+@pytest.mark.parametrize("beta", [(0.3, 0.0, -0.5), (0.2, -0.1, -0.9)], ids=["oblique", "fast_forward"])
+def test_world_is_shifted_at_every_pixel(relativity_addon, tmp_path, beta):
+    bpy = __import__("bpy")
+    scene, camera, _background = _world_scene(bpy)
+    _set_up(bpy, scene, beta)
+    image = dh.render(bpy, scene, tmp_path / "world.exr")
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    d = _doppler(view, beta)
+    assert d.max() > (3.0 if beta[2] < -0.8 else 1.5)
+    _assert_shifted(image, d)
+
+
+def test_equirectangular_world_is_shifted_at_every_pixel(relativity_addon, tmp_path):
+    bpy = __import__("bpy")
+    width, height = 128, 64
+    scene, camera, _background = _world_scene(bpy, resolution=(width, height))
+    camera.data.type = "PANO"
+    camera.data.panorama_type = "EQUIRECTANGULAR"
+    beta = (0.2, 0.3, -0.6)
+    _set_up(bpy, scene, beta)
+    image = dh.render(bpy, scene, tmp_path / "panorama.exr")
+    d = _doppler(_equirectangular_directions(width, height), beta)
+    # A pixel holds 2.8 degrees of directions, over which D varies by up to 10% here: the pixel's
+    # mean of D^4 (the rendered brightness) is not exp(4 <ln D>) (the compositor's division)
+    _assert_shifted(image[2:-2], d[2:-2], tolerance=0.08)
+
+
+def test_world_colour_group_feeds_the_background_only_where_needed(relativity_addon):
+    """Fast mode: the Background keeps its own colour (the compositor shifts the pixel); a spectral
+    pass and a blackbody background need the group; removal restores the tree exactly."""
+    bpy = __import__("bpy")
+    effect = dh.addon_module(relativity_addon, "effect")
+    materials = dh.addon_module(relativity_addon, "materials")
+    world_colour = dh.addon_module(relativity_addon, "world_colour")
+    scene, _camera, background = _world_scene(bpy)
+    tree = scene.world.node_tree
+    rgb = tree.nodes.new("ShaderNodeRGB")  # a linked colour and ...
+    second = tree.nodes.new("ShaderNodeBackground")  # ... an unlinked one (not in the output)
+    second.inputs["Color"].default_value = (0.1, 0.2, 0.7, 1.0)
+    tree.links.new(rgb.outputs[0], background.inputs["Color"])
+    before = _signature(tree)
+    _set_up(bpy, scene, (0.0, 0.0, -0.5))
+    assert len(tree.nodes) > len(before[0])  # the groups are in the tree ...
+    assert world_colour.linked_groups(scene.world) == []  # ... and feed nothing
+    assert background.inputs["Color"].links[0].from_node == rgb
+    assert not second.inputs["Color"].is_linked
+
+    second.inputs["Color"].default_value = (0.4, 0.1, 0.1, 1.0)  # edited while the group is out
+    materials.set_spectral_pass((450.0, 550.0, 650.0))
+    try:
+        effect.sync(scene)
+        assert len(world_colour.linked_groups(scene.world)) == 2
+        for socket in (background.inputs["Color"], second.inputs["Color"]):
+            assert socket.links[0].from_node.node_tree.name == materials.DOPPLER_EMISSION
+        group = second.inputs["Color"].links[0].from_node
+        assert tuple(group.inputs["Color"].default_value) == pytest.approx((0.4, 0.1, 0.1, 1.0))
+    finally:
+        materials.set_spectral_pass(None)
+    effect.sync(scene)
+    assert world_colour.linked_groups(scene.world) == []
+    assert background.inputs["Color"].links[0].from_node == rgb
+
+    effect.remove(scene)
+    assert _signature(tree) == before
+    assert tuple(second.inputs["Color"].default_value) == pytest.approx((0.4, 0.1, 0.1, 1.0))
+
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")  # a blackbody background keeps its group
+    tree.links.new(blackbody.outputs[0], background.inputs["Color"])
+    _set_up(bpy, scene, (0.0, 0.0, -0.5))
+    linked = world_colour.linked_groups(scene.world)
+    assert len(linked) == 1 and background.inputs["Color"].links[0].from_node == linked[0]
+    effect.remove(scene)
+    assert background.inputs["Color"].links[0].from_node == blackbody
+
+
+def test_spectral_render_of_a_coloured_world(relativity_addon):
+    """Spectral passes see the world through its colour group: ``D^5 S(lambda D)`` per pixel."""
+    bpy = __import__("bpy")
+    scene, camera, _background = _world_scene(bpy, resolution=(32, 24))
+    beta = (0.3, 0.0, -0.6)
+    _set_up(bpy, scene, beta)
+    pixels, _info = dh.addon_module(relativity_addon, "spectral_render").render(scene, 3)
+    image = pixels[::-1, :, :3].astype(float)  # top row first
+    d = _doppler(-dh.pixel_photon_directions(bpy, scene, camera), beta)
+    spectrum = dh.emitted_spectrum(COLOUR)
+    for rows, cols in ((slice(2, 6), slice(2, 6)), (slice(10, 14), slice(14, 18)), (slice(18, 22), slice(26, 30))):
+        expected = np.mean([dh.observed_xyz(spectrum, value) for value in d[rows, cols].ravel()], axis=0)
+        measured = dh.linear_rec709_to_xyz(image[rows, cols].reshape(-1, 3).mean(0))
+        delta_e = dh.delta_e_2000_normalised(measured, expected)
+        print(f"D {d[rows, cols].mean():.3f}: Delta E {delta_e:.2f}, Y/expected {measured[1] / expected[1]:.3f}")
+        assert delta_e < 2.0
+        assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    assert d.max() / d.min() > 1.3
