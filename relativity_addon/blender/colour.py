@@ -10,7 +10,7 @@ group (materials) and the compositor group's flag inputs.
 import bpy
 
 from ..errors import RelativityError
-from . import compositing, luts, materials, volumes, world_colour, world_sampling
+from . import compositing, luts, materials, names, volumes, world_colour, world_sampling
 from .compositing import is_applied as compositor_applied
 
 
@@ -81,7 +81,7 @@ def remove_unused_data():
         tree = bpy.data.node_groups.get(name)
         if tree is not None:
             bpy.data.node_groups.remove(tree)
-    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME):
+    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, names.WORLD_DOPPLER_IMAGE):
         image = bpy.data.images.get(name)
         if image is not None:
             bpy.data.images.remove(image)
