@@ -161,8 +161,10 @@ def test_world_colour_group_feeds_the_background_only_where_needed(relativity_ad
     assert world_colour.linked_groups(scene.world) == []
     assert background.inputs["Color"].links[0].from_node == rgb
 
+    assert "Relativity World Doppler" in bpy.data.images  # the compositor's world ln D
     effect.remove(scene)
     assert _signature(tree) == before
+    assert "Relativity World Doppler" not in bpy.data.images
     assert tuple(second.inputs["Color"].default_value) == pytest.approx((0.4, 0.1, 0.1, 1.0))
 
     blackbody = tree.nodes.new("ShaderNodeBlackbody")  # a blackbody background keeps its group
