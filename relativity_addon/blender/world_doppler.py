@@ -19,9 +19,9 @@ compositor divides the AOV by the coverage as before (``problem``): time-of-flig
 leave along ``d - beta``), Blender's stereo pair (each eye's view is shifted or turned), a render
 cropped to its border, a panorama with a lens shift. The image is written at every sync whose
 inputs changed before a render (``render_pre``, every frame of an animation render), sized to
-the render (its percentage included), from the frame's snapshot alone; it goes with the effect.
-A generated image keeps no pixels in the saved file: a file rendered without the add-on gets
-``ln D`` = 0 for its world pixels.
+the render (its percentage included), from the frame's snapshot alone, and packed into the file
+(0.3 s for 1920 x 1080), so that a saved file renders the same without the add-on; it goes with
+the effect.
 """
 
 import numpy as np
@@ -94,7 +94,7 @@ def _mute_world_writer(world, mute):
 def write(scene, snap, pixels=True):
     """Bring the world's AOV writer, the compositor's switch and (with ``pixels``: before a render)
     the image up to date for ``snap`` (exact camera, compositor stage applied). Only what changed
-    is written: the image costs about 0.1 s a megapixel, too much for every edit in the UI."""
+    is written: the image costs a few tenths of a second at full HD, too much for every edit."""
     if not compositing.is_applied(scene):
         return False
     use_image = problem(scene, snap) is None
@@ -112,6 +112,7 @@ def write(scene, snap, pixels=True):
     pixels[..., 3] = 1.0
     image.pixels.foreach_set(pixels.ravel())
     image.update()
+    image.pack()  # into the .blend (as OpenEXR): the saved file renders the same without the add-on
     _written[image.session_uid] = inputs
     return True
 

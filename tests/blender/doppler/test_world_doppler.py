@@ -11,6 +11,8 @@ the world back exactly.
 """
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -239,3 +241,29 @@ def test_animation_render_shifts_the_world_for_each_frame(relativity_addon, tmp_
     for frame, speed in speeds.items():
         image = dh.ch.read_exr(bpy, tmp_path / f"f_{frame:04d}.exr")
         _assert_shifted(image, _doppler(view, (0.0, 0.0, -speed)), tolerance=0.02)
+
+
+def test_saved_file_renders_the_world_without_the_addon(relativity_addon, tmp_path):
+    """The world's ln D image is packed into the file: opened and rendered where the add-on is not
+    installed, the shifted world is the same."""
+    bpy = __import__("bpy")
+    scene, _camera, _background = _world_scene(bpy)
+    _set_up(bpy, scene, (0.3, 0.0, -0.6))
+    reference = dh.render(bpy, scene, tmp_path / "with_addon.exr")
+    blend = dh.ch.save_blend(bpy, tmp_path / "world.blend")
+    worker = (
+        "import os, sys\n"
+        "import bpy\n"
+        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r})\n"
+        "scene = bpy.context.scene\n"
+        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
+        f"scene.render.filepath = {str(tmp_path / 'plain.exr')!r}\n"
+        "bpy.ops.render.render(write_still=True)\n"
+        "sys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"  # bpy 4.5 can hang in exit()
+    )
+    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    plain = dh.ch.read_exr(bpy, tmp_path / "plain.exr")
+    print(f"max |plain - with add-on| / max = {np.abs(plain - reference).max() / reference.max():.2e}")
+    assert np.abs(plain - reference).max() < 1e-5 * reference.max()
+    assert np.abs(reference[5, 5] - COLOUR).max() > 0.05  # shifted
