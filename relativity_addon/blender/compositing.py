@@ -189,11 +189,16 @@ def write_colour_stage(scene, snap):
 
 
 def write_world_directions(scene, value):
-    """1: the samples without ln D AOV take the world image's ln D; 0: the world writes the AOV."""
+    """1: the samples without ln D AOV take the world image's ln D; 0: the world writes the AOV.
+    False if an inserted group has no such input (a file set up before it: set up again)."""
     _tree, nodes = _inserted_nodes(scene)
-    for node in nodes:
-        if node.inputs["World Directions"].default_value != value:
-            node.inputs["World Directions"].default_value = value
+    sockets = [node.inputs.get("World Directions") for node in nodes]
+    if not nodes or None in sockets:
+        return False
+    for socket in sockets:
+        if socket.default_value != value:
+            socket.default_value = value
+    return True
 
 
 def is_applied(scene):

@@ -98,8 +98,9 @@ def write(scene, snap, pixels=True):
     if not compositing.is_applied(scene):
         return False
     use_image = problem(scene, snap) is None
+    # an older file's compositor group has no World Directions input: its world keeps the writer
+    use_image = compositing.write_world_directions(scene, 1.0 if use_image else 0.0) and use_image
     _mute_world_writer(scene.world, use_image)  # a muted writer is left out of the shader
-    compositing.write_world_directions(scene, 1.0 if use_image else 0.0)
     if not use_image or not pixels:
         return use_image
     inputs = _inputs(scene, snap)
