@@ -145,7 +145,7 @@ def _fitted_sensor(scene, camera_data):
     return size * x_ratio / y_ratio, size
 
 
-def _projection_parameters(scene, camera_data):
+def projection_parameters(scene, camera_data):
     kind = lens_type(camera_data)
     projection = PANORAMA_PROJECTIONS.get(camera_data.panorama_type, 0) if kind == "PANO" else 0
     sensor_width, sensor_height = _fitted_sensor(scene, camera_data)
@@ -218,7 +218,7 @@ def shader_parameters(scene, camera_data, snap):
         "settings_valid": True,
         "use_eye_offset": stereo_eyes(scene),
         "camera_origin": tuple(float(row[3]) for row in snap.camera_matrix[:3]),
-        **_projection_parameters(scene, camera_data),
+        **projection_parameters(scene, camera_data),
     }
 
 

@@ -10,7 +10,7 @@ group (materials) and the compositor group's flag inputs.
 import bpy
 
 from ..errors import RelativityError
-from . import compositing, luts, materials, volumes, world_sampling
+from . import compositing, luts, materials, names, volumes, world_colour, world_sampling
 from .compositing import is_applied as compositor_applied
 
 
@@ -36,6 +36,8 @@ def write(scene, snap, attach_new_materials=False):
     if attach_new_materials:
         _attach(scene, snap)
     materials.write_settings(snap)
+    if snap.colour.camera_path:
+        world_colour.write(scene.world)  # the world's colour groups only where they change the colour
     compositing.write_colour_stage(scene, snap)
 
 
@@ -79,7 +81,8 @@ def remove_unused_data():
         tree = bpy.data.node_groups.get(name)
         if tree is not None:
             bpy.data.node_groups.remove(tree)
-    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, *luts.ILLUMINANT_LUT_NAMES):
+    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, names.WORLD_DOPPLER_IMAGE,
+                 *luts.ILLUMINANT_LUT_NAMES):
         image = bpy.data.images.get(name)
         if image is not None:
             bpy.data.images.remove(image)

@@ -5,13 +5,14 @@ change needs the spectrum, which a camera shader cannot touch, so this stage app
 spectral Doppler matrix per pixel after the render, with no second render:
 
 - ``ln D`` per pixel comes from the ``relativity_log_doppler`` AOV, written by every material
-  and the world at the first camera hit (``materials.doppler_aov_group``):
+  at the first camera hit (``materials.doppler_aov_group``), and for the other samples (the
+  world, volume scattering) from the pixel centre's direction (``world_doppler``):
   ``D = gamma (1 - beta . k)`` with ``k`` the scene-frame photon direction (the Incoming vector)
   and ``beta`` the observer velocity (docs/physics.md). Computed by Cycles per sample, so it holds
   for every shutter model, depth of field and the Lorentz window, and it follows the velocity
-  frame by frame in animation renders. It is divided by the ``relativity_coverage`` AOV (1 from
-  every writer): a camera ray scattered in a volume writes neither, and would otherwise pull the
-  pixel's mean ``ln D`` toward 0.
+  frame by frame in animation renders. The ``relativity_coverage`` AOV (1 from every writer)
+  is the share of samples that wrote it: ``ln D = AOV + (1 - coverage) ln D_pixel``, or, where
+  the world writes its own AOV (``world_doppler.problem``), ``AOV / coverage``.
 - ``rgb = C exp(-p_cam ln D)`` undoes the shader's ``D^4`` (``p_cam`` = 4 with the searchlight),
   and the output is ``exp(E) gamut_map(N(D) rgb)`` exactly as in the materials
   (``materials.doppler_colour_group``): ``M(D) = exp(a(D)) N(D)`` read from the packed table
@@ -79,10 +80,20 @@ def _matrix_nodes(key, image_name, colour):
 def compositor_group():
     scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
     nodes = {
-        # ln D per pixel from the materials' and world's AOV (materials.doppler_aov_group), the mean
-        # over the samples that wrote it (a camera ray scattered in a volume writes none)
-        "coverage": fmath("MAXIMUM", "group.Coverage", 1e-3),
-        "ln_d": fmath("DIVIDE", "group.Log Doppler", "coverage"),
+        # ln D per pixel from the materials' AOV (materials.doppler_aov_group), over the share
+        # ``coverage`` of samples that wrote it. With World Directions = 1 the other samples (the
+        # world, a camera ray scattered in a volume) take the pixel centre's ln D from the image
+        # world_doppler writes: ln D = AOV + (1 - coverage) ln D_pixel. With 0 (the world writes the
+        # AOV itself), the mean over the writing samples: AOV / coverage.
+        "world_image": Node("CompositorNodeImage", props={"image": names.WORLD_DOPPLER_IMAGE}),
+        "world_split": Node("CompositorNodeSeparateColor", {0: "world_image.Image"}),
+        "uncovered": fmath("SUBTRACT", 1.0, "group.Coverage"),
+        "world_share": fmath("MULTIPLY", "uncovered", "group.World Directions"),
+        "world_term": fmath("MULTIPLY", "world_share", "world_split.Red"),
+        "sum": fmath("ADD", "group.Log Doppler", "world_term"),
+        "weight": fmath("ADD", "group.Coverage", "world_share"),
+        "coverage": fmath("MAXIMUM", "weight", 1e-3),
+        "ln_d": fmath("DIVIDE", "sum", "coverage"),
         # Linear interpolation between the two nearest texels, done here with two nearest-texel
         # reads (Blender 4.5's Map UV has no bilinear mode nor an Extend border): x is the texel
         # coordinate, clamped to the table (= Extend), i0 the left texel, at most size - 2.
@@ -126,6 +137,7 @@ def compositor_group():
             ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
             ("Lit 1", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the light groups' passes
             ("Lit 2", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("World Directions", "NodeSocketFloat", 0.0),  # 1: the image has the samples' ln D without AOV
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
         (("Image", "NodeSocketColor", "out"),),
@@ -133,11 +145,25 @@ def compositor_group():
     )
 
 
+def ensure_world_image(size=(1, 1)):
+    """The float image of the pixels' world ``ln D`` (``world_doppler`` writes it), of ``size``."""
+    image = bpy.data.images.get(names.WORLD_DOPPLER_IMAGE)
+    if image is not None and (tuple(image.size) != tuple(size) or not image.is_float):
+        if tuple(size) == (1, 1):
+            return image  # any size will do for the group's node
+        image.scale(*size)
+    if image is None:
+        image = bpy.data.images.new(names.WORLD_DOPPLER_IMAGE, *size, alpha=True, float_buffer=True)
+        image.colorspace_settings.is_data = True  # ln D, not a colour
+    return image
+
+
 def ensure_compositor_group():
     luts.ensure_doppler_matrix_lut()
     for name in luts.ILLUMINANT_LUT_NAMES:
         if bpy.data.images.get(name) is None:
             luts.ensure_illuminant_lut(name, 0.0)
+    ensure_world_image()
     version = (names.GROUP_VERSION_KEY, names.COMPOSITOR_GROUPS_VERSION)
     ensure_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"), *version)
     return ensure_group(compositor_group(), *version)
@@ -233,6 +259,19 @@ def _link_light_group_pass(tree, layers, denoiser, slot):
                                     ("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")):
         if output_name in outputs:
             tree.links.new(outputs[output_name], denoiser.inputs[input_name])
+
+
+def write_world_directions(scene, value):
+    """1: the samples without ln D AOV take the world image's ln D; 0: the world writes the AOV.
+    False if an inserted group has no such input (a file set up before it: set up again)."""
+    _tree, nodes = _inserted_nodes(scene)
+    sockets = [node.inputs.get("World Directions") for node in nodes]
+    if not nodes or None in sockets:
+        return False
+    for socket in sockets:
+        if socket.default_value != value:
+            socket.default_value = value
+    return True
 
 
 def is_applied(scene):

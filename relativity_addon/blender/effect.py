@@ -35,6 +35,7 @@ from . import (
     snapshot,
     traveller,
     volumes,
+    world_doppler,
 )
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
@@ -80,6 +81,8 @@ def apply(scene, frame_range=None, objects=None):
     try:
         moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
         colour.apply(scene, snap)
+        if snap.colour.camera_path:
+            world_doppler.write(scene, snap)  # the world pixels' ln D for the compositor stage
         metadata.write(scene, snap)
         clamping.write(scene, snap)
         lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
@@ -183,13 +186,14 @@ def _remove_render_only_camera(scene):
         camera.remove(camera_object)
 
 
-def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False):
+def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False, before_render=False):
     """Bring the applied render path up to date with the scene at its current frame.
 
     ``update_geometry=False`` skips the apparent geometry (it needs the frame's evaluated meshes,
     which exist only after a frame change); only objects whose inputs changed (the frame among
     them) are recomputed; ``attach_new_materials`` attaches the Doppler colour to materials added
-    since Set Up.
+    since Set Up; ``before_render`` (``render_pre``) also writes what only a render reads (the
+    world's direction image).
     Never raises."""
     if busy.is_computing():
         return None
@@ -208,6 +212,8 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         if method is not None:
             moving_lights.write(scene, snap, attach_new_materials, depsgraph)
             colour.write(scene, snap, attach_new_materials)
+            if snap.colour.camera_path:
+                world_doppler.write(scene, snap, pixels=before_render)
             metadata.write(scene, snap)
             clamping.write(scene, snap)
             lamp_doppler.write(scene, snap)

@@ -43,7 +43,7 @@ def depsgraph_update_post(scene, depsgraph=None):
 
 @persistent
 def render_pre(scene, _depsgraph=None):
-    _sync(scene, update_geometry=False, attach_new_materials=True)
+    _sync(scene, update_geometry=False, attach_new_materials=True, before_render=True)
 
 
 @persistent

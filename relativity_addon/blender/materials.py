@@ -469,8 +469,9 @@ def attach_scene(scene, camera_path):
 
 
 def attach_world(world):
-    """The world writes the Doppler AOV too, so background pixels get their D; a Background
-    colour fed by a blackbody (``sources``) gets the colour group, like an emission."""
+    """The world's Doppler AOV writer (muted where ``world_doppler`` gives the compositor the
+    world's D) and a colour group in front of every Background colour (``world_colour`` links it
+    where it changes the colour: blackbodies, spectral passes)."""
     if world is None or world.node_tree is None or ATTACHED_KEY in world:
         return False
     tree = world.node_tree

@@ -45,13 +45,15 @@ GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor group
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
 COMPOSITOR_GROUP = "Relativity Doppler Compositor"
 COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
-COMPOSITOR_GROUPS_VERSION = 6  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
-# 5: ln D over the coverage AOV; 6: emitted and reflected light through their own tables
+COMPOSITOR_GROUPS_VERSION = 7  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
+# 5: ln D over the coverage AOV; 6: the samples without AOV take ln D from the world-direction image;
+# 7: the light groups' passes through their own tables
 COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
 COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
 LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit
 COVERAGE_AOV = "relativity_coverage"  # 1 with it: the pixel's share of samples that wrote ln D
 COLOUR_DONE_AOV = "relativity_colour_done"  # 1 where a material already shifted the colour
+WORLD_DOPPLER_IMAGE = "Relativity World Doppler"  # ln D of each pixel centre's direction (world_doppler)
 
 # --- spectral mode -------------------------------------------------------------------------
 SPECTRAL_IMAGE = "Relativity Spectral Render"  # the picture the spectral render makes

@@ -20,6 +20,7 @@ PARTS = {
     "colour": {
         "relativity_addon.blender.colour", "relativity_addon.blender.materials",
         "relativity_addon.blender.compositing", "relativity_addon.blender.luts",
+        "relativity_addon.blender.world_colour",
     },
 }
 
