@@ -91,6 +91,27 @@ def emission_in_group(bpy, material, kind, temperature):
     return node
 
 
+def render_without_addon(bpy, blend, out):
+    """Open ``blend`` in a fresh process where neither the add-on nor colour-science is installed,
+    render it to ``out`` (EXR) and return the pixels: what a render-farm worker sees."""
+    import subprocess
+
+    worker = (
+        "import os, sys\n"
+        "sys.modules['colour'] = None  # colour-science must not be needed to render\n"
+        "import bpy\n"
+        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r})\n"
+        "scene = bpy.context.scene\n"
+        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
+        f"scene.render.filepath = {str(out)!r}\n"
+        "bpy.ops.render.render(write_still=True)\n"
+        "sys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"  # bpy 4.5 can hang in exit()
+    )
+    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return ch.read_exr(bpy, out)
+
+
 def render(bpy, scene, path):
     return ch.render_exr(bpy, scene, path)
 
