@@ -209,9 +209,15 @@ def write_colour_stage(scene, snap):
     _tree, nodes = _inserted_nodes(scene)
     if not nodes:
         return False
-    temperatures = light_groups.assign(scene, snap.lit_groups)
-    for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
-        luts.ensure_illuminant_lut(name, temperature)
+    if _stage_mode["mode"] == "PASS_THROUGH":
+        # spectral passes: the lamps' colours are spectral values now, the groups stay as they were
+        # (the stage passes every part through; their denoisers still match the denoised Image)
+        temperatures = tuple(float(image.get(names.ILLUMINANT_KEY, 0.0)) if image is not None else 0.0
+                             for image in map(bpy.data.images.get, luts.ILLUMINANT_LUT_NAMES))
+    else:
+        temperatures = light_groups.assign(scene, snap.lit_groups)
+        for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
+            luts.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
     tree = compat.compositor_tree(scene)
     for record in scene[SAVED_KEY]["inserted"]:

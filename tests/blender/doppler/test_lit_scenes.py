@@ -362,6 +362,14 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
           f"against {spreads[1]:.4f} not denoised")
     assert dh.delta_e_2000_normalised(denoised.mean(axis=0), expected) < 2.0
     assert spreads[0] < 0.5 * spreads[1]
+    scene.cycles.use_denoising, scene.cycles.samples = True, 32  # the spectral passes, denoised
+    spectral, _info = _render_spectral(bpy, relativity_addon, scene)
+    spectral_xyz = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
+    print(f"spectral, denoised: Delta E {dh.delta_e_2000_normalised(spectral_xyz, expected):.2f}, "
+          f"Y / expected {spectral_xyz[1] / expected[1]:.4f}")
+    assert dh.delta_e_2000_normalised(spectral_xyz, expected) < 2.0
+    assert spectral_xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05)
+    scene.cycles.use_denoising = False
     scene.relativity.fast_illuminant = "WHITE"
     white = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)
     print(f"read in white: Delta E {dh.delta_e_2000_normalised(white, expected):.2f}, "
