@@ -43,6 +43,11 @@ def hold(scene):
     return True
 
 
+def _datablock(kind, name):
+    """The object or world ``name`` (``kind``: a key of the record), or None."""
+    return (bpy.data.objects if kind == "objects" else bpy.data.worlds).get(name)
+
+
 def assign(scene, groups):
     """Put the lamps of ``groups`` (``illuminants.LitGroup``, one per slot) into the slots' light
     groups and take every other lamp the add-on put there out again. Returns the temperature of
@@ -50,33 +55,28 @@ def assign(scene, groups):
     if KEY not in scene:
         return (0.0,) * len(SLOTS)
     record = scene[KEY]
-    wanted = {member: SLOTS[index] for index, group in enumerate(groups) for member in group.members}
-    held_objects, held_worlds = dict(record["objects"]), dict(record["world"])
-    for name in list(held_objects):
-        obj = bpy.data.objects.get(name)
-        if obj is not None and name not in wanted:
-            obj.lightgroup = held_objects.pop(name)
-    for member, slot in wanted.items():
-        if member == illuminants.WORLD:
-            continue
-        obj = bpy.data.objects.get(member)
-        if obj is None or (member not in held_objects and obj.lightgroup):
+    wanted = {}
+    for index, group in enumerate(groups):
+        for member in group.members:
+            if member != illuminants.WORLD:
+                wanted["objects", member] = SLOTS[index]
+            elif scene.world is not None:
+                wanted["world", scene.world.name] = SLOTS[index]
+    held = {kind: dict(record[kind]) for kind in ("objects", "world")}
+    for kind, names_held in held.items():
+        for name in list(names_held):
+            block = _datablock(kind, name)
+            if block is not None and (kind, name) not in wanted:
+                block.lightgroup = names_held.pop(name)
+    for (kind, name), slot in wanted.items():
+        block = _datablock(kind, name)
+        if block is None or (name not in held[kind] and block.lightgroup):
             continue  # the user's own light group
-        held_objects.setdefault(member, obj.lightgroup)
-        if obj.lightgroup != slot:
-            obj.lightgroup = slot
-    world = scene.world
-    world_slot = wanted.get(illuminants.WORLD)
-    if world is not None and world_slot is not None and (world.name in held_worlds or not world.lightgroup):
-        held_worlds.setdefault(world.name, world.lightgroup)
-        if world.lightgroup != world_slot:
-            world.lightgroup = world_slot
-    for name in list(held_worlds):
-        held = bpy.data.worlds.get(name)
-        if held is not None and (held != world or world_slot is None):
-            held.lightgroup = held_worlds.pop(name)
-    if dict(record["objects"]) != held_objects or dict(record["world"]) != held_worlds:
-        scene[KEY] = {"objects": held_objects, "world": held_worlds}
+        held[kind].setdefault(name, block.lightgroup)
+        if block.lightgroup != slot:
+            block.lightgroup = slot
+    if any(dict(record[kind]) != held[kind] for kind in held):
+        scene[KEY] = held
     temperatures = [group.temperature for group in groups] + [0.0] * len(SLOTS)
     return tuple(temperatures[:len(SLOTS)])
 
@@ -86,14 +86,11 @@ def release(scene):
     if KEY not in scene:
         return False
     record = scene[KEY].to_dict()
-    for name, group in record["objects"].items():
-        obj = bpy.data.objects.get(name)
-        if obj is not None:
-            obj.lightgroup = group
-    for name, group in record["world"].items():
-        world = bpy.data.worlds.get(name)
-        if world is not None:
-            world.lightgroup = group
+    for kind, names_held in record.items():
+        for name, group in names_held.items():
+            block = _datablock(kind, name)
+            if block is not None:
+                block.lightgroup = group
     for layer in scene.view_layers:
         for name in SLOTS:
             group = layer.lightgroups.get(name)
