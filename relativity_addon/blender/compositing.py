@@ -206,7 +206,7 @@ def write_colour_stage(scene, snap):
     one frame late (measured with 5.0.1). They are plain values, not drivers, so the file
     renders the same without the add-on.
     """
-    _tree, nodes = _inserted_nodes(scene)
+    tree, nodes = _inserted_nodes(scene)
     if not nodes:
         return False
     if _stage_mode["mode"] == "PASS_THROUGH":
@@ -219,7 +219,7 @@ def write_colour_stage(scene, snap):
         for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
             luts.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
-    tree = compat.compositor_tree(scene)
+    held = light_groups.KEY in scene  # else the view layers have no slot groups to link
     for record in scene[SAVED_KEY]["inserted"]:
         node, layers = tree.nodes.get(record["group_node"]), tree.nodes.get(record["layers"])
         if node is None:
@@ -231,10 +231,13 @@ def write_colour_stage(scene, snap):
         denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
         for slot, (name, temperature) in enumerate(zip(record.get("denoisers", ()), temperatures, strict=False), 1):
             denoiser = tree.nodes.get(name)
-            if denoiser is not None and layers is not None:
+            if denoiser is None:
+                continue
+            if held and layers is not None:
                 _link_light_group_pass(tree, layers, denoiser, slot)
-            if denoiser is not None and denoiser.mute != (not denoised or not temperature):
-                denoiser.mute = not denoised or not temperature  # muted: the pass as rendered
+            mute = not denoised or not temperature  # muted: the pass as rendered
+            if denoiser.mute != mute:
+                denoiser.mute = mute
     return True
 
 

@@ -35,22 +35,24 @@ class LitGroup(NamedTuple):
     members: tuple
 
 
-def _blackbody_emission(tree):
-    """Temperatures of the blackbody emission colours with strength of a material's tree."""
-    found = set()
+def _emission(tree):
+    """``(temperatures, emits)`` of a material's tree: the temperatures of its blackbody emission
+    colours with strength, and whether it has an emission colour at all."""
+    found, emits = set(), False
     for node, socket, is_emission in grouped_colours.targets(tree):
+        emits |= is_emission
         strength = node.inputs.get(STRENGTHS.get(node.bl_idname, ""))
         if not is_emission or (strength is not None and sources.constant_value(strength) == 0.0):
             continue
         blackbody = sources.blackbody_source(sources.rest_colour_input(socket))  # in front of the colour group
         if blackbody is not None and isinstance(blackbody.temperature, float):
             found.add(blackbody.temperature)
-    return found
+    return found, emits
 
 
 def _lamp_temperature(obj, seen):
     """The blackbody temperature of a lamp object (a light or an emitting mesh), or None;
-    ``seen`` caches each material's ``(blackbody temperatures, whether it emits)``."""
+    ``seen`` caches each material's :func:`_emission`."""
     if obj.type == "LIGHT":
         return sources.light_blackbody(obj.data) if obj.data.energy > 0.0 else None
     found = set()
@@ -59,8 +61,7 @@ def _lamp_temperature(obj, seen):
         if material is None or material.node_tree is None:
             continue
         if material.name not in seen:
-            tree = material.node_tree
-            seen[material.name] = (_blackbody_emission(tree), any(emits for *_, emits in grouped_colours.targets(tree)))
+            seen[material.name] = _emission(material.node_tree)
         temperatures, emits = seen[material.name]
         found |= temperatures
         if obj.relativity.temperature and emits:

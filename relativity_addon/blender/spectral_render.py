@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import RelativityError
 from ..physics import exposure, spectral_render
-from . import compositing, effect, materials, modifier, names, snapshot, volumes
+from . import compositing, effect, materials, modifier, names, snapshot, volumes, world_doppler
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
@@ -100,9 +100,7 @@ class _Saved:
 
 def pixel_log_doppler(scene, snap):
     """``ln D`` at every pixel centre (rows bottom first, as Blender stores images)."""
-    render = scene.render
-    size = (int(render.resolution_x * render.resolution_percentage / 100),
-            int(render.resolution_y * render.resolution_percentage / 100))
+    size = world_doppler.render_size(scene)
     directions = exposure.pixel_directions(snapshot.view_window(scene, scene.objects[snap.camera]), size)
     return exposure.log_doppler(directions, snap.beta_camera, snap.use_geometry and not snap.use_lorentz_window)
 
