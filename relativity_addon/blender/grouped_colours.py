@@ -38,7 +38,7 @@ def user_groups(tree):
 def _group_input(socket):
     """Identifier of the Group Input colour output feeding input ``socket`` through reroutes, or None."""
     for _step in range(256):
-        link = next((link for link in socket.links if link.is_valid and not link.is_muted), None)
+        link = sources.live_link(socket)
         if link is None:
             return None
         if link.from_node.bl_idname == "NodeGroupInput":
@@ -62,7 +62,7 @@ def targets(tree, seen=()):
                         yield node, socket, kind == "ShaderNodeEmission" or name == "Emission Color"
     for node in user_groups(tree):
         for identifier, is_emission in pass_throughs(node.node_tree, seen).items():
-            socket = next((s for s in node.inputs if s.identifier == identifier), None)
+            socket = sources.by_identifier(node.inputs, identifier)
             if socket is not None:
                 yield node, socket, is_emission
 

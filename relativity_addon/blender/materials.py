@@ -419,22 +419,25 @@ def detach(material):
     return _detach_records(material, material.node_tree)
 
 
+def resolve_record(tree, record):
+    """``(group node, target input socket, source output socket)`` of an insertion record
+    (:func:`insert_colour_group`) in ``tree``, each None where it is gone (or was never there)."""
+    node = tree.nodes.get(record["group_node"])
+    target = tree.nodes.get(record["target"]) if record["target"] else None
+    source_node = tree.nodes.get(record["source_node"]) if record["source_node"] else None
+    socket = sources.by_identifier(target.inputs, record["socket"]) if target is not None else None
+    source = sources.by_identifier(source_node.outputs, record["source_socket"]) if source_node is not None else None
+    return node, socket, source
+
+
 def _detach_records(owner, tree):
     """Undo the insertions recorded on ``owner`` (a material, world or node group) in ``tree``."""
     for record in list(owner[ATTACHED_KEY]):
-        record = record.to_dict()
-        node = tree.nodes.get(record["group_node"])
+        node, socket, source = resolve_record(tree, record.to_dict())
         if node is not None:
             tree.nodes.remove(node)
-        target = tree.nodes.get(record["target"])
-        if target is None:
-            continue
-        socket = next((s for s in target.inputs if s.identifier == record["socket"]), None)
-        source_node = tree.nodes.get(record["source_node"]) if record["source_node"] else None
-        if socket is not None and source_node is not None:
-            source = next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
-            if source is not None:
-                tree.links.new(source, socket)
+        if socket is not None and source is not None:
+            tree.links.new(source, socket)
     del owner[ATTACHED_KEY]
     return True
 

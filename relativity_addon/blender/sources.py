@@ -52,7 +52,7 @@ class Blackbody(NamedTuple):
 # --- following links ------------------------------------------------------------------------
 
 
-def _live_link(socket):
+def live_link(socket):
     """The link feeding input ``socket`` as Cycles sees it (muted and invalid links do not count)."""
     for link in socket.links:
         if link.is_valid and not link.is_muted:
@@ -71,7 +71,7 @@ def _group_output_input(group_node, identifier):
     return next((socket for socket in output.inputs if socket.identifier == identifier), None)
 
 
-def _by_identifier(sockets, identifier):
+def by_identifier(sockets, identifier):
     return next((socket for socket in sockets if socket.identifier == identifier), None)
 
 
@@ -89,7 +89,7 @@ def _upstream(socket, groups):
                 inner = next((link.from_socket for link in node.internal_links if link.to_socket == socket), None)
                 if inner is None:
                     return None
-            link = _live_link(inner)
+            link = live_link(inner)
             if link is None:
                 return None, groups, inner
             socket = link.from_socket
@@ -98,18 +98,18 @@ def _upstream(socket, groups):
             if inner is None:
                 return None
             groups = (*groups, node)
-            link = _live_link(inner)
+            link = live_link(inner)
             if link is None:
                 return None, groups, inner
             socket = link.from_socket
         elif node.bl_idname == "NodeGroupInput":
             if not groups:
                 return None
-            outer = _by_identifier(groups[-1].inputs, socket.identifier)
+            outer = by_identifier(groups[-1].inputs, socket.identifier)
             groups = groups[:-1]
             if outer is None:
                 return None
-            link = _live_link(outer)
+            link = live_link(outer)
             if link is None:
                 return None, groups, outer
             socket = link.from_socket
@@ -119,7 +119,7 @@ def _upstream(socket, groups):
 
 def _feed(input_socket, groups):
     """``(output socket or None, groups, unlinked input or None)`` for what feeds ``input_socket``."""
-    link = _live_link(input_socket)
+    link = live_link(input_socket)
     if link is None:
         return None, groups, input_socket
     return _upstream(link.from_socket, groups)
@@ -185,8 +185,8 @@ def _trace(input_socket, groups):
     if node.bl_idname in MIX_NODES:
         return _mix(node, groups)
     if node.bl_idname == "ShaderNodeVectorMath" and node.operation == "SCALE":
-        scale = _constant(_by_identifier(node.inputs, "Scale"), groups)
-        inner = _trace(_by_identifier(node.inputs, "Vector"), groups)
+        scale = _constant(by_identifier(node.inputs, "Scale"), groups)
+        inner = _trace(by_identifier(node.inputs, "Vector"), groups)
         if inner is None or scale is None or scale < 0.0:
             return None
         return Blackbody(inner.temperature, _times(inner.scale, scale))

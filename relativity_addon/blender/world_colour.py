@@ -24,20 +24,11 @@ def _colour_records(world):
     if world is None or world.node_tree is None or names.MATERIAL_ATTACHED_KEY not in world \
             or isinstance(world[names.MATERIAL_ATTACHED_KEY], str):
         return []
-    tree = world.node_tree
     found = []
     for record in world[names.MATERIAL_ATTACHED_KEY]:
-        group = tree.nodes.get(record["group_node"])
-        target = tree.nodes.get(record["target"]) if record["target"] else None
-        if group is None or target is None or group.node_tree is None \
-                or group.node_tree.name != materials.DOPPLER_EMISSION:
-            continue
-        socket = next((s for s in target.inputs if s.identifier == record["socket"]), None)
-        source_node = tree.nodes.get(record["source_node"]) if record["source_node"] else None
-        source = None
-        if source_node is not None:
-            source = next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
-        if socket is not None:
+        group, socket, source = materials.resolve_record(world.node_tree, record)
+        if group is not None and socket is not None and group.node_tree is not None \
+                and group.node_tree.name == materials.DOPPLER_EMISSION:
             found.append((group, socket, source))
     return found
 
