@@ -122,7 +122,10 @@ batch.enable_addon()
 phase("enable the add-on (register)")
 addon_modules = sorted(set(sys.modules) - before_addon)
 
-from relativity_addon.blender import camera, compositing, effect, luts, materials, modifier
+from relativity_addon.blender.camera import exact_camera as camera
+from relativity_addon.blender.colour import compositing, lut_images as luts, materials
+from relativity_addon.blender.pipeline import effect
+from relativity_addon.blender.geometry import modifier
 timers = {}
 stack = []
 

@@ -32,7 +32,7 @@ def build_scene(bpy, resolution, samples):
     scene.cycles.use_adaptive_sampling = False
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     scene.world = bpy.data.worlds.new("World")  # Blender's default: a constant grey Background
     compat.world_node_tree(scene.world).nodes["Background"].inputs["Color"].default_value = (0.05, 0.05, 0.05, 1.0)
@@ -64,7 +64,7 @@ def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
     reference) alternately ``repeats`` times after one warm-up round (shader compilation, kernel
     loading, caches) and prints each case's median time and its median ratio to the reference's
     time of that round."""
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     def render(beta, name):
         undo = None
@@ -115,6 +115,6 @@ def main():
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

@@ -82,7 +82,9 @@ def core_throughput(count, repeats):
 
 
 def addon_throughput(bpy, count, repeats):
-    from relativity_addon.blender import effect, geometry, snapshot
+    from relativity_addon.blender.geometry import apparent_meshes as geometry
+    from relativity_addon.blender.pipeline import effect
+    from relativity_addon.blender.scene import snapshot
 
     side = int(math.ceil(math.sqrt(count)))
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -126,7 +128,7 @@ def build_render_scene(bpy, resolution, samples):
 
 
 def render_overhead(bpy, resolution, samples, repeats):
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     scene = build_render_scene(bpy, resolution, samples)
     path = os.path.join(tempfile.mkdtemp(prefix="relativity-bench-"), "frame.png")
@@ -186,6 +188,6 @@ def main():
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

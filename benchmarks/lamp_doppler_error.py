@@ -13,7 +13,7 @@ direction aberrated into the object's frame) against what the renderer computes 
 - ``total``: irradiance-weighted mean ``|E_render - E'| / E'`` with the scene-frame cosine too, with
   the lamp where it is (unturned) and with the copy turned about the centre to the aberrated
   direction (``lamp_doppler.aberrated_lamp_matrix``), on the contracted surface's normals and on
-  the rest-frame normals (what the add-on renders, ``blender/rest_normals.py``).
+  the rest-frame normals (what the add-on renders, ``blender/lights/rest_normals.py``).
 
 Numpy only (no Blender).
 """

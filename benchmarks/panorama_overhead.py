@@ -44,7 +44,7 @@ def minimal_osl_camera(scene):
     """Turn the scene's camera into the minimal equirectangular OSL camera; return the undo."""
     import bpy
 
-    from relativity_addon.blender import osl
+    from relativity_addon.blender.common import osl
 
     data = scene.camera.data
     text = bpy.data.texts.get("minimal_equirectangular.osl") or bpy.data.texts.new("minimal_equirectangular.osl")
@@ -104,6 +104,6 @@ def main():
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

@@ -32,7 +32,7 @@ def main():
     from camera_overhead import build_scene, timed_render
 
     import relativity_addon
-    from relativity_addon.blender import effect, spectral_render
+    from relativity_addon.blender.pipeline import effect, spectral_render
 
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
@@ -60,6 +60,6 @@ def main():
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

@@ -67,7 +67,7 @@ def fly_camera(scene, camera_object, speed, lens_mm=55.0):
     Aberration shrinks the view ahead (by about 1/D), so a longer lens (``lens_mm``) frames the
     objects at a useful size while the floor still shows its bend at the image edges.
     """
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     camera_object.data.lens = lens_mm
     bpy.context.view_layer.update()  # matrix_world of a just-built camera is stale until then
@@ -117,6 +117,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

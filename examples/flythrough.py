@@ -28,7 +28,7 @@ sys.path[:0] = [str(REPO_ROOT), str(EXAMPLES_DIR)]
 
 import scenes  # noqa: E402
 from relativity_addon import batch  # noqa: E402
-from relativity_addon.blender import compat  # noqa: E402
+from relativity_addon.blender.common import compat  # noqa: E402
 
 EYE_HEIGHT = 1.6  # metres
 BLOCK_COLOURS = (scenes.RED, scenes.GREEN, scenes.BLUE, scenes.YELLOW, (0.7, 0.7, 0.7))
@@ -107,7 +107,7 @@ def build(out_dir, frames, beta_max, c, resolution, samples, searchlight=True):
     settings.speed_of_light = c
     settings.velocity_source = "CAMERA_ANIMATION"
     settings.method = "CAMERA"
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     scene.frame_set(1)
     effect.apply(scene)

@@ -96,7 +96,7 @@ def read_image(path):
 
 def render_figure(name, out_dir, work_dir, width, height, samples):
     """Build, render (EXR, linear) and save the PNG; return (linear image, context)."""
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     builder, arguments, exposure = FIGURES[name]
     scene = new_scene(width, height, samples)
@@ -204,6 +204,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     compat.run_main(main)

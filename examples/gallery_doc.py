@@ -179,7 +179,7 @@ the default clamp (64.64 against 67.71 at 320x240, 16 samples; the same 4.5 % fo
 and within 1 % with no clamping (67.29 against 67.71, Chang's 2.848 against 2.865, same size and
 samples). The gallery renders with both clamps off. Since then the add-on scales the clamps by the
 brightest `D^4`, `(gamma (1 + beta))^4`, while the exact camera renders, and gives the user's values
-back on removal (`blender/clamping.py`).
+back on removal (`blender/camera/clamping.py`).
 """
 
 

@@ -13,7 +13,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 from relativity_addon.physics.lorentz import camera_to_scene_event
 from relativity_addon.physics.shutter import ShutterModel, lens_time
 from scenes import _link, _mesh_from_bmesh, add_box, add_camera, add_sphere, aim, principled_material

@@ -8,7 +8,7 @@ import bmesh
 import bpy
 from mathutils import Vector
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 # Colours are linear Rec.709 base colours.
 RED = (0.8, 0.06, 0.05)

@@ -41,6 +41,8 @@ settings.load_profile("relativity")
 # The package (for the bpy-free physics tests), the build script and ``blender_support``
 # (helpers to enable/disable the add-on), importable from any test.
 sys.path[:0] = [str(REPO_ROOT), str(REPO_ROOT / "tools"), str(REPO_ROOT / "tests")]
+# Each subsystem's test helpers (camera_helpers, colour_helpers, ...), whichever folder a test is in.
+sys.path[3:3] = sorted(str(folder) for folder in (REPO_ROOT / "tests" / "blender").iterdir() if folder.is_dir())
 
 _USER_RESOURCES = tempfile.mkdtemp(prefix="relativity-blender-user-")
 atexit.register(shutil.rmtree, _USER_RESOURCES, ignore_errors=True)

@@ -12,8 +12,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from relativity_addon import lut_data  # noqa: E402
-from relativity_addon.physics import spectral_luts  # noqa: E402
+from relativity_addon.physics import (
+    shipped_luts,  # noqa: E402
+    spectral_luts,  # noqa: E402
+)
 
 
 def compute_tables():
@@ -40,7 +42,7 @@ RTOL = 1e-6
 ATOL = 1e-12
 
 
-def stale_tables(path=lut_data.LUT_PATH, rtol=RTOL, atol=ATOL):
+def stale_tables(path=shipped_luts.LUT_PATH, rtol=RTOL, atol=ATOL):
     """Names of the tables whose shipped values differ from a fresh computation."""
     if not os.path.exists(path):
         return ["(file missing)"]
@@ -62,8 +64,8 @@ def main(argv=None):
             return 1
         print("spectral tables are current")
         return 0
-    np.savez_compressed(lut_data.LUT_PATH, **compute_tables())
-    print(f"wrote {lut_data.LUT_PATH}")
+    np.savez_compressed(shipped_luts.LUT_PATH, **compute_tables())
+    print(f"wrote {shipped_luts.LUT_PATH}")
     return 0
 
 

@@ -10,9 +10,9 @@ import math
 import os
 import sys
 
-from .errors import BatchError, RelativityError
+from ..errors import BatchError, RelativityError
+from ..physics.shutter import ShutterModel
 from .frame_files import format_seconds, frame_output_path, partial_path
-from .physics.shutter import ShutterModel
 
 ADDON_PACKAGE = "relativity_addon"
 
@@ -156,7 +156,7 @@ def enable_addon():
             addon_utils.enable(module.__name__, default_set=True)
             if hasattr(bpy.types.Scene, "relativity"):
                 return
-    repo_root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    repo_root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     if repo_root not in sys.path:
         sys.path.insert(0, repo_root)
     import importlib
@@ -276,7 +276,7 @@ def _frames(scene, options):
 
 
 def _render_spectral(scene, path, passes):
-    spectral_render = addon_module("spectral_render")
+    spectral_render = addon_module("pipeline.spectral_render")
     try:
         pixels, _info = spectral_render.render(scene, passes)
     except spectral_render.RelativityError as error:
@@ -299,7 +299,7 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
     if relativistic:
         # The frame-change handler records a failed apparent-geometry update on the object
         # instead of raising; rendering then would show the previous frame's shapes.
-        geometry = addon_module("geometry")
+        geometry = addon_module("geometry.apparent_meshes")
         errors = geometry.scene_errors(scene)
         if errors:
             raise BatchError(f"frame {frame}: {errors[0]}")
@@ -323,7 +323,7 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
             cam = scene.camera.data
             if not cam.cycles_custom.get("settings_valid", False):
                 raise BatchError(f"relativistic camera became invalid during the render of frame {frame}")
-        effect = addon_module("effect")
+        effect = addon_module("pipeline.effect")
         if relativistic and scene.relativity.method == "GEOMETRY" and not effect.final_render_was_valid(scene):
             warnings = effect.scene_warnings(scene)
             raise BatchError(f"frame {frame}: {warnings[0] if warnings else 'the exact camera became invalid'}")
@@ -362,7 +362,7 @@ def run(argv, log=print):
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}") from None
     enable_addon()
-    effect = addon_module("effect")
+    effect = addon_module("pipeline.effect")
 
     scene = bpy.context.scene
     frames = _frames(scene, options)
@@ -393,7 +393,7 @@ def run(argv, log=print):
             if options.reference:
                 raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
             _apply_options(scene, options)
-            scene_frames = [float(f) for f in addon_module("traveller").frames_at_proper_times(
+            scene_frames = [float(f) for f in addon_module("scene.traveller").frames_at_proper_times(
                 scene, [frame / animation_fps(scene) for frame in frames])]
         if options.reference:
             effect.remove(scene)
@@ -442,7 +442,7 @@ def command_line():
         distributed = False
     if distributed and not _running_inside_blender(sys.argv):
         sys.exit(main())
-    from .blender import compat
+    from ..blender.common import compat
 
     compat.run_main(main)
 
@@ -455,7 +455,7 @@ def main(argv=None):
             if _running_inside_blender(argv):
                 raise BatchError("--workers and --scheduler need the bpy wheel form: "
                                  "python examples/render.py FILE.blend ...")
-            from . import farm  # Dask is imported only here
+            from . import farm
 
             return farm.render(options, parser)
         paths = run(argv)

@@ -18,8 +18,8 @@ import os
 import sys
 import time
 
+from ..errors import BatchError
 from . import frame_files
-from .errors import BatchError
 
 # Options of the coordinator, not passed on to the per-task batch script.
 COORDINATOR_OPTIONS = {"help", "blend_file", "out", "frame", "frames", "workers", "scheduler", "chunk", "resume",
@@ -39,7 +39,7 @@ if sys.platform.startswith("linux"):
         sys.exit("render.py: error: the worker that started this task is gone")
 sys.path.insert(0, root)
 from relativity_addon import batch
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 compat.run_main(batch.main)
 """
 
@@ -56,7 +56,7 @@ def render_task(arguments, label):
     import socket
     import subprocess
 
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     command = [sys.executable, "-c", LAUNCH, str(os.getpid()), root, *arguments]
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)

@@ -13,13 +13,13 @@ reverse, so a module may rely on everything listed before it.
 import importlib
 
 _MODULES = (
-    "props",  # Scene.relativity
-    "objects",  # Object.relativity
-    "presets",  # preset menus and the shipped presets folder
-    "ops",  # Set Up, Remove, Check Camera Speed
-    "bakes",  # Bake Motion, Bake Deformation
-    "panel",  # the N-panel
-    "handlers",  # the handler table (effect.sync)
+    "ui.props",  # Scene.relativity
+    "ui.objects",  # Object.relativity
+    "ui.presets",  # preset menus and the shipped presets folder
+    "ui.ops",  # Set Up, Remove, Check Camera Speed
+    "geometry.bakes",  # Bake Motion, Bake Deformation
+    "ui.panel",  # the N-panel
+    "pipeline.handlers",  # the handler table (effect.sync)
 )
 
 

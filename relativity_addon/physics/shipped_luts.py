@@ -12,7 +12,7 @@ import os
 
 import numpy as np
 
-LUT_PATH = os.path.join(os.path.dirname(__file__), "data", "spectral_luts.npz")
+LUT_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "spectral_luts.npz")
 
 
 @functools.lru_cache(maxsize=1)

@@ -2,7 +2,7 @@
 
 Blender's shaders cannot call colour-science, so the two functions of one variable they need are
 tabulated here, once, at development time (``tools/build_luts.py`` writes them to
-``data/spectral_luts.npz``, which :mod:`relativity_addon.lut_data` reads without colour-science):
+``data/spectral_luts.npz``, which :mod:`relativity_addon.physics.shipped_luts` reads without colour-science):
 
 - :func:`blackbody_rgb_lut`: the gamut-mapped colour and ``ln Y`` of a blackbody against
   ``log10 T`` (from :func:`.spectral.blackbody_XYZ`);

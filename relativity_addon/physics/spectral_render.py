@@ -20,7 +20,7 @@ Mallett & Yuksel's basis with weights ``rgb`` (white reflects 1 at every wavelen
 ``Y B(mu, T) / Y_B(T)``. Units: radiance per nanometre, integrated over the CIE 1931 observer's
 1 nm grid, the fast mode's normalisation, so both modes agree for white light.
 
-Everything here is numpy on the tables the add-on ships (``lut_data.spectral_mode_tables``, made
+Everything here is numpy on the tables the add-on ships (``shipped_luts.spectral_mode_tables``, made
 with colour-science by ``tools/build_luts.py``): it runs inside Blender, which has no
 colour-science. ``tests/physics/test_spectral_render.py`` checks it against :mod:`.spectral`.
 """
@@ -31,7 +31,7 @@ import functools
 
 import numpy as np
 
-from .. import lut_data
+from . import shipped_luts
 from .arrays import ArrayLike, FloatArray
 
 __all__ = [
@@ -62,7 +62,7 @@ WHITE_TEMPERATURE_K = 6504.0  # the white light of up-sampled colours (spectral.
 
 @functools.lru_cache(maxsize=1)
 def _tables():
-    return lut_data.spectral_mode_tables()
+    return shipped_luts.spectral_mode_tables()
 
 
 def tables():

@@ -1,4 +1,4 @@
-"""The fast mode's table for light reflected under an illuminant (physics/illuminant.py), against
+"""The fast mode's table for light reflected under an illuminant (physics/illuminants.py), against
 colour-science: Planck's law, Mallett & Yuksel's basis and the CIE 1931 observer integrated here,
 with ``L_obs(lambda) = D^5 L(lambda D)`` (Weiskopf et al. 1999 eq. 14, docs/physics.md)."""
 
@@ -6,7 +6,7 @@ import colour
 import numpy as np
 import pytest
 
-from relativity_addon.physics import illuminant, spectral, spectral_luts
+from relativity_addon.physics import illuminants, spectral, spectral_luts
 
 CMFS = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(colour.SpectralShape(360, 830, 1))
 WAVELENGTHS = CMFS.wavelengths
@@ -23,7 +23,7 @@ def _observed_rgb(weights, temperature, doppler):
 def test_white_illuminant_is_the_emitter_table():
     """With 6504 K white the table is the one shipped for emitters (built with colour-science)."""
     grid = spectral_luts.doppler_lut_log10_d_grid(256)
-    np.testing.assert_allclose(illuminant.doppler_lut(grid, None), spectral_luts.doppler_matrix_lut(grid),
+    np.testing.assert_allclose(illuminants.doppler_lut(grid, None), spectral_luts.doppler_matrix_lut(grid),
                                rtol=2e-6, atol=2e-6)
 
 
@@ -35,7 +35,7 @@ def test_reflected_light_is_shifted_as_reflectance_times_illuminant(temperature,
     for weights in (np.ones(3), np.array([0.8, 0.15, 0.1]), np.array([0.1, 0.2, 0.7])):
         rest = _observed_rgb(weights, temperature, 1.0)
         expected = _observed_rgb(weights, temperature, doppler)
-        observed = illuminant.doppler_matrix(doppler, temperature) @ rest
+        observed = illuminants.doppler_matrix(doppler, temperature) @ rest
         np.testing.assert_allclose(observed, expected, rtol=0, atol=1e-6 * np.abs(expected).max())
 
 
@@ -44,7 +44,7 @@ def test_white_wall_is_the_blackbody_at_d_t():
     for temperature in (2700.0, 4000.0):
         for doppler in (0.5, 2.0):
             rest = spectral.XYZ_to_linear_rec709(spectral.blackbody_XYZ(temperature))
-            observed = illuminant.doppler_matrix(doppler, temperature) @ rest
+            observed = illuminants.doppler_matrix(doppler, temperature) @ rest
             expected = spectral.XYZ_to_linear_rec709(spectral.blackbody_XYZ(doppler * temperature))
             np.testing.assert_allclose(observed, expected, rtol=1e-6)
 
@@ -52,5 +52,5 @@ def test_white_wall_is_the_blackbody_at_d_t():
 def test_table_is_finite_over_the_whole_range():
     grid = spectral_luts.doppler_lut_log10_d_grid(2048)
     for temperature in (1000.0, 2700.0, 40000.0):
-        table = illuminant.doppler_lut(grid, temperature)
+        table = illuminants.doppler_lut(grid, temperature)
         assert np.all(np.isfinite(table))

@@ -129,7 +129,7 @@ def test_rejects_light_at_or_above_c():
         moving_lights.retarded_light((1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (1.0, 0.0, 0.0))
 
 
-# --- the stand-in lamps' placement (blender/moving_lamps.py) ---------------------------------------
+# --- the stand-in lamps' placement (blender/lights/stand_in_lamps.py) ---------------------------------------
 
 
 def _bisect_on_path(x, camera, position_at):

@@ -68,7 +68,7 @@ def test_a_small_change_to_the_blackbody_table_is_detected(tmp_path, fresh_table
 def test_reading_the_tables_needs_no_colour_science():
     script = (
         "import sys; sys.modules['colour'] = None; sys.modules['bpy'] = None\n"
-        "from relativity_addon import lut_data\n"
+        "from relativity_addon.physics import shipped_luts as lut_data\n"
         "grid, pixels = lut_data.doppler_matrix_lut()\n"
         "assert pixels.dtype.name == 'float32' and pixels.size == grid.size * 3 * 4\n"
         "grid, pixels = lut_data.blackbody_rgb_lut()\n"

@@ -13,7 +13,7 @@ from relativity_addon.physics.shutter import SHUTTER_MODEL_NAMES, ShutterModel
 
 ADDON = Path(__file__).resolve().parents[2] / "relativity_addon"
 SHADER = ADDON / "shaders" / "relativistic_camera.osl"
-PROPS = ADDON / "blender" / "props.py"
+PROPS = ADDON / "blender" / "ui" / "props.py"
 
 
 def _shader_source():

@@ -12,15 +12,15 @@ MAX_LINES = 520  # "about 500"
 # The render paths and the colour stage write their part from the snapshot; only effect.py knows
 # them all.
 PARTS = {
-    "camera": {"relativity_addon.blender.camera", "relativity_addon.blender.osl"},
+    "camera": {"relativity_addon.blender.camera.exact_camera", "relativity_addon.blender.common.osl"},
     "geometry": {
-        "relativity_addon.blender.geometry", "relativity_addon.blender.modifier",
-        "relativity_addon.blender.world_lines", "relativity_addon.blender.bakes",
+        "relativity_addon.blender.geometry.apparent_meshes", "relativity_addon.blender.geometry.modifier",
+        "relativity_addon.blender.geometry.motion", "relativity_addon.blender.geometry.bakes",
     },
     "colour": {
-        "relativity_addon.blender.colour", "relativity_addon.blender.materials",
-        "relativity_addon.blender.compositing", "relativity_addon.blender.luts",
-        "relativity_addon.blender.world_colour",
+        "relativity_addon.blender.colour.doppler_colour", "relativity_addon.blender.colour.materials",
+        "relativity_addon.blender.colour.compositing", "relativity_addon.blender.colour.lut_images",
+        "relativity_addon.blender.colour.world_colour",
     },
 }
 
@@ -86,9 +86,9 @@ def _find_cycle(graph):
 
 
 def test_the_walk_sees_the_package():
-    assert "relativity_addon.blender.effect" in GRAPH
-    assert "relativity_addon.blender.camera" in GRAPH["relativity_addon.blender.effect"]
-    assert "relativity_addon.physics.shutter" in GRAPH["relativity_addon.blender.snapshot"]
+    assert "relativity_addon.blender.pipeline.effect" in GRAPH
+    assert "relativity_addon.blender.camera.exact_camera" in GRAPH["relativity_addon.blender.pipeline.effect"]
+    assert "relativity_addon.physics.shutter" in GRAPH["relativity_addon.blender.scene.snapshot"]
 
 
 def test_cycle_finder_finds_a_planted_cycle():
@@ -109,7 +109,7 @@ def test_render_paths_and_colour_import_nothing_from_each_other(part):
 
 
 def test_physics_core_and_errors_never_import_bpy():
-    bpy_free = ("relativity_addon.errors", "relativity_addon.lut_data")
+    bpy_free = ("relativity_addon.errors", "relativity_addon.physics.shipped_luts")
     for name, path in MODULES.items():
         if name.startswith("relativity_addon.physics") or name in bpy_free:
             tree = ast.parse(path.read_text(encoding="utf-8"))

@@ -10,7 +10,7 @@ user types meanwhile becomes the user's value; removing the effect gives the use
 
 import math
 
-from . import names
+from ..common import names
 
 KEY = names.CLAMP_SAVED_KEY
 CLAMPS = ("sample_clamp_direct", "sample_clamp_indirect")

@@ -23,10 +23,10 @@ import os
 
 import bpy
 
-from ..errors import RelativityError
-from . import compat, names, osl
+from ...errors import RelativityError
+from ..common import compat, names, osl
 
-SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.SHADER_TEXT)
+SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.SHADER_TEXT)
 
 # Shader parameters that must exist after compilation; their absence means an empty shader.
 REQUIRED_PARAMETERS = (

@@ -22,7 +22,7 @@ spectral Doppler matrix per pixel after the render, with no second render:
 - Pixels whose material already did the exact blackbody shift (``relativity_colour_done`` AOV,
   written by ``materials``) keep their rendered colour.
 - The light of blackbody lamps (Cycles light groups per temperature, ``light_groups.py``) goes
-  through the table of its blackbody (``physics/illuminant.py``): a surface it lit sends a
+  through the table of its blackbody (``physics/illuminants.py``): a surface it lit sends a
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
 
@@ -32,8 +32,9 @@ created if the scene has none); :func:`remove_colour_stage` restores the composi
 
 import bpy
 
-from . import compat, light_groups, luts, materials, names
-from .nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
+from ..common import compat, names
+from ..common.nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
+from . import light_groups, lut_images, materials
 
 COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
 COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
@@ -78,7 +79,7 @@ def _matrix_nodes(key, image_name, colour):
 
 
 def compositor_group():
-    scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
+    scale, offset = lut_images.texture_u_scale_offset(lut_images.DOPPLER_LOG10_RANGE)
     nodes = {
         # ln D per pixel from the materials' AOV (materials.doppler_aov_group), over the share
         # ``coverage`` of samples that wrote it. With World Directions = 1 the other samples (the
@@ -97,14 +98,16 @@ def compositor_group():
         # Linear interpolation between the two nearest texels, done here with two nearest-texel
         # reads (Blender 4.5's Map UV has no bilinear mode nor an Extend border): x is the texel
         # coordinate, clamped to the table (= Extend), i0 the left texel, at most size - 2.
-        "x_raw": fmath("MULTIPLY_ADD", "ln_d", scale * luts.LUT_SIZE / materials.LN10, offset * luts.LUT_SIZE - 0.5),
+        "x_raw": fmath(
+            "MULTIPLY_ADD", "ln_d", scale * lut_images.LUT_SIZE / materials.LN10, offset * lut_images.LUT_SIZE - 0.5
+        ),
         "x_low": fmath("MAXIMUM", "x_raw", 0.0),
-        "x": fmath("MINIMUM", "x_low", luts.LUT_SIZE - 1.0),
+        "x": fmath("MINIMUM", "x_low", lut_images.LUT_SIZE - 1.0),
         "i_floor": fmath("FLOOR", "x"),
-        "i0": fmath("MINIMUM", "i_floor", luts.LUT_SIZE - 2.0),
+        "i0": fmath("MINIMUM", "i_floor", lut_images.LUT_SIZE - 2.0),
         "frac": fmath("SUBTRACT", "x", "i0"),
-        "u0": fmath("MULTIPLY_ADD", "i0", 1.0 / luts.LUT_SIZE, 0.5 / luts.LUT_SIZE),
-        "u1": fmath("ADD", "u0", 1.0 / luts.LUT_SIZE),
+        "u0": fmath("MULTIPLY_ADD", "i0", 1.0 / lut_images.LUT_SIZE, 0.5 / lut_images.LUT_SIZE),
+        "u1": fmath("ADD", "u0", 1.0 / lut_images.LUT_SIZE),
         "power": fmath("SUBTRACT", "group.Power of D", "group.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
         # The light of blackbody lamps (light_groups.py: one light group per temperature) is read
@@ -114,8 +117,8 @@ def compositor_group():
         "rest": vmath("SUBTRACT", "group.Image", "lit"),
         "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # the passes' noise may push it below 0
     }
-    nodes.update(_matrix_nodes("emit", luts.DOPPLER_LUT_NAME, "other"))
-    for slot, image_name in enumerate(luts.ILLUMINANT_LUT_NAMES, start=1):
+    nodes.update(_matrix_nodes("emit", lut_images.DOPPLER_LUT_NAME, "other"))
+    for slot, image_name in enumerate(lut_images.ILLUMINANT_LUT_NAMES, start=1):
         nodes.update(_matrix_nodes(f"lit{slot}", image_name, f"group.Lit {slot}"))
     nodes.update({
         "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
@@ -159,10 +162,10 @@ def ensure_world_image(size=(1, 1)):
 
 
 def ensure_compositor_group():
-    luts.ensure_doppler_matrix_lut()
-    for name in luts.ILLUMINANT_LUT_NAMES:
+    lut_images.ensure_doppler_matrix_lut()
+    for name in lut_images.ILLUMINANT_LUT_NAMES:
         if bpy.data.images.get(name) is None:
-            luts.ensure_illuminant_lut(name, 0.0)
+            lut_images.ensure_illuminant_lut(name, 0.0)
     ensure_world_image()
     version = (names.GROUP_VERSION_KEY, names.COMPOSITOR_GROUPS_VERSION)
     ensure_group(materials.gamut_map_group(COMPOSITOR_GAMUT_MAP, "CompositorNodeTree"), *version)
@@ -213,11 +216,11 @@ def write_colour_stage(scene, snap):
         # spectral passes: the lamps' colours are spectral values now, the groups stay as they were
         # (the stage passes every part through; their denoisers still match the denoised Image)
         temperatures = tuple(float(image.get(names.ILLUMINANT_KEY, 0.0)) if image is not None else 0.0
-                             for image in map(bpy.data.images.get, luts.ILLUMINANT_LUT_NAMES))
+                             for image in map(bpy.data.images.get, lut_images.ILLUMINANT_LUT_NAMES))
     else:
         temperatures = light_groups.assign(scene, snap.lit_groups)
-        for name, temperature in zip(luts.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
-            luts.ensure_illuminant_lut(name, temperature)
+        for name, temperature in zip(lut_images.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
+            lut_images.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
     held = light_groups.KEY in scene  # else the view layers have no slot groups to link
     for record in scene[SAVED_KEY]["inserted"]:

@@ -9,8 +9,9 @@ group (materials) and the compositor group's flag inputs.
 
 import bpy
 
-from ..errors import RelativityError
-from . import compositing, luts, materials, names, volumes, world_colour, world_sampling
+from ...errors import RelativityError
+from ..common import names
+from . import compositing, lut_images, materials, volumes, world_colour, world_sampling
 from .compositing import is_applied as compositor_applied
 
 
@@ -81,8 +82,8 @@ def remove_unused_data():
         tree = bpy.data.node_groups.get(name)
         if tree is not None:
             bpy.data.node_groups.remove(tree)
-    for name in (luts.DOPPLER_LUT_NAME, luts.BLACKBODY_LUT_NAME, names.WORLD_DOPPLER_IMAGE,
-                 *luts.ILLUMINANT_LUT_NAMES):
+    for name in (lut_images.DOPPLER_LUT_NAME, lut_images.BLACKBODY_LUT_NAME, names.WORLD_DOPPLER_IMAGE,
+                 *lut_images.ILLUMINANT_LUT_NAMES):
         image = bpy.data.images.get(name)
         if image is not None:
             bpy.data.images.remove(image)

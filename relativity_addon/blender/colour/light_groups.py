@@ -2,7 +2,7 @@
 
 Cycles renders, per view-layer light group, the light its lamps (lights, emitting objects, the
 world) contribute to each pixel, by any number of bounces. The exact camera's compositor stage
-reads each group's pass through the table of its lamps' blackbody (``physics/illuminant.py``) and
+reads each group's pass through the table of its lamps' blackbody (``physics/illuminants.py``) and
 the rest of the pixel through the emitters' table (``compositing.py``).
 
 Everything set is recorded on the scene (``names.LIGHT_GROUPS_KEY``) and given back by
@@ -13,7 +13,8 @@ groups of the user's is left alone: its lamps are read in white (:func:`user_gro
 
 import bpy
 
-from . import illuminants, names
+from ..common import names
+from ..scene import illuminants
 
 KEY = names.LIGHT_GROUPS_KEY
 SLOTS = names.LIT_GROUPS

@@ -11,9 +11,8 @@ from the file alone: neither colour-science nor the add-on is needed to render.
 import bpy
 import numpy as np
 
-from .. import lut_data
-from ..physics import illuminant
-from . import names
+from ...physics import illuminants, shipped_luts
+from ..common import names
 
 DOPPLER_LUT_NAME = names.DOPPLER_LUT_IMAGE
 BLACKBODY_LUT_NAME = names.BLACKBODY_LUT_IMAGE
@@ -70,24 +69,24 @@ def _ensure_lut(name, table, log10_range, height):
 def ensure_doppler_matrix_lut():
     """The packed ``N x 3`` Doppler matrix table (``spectral_luts.doppler_matrix_lut``)."""
 
-    return _ensure_lut(DOPPLER_LUT_NAME, lut_data.doppler_matrix_lut, DOPPLER_LOG10_RANGE, 3)
+    return _ensure_lut(DOPPLER_LUT_NAME, shipped_luts.doppler_matrix_lut, DOPPLER_LOG10_RANGE, 3)
 
 
 def ensure_blackbody_lut():
     """The packed ``N x 1`` blackbody table (``spectral_luts.blackbody_rgb_lut``)."""
 
-    return _ensure_lut(BLACKBODY_LUT_NAME, lut_data.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
+    return _ensure_lut(BLACKBODY_LUT_NAME, shipped_luts.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 
 
 def ensure_illuminant_lut(name, temperature_k):
     """The packed ``N x 3`` table ``name`` for light reflected under a blackbody at
-    ``temperature_k`` (0: white), laid out as the Doppler matrix table (``physics/illuminant.py``);
+    ``temperature_k`` (0: white), laid out as the Doppler matrix table (``physics/illuminants.py``);
     rebuilt in place (0.1-0.5 s) only when the illuminant changes, packed so that the file renders alone."""
     image = bpy.data.images.get(name)
     stamp = round(float(temperature_k), 3)
     if image is not None and image.get(names.ILLUMINANT_KEY) == stamp and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         return image
-    pixels = illuminant.doppler_lut(np.linspace(*DOPPLER_LOG10_RANGE, LUT_SIZE), stamp or None)
+    pixels = illuminants.doppler_lut(np.linspace(*DOPPLER_LOG10_RANGE, LUT_SIZE), stamp or None)
     if image is not None and tuple(image.size) == (LUT_SIZE, 3) and image.get(LAYOUT_KEY) == LAYOUT_VERSION:
         image.pixels.foreach_set(pixels)  # in place: the compositor's Image node keeps pointing at it
         image.update()

@@ -25,8 +25,10 @@ import math
 
 import bpy
 
-from . import grouped_colours, luts, names, sources, spectral_nodes
-from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
+from ..common import names
+from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
+from ..scene import grouped_colours, sources
+from . import lut_images, spectral_nodes
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
 DONE_AOV = names.COLOUR_DONE_AOV
@@ -140,10 +142,10 @@ def _lut_texture(image_name, u_reference, v):
 
 def doppler_matrix_group():
     """``gamut_map(N(D) rgb)`` and ``a(D)``: ``M(D) rgb`` mapped is ``exp(a)`` times the colour."""
-    scale, offset = luts.texture_u_scale_offset(luts.DOPPLER_LOG10_RANGE)
+    scale, offset = lut_images.texture_u_scale_offset(lut_images.DOPPLER_LOG10_RANGE)
     nodes = {"u": fmath("MULTIPLY_ADD", "group.Log Doppler", scale / LN10, offset)}
     for row in range(3):
-        lookup = _lut_texture(luts.DOPPLER_LUT_NAME, "u", (row + 0.5) / 3.0)
+        lookup = _lut_texture(lut_images.DOPPLER_LUT_NAME, "u", (row + 0.5) / 3.0)
         nodes[f"uv{row}"] = lookup["uv"]
         nodes[f"row{row}"] = lookup["texture"]
         nodes[f"row{row}"].inputs = {"Vector": f"uv{row}"}
@@ -161,7 +163,7 @@ def doppler_matrix_group():
 
 def blackbody_shift_group():
     """Unit-luminance colour of the blackbody at ``D T`` and ``ln(Y(D T) / Y(T))``."""
-    scale, offset = luts.texture_u_scale_offset(luts.BLACKBODY_LOG10_RANGE)
+    scale, offset = lut_images.texture_u_scale_offset(lut_images.BLACKBODY_LOG10_RANGE)
     nodes = {
         "ln_t": fmath("LOGARITHM", "safe_t", E),
         "safe_t": fmath("MAXIMUM", "group.Temperature", 1.0),
@@ -170,7 +172,7 @@ def blackbody_shift_group():
         "u_dt": fmath("MULTIPLY_ADD", "ln_dt", scale / LN10, offset),
     }
     for key in ("t", "dt"):
-        lookup = _lut_texture(luts.BLACKBODY_LUT_NAME, f"u_{key}", 0.5)
+        lookup = _lut_texture(lut_images.BLACKBODY_LUT_NAME, f"u_{key}", 0.5)
         nodes[f"uv_{key}"] = lookup["uv"]
         nodes[f"lut_{key}"] = lookup["texture"]
         nodes[f"lut_{key}"].inputs = {"Vector": f"uv_{key}"}
@@ -290,8 +292,8 @@ def ensure_node_groups():
     Existing up-to-date groups are left alone: rebuilding a group's interface would drop the
     links of every material node that uses it. Returns the top group.
     """
-    luts.ensure_doppler_matrix_lut()
-    luts.ensure_blackbody_lut()
+    lut_images.ensure_doppler_matrix_lut()
+    lut_images.ensure_blackbody_lut()
     for builder in GROUP_BUILDERS:
         ensure_group(builder(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
     return bpy.data.node_groups[DOPPLER_EMISSION]

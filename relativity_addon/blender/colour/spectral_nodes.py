@@ -18,9 +18,10 @@ import math
 
 import numpy as np
 
-from ..physics import spectral_render
-from . import luts, names
-from .nodes import Group, Node, fmath, group_node, vmath
+from ...physics import spectral_render
+from ..common import names
+from ..common.nodes import Group, Node, fmath, group_node, vmath
+from . import lut_images
 
 SPECTRAL_COLOUR = names.SPECTRAL_COLOUR_GROUP
 # The constants colour.colorimetry.planck_law uses (as physics.spectral does).
@@ -71,7 +72,7 @@ def pass_values(wavelengths_nm):
 
 def spectral_colour_group():
     """Spectral values of ``Color`` at the pass's wavelengths (see the module docstring)."""
-    scale, offset = luts.texture_u_scale_offset(luts.BLACKBODY_LOG10_RANGE)
+    scale, offset = lut_images.texture_u_scale_offset(lut_images.BLACKBODY_LOG10_RANGE)
     nodes = {
         "settings": group_node(names.SETTINGS_GROUP),
         "luminance": vmath("DOT_PRODUCT", "group.Color", (0.2126729, 0.7151522, 0.0721750)),
@@ -80,7 +81,7 @@ def spectral_colour_group():
         "u_t": fmath("MULTIPLY_ADD", "ln_t", scale / LN10, offset),
         "uv_t": Node("ShaderNodeCombineXYZ", {0: "u_t", 1: 0.5, 2: 0.0}),
         "lut_t": Node("ShaderNodeTexImage", {"Vector": "uv_t"},
-                      {"image": luts.BLACKBODY_LUT_NAME, "interpolation": "Linear", "extension": "EXTEND"}),
+                      {"image": lut_images.BLACKBODY_LUT_NAME, "interpolation": "Linear", "extension": "EXTEND"}),
         "safe_y": fmath("MAXIMUM", "luminance.Value", 1e-30),
         "ln_y": fmath("LOGARITHM", "safe_y", math.e),
         "ln_scale": fmath("SUBTRACT", "ln_y", "lut_t.Alpha"),  # ln(Y / Y_B(T))

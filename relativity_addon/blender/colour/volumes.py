@@ -53,8 +53,10 @@ import math
 
 import bpy
 
-from . import materials, names, sources, spectral_nodes
-from .nodes import Group, Node, ensure_group, fmath, group_node, vmath
+from ..common import names
+from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
+from ..scene import sources
+from . import materials, spectral_nodes
 
 GROUP = names.VOLUME_BLACKBODY_GROUP
 NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX

@@ -16,7 +16,8 @@ reaches the Background as black.) :func:`write` runs at every sync, so each spec
 the fast mode after it find the links they need; ``materials.detach`` undoes either state.
 """
 
-from . import materials, names
+from ..common import names
+from . import materials
 
 
 def _colour_records(world):

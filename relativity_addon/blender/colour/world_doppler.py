@@ -26,8 +26,11 @@ the effect.
 
 import numpy as np
 
-from ..physics import exposure
-from . import camera, compositing, names, snapshot
+from ...physics import exposure
+from ..camera import exact_camera
+from ..common import names
+from ..scene import snapshot
+from . import compositing
 
 IMAGE = names.WORLD_DOPPLER_IMAGE
 AOV_NODE = f"{names.MATERIAL_NODE_PREFIX} AOV"  # materials._insert_aov_writer's node in the world
@@ -45,12 +48,12 @@ def problem(scene, snap):
     render = scene.render
     if snap.use_time_of_flight:
         return "time-of-flight rays leave along d - beta"
-    if camera.stereo_eyes(scene):
+    if exact_camera.stereo_eyes(scene):
         return "a stereo pair's eyes look along shifted directions"
     if render.use_border and render.use_crop_to_border:
         return "the render is cropped to its border"
     data = scene.objects[snap.camera].data
-    kind = camera.lens_type(data)
+    kind = exact_camera.lens_type(data)
     if kind == "PANO" and (data.panorama_type not in exposure.PANORAMAS or data.shift_x or data.shift_y):
         return "a panorama with a lens shift"
     if kind not in ("PERSP", "PANO"):
@@ -62,8 +65,8 @@ def _inputs(scene, snap):
     """What the image depends on: camera type and projection, size, velocity, aberration."""
     camera_object = scene.objects[snap.camera]
     data = camera_object.data
-    if camera.lens_type(data) == "PANO":
-        parameters = camera.projection_parameters(scene, data)
+    if exact_camera.lens_type(data) == "PANO":
+        parameters = exact_camera.projection_parameters(scene, data)
         projection = (data.panorama_type, *sorted((key, float(value)) for key, value in parameters.items()))
     else:
         projection = ("PERSP", *snapshot.view_window(scene, camera_object))

@@ -11,7 +11,7 @@ constant world its Sampling is Manual at resolution ``MAP_RESOLUTION`` (a unifor
 the user's settings come back when they go. Worlds that vary (textures, sky) keep theirs.
 """
 
-from . import names
+from ..common import names
 
 MAP_RESOLUTION = 16
 SAVED = names.WORLD_SAMPLING_SAVED_KEY

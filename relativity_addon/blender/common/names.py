@@ -62,7 +62,7 @@ SPECTRAL_IMAGE = "Relativity Spectral Render"  # the picture the spectral render
 DOPPLER_LUT_IMAGE = "Relativity Doppler Matrix LUT"
 BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
 # The fast mode's light of blackbody lamps: one view-layer light group per lamp temperature (slot),
-# its pass read through its own matrix table (light_groups.py, physics/illuminant.py).
+# its pass read through its own matrix table (light_groups.py, physics/illuminants.py).
 LIT_GROUPS = ("Relativity Lit 1", "Relativity Lit 2")
 ILLUMINANT_LUT_IMAGES = ("Relativity Illuminant LUT 1", "Relativity Illuminant LUT 2")
 ILLUMINANT_KEY = "relativity_illuminant_k"  # on such an image: the illuminant it holds (K, 0 = white)

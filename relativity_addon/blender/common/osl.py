@@ -49,11 +49,10 @@ def compile_custom_camera(camera_data):
     """
     ensure_oslquery_importable()
     try:
-        from cycles import engine as cycles_engine
-        from cycles import osl as cycles_osl
+        from cycles import engine, osl
     except ImportError as error:
         raise OSLUnavailableError("the Cycles add-on is not available") from error
-    if not cycles_engine.with_osl():
+    if not engine.with_osl():
         raise OSLUnavailableError("this Blender build has no OSL support")
 
     errors = []
@@ -62,7 +61,7 @@ def compile_custom_camera(camera_data):
         if {"ERROR", "WARNING"} & set(kind):
             errors.append(str(message))
 
-    ok = cycles_osl.update_custom_camera_shader(camera_data, report)
+    ok = osl.update_custom_camera_shader(camera_data, report)
     if not ok and not errors:
         errors.append("Custom Camera shader compilation failed")
     return errors

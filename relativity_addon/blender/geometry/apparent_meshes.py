@@ -19,8 +19,10 @@ the object's cache (:func:`scene_errors`) and the viewport keeps the last valid 
 import bpy
 import numpy as np
 
-from ..errors import RelativityError
-from . import busy, modifier, names, snapshot, world_lines
+from ...errors import RelativityError
+from ..common import busy, names
+from ..scene import snapshot
+from . import modifier, motion
 from .modifier import applied_objects, object_error
 
 # An edge longer than this fraction of its distance to the camera is too coarse for the
@@ -53,10 +55,10 @@ def update_object(scene, obj, snap, depsgraph=None):
         raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
     try:
-        world, beta_seen = world_lines.apparent_world_positions(scene, obj, obj_eval, rest, snap)
+        world, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"object {obj.name!r}: {error}") from None
-    inverse = np.linalg.inv(world_lines.matrix_array(obj_eval.matrix_world))
+    inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
     modifier.write_cache(cache.data, local, beta_seen)
@@ -144,7 +146,7 @@ def longest_edge_fraction(obj, camera_position):
         return 0.0
     coordinates = np.empty(len(mesh.vertices) * 3)
     mesh.vertices.foreach_get("co", coordinates)
-    world = world_lines.to_world(np.array(obj.matrix_world), coordinates.reshape(-1, 3))
+    world = motion.to_world(np.array(obj.matrix_world), coordinates.reshape(-1, 3))
     edges = np.empty(len(mesh.edges) * 2, dtype=np.int64)
     mesh.edges.foreach_get("vertices", edges)
     a, b = world[edges[0::2]], world[edges[1::2]]

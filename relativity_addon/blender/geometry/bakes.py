@@ -13,9 +13,11 @@ import math
 import bpy
 import numpy as np
 
-from ..errors import RelativityError
-from . import animation, busy, geometry, modifier, names, snapshot
-from .world_lines import matrix_array, to_world
+from ...errors import RelativityError
+from ..common import busy, names
+from ..scene import animation, snapshot
+from . import apparent_meshes, modifier
+from .motion import matrix_array, to_world
 
 
 def _bake_frames(scene, obj, frame_start, frame_end):
@@ -98,7 +100,7 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     cache.data[names.BAKE_KEY] = {"mesh": mesh.name, "start": float(frames[0] / fps), "step": 1.0 / (per_frame * fps),
                             "samples": len(samples), "points": count,
                             names.BAKE_ORIGINS_KEY: np.ravel(origins).tolist()}
-    geometry.update_after_bake(scene, obj)
+    apparent_meshes.update_after_bake(scene, obj)
     return len(samples)
 
 
@@ -123,7 +125,7 @@ def bake_motion(scene, obj, frame_start=None, frame_end=None):
         geometry_modifier.show_viewport = shown
     cache.data[names.MOTION_BAKE_KEY] = {"first_frame": float(frames[0]), "samples_per_frame": per_frame,
                                    "matrices": np.ravel(matrices).tolist()}
-    geometry.update_after_bake(scene, obj)
+    apparent_meshes.update_after_bake(scene, obj)
     return len(matrices)
 
 

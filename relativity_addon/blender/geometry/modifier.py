@@ -14,8 +14,8 @@ kept on the cache mesh too (``bakes.py``), so they go with the effect when it is
 import bpy
 import numpy as np
 
-from . import compat, names
-from .nodes import Group, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
+from ..common import compat, names
+from ..common.nodes import Group, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
 
 
 def node_group_spec():

@@ -25,10 +25,12 @@ Every function raises RelativityError (one line) for a motion it cannot show cor
 
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import apparent, proper_time, rest_shape, sampling
-from . import animation, modifier, names, shape_keys
-from .snapshot import check_velocity
+from ...errors import RelativityError
+from ...physics import apparent, proper_time, rest_shape, sampling
+from ..common import names
+from ..scene import animation
+from ..scene.snapshot import check_velocity
+from . import modifier, shape_keys
 
 # Most samples of a keyframed object's clock table (its path from scene time 0 to the retarded times).
 CLOCK_SAMPLES = 200_000

@@ -15,8 +15,9 @@ import re
 
 import numpy as np
 
-from ..errors import RelativityError
-from . import compat, modifier
+from ...errors import RelativityError
+from ..common import compat
+from . import modifier
 
 _VALUE_PATH = re.compile(r'^key_blocks\["(.+)"\]\.value$')
 FRAME_SAMPLES_PER_FRAME = 16  # the values' table between the frames asked for (linear in between)

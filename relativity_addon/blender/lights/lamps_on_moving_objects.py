@@ -28,9 +28,13 @@ import bpy
 import mathutils
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import lamp_doppler
-from . import modifier, names, rest_normals, snapshot, sources, world_lines
+from ...errors import RelativityError
+from ...physics import lamp_doppler
+from ..common import names
+from ..geometry import modifier
+from ..geometry import motion as world_lines
+from ..scene import snapshot, sources
+from . import rest_normals
 
 KEY = names.LAMP_DOPPLER_KEY
 COPY_KEY = names.LAMP_DOPPLER_COPY_KEY

@@ -10,7 +10,7 @@ rays and an emitter mesh of its shape and radiance (its **face**), visible to ca
 is drawn in its place with an ordinary material: the materials' Doppler colour (blackbodies
 exactly, RGB through the compositor) and the spectral passes treat it like any emitter.
 
-Radiance, measured against Cycles' own lamps (tests/blender/doppler/test_visible_lamps.py):
+Radiance, measured against Cycles' own lamps (tests/blender/colour/test_visible_lamps.py):
 an area light of power ``P`` and area ``A`` (Normalize on) shows ``P / (pi A)`` times its colour,
 a point light of radius ``r`` a disc of ``P / (4 pi^2 r^2)``; ``2^exposure`` multiplies both.
 
@@ -31,7 +31,10 @@ import bmesh
 import bpy
 from mathutils import Matrix, Vector
 
-from . import compat, materials, moving_lights, names, snapshot, sources, visibility
+from ..colour import materials
+from ..common import compat, names, visibility
+from ..scene import snapshot, sources
+from . import moving_lights
 
 KINDS = ("POINT", "SPOT", "AREA", "SUN")
 # A sun's face sits this far out, as a fraction of the camera's clip end: behind everything but

@@ -25,11 +25,14 @@ import os
 import bpy
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import spectral_render
-from . import emitter_lights, materials, moving_lamps, names, osl, sources
+from ...errors import RelativityError
+from ...physics import spectral_render
+from ..colour import materials
+from ..common import names, osl
+from ..scene import emitting_meshes, sources
+from . import stand_in_lamps
 
-SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LIGHT_SHADER_TEXT)
+SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
 MATERIAL_KEY = names.MOVING_LIGHTS_MATERIAL_KEY
 NODE_PREFIX = names.MOVING_LIGHT_NODE_PREFIX
@@ -325,7 +328,7 @@ def _scene_materials(scene):
 
 def _hide_light(obj):
     if obj.type == "MESH":  # an emitter lighting the scene: its own light reaches the camera only
-        emitter_lights.hide_from_light_rays(obj)
+        emitting_meshes.hide_from_light_rays(obj)
         return
     if names.LIGHT_SAVED_KEY not in obj:
         obj[names.LIGHT_SAVED_KEY] = {"hide_render": bool(obj.hide_render)}
@@ -334,7 +337,7 @@ def _hide_light(obj):
 
 
 def _restore_light(obj):
-    if emitter_lights.restore(obj):
+    if emitting_meshes.restore(obj):
         return True
     saved = obj.get(names.LIGHT_SAVED_KEY)
     if saved is None:
@@ -384,10 +387,10 @@ def write(scene, snap, attach_new_materials=False, depsgraph=None):
     _enable_osl(scene)
     if uses_lamps(snap):
         _silence_group(snap)  # the preview's material nodes, during an Apparent Geometry final render
-        moving_lamps.write(scene, snap, lights, lambda light: shader_parameters(light, snap),
+        stand_in_lamps.write(scene, snap, lights, lambda light: shader_parameters(light, snap),
                            reception_event(snap)[0], depsgraph)
         return None
-    moving_lamps.remove(scene)  # after an Apparent Geometry final render
+    stand_in_lamps.remove(scene)  # after an Apparent Geometry final render
     group = ensure_group(light_names)
     _write_parameters(group, snap)
     if first or attach_new_materials:
@@ -403,7 +406,7 @@ def apply(scene, snap):
 def remove(scene):
     """Restore everything :func:`write` changed: materials, lights, the scene's shading system;
     delete the group, the stand-in lamps and the shader texts."""
-    moving_lamps.remove(scene)
+    stand_in_lamps.remove(scene)
     for material in bpy.data.materials:
         detach(material)
     for obj in bpy.data.objects:

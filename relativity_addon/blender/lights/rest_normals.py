@@ -20,7 +20,7 @@ Everything is recorded (the mesh names on the scene, the inserted node on each m
 import bpy
 import numpy as np
 
-from . import names, nodes
+from ..common import names, nodes
 
 KEY = names.REST_NORMAL_KEY
 ATTRIBUTE = names.REST_NORMAL_ATTRIBUTE

@@ -24,13 +24,15 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from ..errors import RelativityError
-from ..physics import spectral_render
-from ..physics.lorentz import aberrate, camera_to_scene_direction
-from ..physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
-from . import animation, materials, names, snapshot, sources
+from ...errors import RelativityError
+from ...physics import spectral_render
+from ...physics.lorentz import aberrate, camera_to_scene_direction
+from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
+from ..colour import materials
+from ..common import names
+from ..scene import animation, snapshot, sources
 
-SHADER_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "shaders", names.MOVING_LAMP_SHADER_TEXT)
+SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 

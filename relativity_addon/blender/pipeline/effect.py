@@ -17,26 +17,14 @@ stops a correct render is kept as the scene's warnings (shown in the panel), and
 is marked invalid (it renders black, never a wrong image).
 """
 
-from ..errors import RelativityError
-from . import (
-    animation,
-    busy,
-    camera,
-    clamping,
-    colour,
-    geometry,
-    lamp_doppler,
-    lamp_faces,
-    light_groups,
-    metadata,
-    modifier,
-    moving_lights,
-    shape_keys,
-    snapshot,
-    traveller,
-    volumes,
-    world_doppler,
-)
+from ...errors import RelativityError
+from ..camera import clamping, exact_camera
+from ..colour import doppler_colour, light_groups, volumes, world_doppler
+from ..common import busy
+from ..geometry import apparent_meshes, modifier, shape_keys
+from ..lights import lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..scene import animation, snapshot, traveller
+from . import metadata
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
@@ -49,8 +37,8 @@ def applied_method(scene):
     """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None (the exact
     camera of an Apparent Geometry final render does not count: it is there for the render)."""
     camera_object = scene.camera
-    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_applied(camera_object.data) \
-            and not camera.is_render_only(camera_object.data):
+    if camera_object is not None and camera_object.type == "CAMERA" and exact_camera.is_applied(camera_object.data) \
+            and not exact_camera.is_render_only(camera_object.data):
         return "CAMERA"
     if modifier.applied_objects(scene):
         return "GEOMETRY"
@@ -58,7 +46,7 @@ def applied_method(scene):
 
 
 def is_applied(scene):
-    return applied_method(scene) is not None or bool(camera.applied_cameras())
+    return applied_method(scene) is not None or bool(exact_camera.applied_cameras())
 
 
 def apply(scene, frame_range=None, objects=None):
@@ -73,23 +61,23 @@ def apply(scene, frame_range=None, objects=None):
     if applied_method(scene) not in (None, snap.method):
         remove(scene)
     if snap.method == "CAMERA":
-        result = camera.apply(scene, snap)
-        undo = (lambda: camera.remove(result))  # noqa: E731
+        result = exact_camera.apply(scene, snap)
+        undo = (lambda: exact_camera.remove(result))  # noqa: E731
     else:
-        result = geometry.apply(scene, snap, objects)
-        undo = (lambda: geometry.remove(scene, result))  # noqa: E731
+        result = apparent_meshes.apply(scene, snap, objects)
+        undo = (lambda: apparent_meshes.remove(scene, result))  # noqa: E731
     try:
         moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
-        colour.apply(scene, snap)
+        doppler_colour.apply(scene, snap)
         if snap.colour.camera_path:
             world_doppler.write(scene, snap)  # the world pixels' ln D for the compositor stage
         metadata.write(scene, snap)
         clamping.write(scene, snap)
-        lamp_doppler.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
-        lamp_faces.write(scene, snap)  # lamps seen directly, drawn by emitters (exact camera)
+        lamps_on_moving_objects.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
+        lamps_seen_directly.write(scene, snap)  # lamps seen directly, drawn by emitters (exact camera)
     except RelativityError:
-        lamp_faces.remove(scene)
-        lamp_doppler.remove(scene)
+        lamps_seen_directly.remove(scene)
+        lamps_on_moving_objects.remove(scene)
         moving_lights.remove(scene)
         metadata.remove(scene)
         clamping.remove(scene)
@@ -102,15 +90,15 @@ def apply(scene, frame_range=None, objects=None):
 def remove(scene):
     """Remove everything the add-on added (every relativistic camera, the apparent geometry, the
     colour stage); the settings stay, they are the user's. Returns the number of things removed."""
-    removed = len(geometry.remove(scene))
-    for camera_object in camera.applied_cameras():
-        removed += bool(camera.remove(camera_object))
-    colour.remove(scene)
+    removed = len(apparent_meshes.remove(scene))
+    for camera_object in exact_camera.applied_cameras():
+        removed += bool(exact_camera.remove(camera_object))
+    doppler_colour.remove(scene)
     moving_lights.remove(scene)
     metadata.remove(scene)
     clamping.remove(scene)
-    lamp_doppler.remove(scene)
-    lamp_faces.remove(scene)
+    lamps_on_moving_objects.remove(scene)
+    lamps_seen_directly.remove(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
@@ -129,7 +117,7 @@ def final_render_problem(scene, snap):
         return "the observer is at rest"
     if snap.engine != "CYCLES":
         return f"the exact camera needs Cycles, not {snap.engine}"
-    return camera.type_problem(snap.camera, scene.objects[snap.camera].data)
+    return exact_camera.type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
 def begin_final_render(scene):
@@ -148,8 +136,8 @@ def begin_final_render(scene):
     snapshot.begin_final_render(scene)
     try:
         snap = snapshot.read(scene)
-        camera.apply(scene, snap, render_only=True)
-        colour.apply(scene, snap)
+        exact_camera.apply(scene, snap, render_only=True)
+        doppler_colour.apply(scene, snap)
     except RelativityError:
         end_final_render(scene)
         raise
@@ -164,11 +152,11 @@ def end_final_render(scene):
     was_exact = snapshot.in_final_render(scene)
     snapshot.end_final_render(scene)
     camera_object = scene.camera
-    if was_exact and camera_object is not None and camera.is_render_only(camera_object.data):
+    if was_exact and camera_object is not None and exact_camera.is_render_only(camera_object.data):
         _final_render_valid[scene.name] = bool(camera_object.data.cycles_custom.get("settings_valid", False))
     _remove_render_only_camera(scene)
     if was_exact:
-        colour.remove_camera_stage(scene)
+        doppler_colour.remove_camera_stage(scene)
         sync(scene, update_geometry=False)
         for obj in modifier.applied_objects(scene):
             obj.update_tag()
@@ -182,8 +170,8 @@ def final_render_was_valid(scene):
 
 def _remove_render_only_camera(scene):
     camera_object = scene.camera
-    if camera_object is not None and camera_object.type == "CAMERA" and camera.is_render_only(camera_object.data):
-        camera.remove(camera_object)
+    if camera_object is not None and camera_object.type == "CAMERA" and exact_camera.is_render_only(camera_object.data):
+        exact_camera.remove(camera_object)
 
 
 def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False, before_render=False):
@@ -206,21 +194,21 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
             # applied with the other method (the setting changed where no callback ran)
             raise RelativityError(f"Set up again: the scene is set up for {method.title()}")
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
-            camera.write(scene, snap)
+            exact_camera.write(scene, snap)
         if method == "GEOMETRY" and update_geometry:
-            geometry.update(scene, snap, depsgraph, only_changed=True)
+            apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
             moving_lights.write(scene, snap, attach_new_materials, depsgraph)
-            colour.write(scene, snap, attach_new_materials)
+            doppler_colour.write(scene, snap, attach_new_materials)
             if snap.colour.camera_path:
                 world_doppler.write(scene, snap, pixels=before_render)
             metadata.write(scene, snap)
             clamping.write(scene, snap)
-            lamp_doppler.write(scene, snap)
-            lamp_faces.write(scene, snap)
+            lamps_on_moving_objects.write(scene, snap)
+            lamps_seen_directly.write(scene, snap)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
-            camera.invalidate(scene.camera)
+            exact_camera.invalidate(scene.camera)
         _refused(scene, error)
         return None
     _record(scene, snap)
@@ -246,7 +234,7 @@ def object_changed(scene, obj):
     if applied_method(scene) == "GEOMETRY" and obj.type == "MESH" and obj.relativity.enabled \
             and modifier.find_modifier(obj) is None:
         try:
-            geometry.apply(scene, snapshot.read(scene), [obj])
+            apparent_meshes.apply(scene, snapshot.read(scene), [obj])
         except RelativityError as error:
             _refused(scene, error)
             return
@@ -267,21 +255,21 @@ def _record(scene, snap):
         warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
     if snap.method == "CAMERA":
         camera_object = scene.objects.get(snap.camera)
-        problem = camera_object and camera.type_problem(camera_object.name, camera_object.data)
+        problem = camera_object and exact_camera.type_problem(camera_object.name, camera_object.data)
         if problem:
             warnings.append(problem[0].upper() + problem[1:])
     if snap.exact_camera:
-        warnings += camera.lens_warnings(scene.objects.get(snap.camera))
+        warnings += exact_camera.lens_warnings(scene.objects.get(snap.camera))
     if snap.method == "GEOMETRY":
         problem = final_render_problem(scene, snap)
         if snap.speed > 0.0 and problem is not None:
             warnings.append(f"Lamps, shadows and the world are not relativistic in this render: {problem}")
             if snap.exposure_mode == "COMPENSATED":
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
-    warnings += geometry.scene_errors(scene)
+    warnings += apparent_meshes.scene_errors(scene)
     warnings += moving_lights.warnings(scene, snap)
-    warnings += lamp_doppler.warnings(scene, snap)
-    warnings += lamp_faces.warnings(scene, snap)
+    warnings += lamps_on_moving_objects.warnings(scene, snap)
+    warnings += lamps_seen_directly.warnings(scene, snap)
     if snap.exact_camera:
         warnings += volumes.warnings(scene)
         warnings += light_groups.warnings(scene, snap)
@@ -303,7 +291,7 @@ def _mesh_warnings(obj, snap):
     known = _object_warnings.get(obj.name)
     if known is not None and known[0] == inputs:
         return known
-    coarse = geometry.coarse_mesh_warning(obj, snap.camera_position)
+    coarse = apparent_meshes.coarse_mesh_warning(obj, snap.camera_position)
     return inputs, [coarse] if coarse else []
 
 

@@ -8,7 +8,7 @@ recoverable from any output file: divide by ``exposure``. The user's own note co
 effect is removed.
 """
 
-from . import names
+from ..common import names
 
 SAVED_KEY = names.STAMP_SAVED_KEY
 PREFIX = "relativity:"

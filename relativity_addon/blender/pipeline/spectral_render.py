@@ -26,9 +26,13 @@ import time
 import bpy
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import exposure, spectral_render
-from . import compositing, effect, materials, modifier, names, snapshot, volumes, world_doppler
+from ...errors import RelativityError
+from ...physics import exposure, spectral_render
+from ..colour import compositing, materials, volumes, world_doppler
+from ..common import names
+from ..geometry import modifier
+from ..scene import snapshot
+from . import effect
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
 

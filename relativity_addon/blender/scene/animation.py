@@ -15,9 +15,9 @@ these matrices.
 import numpy as np
 from mathutils import Matrix
 
-from ..errors import RelativityError
-from ..physics import transforms
-from . import compat
+from ...errors import RelativityError
+from ...physics import transforms
+from ..common import compat
 
 
 def frames_per_second(scene):

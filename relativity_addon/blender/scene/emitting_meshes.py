@@ -17,7 +17,8 @@ not followed), and the object's velocity for every part of it.
 
 import numpy as np
 
-from . import names, sources, visibility
+from ..common import names, visibility
+from . import sources
 
 RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 

@@ -22,7 +22,8 @@ materials' own nodes and their pass-throughs, not colours computed inside a shar
 
 import bpy
 
-from . import names, sources
+from ..common import names
+from . import sources
 
 KEY = names.MATERIAL_ATTACHED_KEY
 OWN_PREFIX = "Relativity"  # the add-on's node groups and inserted nodes

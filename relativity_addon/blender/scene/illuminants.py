@@ -1,4 +1,4 @@
-"""Which lamps lit the scene, for the fast mode's reflected light (``physics/illuminant.py``).
+"""Which lamps lit the scene, for the fast mode's reflected light (``physics/illuminants.py``).
 
 The fast mode reads a pixel's colour as a spectrum and shifts that. Light that a blackbody lamp
 at ``T`` sent onto surfaces is a reflectance times ``B(lambda, T)``; everything else (emitters
@@ -21,7 +21,8 @@ groups (``light_groups.py``), whose passes the compositor reads through their ow
 
 from typing import NamedTuple
 
-from . import grouped_colours, names, sources
+from ..common import names
+from . import grouped_colours, sources
 
 OWN_PREFIX = "Relativity"  # the add-on's stand-in lamps, copies and lamp faces
 STRENGTHS = {"ShaderNodeEmission": "Strength", "ShaderNodeBsdfPrincipled": "Emission Strength"}

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import exposure
-from ..physics.shutter import ShutterModel
-from . import animation, emitter_lights, illuminants, names, sources
+from ...errors import RelativityError
+from ...physics import exposure
+from ...physics.shutter import ShutterModel
+from ..common import names
+from . import animation, emitting_meshes, illuminants, sources
 
 Vector3 = tuple[float, float, float]
 
@@ -304,7 +305,7 @@ def moving_lights(scene, frame, depsgraph=None):
     found = []
     for obj in scene.objects:
         motion = obj.relativity.motion
-        if emitter_lights.is_emitter_light(obj) and not obj.hide_render:
+        if emitting_meshes.is_emitter_light(obj) and not obj.hide_render:
             found += _emitter_light(scene, obj, frame, depsgraph)
             continue
         if obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
@@ -331,7 +332,7 @@ def _emitter_light(scene, obj, frame, depsgraph):
     """A moving emissive mesh as a moving point light at its origin (``emitter_lights``), or none."""
     beta = check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity beta")
     matrix = camera_matrix(scene, obj, frame, depsgraph)
-    intensity = emitter_lights.intensity(obj, matrix)
+    intensity = emitting_meshes.intensity(obj, matrix)
     if intensity is None:
         return []
     return [MovingLight(name=obj.name, kind="POINT", position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,

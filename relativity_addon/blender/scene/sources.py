@@ -34,7 +34,7 @@ Principled Volume's own blackbody emission (shifted for camera rays by ``volumes
 
 from typing import NamedTuple
 
-from . import compat, names
+from ..common import compat, names
 
 MIX_NODES = ("ShaderNodeMix", "ShaderNodeMixRGB")
 BLACKBODY_INTENSITY_CUTOFF = 1e-3  # below this Blender's Principled Volume emits no blackbody

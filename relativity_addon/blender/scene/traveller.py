@@ -9,8 +9,8 @@ and ``physics/proper_time.py`` integrates ``dt / gamma``.
 
 import numpy as np
 
-from ..errors import RelativityError
-from ..physics import proper_time
+from ...errors import RelativityError
+from ...physics import proper_time
 from . import animation, snapshot
 
 SAMPLES_PER_FRAME = 4

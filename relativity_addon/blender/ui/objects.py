@@ -7,7 +7,7 @@ Saved with the .blend and animatable. Changing a setting syncs the effect at onc
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import effect
+from ..pipeline import effect
 from .props import velocity_property
 
 MOTION_ITEMS = (

@@ -6,8 +6,9 @@ and report a ``RelativityError`` in one line instead of leaving a half-applied s
 
 from bpy.types import Operator
 
-from ..errors import RelativityError
-from . import effect, snapshot, spectral_render
+from ...errors import RelativityError
+from ..pipeline import effect, spectral_render
+from ..scene import snapshot
 
 
 def _poll_scene(cls, context):

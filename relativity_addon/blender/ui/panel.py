@@ -8,7 +8,7 @@ import math
 
 from bpy.types import Panel
 
-from . import effect
+from ..pipeline import effect
 
 
 def _split(layout):
@@ -205,7 +205,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
 
 
 def _draw_light(layout, obj):
-    """Lights: the same motion settings as meshes (blender/moving_lights.py: point and spot lights
+    """Lights: the same motion settings as meshes (blender/lights/moving_lights.py: point and spot lights
     with constant velocity on both paths; with the exact camera also sun and area lights and
     keyframed lights)."""
     settings = obj.relativity

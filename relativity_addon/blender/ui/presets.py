@@ -18,7 +18,7 @@ from bl_operators.presets import AddPresetBase
 from bpy.types import Menu, Operator
 
 PRESET_ROOT = "relativity"
-_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 _registered_path = None
 
 

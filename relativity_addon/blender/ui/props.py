@@ -14,8 +14,8 @@ from bpy.props import (
     PointerProperty,
 )
 
-from ..physics.shutter import ShutterModel
-from . import effect
+from ...physics.shutter import ShutterModel
+from ..pipeline import effect
 
 METHOD_ITEMS = (
     ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 REPO_ROOT = Path(__file__).resolve().parents[3]
 RENDER_SCRIPT = REPO_ROOT / "examples" / "render.py"

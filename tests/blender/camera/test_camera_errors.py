@@ -11,7 +11,7 @@ import camera_helpers as ch
 def addon(factory_blender):
     """The add-on registered from this source tree (in-process, for glue-level tests)."""
     import relativity_addon
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     relativity_addon.register()
     yield effect
@@ -31,9 +31,9 @@ def test_apply_then_remove_restores_camera(addon, factory_blender):
     scene.relativity.beta = (0.3, 0.0, -0.4)
     addon.apply(scene)
     assert data.type == "CUSTOM" and data.custom_mode == "INTERNAL"
-    assert data.custom_shader.name == addon.camera.names.SHADER_TEXT
+    assert data.custom_shader.name == addon.exact_camera.names.SHADER_TEXT
     assert data.custom_bytecode
-    assert set(addon.camera.REQUIRED_PARAMETERS) <= set(data.cycles_custom.keys())
+    assert set(addon.exact_camera.REQUIRED_PARAMETERS) <= set(data.cycles_custom.keys())
     # World beta (0.3, 0, -0.4) with an unrotated camera: shader axes are (x, y, -z).
     assert tuple(data.cycles_custom["beta"]) == pytest.approx((0.3, 0.0, 0.4))
 
@@ -51,9 +51,9 @@ def test_apply_then_remove_restores_camera(addon, factory_blender):
     assert addon.remove(scene)
     assert data.type == "PERSP"
     assert data.custom_shader is None
-    assert addon.camera.names.CAMERA_SAVED_STATE_KEY not in data
+    assert addon.exact_camera.names.CAMERA_SAVED_STATE_KEY not in data
     assert len(data.cycles_custom.keys()) == 0
-    assert addon.camera.names.SHADER_TEXT not in bpy.data.texts
+    assert addon.exact_camera.names.SHADER_TEXT not in bpy.data.texts
 
 
 @pytest.mark.parametrize(
@@ -92,12 +92,12 @@ def test_wrong_engine_camera_type_and_method_are_refused(addon, factory_blender)
 )
 def test_compile_failure_or_empty_shader_is_detected(addon, factory_blender, monkeypatch, source):
     scene, camera_object = _scene(factory_blender)
-    monkeypatch.setattr(addon.camera, "shader_source", lambda: source)
+    monkeypatch.setattr(addon.exact_camera, "shader_source", lambda: source)
     with pytest.raises(addon.RelativityError, match="compile|empty shader"):
         addon.apply(scene)
     # The failed attempt leaves the camera as it was.
     assert camera_object.data.type == "PERSP"
-    assert addon.camera.names.CAMERA_SAVED_STATE_KEY not in camera_object.data
+    assert addon.exact_camera.names.CAMERA_SAVED_STATE_KEY not in camera_object.data
 
 
 def test_render_script_fails_with_one_line_reasons(factory_blender, tmp_path):

@@ -109,7 +109,7 @@ BETA_DIRECTION = (0.3, 1.0, 0.2)  # world: oblique to the camera's axes
 def addon(factory_blender):
     """The add-on registered from this source tree (in-process)."""
     import relativity_addon
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     relativity_addon.register()
     yield effect

@@ -158,7 +158,7 @@ def test_stereo_settings_reach_the_camera_and_toe_in_is_refused(factory_blender)
     """In-process: the eye-offset parameters follow Blender's stereo settings; toe-in (eyes turned
     apart) and stereo panoramas (spherical stereo) are refused in one line, the camera restored."""
     import relativity_addon
-    from relativity_addon.blender import effect
+    from relativity_addon.blender.pipeline import effect
 
     bpy = factory_blender
     relativity_addon.register()

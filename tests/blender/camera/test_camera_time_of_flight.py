@@ -119,7 +119,8 @@ def test_rest_colours_and_refusals(factory_blender):
     metadata, and refuses what it cannot render with one line: the mesh path, the Lorentz window,
     the fixed-point surface."""
     import relativity_addon
-    from relativity_addon.blender import effect, snapshot
+    from relativity_addon.blender.pipeline import effect
+    from relativity_addon.blender.scene import snapshot
     from relativity_addon.errors import RelativityError
 
     relativity_addon.register()

@@ -173,7 +173,7 @@ def delta_e_2000_normalised(xyz_a, xyz_b):
 
 def volume_material(bpy, name, kind="ShaderNodeVolumePrincipled", **inputs):
     """A material whose Volume output is one ``kind`` node with these input values (colours as RGB)."""
-    from relativity_addon.blender import compat
+    from relativity_addon.blender.common import compat
 
     material = bpy.data.materials.new(name)
     tree = compat.material_node_tree(material)

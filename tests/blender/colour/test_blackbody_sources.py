@@ -1,9 +1,10 @@
-"""relativity_addon.blender.sources on real node trees (bpy, no render): each tracing rule, with
+"""relativity_addon.blender.scene.sources on real node trees (bpy, no render): each tracing rule, with
 the cases that must stay on the RGB path."""
 
 import pytest
 
-from relativity_addon.blender import compat, sources
+from relativity_addon.blender.common import compat
+from relativity_addon.blender.scene import sources
 
 T = 4200.0
 

@@ -1,4 +1,4 @@
-"""Blackbody sources that do not link straight into the emission (relativity_addon.blender.sources),
+"""Blackbody sources that do not link straight into the emission (relativity_addon.blender.scene.sources),
 in real Cycles renders: a Blackbody reaching the Emission through a reroute, a Mix multiplying
 by a grey, or a node group must be seen as a blackbody at ``D T`` like a direct link; the world's
 Background fed by a Blackbody too, on the exact camera's path.
@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 TEMPERATURE = 5762.0
 VARIANTS = ("direct", "reroute", "multiply", "group")
@@ -93,9 +93,9 @@ def test_traced_blackbodies_seen_at_dt_on_the_mesh_path(relativity_addon, factor
     _feed_blackbody(bpy, tinted.active_material, "multiply", tint=(0.2, 0.5, 0.2))
 
     scene.relativity.method = "GEOMETRY"
-    materials = dh.addon_module(relativity_addon, "materials")
+    materials = dh.addon_module(relativity_addon, "colour.materials")
     materials.attach_scene(scene, camera_path=False)
-    materials.write_settings(dh.addon_module(relativity_addon, "snapshot").read(scene))
+    materials.write_settings(dh.addon_module(relativity_addon, "scene.snapshot").read(scene))
     for kind in variants:
         assert _colour_group(bpy.data.materials[f"{kind}0"]).inputs["Is Blackbody"].default_value == 1.0
     # a Mix with a non-grey colour is not a blackbody: the RGB path
@@ -177,7 +177,7 @@ def test_blackbody_world_attach_and_detach_restore_the_links(relativity_addon, f
     blackbody = tree.nodes.new("ShaderNodeBlackbody")
     tree.links.new(blackbody.outputs[0], background.inputs["Color"])
     before = sorted(node.name for node in tree.nodes)
-    materials = dh.addon_module(relativity_addon, "materials")
+    materials = dh.addon_module(relativity_addon, "colour.materials")
     materials.ensure_node_groups()
     assert materials.attach_world(scene.world)
     group = background.inputs["Color"].links[0].from_node

@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 COLOUR = (0.3, 0.6, 0.2)
 

@@ -9,7 +9,7 @@ observer. Expected Doppler factors are computed per pixel from the pixel's viewi
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
+import colour_helpers as dh
 
 GREY = (0.5, 0.5, 0.5)
 
@@ -24,11 +24,11 @@ def _setup(bpy, addon, **settings):
 def _apply(addon, scene):
     """The mesh path's colour stage alone (emitters carry a hand-written ``relativity_beta``):
     what ``effect.apply`` and ``effect.sync`` do for method GEOMETRY, without the modifier.
-    tests/blender/workflow/test_settings_reach_render.py covers the whole path from the panel."""
+    tests/blender/pipeline/test_settings_reach_render.py covers the whole path from the panel."""
     scene.relativity.method = "GEOMETRY"
-    materials = dh.addon_module(addon, "materials")
+    materials = dh.addon_module(addon, "colour.materials")
     materials.attach_scene(scene, camera_path=False)
-    materials.write_settings(dh.addon_module(addon, "snapshot").read(scene))
+    materials.write_settings(dh.addon_module(addon, "scene.snapshot").read(scene))
 
 
 def _region(image, rows, cols):

@@ -13,8 +13,8 @@ Doppler factor of each pixel's camera-frame viewing direction (docs/physics.md).
 import pytest
 from test_doppler_camera_path import _camera_frame_doppler, _render, _wall_scene
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 TEMPERATURE = 5762.0
 WINDOW = (slice(22, 26), slice(30, 34))

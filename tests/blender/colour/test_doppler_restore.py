@@ -9,9 +9,9 @@ import sys
 
 import numpy as np
 
-import doppler_helpers as dh
-from doppler_helpers import ch
-from relativity_addon.blender import compat
+import colour_helpers as dh
+from colour_helpers import ch
+from relativity_addon.blender.common import compat
 
 # End of a worker script: bpy 4.5 can hang in exit() (see compat.run_main), so leave with os._exit.
 EXIT_WORKER = "import os\nsys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"
@@ -68,7 +68,7 @@ def _scene_with_user_compositor(bpy):
 
 def test_apply_then_remove_restores_everything(relativity_addon, factory_blender):
     bpy = factory_blender
-    effect = dh.addon_module(relativity_addon, "effect")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
     scene, _camera = _scene_with_user_compositor(bpy)
     before = _signature(bpy, scene)
 
@@ -91,7 +91,7 @@ def test_apply_then_remove_restores_everything(relativity_addon, factory_blender
 
 def test_saved_file_renders_without_addon_or_colour_science(relativity_addon, factory_blender, tmp_path):
     bpy = factory_blender
-    effect = dh.addon_module(relativity_addon, "effect")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
     scene, camera = dh.emitter_scene(bpy, samples=4)
     dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), (0.3, 0.6, 0.2), beta=None)
     dh.add_emitter_plane(bpy, scene, "Sun", (-0.5, 0.5), (-0.5, 0.5), beta=None, temperature=5762.0, depth=4.0)
@@ -123,8 +123,8 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
         f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r})\n"
         "from relativity_addon import batch\n"
         "batch.enable_addon()\n"
-        "from relativity_addon import lut_data\n"
-        "from relativity_addon.blender import effect\n"
+        "from relativity_addon.physics import shipped_luts as lut_data\n"
+        "from relativity_addon.blender.pipeline import effect\n"
         "scene = bpy.context.scene\n"
         "scene.relativity.beta = (0.0, 0.0, -0.5)\n"
         "effect.apply(scene)  # works without colour-science\n"
@@ -159,7 +159,7 @@ def test_material_added_after_apply_is_shifted_at_render(relativity_addon, facto
     from relativity_addon.physics import spectral
 
     bpy = factory_blender
-    effect = dh.addon_module(relativity_addon, "effect")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
     scene, camera = dh.emitter_scene(bpy, samples=4)
     scene.relativity.beta = (0.0, 0.0, -0.5)
     effect.apply(scene)
@@ -179,7 +179,7 @@ def test_constant_world_gets_a_uniform_light_map_while_applied(relativity_addon,
     constant world gets a uniform 16 map while the exact camera is applied and its own settings back
     afterwards; a world with a texture keeps its own."""
     bpy = factory_blender
-    effect = dh.addon_module(relativity_addon, "effect")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
     scene, _camera = dh.emitter_scene(bpy)
     world = bpy.data.worlds.new("Constant")
     tree = compat.world_node_tree(world)

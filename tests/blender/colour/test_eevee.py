@@ -8,9 +8,9 @@ with Doppler colour and searchlight. Both images must show the same outline and 
 
 import numpy as np
 
-import doppler_helpers as dh
-from doppler_helpers import ch
-from relativity_addon.blender import compat
+import colour_helpers as dh
+from colour_helpers import ch
+from relativity_addon.blender.common import compat
 
 C = 5.0
 
@@ -29,7 +29,7 @@ def _scene(bpy, addon):
     plane.relativity.motion = "CONSTANT"
     plane.relativity.beta = (-0.5, 0.0, 0.0)
     scene.relativity.method = "GEOMETRY"
-    dh.addon_module(addon, "effect").apply(scene)
+    dh.addon_module(addon, "pipeline.effect").apply(scene)
     return scene
 
 

@@ -10,8 +10,8 @@ here too, to show that the test tells the two apart.
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 RESOLUTION = (160, 120)
 BETA = (0.45, 0.0, -0.45)  # |beta| 0.64, sideways and toward the wall

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 RESOLUTION = (48, 36)
 CENTRE = (slice(14, 22), slice(20, 28))  # 8 x 8 pixels around the optical axis
@@ -79,7 +79,7 @@ def _render_f12(bpy, scene, tmp_path, name):
 
 
 def _render_spectral(bpy, addon, scene, passes=PASSES):
-    spectral_render = dh.addon_module(addon, "spectral_render")
+    spectral_render = dh.addon_module(addon, "pipeline.spectral_render")
     pixels, info = spectral_render.render(scene, passes)
     return pixels[::-1, :, :3].astype(float), info  # top row first, like the EXR reader
 
@@ -342,7 +342,7 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     expected = np.mean([sum(parts[name] * dh.blackbody_xyz_colour_science(d * t)
                             / dh.blackbody_xyz_colour_science(t)[1] for name, t in spectra.items())
                         for d in doppler], axis=0)
-    tree = dh.addon_module(relativity_addon, "compat").compositor_tree(scene)
+    tree = dh.addon_module(relativity_addon, "common.compat").compositor_tree(scene)
     denoisers = [node for node in tree.nodes if node.bl_idname == "CompositorNodeDenoise"]
     assert len(denoisers) == 2 and all(node.inputs["Image"].is_linked for node in denoisers)
     fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
@@ -382,7 +382,7 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     scene.view_layers[0].lightgroups.add(name="Key")
     scene.relativity.fast_illuminant = "AUTO"
     _set_up(bpy, scene, beta)
-    warnings = dh.addon_module(relativity_addon, "effect").scene_warnings(scene)
+    warnings = dh.addon_module(relativity_addon, "pipeline.effect").scene_warnings(scene)
     assert any("own light groups (Key)" in line for line in warnings), warnings
     assert [group.name for group in scene.view_layers[0].lightgroups] == ["Key"]
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
@@ -392,7 +392,7 @@ def test_lit_by_sorts_blackbody_lamps_by_temperature(relativity_addon):
     """Lit By: Automatic groups the blackbody lamps by temperature (two at most, the most frequent);
     RGB emitters and white lamps stay out; Blackbody and White override it."""
     bpy = __import__("bpy")
-    illuminants = dh.addon_module(relativity_addon, "illuminants")
+    illuminants = dh.addon_module(relativity_addon, "scene.illuminants")
     scene, _camera = dh.emitter_scene(bpy)
 
     def groups():

@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
-from doppler_helpers import ch
+import colour_helpers as dh
+from colour_helpers import ch
 
 TEMPERATURE = 3000.0
 RESOLUTION = (64, 48)
@@ -96,7 +96,8 @@ def test_volumes_with_temperature_grids_are_left_to_the_rgb_shift_with_a_warning
     correction does not follow: its material gets no correction nodes, the scene's warnings name
     it, and the mesh gas beside it is still corrected."""
     bpy = __import__("bpy")
-    from relativity_addon.blender import effect, volumes
+    from relativity_addon.blender.colour import volumes
+    from relativity_addon.blender.pipeline import effect
 
     scene, _camera, material = _scene(bpy)
     grid_material = material.copy()

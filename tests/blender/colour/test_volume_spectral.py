@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
+import colour_helpers as dh
 
 TEMPERATURE = 3000.0
 RESOLUTION = (64, 48)
@@ -60,7 +60,7 @@ def _border(scene, rows):
 
 
 def _spectral(addon, scene, passes=PASSES):
-    pixels, _info = dh.addon_module(addon, "spectral_render").render(scene, passes)
+    pixels, _info = dh.addon_module(addon, "pipeline.spectral_render").render(scene, passes)
     return pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
 
 
@@ -222,7 +222,7 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     bpy = __import__("bpy")
     from importlib import import_module
 
-    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     relativity_error = import_module(f"{relativity_addon}.errors").RelativityError
     scene, _camera = dh.emitter_scene(bpy, samples=1, resolution=(16, 12))
     fire = dh.volume_material(bpy, "Fire", Density=1.0, Blackbody_Intensity=1.0, Temperature=1500.0)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from test_volume_blackbody import _slab_path_ratio
 
-import doppler_helpers as dh
+import colour_helpers as dh
 
 RESOLUTION = (64, 48)
 BETA = (0.0, 0.0, -0.5)

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
+import colour_helpers as dh
 
 COLOUR = (0.3, 0.6, 0.2)
 RESOLUTION = (48, 32)
@@ -94,9 +94,9 @@ def test_world_is_shifted_at_every_pixel(relativity_addon, tmp_path, beta):
 
 def _assert_world_writes_no_aov(addon, scene):
     """The world's ln D comes from the compositor's direction image, not from an AOV writer."""
-    world_doppler = dh.addon_module(addon, "world_doppler")
+    world_doppler = dh.addon_module(addon, "colour.world_doppler")
     assert scene.world.node_tree.nodes[world_doppler.AOV_NODE].mute
-    stage = next(node for node in dh.addon_module(addon, "compat").compositor_tree(scene).nodes
+    stage = next(node for node in dh.addon_module(addon, "common.compat").compositor_tree(scene).nodes
                  if node.bl_idname == "CompositorNodeGroup")
     assert stage.inputs["World Directions"].default_value == 1.0
 
@@ -130,9 +130,9 @@ def test_world_colour_group_feeds_the_background_only_where_needed(relativity_ad
     """Fast mode: the Background keeps its own colour (the compositor shifts the pixel); a spectral
     pass and a blackbody background need the group; removal restores the tree exactly."""
     bpy = __import__("bpy")
-    effect = dh.addon_module(relativity_addon, "effect")
-    materials = dh.addon_module(relativity_addon, "materials")
-    world_colour = dh.addon_module(relativity_addon, "world_colour")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
+    materials = dh.addon_module(relativity_addon, "colour.materials")
+    world_colour = dh.addon_module(relativity_addon, "colour.world_colour")
     scene, _camera, background = _world_scene(bpy)
     tree = scene.world.node_tree
     rgb = tree.nodes.new("ShaderNodeRGB")  # a linked colour and ...
@@ -182,7 +182,7 @@ def test_spectral_render_of_a_coloured_world(relativity_addon):
     scene, camera, _background = _world_scene(bpy, resolution=(32, 24))
     beta = (0.3, 0.0, -0.6)
     _set_up(bpy, scene, beta)
-    pixels, _info = dh.addon_module(relativity_addon, "spectral_render").render(scene, 3)
+    pixels, _info = dh.addon_module(relativity_addon, "pipeline.spectral_render").render(scene, 3)
     image = pixels[::-1, :, :3].astype(float)  # top row first
     d = _doppler(-dh.pixel_photon_directions(bpy, scene, camera), beta)
     spectrum = dh.emitted_spectrum(COLOUR)
@@ -204,10 +204,10 @@ def test_stereo_pair_keeps_the_world_aov_writer(relativity_addon):
     scene.render.use_multiview = True
     scene.render.views_format = "STEREO_3D"
     _set_up(bpy, scene, (0.0, 0.0, -0.5))
-    world_doppler = dh.addon_module(relativity_addon, "world_doppler")
+    world_doppler = dh.addon_module(relativity_addon, "colour.world_doppler")
     assert not scene.world.node_tree.nodes[world_doppler.AOV_NODE].mute
     scene.render.use_multiview = False
-    dh.addon_module(relativity_addon, "effect").sync(scene)
+    dh.addon_module(relativity_addon, "pipeline.effect").sync(scene)
     _assert_world_writes_no_aov(relativity_addon, scene)
 
 
@@ -216,7 +216,7 @@ def test_animation_render_shifts_the_world_for_each_frame(relativity_addon, tmp_
     world pixels are shifted by that frame's D (the direction image is written per frame, before
     the frame's render; the compositor must not see the previous frame's)."""
     bpy = __import__("bpy")
-    compat = dh.addon_module(relativity_addon, "compat")
+    compat = dh.addon_module(relativity_addon, "common.compat")
     scene, camera, _background = _world_scene(bpy)
     scene.relativity.speed_of_light = 10.0
     scene.relativity.velocity_source = "CAMERA_ANIMATION"

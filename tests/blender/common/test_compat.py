@@ -1,8 +1,8 @@
-"""relativity_addon.blender.compat on the running Blender (each supported line runs this file)."""
+"""relativity_addon.blender.common.compat on the running Blender (each supported line runs this file)."""
 
 import pytest
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 
 def _nodes_modifier(bpy):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402
@@ -15,7 +15,7 @@ from blender_support import ADDON_MODULE  # noqa: E402
 
 
 def geometry_module():
-    return importlib.import_module(f"{ADDON_MODULE}.blender.geometry")
+    return importlib.import_module(f"{ADDON_MODULE}.blender.geometry.apparent_meshes")
 
 
 def addon_module(name):
@@ -25,12 +25,12 @@ def addon_module(name):
 def apply_geometry(scene, objects=None):
     """Set the scene up for Apparent Geometry as the Set Up button does (``effect.apply``)."""
     scene.relativity.method = "GEOMETRY"
-    return addon_module("effect").apply(scene, objects=objects)
+    return addon_module("pipeline.effect").apply(scene, objects=objects)
 
 
 def remove_effect(scene):
     """What the Remove button does; returns the number of things removed."""
-    return addon_module("effect").remove(scene)
+    return addon_module("pipeline.effect").remove(scene)
 
 
 def evaluated_points(bpy, obj, attribute=None):

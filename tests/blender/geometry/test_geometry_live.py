@@ -63,7 +63,7 @@ def test_superluminal_object_velocity_is_a_one_line_error(relativity_addon, fact
     obj.relativity.beta = (1.2, 0.0, 0.0)
     with pytest.raises(gh.geometry_module().RelativityError, match="below 1"):
         gh.apply_geometry(scene)
-    assert gh.addon_module("modifier").find_modifier(obj) is None  # nothing changed
+    assert gh.addon_module("geometry.modifier").find_modifier(obj) is None  # nothing changed
     blend = ch.save_blend(bpy, tmp_path / "fast.blend")
     result = ch.run_render_script(blend, tmp_path / "fast.png", "--method=geometry", check=False)
     assert result.returncode == 1
@@ -107,7 +107,7 @@ def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blen
     scene, camera_object, obj = _scene(bpy)
     bpy.context.view_layer.objects.active = obj
     with pytest.raises(gh.geometry_module().RelativityError, match="at least two samples"):
-        gh.addon_module("bakes").bake_deformation(scene, obj, 1, 1)
+        gh.addon_module("geometry.bakes").bake_deformation(scene, obj, 1, 1)
     scene.camera = None
     with pytest.raises(RuntimeError, match="no active camera"):
         bpy.ops.relativity.bake_deformation()
@@ -115,7 +115,7 @@ def test_bake_operator_reports_errors_in_one_line(relativity_addon, factory_blen
     scene.frame_start, scene.frame_end = 1, 3
     obj.relativity.samples_per_frame = 2
     assert bpy.ops.relativity.bake_deformation() == {"FINISHED"}
-    assert gh.addon_module("modifier").bake_mesh(obj) is not None
+    assert gh.addon_module("geometry.modifier").bake_mesh(obj) is not None
     assert gh.geometry_module().scene_errors(scene) == []
 
 
@@ -129,7 +129,8 @@ def test_duplicated_object_gets_its_own_cache(relativity_addon, factory_blender)
     twin.location = (1.5, 1.0, -6.0)
     scene.collection.objects.link(twin)
     twin.relativity.beta = (0.0, 0.0, 0.0)  # update callback
-    assert gh.addon_module("modifier").cache_object(twin) != gh.addon_module("modifier").cache_object(obj)
+    modifier = gh.addon_module("geometry.modifier")
+    assert modifier.cache_object(twin) != modifier.cache_object(obj)
     first, _ = gh.evaluated_points(bpy, obj)
     second, beta = gh.evaluated_points(bpy, twin, "relativity_beta")
     assert np.allclose(beta, 0.0)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import geometry_helpers as gh
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 C = 10.0
 FPS = 24
@@ -136,7 +136,7 @@ def test_keyframe_matrices_match_blender(relativity_addon, factory_blender):
     matrix_world: every rotation mode, keyed deltas, a three-level parent chain with a parent
     inverse, muted curves skipped (and, as in Blender 5.0, curves of a muted group still count)."""
     bpy = factory_blender
-    animation = importlib.import_module(f"{relativity_addon}.blender.animation")
+    animation = importlib.import_module(f"{relativity_addon}.blender.scene.animation")
     scene, _ = _scene(bpy)
     rng = np.random.default_rng(7)
     modes = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX", "QUATERNION", "AXIS_ANGLE")
@@ -202,14 +202,14 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
     gh.remove_effect(scene)
     with pytest.raises(gh.geometry_module().RelativityError, match=r"'Box'.*constraints.*Bake Motion"):
         gh.apply_geometry(scene)
-    assert gh.addon_module("modifier").find_modifier(box) is None
+    assert gh.addon_module("geometry.modifier").find_modifier(box) is None
 
     # The operator bakes the scene's range, started earlier by the light-travel time.
     scene.frame_start, scene.frame_end = 20, FRAME
     bpy.context.view_layer.objects.active = box
     assert bpy.ops.relativity.bake_motion() == {"FINISHED"}
     assert (scene.frame_current, scene.frame_subframe) == (FRAME, 0.0)
-    first, per_frame, matrices = gh.addon_module("modifier").motion_bake(box)
+    first, per_frame, matrices = gh.addon_module("geometry.modifier").motion_bake(box)
     assert per_frame == 16 and first < 20 - 2 * 4.0 / C * FPS and first + (len(matrices) - 1) / 16 == FRAME
     gh.apply_geometry(scene)
     assert gh.geometry_module().scene_errors(scene) == []
@@ -232,7 +232,7 @@ def test_constraint_needs_a_bake_then_matches_blender(relativity_addon, factory_
 
 def test_non_object_parent_needs_a_bake(relativity_addon, factory_blender):
     bpy = factory_blender
-    animation = importlib.import_module(f"{relativity_addon}.blender.animation")
+    animation = importlib.import_module(f"{relativity_addon}.blender.scene.animation")
     scene, _ = _scene(bpy)
     anchor = _box(bpy, location=(0.0, 0.0, -6.0), size=2.0)
     anchor.name = "Anchor"
@@ -248,14 +248,14 @@ def test_non_object_parent_needs_a_bake(relativity_addon, factory_blender):
         animation.world_matrices(box, [FRAME])
     with pytest.raises(gh.geometry_module().RelativityError, match=r"'Box' has a vertex parent.*Bake Motion"):
         gh.apply_geometry(scene, [box])
-    assert gh.addon_module("bakes").bake_motion(scene, box, 0, FRAME) == FRAME * 4 + 1
+    assert gh.addon_module("geometry.bakes").bake_motion(scene, box, 0, FRAME) == FRAME * 4 + 1
     gh.apply_geometry(scene, [box])
     assert gh.geometry_module().scene_errors(scene) == []
 
 
 def test_what_keyframes_miss_is_named(relativity_addon, factory_blender):
     bpy = factory_blender
-    animation = importlib.import_module(f"{relativity_addon}.blender.animation")
+    animation = importlib.import_module(f"{relativity_addon}.blender.scene.animation")
     scene, _ = _scene(bpy)
     rig = _empty(bpy, scene, "Rig")
     box = _box(bpy)
@@ -292,14 +292,14 @@ def test_remove_takes_the_motion_bake_and_restores_the_file(relativity_addon, fa
     scene.frame_set(FRAME)
     before = gh.file_fingerprint(bpy)
 
-    gh.addon_module("bakes").bake_motion(scene, box, 0, FRAME)
+    gh.addon_module("geometry.bakes").bake_motion(scene, box, 0, FRAME)
     gh.apply_geometry(scene)
     assert gh.file_fingerprint(bpy) != before
     points, _ = gh.evaluated_points(bpy, box)
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"))
     bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "baked.blend"))
     scene, box = bpy.context.scene, bpy.data.objects["Box"]
-    assert gh.addon_module("modifier").motion_bake(box) is not None
+    assert gh.addon_module("geometry.modifier").motion_bake(box) is not None
     scene.frame_set(FRAME)
     reloaded, _ = gh.evaluated_points(bpy, box)
     assert np.allclose(reloaded, points, atol=1e-6)
@@ -307,5 +307,5 @@ def test_remove_takes_the_motion_bake_and_restores_the_file(relativity_addon, fa
 
     assert gh.remove_effect(scene) == 1
     assert gh.file_fingerprint(bpy) == before
-    assert not any(gh.addon_module("names").MOTION_BAKE_KEY in mesh for mesh in bpy.data.meshes)
+    assert not any(gh.addon_module("common.names").MOTION_BAKE_KEY in mesh for mesh in bpy.data.meshes)
     assert not any(o.name.startswith("RelativityCache") for o in bpy.data.objects)

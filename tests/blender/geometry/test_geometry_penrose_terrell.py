@@ -26,7 +26,7 @@ def _moving_setup(bpy, resolution=(320, 240), lens=None):
 
 
 # Outlines and face areas are geometry: searchlight and Doppler colour (tested in
-# tests/blender/doppler/) would only dim the receding side.
+# tests/blender/colour/) would only dim the receding side.
 GEOMETRY_ONLY = ("--no-doppler", "--no-searchlight")
 
 

@@ -268,7 +268,7 @@ def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
     face.relativity.beta = (0.5, 0.0, 0.0)
     face.relativity.tessellation = 1
     scene.frame_set(FRAME)
-    effect = gh.addon_module("effect")
+    effect = gh.addon_module("pipeline.effect")
     gh.apply_geometry(scene)
     assert gh.geometry_module().scene_errors(scene) == []
     dilated = gh.evaluated_points(bpy, face)[0]
@@ -322,7 +322,7 @@ def test_armature_hand_runs_on_proper_time(relativity_addon, tmp_path):
     face.relativity.samples_per_frame = 4
     scene.frame_set(FRAME)
     scene.relativity.method = "GEOMETRY"
-    gh.addon_module("bakes").bake_deformation(scene, face, 0, FRAME)
+    gh.addon_module("geometry.bakes").bake_deformation(scene, face, 0, FRAME)
     measured = _render(bpy, scene, tmp_path)
 
     def spin(tau):
@@ -340,7 +340,7 @@ def test_clock_table_follows_the_keyframes(relativity_addon):
     scene, _ = _scene(bpy)
     face = _face(bpy, scene)
     _key_path(face, 0.0)
-    world_lines = gh.addon_module("world_lines")
+    world_lines = gh.addon_module("geometry.motion")
     step = 1.0 / (8 * FPS)
 
     def reading(t):

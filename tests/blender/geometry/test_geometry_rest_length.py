@@ -134,7 +134,7 @@ def test_moving_deforming_mesh_is_contracted_about_its_origin(relativity_addon, 
     blob.relativity.samples_per_frame = 8
     frame = 24
     scene.frame_set(frame)
-    gh.addon_module("bakes").bake_deformation(scene, blob, 0, 36)
+    gh.addon_module("geometry.bakes").bake_deformation(scene, blob, 0, 36)
     gh.apply_geometry(scene)
     x_a, _ = gh.evaluated_points(bpy, blob)
     x_o = np.array(camera_object.matrix_world.translation)
@@ -162,8 +162,8 @@ def test_moving_deforming_mesh_is_contracted_about_its_origin(relativity_addon, 
     # The contraction is not negligible here: (1 - 1/gamma) of each vertex's ~0.9 m from the origin.
     assert np.max(np.linalg.norm(x_e - uncontracted, axis=1)) > 0.1
 
-    record = gh.addon_module("modifier").cache_data(blob)[gh.addon_module("names").BAKE_KEY]
-    del record[gh.addon_module("names").BAKE_ORIGINS_KEY]
+    record = gh.addon_module("geometry.modifier").cache_data(blob)[gh.addon_module("common.names").BAKE_KEY]
+    del record[gh.addon_module("common.names").BAKE_ORIGINS_KEY]
     scene.frame_set(frame - 1)
     errors = gh.geometry_module().scene_errors(scene)
     assert len(errors) == 1 and "no origin path" in errors[0] and "bake again" in errors[0]

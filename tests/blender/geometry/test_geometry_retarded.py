@@ -147,11 +147,11 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
     scene.frame_set(frame)
     with pytest.raises(gh.geometry_module().RelativityError, match="not baked"):
         gh.apply_geometry(scene)
-    assert gh.addon_module("modifier").find_modifier(blob) is None  # nothing applied
+    assert gh.addon_module("geometry.modifier").find_modifier(blob) is None  # nothing applied
     blob.relativity.use_deformation = False
     gh.apply_geometry(scene)
     blob.relativity.use_deformation = True
-    assert gh.addon_module("bakes").bake_deformation(scene, blob, 0, 24) == 24 * 16 + 1
+    assert gh.addon_module("geometry.bakes").bake_deformation(scene, blob, 0, 24) == 24 * 16 + 1
     assert scene.frame_current == frame
     x_a, _ = gh.evaluated_points(bpy, blob)
     x_o = np.array(camera_object.matrix_world.translation)

@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 from blender_support import ADDON_MODULE
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 from relativity_addon.physics import spectral
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
@@ -114,10 +114,10 @@ def _renders(bpy, scene, monkeypatch, tmp_path):
     """(with eq. 18, without): the same applied scene, eq. 18's factor set to D = 1 for the second
     (the lamp copies, light linking and rest-frame normals kept); each as (face lit from ahead,
     face lit from behind) mean RGB."""
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     effect.apply(scene)
     with_eq18 = _render(bpy, scene, tmp_path / "with.exr")
-    stage = _module("lamp_doppler")
+    stage = _module("lights.lamps_on_moving_objects")
     placement = stage.placement
     monkeypatch.setattr(stage, "placement", lambda *args: (1.0, placement(*args)[1]))
     without = _render(bpy, scene, tmp_path / "without.exr")
@@ -240,8 +240,8 @@ def test_object_at_rest_renders_as_without_the_effect(relativity_addon, factory_
     bpy = factory_blender
     scene, cube = _scene(bpy, beta=0.0)
     plain = _render(bpy, scene, tmp_path / "plain.exr")
-    _module("effect").apply(scene)
-    assert not any(_module("lamp_doppler").is_copy(obj) for obj in scene.objects)
+    _module("pipeline.effect").apply(scene)
+    assert not any(_module("lights.lamps_on_moving_objects").is_copy(obj) for obj in scene.objects)
     applied = _render(bpy, scene, tmp_path / "applied.exr")
     assert plain.max() > 0.05
     np.testing.assert_allclose(applied, plain, rtol=1e-4, atol=1e-5)
@@ -273,16 +273,16 @@ def test_remove_restores_lights_collections_and_light_linking(relativity_addon, 
     scene, cube = _scene(bpy, temperature=5000.0)
     before = _state(bpy)
     plain = _render(bpy, scene, tmp_path / "plain.exr")
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     effect.apply(scene)
-    added = [obj for obj in scene.objects if _module("lamp_doppler").is_copy(obj)]
+    added = [obj for obj in scene.objects if _module("lights.lamps_on_moving_objects").is_copy(obj)]
     assert len(added) == 2 and scene.objects["Ahead"].light_linking.receiver_collection is not None
-    assert cube.data.attributes.get(_module("names").REST_NORMAL_ATTRIBUTE) is not None
+    assert cube.data.attributes.get(_module("common.names").REST_NORMAL_ATTRIBUTE) is not None
     scene.objects["Ahead"].data.energy = POWER  # an edit while applied: the copies follow, nothing new
     effect.sync(scene)
     scene.objects["Behind"].name = "Renamed"  # a lamp renamed while applied: its copy is rebuilt
     effect.sync(scene)
-    assert sum(_module("lamp_doppler").is_copy(obj) for obj in scene.objects) == 2
+    assert sum(_module("lights.lamps_on_moving_objects").is_copy(obj) for obj in scene.objects) == 2
     effect.remove(scene)
     scene.objects["Renamed"].name = "Behind"
     assert _state(bpy) == before
@@ -301,7 +301,7 @@ def test_copy_of_a_side_lamp_lights_from_the_aberrated_direction(relativity_addo
     for name in ("Behind",):
         bpy.data.objects.remove(bpy.data.objects[name])
     lamp = scene.objects["Ahead"]
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     centre = _apparent(np.array([[BETA * CAMERA_DISTANCE, 0.0, 0.0]]))[0]
     gamma = 1.0 / math.sqrt(1.0 - BETA**2)
     beta = np.array([BETA, 0.0, 0.0])
@@ -312,7 +312,7 @@ def test_copy_of_a_side_lamp_lights_from_the_aberrated_direction(relativity_addo
             effect.apply(scene)
         else:
             effect.sync(scene)
-        (copy,) = [obj for obj in scene.objects if _module("lamp_doppler").is_copy(obj)]
+        (copy,) = [obj for obj in scene.objects if _module("lights.lamps_on_moving_objects").is_copy(obj)]
         k = (centre - np.array(position)) / np.linalg.norm(centre - np.array(position))
         doppler = gamma * (1.0 - beta @ k)
         k_object = (k + (gamma - 1.0) * k[0] * np.array([1.0, 0.0, 0.0]) - gamma * beta) / doppler
@@ -344,10 +344,10 @@ def test_keyframed_motion_gives_the_constant_velocity_factor(relativity_addon, f
                 point.interpolation = "LINEAR"
             fcurve.extrapolation = "LINEAR"
             scene.frame_set(scene.frame_current)
-        _module("effect").apply(scene)
+        _module("pipeline.effect").apply(scene)
         colours[motion] = {obj.name: (tuple(obj.data.color), tuple(obj.matrix_world.translation))
-                           for obj in scene.objects if _module("lamp_doppler").is_copy(obj)}
-        _module("effect").remove(scene)
+                           for obj in scene.objects if _module("lights.lamps_on_moving_objects").is_copy(obj)}
+        _module("pipeline.effect").remove(scene)
     assert set(colours["CONSTANT"]) == set(colours["ANIMATION"]) and len(colours["CONSTANT"]) == 2
     for name, (colour, position) in colours["CONSTANT"].items():
         np.testing.assert_allclose(colours["ANIMATION"][name][0], colour, rtol=1e-4)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-import doppler_helpers as dh
+import colour_helpers as dh
 
 TEMPERATURE = 3000.0
 RESOLUTION = (64, 48)

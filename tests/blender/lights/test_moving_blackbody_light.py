@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 import test_moving_point_light as mp
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
-import doppler_helpers as dh  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "colour"))
+import colour_helpers as dh  # noqa: E402
 
 TEMPERATURE = 3000.0
 RESOLUTION = (80, 60)
@@ -90,7 +90,7 @@ def test_floor_under_a_moving_blackbody_lamp_is_lit_by_the_blackbody_at_d_t(rela
         assert delta_e < 1.0
         assert ratio == pytest.approx(1.0, abs=0.08)  # noise: 16 samples
 
-    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, info = spectral_render.render(scene, PASSES)
     spectral = pixels[::-1, :, :3].astype(float)
     assert np.all(np.isfinite(spectral))
@@ -131,7 +131,7 @@ def test_moving_blackbody_lamp_seen_by_a_moving_observer(relativity_addon, facto
     total = observer_doppler * lamp_doppler
     expected = geometry[..., None] * _blackbodies(total)  # D_o^5 B(lambda D_o, D_L T) = B(lambda, D_o D_L T)
 
-    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, info = spectral_render.render(scene, PASSES + 1)
     spectral = pixels[::-1, :, :3].astype(float)
     print(f"D_o {observer_doppler[ROWS].min():.3f} .. {observer_doppler[ROWS].max():.3f}; "

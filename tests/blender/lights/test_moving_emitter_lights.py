@@ -1,5 +1,5 @@
 """A glowing sphere moving at 0.5c above a white floor lights it as a moving light (eq. 19):
-``Object.relativity.lights_scene`` (blender/emitter_lights.py), Apparent Geometry, camera at rest.
+``Object.relativity.lights_scene`` (blender/scene/emitting_meshes.py), Apparent Geometry, camera at rest.
 
 A sphere of radius R and radiance L is, seen from outside, a point source of intensity
 ``I = L pi R^2`` in every direction, so the floor's radiance is eq. 19's ``a / pi D^4 I cos / r^2``
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import test_moving_point_light as mp
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 RADIUS = 0.15
 RADIANCE = 400.0  # W m^-2 sr^-1, white

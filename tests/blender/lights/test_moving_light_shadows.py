@@ -1,5 +1,5 @@
 """Shadows of a moving light behind the exact camera (method CAMERA, an OSL camera): the stand-in
-lamps of blender/moving_lamps.py, measured in a real Cycles render against the exact shadow of eq. 19
+lamps of blender/lights/stand_in_lamps.py, measured in a real Cycles render against the exact shadow of eq. 19
 with retarded positions written out in numpy (test_moving_point_light.py's helpers).
 
 The scene is that module's floor with a black square 0.5 above it, under the lamp (height 1,

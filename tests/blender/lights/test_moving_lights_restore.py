@@ -8,7 +8,7 @@ import pytest
 from test_moving_point_light import _floor_scene
 
 from blender_support import ADDON_MODULE
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 
 def _module(name):
@@ -38,7 +38,7 @@ def _signature(bpy, scene):
 @pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
 def test_apply_then_remove_restores_everything(relativity_addon, factory_blender, method):
     bpy = factory_blender
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     scene, _camera, lamp = _floor_scene(bpy, occluder=True, method=method)
     scene.cycles.shading_system = False
     before = _signature(bpy, scene)
@@ -64,16 +64,16 @@ def test_a_light_hidden_by_the_user_stays_hidden_and_unlit(relativity_addon, fac
     bpy = factory_blender
     scene, _camera, lamp = _floor_scene(bpy)
     lamp.hide_render = True
-    snap = _module("snapshot").read(scene)
+    snap = _module("scene.snapshot").read(scene)
     assert snap.moving_lights == ()
-    _module("effect").apply(scene)
-    _module("effect").remove(scene)
+    _module("pipeline.effect").apply(scene)
+    _module("pipeline.effect").remove(scene)
     assert lamp.hide_render
 
 
 def test_switching_motion_off_after_set_up_shows_the_lamp_again(relativity_addon, factory_blender):
     bpy = factory_blender
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     scene, _camera, lamp = _floor_scene(bpy)
     scene.cycles.shading_system = False
     effect.apply(scene)
@@ -90,7 +90,7 @@ def test_switching_motion_off_after_set_up_shows_the_lamp_again(relativity_addon
 
 def test_unsupported_lights_are_reported(relativity_addon, factory_blender):
     bpy = factory_blender
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     scene, _camera, lamp = _floor_scene(bpy)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     scene.collection.objects.link(sun)
@@ -133,7 +133,7 @@ def test_keyframed_light_with_a_constraint_is_refused_in_one_line(relativity_add
     """Keyframes alone do not give a constrained light's path: Set Up refuses, naming the light,
     and leaves the scene as it was."""
     bpy = factory_blender
-    effect = _module("effect")
+    effect = _module("pipeline.effect")
     errors = importlib.import_module(f"{ADDON_MODULE}.errors")
     scene, _camera, lamp = _floor_scene(bpy)
     lamp.relativity.motion = "ANIMATION"

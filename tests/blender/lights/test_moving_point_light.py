@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from blender_support import ADDON_MODULE
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402
@@ -38,13 +38,13 @@ OCCLUDER_CENTRE = np.array([-1.3, 0.4, 0.5])
 OCCLUDER_HALF = 0.2
 SPOT_SIZE = math.radians(80.0)  # full cone angle
 SPOT_BLEND = 0.3
-# Behind the exact camera moving lights are stand-in lamps on the light's path (blender/moving_lamps.py):
+# Behind the exact camera moving lights are stand-in lamps on the light's path (blender/lights/stand_in_lamps.py):
 # Cycles samples one of them per light sample and only two light a point, so these renders need more samples.
 SAMPLES_LAMPS = 64
 
 
 def _effect():
-    return importlib.import_module(f"{ADDON_MODULE}.blender.effect")
+    return importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
 
 
 def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA", kind="POINT"):

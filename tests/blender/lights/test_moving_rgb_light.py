@@ -20,8 +20,8 @@ import pytest
 import test_moving_point_light as mp
 from test_moving_blackbody_light import ROWS, _compare
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
-import doppler_helpers as dh  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "colour"))
+import colour_helpers as dh  # noqa: E402
 
 COLOUR = (1.0, 0.5, 0.1)
 RESOLUTION = (80, 60)
@@ -85,7 +85,7 @@ def test_floor_under_a_moving_rgb_lamp_gets_its_shifted_spectrum(relativity_addo
     expected, doppler = _expected_xyz(points)
     assert doppler[ROWS].min() < 0.95 and doppler[ROWS].max() > 1.5, "the view must hold red and blue shifts"
 
-    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, _info = spectral_render.render(scene, PASSES)
     spectral = pixels[::-1, :, :3].astype(float)
     assert np.all(np.isfinite(spectral))
@@ -114,7 +114,7 @@ def test_the_shaders_basis_table_is_the_physics_cores(relativity_addon, factory_
     core's extended basis (colour-science's table) at and between its grid points."""
     from relativity_addon.physics import spectral
 
-    moving_lamps = dh.addon_module(relativity_addon, "moving_lamps")
+    moving_lamps = dh.addon_module(relativity_addon, "lights.stand_in_lamps")
     text = moving_lamps.basis_defines()
     low = float(re.search(r"#define BASIS_LOW (\S+)", text).group(1))
     step = float(re.search(r"#define BASIS_STEP (\S+)", text).group(1))

@@ -1,4 +1,4 @@
-"""Moving sun and area lights behind the exact camera (blender/moving_lamps.py), on the floor of
+"""Moving sun and area lights behind the exact camera (blender/lights/stand_in_lamps.py), on the floor of
 test_moving_point_light.py, against relations written out here in numpy (docs/physics.md):
 
 - A sun is a plane wave: moving with beta, its photon direction in the scene frame is its own
@@ -116,8 +116,8 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     so the floor is the blackbody at ``D T`` (colour-science) with luminance
     ``a / pi E cos D^-2 Y(D T) / Y(T)``, in the fast mode too. Without the shift it kept its
     5000 K colour at ``D^2``."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "doppler"))
-    import doppler_helpers as dh
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "colour"))
+    import colour_helpers as dh
 
     bpy = factory_blender
     temperature = 5000.0
@@ -129,7 +129,7 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     floor._effect().apply(scene)
     k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)
     d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
-    spectral_render = dh.addon_module(relativity_addon, "spectral_render")
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, _info = spectral_render.render(scene, 3)
     floor_xyz = dh.linear_rec709_to_xyz(pixels[:, :, :3].reshape(-1, 3).astype(float)).mean(axis=0)
     blackbody = dh.blackbody_xyz_colour_science(d * temperature)

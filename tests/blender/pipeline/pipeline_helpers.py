@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from relativity_addon.blender import compat
+from relativity_addon.blender.common import compat
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "camera"))
 import camera_helpers as ch  # noqa: E402

@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 C_SLOW = 10.0  # scene units per second for the animated tests (fps 24)
 

@@ -15,8 +15,9 @@ import numpy as np
 import psutil
 import pytest
 
-import workflow_helpers as wh
-from relativity_addon import batch, farm, frame_files
+import pipeline_helpers as wh
+from relativity_addon import batch
+from relativity_addon.batch import farm, frame_files
 
 TINY = ("--resolution=32x32",)
 
@@ -264,7 +265,7 @@ def test_task_options_chunks_and_output_names():
 
 
 def test_single_process_path_imports_no_dask():
-    code = ("import sys; from relativity_addon import batch, farm; "
+    code = ("import sys; from relativity_addon import batch; from relativity_addon.batch import farm; "
             "batch.parse(['render.py', 'x.blend', '--out=x.png', '--workers=2']); "
             "found = sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed', 'bpy')); "
             "print(found); sys.exit(bool(found))")

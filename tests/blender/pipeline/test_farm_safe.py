@@ -5,7 +5,7 @@ sequence, pixel for pixel (fixed seed), whether the sequence is Blender's own an
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 # Blender's own animation render in a fresh process, as a farm worker runs it: open the file,
 # enable the add-on (installed on the worker), render frames FIRST..LAST to OUT (#### = frame).

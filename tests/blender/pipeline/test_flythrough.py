@@ -5,7 +5,7 @@ import sys
 
 import numpy as np
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 
 def test_flythrough_renders_a_short_sequence(factory_blender, tmp_path):

@@ -19,7 +19,7 @@ import sys
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 GALLERY_SCRIPT = wh.REPO_ROOT / "examples" / "gallery.py"
 TEMPERATURE = 5762.0

@@ -13,7 +13,7 @@ import re
 
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 ch = wh.ch
 C = 10.0

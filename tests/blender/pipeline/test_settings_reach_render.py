@@ -30,7 +30,7 @@ velocity and there is no "fresh set-up with that setting" to compare with.
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 ch = wh.ch
 

@@ -6,21 +6,21 @@ import math
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
+import pipeline_helpers as wh
 
 
 @pytest.fixture
 def animation(relativity_addon, factory_blender):
     import importlib
 
-    return importlib.import_module(f"{relativity_addon}.blender.animation")
+    return importlib.import_module(f"{relativity_addon}.blender.scene.animation")
 
 
 @pytest.fixture
 def snapshot(relativity_addon, factory_blender):
     import importlib
 
-    return importlib.import_module(f"{relativity_addon}.blender.snapshot")
+    return importlib.import_module(f"{relativity_addon}.blender.scene.snapshot")
 
 
 def test_linear_keys_give_slope_over_c(snapshot, factory_blender):

@@ -11,8 +11,8 @@ import os
 import numpy as np
 import pytest
 
-import workflow_helpers as wh
-from relativity_addon.blender import compat
+import pipeline_helpers as wh
+from relativity_addon.blender.common import compat
 from relativity_addon.physics.shutter import lens_time
 
 

@@ -1,0 +1,3 @@
+"""What the user touches: the settings (props: Scene.relativity; objects: Object.relativity), the
+operators (ops), the N-panel (panel) and presets (presets).
+"""
