@@ -1,28 +1,61 @@
-"""The package's shape, read from its source (no Blender): no import cycles, the render paths
-independent of each other, the physics core free of bpy, no module past about 500 lines."""
+"""The package's shape, read from its source (no Blender): every module belongs to one part, each
+part imports only the parts below it, no import cycles, the physics core free of bpy and of the
+rest of the package, the stage list in the docs the one in the code, no module past about 500
+lines."""
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "relativity_addon"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "architecture.md"
 MAX_LINES = 520  # "about 500"
 
-# The render paths and the colour stage write their part from the snapshot; only effect.py knows
-# them all.
-PARTS = {
-    "camera": {"relativity_addon.blender.camera.exact_camera", "relativity_addon.blender.common.osl"},
-    "geometry": {
-        "relativity_addon.blender.geometry.apparent_meshes", "relativity_addon.blender.geometry.modifier",
-        "relativity_addon.blender.geometry.motion", "relativity_addon.blender.geometry.bakes",
-    },
-    "colour": {
-        "relativity_addon.blender.colour.doppler_colour", "relativity_addon.blender.colour.materials",
-        "relativity_addon.blender.colour.compositing", "relativity_addon.blender.colour.lut_images",
-        "relativity_addon.blender.colour.world_colour",
-    },
+# The parts, lowest first, and what each may import (besides itself). The read side (scene) imports
+# no stage; the two render paths (camera, geometry) import nothing from each other; everything that
+# writes the effect sits below pipeline, which alone knows them all; the panel and operators (ui)
+# sit on top. docs/architecture.md draws the same picture.
+ALLOWED = {
+    "physics": set(),
+    "errors": set(),
+    "common": {"physics", "errors"},
+    "scene": {"common", "physics", "errors"},
+    "camera": {"scene", "common", "physics", "errors"},
+    "geometry": {"scene", "common", "physics", "errors"},
+    "colour": {"camera", "scene", "common", "physics", "errors"},
+    "lights": {"colour", "geometry", "camera", "scene", "common", "physics", "errors"},
+    "pipeline": {"lights", "colour", "geometry", "camera", "scene", "common", "physics", "errors"},
+    "ui": {"pipeline", "lights", "colour", "geometry", "camera", "scene", "common", "physics", "errors"},
+    "blender": {"ui", "pipeline", "geometry"},  # blender/__init__.py: registers ui, bakes and handlers
+    "batch": {"common", "physics", "errors"},  # the script side: no bpy at import, Blender glue only lazily
+    "root": {"blender"},  # relativity_addon/__init__.py: register() / unregister()
 }
+SUBPACKAGES = ("common", "scene", "camera", "geometry", "colour", "lights", "pipeline", "ui")
+
+
+def part_of(module):
+    """The part a module belongs to, or None (a module outside every part)."""
+    parts = module.split(".")
+    if parts[0] != "relativity_addon":
+        return None
+    if len(parts) == 1:
+        return "root"
+    if parts[1] in ("physics", "batch", "errors") and (len(parts) == 2 or parts[1] != "errors"):
+        return parts[1]
+    if parts[1] == "blender":
+        if len(parts) == 2:
+            return "blender"
+        if parts[2] in SUBPACKAGES:
+            return parts[2]
+    return None
+
+
+def upward_imports(graph):
+    """(module, imported module) pairs that break the parts' order."""
+    return sorted((module, target) for module, targets in graph.items() for target in targets
+                  if part_of(target) != part_of(module) and part_of(target) not in ALLOWED[part_of(module)])
 
 
 def _modules():
@@ -101,15 +134,52 @@ def test_no_import_cycles():
     assert _find_cycle(GRAPH) is None
 
 
-@pytest.mark.parametrize("part", sorted(PARTS))
-def test_render_paths_and_colour_import_nothing_from_each_other(part):
-    others = set().union(*(modules for name, modules in PARTS.items() if name != part))
-    for module in PARTS[part]:
-        assert not GRAPH[module] & others, f"{module} imports {sorted(GRAPH[module] & others)}"
+def test_every_module_belongs_to_a_part():
+    outside = [name for name in MODULES if part_of(name) is None]
+    assert not outside, f"modules outside every part (add them to a part in ALLOWED): {outside}"
+
+
+def test_part_finder_refuses_a_planted_module_outside_every_part():
+    assert part_of("relativity_addon.blender.newthing") is None
+    assert part_of("relativity_addon.helpers") is None
+    assert part_of("relativity_addon.blender.lights.moving_lights") == "lights"
+
+
+def test_each_part_imports_only_the_parts_below_it():
+    assert upward_imports(GRAPH) == []
+
+
+def test_order_check_finds_planted_upward_imports():
+    planted = dict(GRAPH)
+    snapshot = "relativity_addon.blender.scene.snapshot"
+    planted[snapshot] = GRAPH[snapshot] | {"relativity_addon.blender.colour.materials"}  # read side -> stage
+    planted["relativity_addon.physics.lorentz"] = {"relativity_addon.errors"}  # physics -> rest of the package
+    planted["relativity_addon.blender.camera.exact_camera"] = {"relativity_addon.blender.geometry.modifier"}
+    assert upward_imports(planted) == [
+        ("relativity_addon.blender.camera.exact_camera", "relativity_addon.blender.geometry.modifier"),
+        ("relativity_addon.blender.scene.snapshot", "relativity_addon.blender.colour.materials"),
+        ("relativity_addon.physics.lorentz", "relativity_addon.errors"),
+    ]
+
+
+def _stage_names():
+    """The names of pipeline/stages.py's STAGES, read from its source (it needs bpy to import)."""
+    tree = ast.parse((PACKAGE / "blender" / "pipeline" / "stages.py").read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.AnnAssign) and getattr(node.target, "id", None) == "STAGES":
+            return [call.args[0].value for call in node.value.elts]
+    raise AssertionError("no STAGES in pipeline/stages.py")
+
+
+def test_the_docs_list_the_stages_of_the_code_in_order():
+    text = DOCS.read_text(encoding="utf-8")
+    table = text[text.index("## The stages"):]
+    documented = re.findall(r"^\| \d+ \| ([^|]+?) \|", table, flags=re.M)
+    assert documented == _stage_names()
 
 
 def test_physics_core_and_errors_never_import_bpy():
-    bpy_free = ("relativity_addon.errors", "relativity_addon.physics.shipped_luts")
+    bpy_free = ("relativity_addon.errors",)
     for name, path in MODULES.items():
         if name.startswith("relativity_addon.physics") or name in bpy_free:
             tree = ast.parse(path.read_text(encoding="utf-8"))

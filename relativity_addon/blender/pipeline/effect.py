@@ -2,29 +2,30 @@
 
 One data path from a setting to the render::
 
-    scene.relativity, Object.relativity, the camera    (settings: props.py, objects.py)
+    scene.relativity, Object.relativity, the camera    (settings: ui/props.py, ui/objects.py)
           |  snapshot.read (every check, once)
           v
-    Snapshot  ->  camera.write       exact camera: OSL parameters          (method CAMERA)
-              ->  geometry.update    apparent geometry: cache meshes       (method GEOMETRY)
-              ->  colour.write       materials' settings group, compositor flags (both)
-              ->  moving_lights.write  lights with constant velocity: OSL in materials (both)
+    Snapshot  ->  the render path of the Method:
+                    exact_camera.write      OSL parameters of the exact camera   (Exact Camera)
+                    apparent_meshes.update  cache meshes of apparent geometry    (Apparent Geometry)
+              ->  every stage of stages.STAGES, in order: apply at Set Up, write at every sync,
+                  remove in reverse, warnings for the panel
 
 :func:`sync` runs that path; every handler (``handlers.py``) and every property update callback
-calls it, so a setting changed in the panel reaches the next render on either path. The camera,
-geometry and colour modules import nothing from each other. :func:`sync` never raises: what
-stops a correct render is kept as the scene's warnings (shown in the panel), and the exact camera
-is marked invalid (it renders black, never a wrong image).
+calls it, so a setting changed in the panel reaches the next render on either path. The two render
+paths and the stages import nothing from each other's subpackages upwards
+(``tests/static/test_architecture.py``). :func:`sync` never raises: what stops a correct render is
+kept as the scene's warnings (shown in the panel), and the exact camera is marked invalid (it
+renders black, never a wrong image).
 """
 
 from ...errors import RelativityError
-from ..camera import clamping, exact_camera
-from ..colour import doppler_colour, light_groups, volumes, world_doppler
+from ..camera import exact_camera
+from ..colour import doppler_colour
 from ..common import busy
 from ..geometry import apparent_meshes, modifier, shape_keys
-from ..lights import lamps_on_moving_objects, lamps_seen_directly, moving_lights
 from ..scene import animation, snapshot, traveller
-from . import metadata
+from .stages import STAGES, Sync
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
@@ -67,24 +68,20 @@ def apply(scene, frame_range=None, objects=None):
         result = apparent_meshes.apply(scene, snap, objects)
         undo = (lambda: apparent_meshes.remove(scene, result))  # noqa: E731
     try:
-        moving_lights.apply(scene, snap)  # before the colour stage: it reads the materials' own colours
-        doppler_colour.apply(scene, snap)
-        if snap.colour.camera_path:
-            world_doppler.write(scene, snap)  # the world pixels' ln D for the compositor stage
-        metadata.write(scene, snap)
-        clamping.write(scene, snap)
-        lamps_on_moving_objects.apply(scene, snap)  # lamps at rest on moving objects (eq. 18)
-        lamps_seen_directly.write(scene, snap)  # lamps seen directly, drawn by emitters (exact camera)
+        for stage in STAGES:
+            stage.apply(scene, snap)
     except RelativityError:
-        lamps_seen_directly.remove(scene)
-        lamps_on_moving_objects.remove(scene)
-        moving_lights.remove(scene)
-        metadata.remove(scene)
-        clamping.remove(scene)
+        _remove_stages(scene)
         undo()
         raise
     _record(scene, snap)
     return result
+
+
+def _remove_stages(scene):
+    """Every stage removed, in reverse order of :data:`STAGES` (the last applied goes first)."""
+    for stage in reversed(STAGES):
+        stage.remove(scene)
 
 
 def remove(scene):
@@ -93,12 +90,7 @@ def remove(scene):
     removed = len(apparent_meshes.remove(scene))
     for camera_object in exact_camera.applied_cameras():
         removed += bool(exact_camera.remove(camera_object))
-    doppler_colour.remove(scene)
-    moving_lights.remove(scene)
-    metadata.remove(scene)
-    clamping.remove(scene)
-    lamps_on_moving_objects.remove(scene)
-    lamps_seen_directly.remove(scene)
+    _remove_stages(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
     return removed
@@ -198,14 +190,9 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         if method == "GEOMETRY" and update_geometry:
             apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
-            moving_lights.write(scene, snap, attach_new_materials, depsgraph)
-            doppler_colour.write(scene, snap, attach_new_materials)
-            if snap.colour.camera_path:
-                world_doppler.write(scene, snap, pixels=before_render)
-            metadata.write(scene, snap)
-            clamping.write(scene, snap)
-            lamps_on_moving_objects.write(scene, snap)
-            lamps_seen_directly.write(scene, snap)
+            update = Sync(depsgraph, attach_new_materials, before_render)
+            for stage in STAGES:
+                stage.write(scene, snap, update)
     except RelativityError as error:
         if method == "CAMERA" or snapshot.in_final_render(scene):
             exact_camera.invalidate(scene.camera)
@@ -267,12 +254,8 @@ def _record(scene, snap):
             if snap.exposure_mode == "COMPENSATED":
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
-    warnings += moving_lights.warnings(scene, snap)
-    warnings += lamps_on_moving_objects.warnings(scene, snap)
-    warnings += lamps_seen_directly.warnings(scene, snap)
-    if snap.exact_camera:
-        warnings += volumes.warnings(scene)
-        warnings += light_groups.warnings(scene, snap)
+    for stage in STAGES:
+        warnings += stage.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)
