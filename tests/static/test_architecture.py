@@ -7,8 +7,6 @@ import ast
 import re
 from pathlib import Path
 
-import pytest
-
 PACKAGE = Path(__file__).resolve().parents[2] / "relativity_addon"
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "architecture.md"
 MAX_LINES = 520  # "about 500"
