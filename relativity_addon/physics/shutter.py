@@ -85,6 +85,27 @@ def fixed_point_plane(shutter_time: float, beta: ArrayLike, c: float) -> tuple[F
     return point, beta / np.sqrt(speed_squared)
 
 
+def image_distance(focal_length: float, focus_distance: float | None = None) -> float:
+    """Thin-lens distance from the lens to the detector, ``1/s = 1/f - 1/u``, for a lens of focal
+    length ``f`` focused at distance ``u`` (both in one length unit).
+
+    ``focus_distance=None`` (or infinite) is the lens focused at infinity, the detector at the
+    focal length: Blender's perspective camera with depth of field off, a pinhole whose sensor
+    sits ``f`` behind it. The detector-plane shutter's rays then reach that sensor at ``t_S``.
+    ``u <= f`` forms no real image (the rays from the focus point diverge behind the lens):
+    ``ValueError``.
+    """
+    f = float(focal_length)
+    if not (np.isfinite(f) and f > 0.0):
+        raise ValueError("the focal length must be positive and finite")
+    if focus_distance is None or np.isposinf(focus_distance):
+        return f
+    u = float(focus_distance)
+    if not u > f:
+        raise ValueError(f"a lens of focal length {f:g} focused at {u:g} forms no real image")
+    return 1.0 / (1.0 / f - 1.0 / u)
+
+
 def lens_time(model: ShutterModel | int | str, lens_point: ArrayLike, object_point: ArrayLike, *, c: float,
               shutter_time: ArrayLike = 0.0, detector_point: ArrayLike | None = None, beta: ArrayLike | None = None,
               plane_point: ArrayLike | None = None, plane_normal: ArrayLike | None = None, ideal_lens: bool = True

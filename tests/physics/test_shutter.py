@@ -198,3 +198,31 @@ def test_shutter_inputs_are_checked():
         shutter.photo_ray_in_scene(np.zeros(3), np.zeros(3), 0.0, [0.5, 0, 0], C)
     with pytest.raises(ValueError, match="finite"):
         shutter.photo_ray_in_scene(np.zeros(3), [0, 0, 1.0], np.inf, [0.5, 0, 0], C)
+
+
+def test_image_distance_is_the_thin_lens_equation():
+    f = 0.05
+    assert shutter.image_distance(f) == f  # depth of field off: focused at infinity, sensor at f
+    assert shutter.image_distance(f, np.inf) == f
+    assert_allclose(shutter.image_distance(f, 5.0), 1.0 / (1.0 / f - 1.0 / 5.0))
+    for inside in (0.03, f, 1e-5):  # 1e-5: what Cycles reports as the focal distance with DoF off
+        with pytest.raises(ValueError, match="no real image"):
+            shutter.image_distance(f, inside)
+
+
+def test_detector_plane_pinhole_ray_starts_at_the_detector_time():
+    """Depth of field off (issue 25): the chief ray reaches the sensor at the focal length at t_S,
+    so it passed the lens |D|/c earlier; its scene-frame origin is within gamma |D| of the lens,
+    the same pinhole picture as the aperture-plane shutter at t_S - |D|/c."""
+    f, beta = 0.05, np.array([0.0, 0.0, 0.5])
+    direction = np.array([0.1, -0.05, 1.0])
+    detector = -direction * shutter.image_distance(f)
+    for focus in (1e-5, 5.0, 1e6):  # the chief ray's timing does not depend on where P is
+        t_l = shutter.lens_time("DETECTOR_PLANE", np.zeros(3), focus * direction, c=C, detector_point=detector)
+        assert_allclose(t_l, -np.linalg.norm(detector) / C, rtol=1e-9)
+        _, origin, _ = shutter.photo_ray_in_scene(np.zeros(3), focus * direction, t_l, beta, C)
+        assert np.linalg.norm(origin) <= lorentz_gamma(beta) * np.linalg.norm(detector) * (1 + 1e-9)
+
+
+def lorentz_gamma(beta):
+    return 1.0 / np.sqrt(1.0 - beta @ beta)

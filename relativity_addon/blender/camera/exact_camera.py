@@ -19,12 +19,14 @@ the camera data (the same properties in 4.5 and 5.x), and :func:`remove` gives b
 type, so a panoramic camera comes back panoramic.
 """
 
+import math
 import os
 
 import bpy
 
 from ...errors import RelativityError
 from ..common import compat, names, osl
+from ..scene import snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.SHADER_TEXT)
 
@@ -44,6 +46,7 @@ REQUIRED_PARAMETERS = (
     "sensor_width",
     "sensor_height",
     "lens_focal_length",
+    "use_dof",
     "aperture_scale",
     "beta",
     "speed_of_light",
@@ -117,13 +120,49 @@ def type_problem(camera_name, camera_data):
 
 
 def lens_warnings(camera_object):
-    """One-line notes on what the exact camera does not render for this camera."""
-    if camera_object is None or camera_object.type != "CAMERA" or lens_type(camera_object.data) != "PANO":
+    """One-line notes on what the exact camera does not render for this camera (the shutter model
+    read from the scene whose active camera it is)."""
+    if camera_object is None or camera_object.type != "CAMERA" or not camera_object.data.dof.use_dof:
         return []
-    if camera_object.data.dof.use_dof:
-        name = camera_object.name
+    name = camera_object.name
+    if lens_type(camera_object.data) == "PANO":
         return [f"Camera {name!r}: the relativistic panorama is a pinhole, depth of field is not rendered"]
+    scene = next((s for s in camera_object.users_scene if s.camera == camera_object), None)
+    if scene is None or lens_type(camera_object.data) != "PERSP":
+        return []
+    settings = scene.relativity
+    if settings.shutter_model == "PINHOLE":
+        return [f"Camera {name!r}: Pinhole shutter ignores depth of field: choose Aperture Plane for a blurred image"]
+    if settings.shutter_model == "FOCUS_SURFACE":
+        warning = _focus_surface_warning(scene, camera_object)
+        return [warning] if warning else []
     return []
+
+
+def _focus_surface_warning(scene, camera_object):
+    """The focus-surface shutter times each ray where it crosses the focus surface, so the ray
+    passes the lens ``|L - P|/c`` after the shutter time; by then the camera has moved on, and
+    what lies nearer than that surface at the shutter time is not photographed (a black frame when
+    nothing is beyond it). One line when the axial ray's lens event is displaced noticeably."""
+    settings = scene.relativity
+    try:
+        beta = snapshot.observer_velocity(scene, camera_object, snapshot.current_frame(scene))
+    except RelativityError:
+        return None
+    speed = math.sqrt(sum(b * b for b in beta))
+    focus = snapshot.focus_distance(camera_object)
+    c = settings.speed_of_light
+    if speed == 0.0 or focus is None or not (c > 0.0):
+        return None
+    lens_time = settings.shutter_time + focus / c  # the axial ray at the lens centre
+    moved = speed / math.sqrt(1.0 - speed * speed) * c * lens_time  # eq. (1): gamma beta c t_L
+    if moved <= 0.01 * focus:
+        return None
+    scale = scene.unit_settings.scale_length or 1.0
+    return (f"Camera {camera_object.name!r}: the Focus Surface shutter times rays at the focus surface "
+            f"{focus * scale:.3g} m ahead, so they reach the lens {lens_time:.3g} s after the shutter time, "
+            f"{moved * scale:.3g} m further on: nearer objects are not photographed "
+            f"(shutter time {-focus / c:.3g} s times them at the lens)")
 
 
 def stereo_eyes(scene):
@@ -200,6 +239,7 @@ def shader_parameters(scene, camera_data, snap):
         "frame_bottom": bottom,
         "frame_top": top,
         "lens_focal_length": camera_data.lens * 1e-3 / unit_scale,
+        "use_dof": lens_type(camera_data) == "PERSP" and camera_data.dof.use_dof,
         "aperture_scale": compat.custom_camera_aperture_scale(camera_data.lens * 1e-3 / unit_scale),
         "beta": _local_to_shader(snap.beta_camera),
         "speed_of_light": snap.speed_of_light,
