@@ -58,3 +58,71 @@ def test_a_set_up_scene_still_says_why_on_the_console(relativity_addon, factory_
     capfd.readouterr()
     scene.relativity.beta = (0.0, 0.0, -1.2)
     assert any("must be below 1" in line for line in _relativity_lines(capfd))
+
+
+def _set_up_then_faster_than_light(bpy):
+    scene, _, _ = wh.new_scene(bpy, samples=1)
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    scene.relativity.beta = (0.0, 0.0, -1.2)
+    return scene
+
+
+def test_f12_refused_after_set_up_is_shown_in_the_panel(relativity_addon, factory_blender):
+    """F12 is Blender's operator: it finishes, the exact camera renders black; the panel says why,
+    and in background mode no popup is queued (the batch script exits 1 instead)."""
+    from test_ui_workflow import draw_panel
+
+    bpy = factory_blender
+    notice = _module(bpy, "pipeline.render_notice")
+    scene = _set_up_then_faster_than_light(bpy)
+    assert notice.last_refusal(scene) is None
+    assert bpy.ops.render.render() == {"FINISHED"}
+    assert "must be below 1" in notice.last_refusal(scene)
+    assert notice._pending.empty()
+    assert notice._popup("title", "reason") is None  # no window in background: nothing to show it in
+    log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
+    assert any(e[0] == "label" and e[2] == "ERROR" and e[1].startswith("Last render refused: ")
+               and "must be below 1" in e[1] for e in log), log
+
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    assert bpy.ops.render.render() == {"FINISHED"}
+    assert notice.last_refusal(scene) is None
+    log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
+    assert not any(e[0] == "label" and e[1].startswith("Last render refused") for e in log)
+
+
+def test_f12_refused_pops_up_after_the_render_with_a_window(relativity_addon, factory_blender, monkeypatch):
+    """With a window (not background), the render thread queues the notice and the main-thread
+    timer shows it once as a popup; the timer is registered only then."""
+    bpy = factory_blender
+    notice = _module(bpy, "pipeline.render_notice")
+    assert not bpy.app.timers.is_registered(notice.show_pending)  # background: no timer
+    shown = []
+    monkeypatch.setattr(notice, "_background", lambda: False)
+    monkeypatch.setattr(notice, "_popup", lambda title, reason: shown.append((title, reason)))
+    notice.register()
+    try:
+        assert bpy.app.timers.is_registered(notice.show_pending)
+        _set_up_then_faster_than_light(bpy)
+        assert bpy.ops.render.render() == {"FINISHED"}
+        assert bpy.ops.render.render() == {"FINISHED"}
+        assert shown == []  # nothing from the render thread itself
+        assert notice.show_pending() == notice.POLL_SECONDS
+        assert len(shown) == 1, shown
+        title, reason = shown[0]
+        assert title == "Relativity: this render is black" and "must be below 1" in reason
+        assert notice.show_pending() == notice.POLL_SECONDS and len(shown) == 1
+    finally:
+        notice.unregister()
+    assert not bpy.app.timers.is_registered(notice.show_pending)
+
+
+def test_an_ordinary_render_of_a_scene_never_set_up_queues_nothing(relativity_addon, factory_blender, monkeypatch):
+    bpy = factory_blender
+    notice = _module(bpy, "pipeline.render_notice")
+    monkeypatch.setattr(notice, "_background", lambda: False)
+    scene, _, _ = wh.new_scene(bpy, samples=1)
+    scene.relativity.beta = (0.0, 0.0, -1.2)
+    assert bpy.ops.render.render() == {"FINISHED"}
+    assert notice.last_refusal(scene) is None and notice._pending.empty()
