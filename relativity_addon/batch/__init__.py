@@ -442,6 +442,12 @@ def command_line():
         distributed = False
     if distributed and not _running_inside_blender(sys.argv):
         sys.exit(main())
+    try:
+        import bpy  # noqa: F401
+    except ImportError:
+        sys.exit("render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
+                 "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
+                 "examples/render.py -- OPTIONS")
     from ..blender.common import compat
 
     compat.run_main(main)

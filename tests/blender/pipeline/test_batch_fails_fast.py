@@ -2,6 +2,9 @@
 written (checked before the .blend is loaded or anything rendered), and a Python without bpy (one
 line saying what to run instead, no traceback)."""
 
+import subprocess
+import sys
+
 import pytest
 
 import pipeline_helpers as wh
@@ -40,3 +43,29 @@ def test_out_where_no_file_can_be_created(plain_blend, out):
     result = wh.run_render_script(plain_blend, "--beta=0,0,-0.5", "--samples=1", f"--out={out}")
     _assert_refused_before_loading(result, out)
     assert "cannot create files in /proc" in wh.error_lines(result)[0]
+
+
+BLOCK_BPY = """
+import runpy, sys
+sys.modules["bpy"] = None  # a Python without Blender's module
+script = sys.argv[1]
+sys.argv = sys.argv[1:]
+runpy.run_path(script, run_name="__main__")
+"""
+
+
+@pytest.mark.parametrize("script, options", [
+    ("render.py", ["scene.blend", "--out=out.png"]),
+    ("demo_still.py", ["--out=out.png"]),
+    ("flythrough.py", []),
+    ("gallery.py", []),
+])
+def test_examples_without_bpy_say_what_to_run(script, options, tmp_path):
+    path = wh.REPO_ROOT / "examples" / script
+    result = subprocess.run([sys.executable, "-c", BLOCK_BPY, str(path), *options], capture_output=True,
+                            text=True, timeout=120, cwd=tmp_path)
+    assert result.returncode == 1, (result.returncode, result.stderr[-2000:])
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "needs Blender's Python or the bpy module" in lines[0], result.stderr[-2000:]
+    assert "./dev.sh demo" in lines[0] and f"--python examples/{script}" in lines[0]
+    assert "Traceback" not in result.stdout + result.stderr
