@@ -25,7 +25,11 @@ import sys
 import time
 from pathlib import Path
 
-import bpy
+try:
+    import bpy
+except ImportError:
+    sys.exit("demo_still.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+             "or blender -b --python examples/demo_still.py -- OPTIONS")
 
 EXAMPLES_DIR = Path(__file__).resolve().parent
 REPO_ROOT = EXAMPLES_DIR.parent

@@ -20,7 +20,11 @@ import math
 import sys
 from pathlib import Path
 
-import bpy
+try:
+    import bpy
+except ImportError:
+    sys.exit("flythrough.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+             "or blender -b --python examples/flythrough.py -- OPTIONS")
 
 EXAMPLES_DIR = Path(__file__).resolve().parent
 REPO_ROOT = EXAMPLES_DIR.parent

@@ -20,7 +20,11 @@ import tempfile
 import time
 from pathlib import Path
 
-import bpy
+try:
+    import bpy
+except ImportError:
+    sys.exit("gallery.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+             "or blender -b --python examples/gallery.py -- OPTIONS")
 import numpy as np
 
 EXAMPLES_DIR = Path(__file__).resolve().parent

@@ -12,7 +12,7 @@ import sys
 
 from ..errors import BatchError, RelativityError
 from ..physics.shutter import ShutterModel
-from .frame_files import format_seconds, frame_output_path, partial_path
+from .frame_files import format_seconds, frame_output_path, output_problem, partial_path
 
 ADDON_PACKAGE = "relativity_addon"
 
@@ -442,6 +442,12 @@ def command_line():
         distributed = False
     if distributed and not _running_inside_blender(sys.argv):
         sys.exit(main())
+    try:
+        import bpy  # noqa: F401
+    except ImportError:
+        sys.exit("render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
+                 "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
+                 "examples/render.py -- OPTIONS")
     from ..blender.common import compat
 
     compat.run_main(main)
@@ -451,6 +457,9 @@ def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
         options, parser = parse(argv)
+        problem = output_problem(options.out)
+        if problem is not None:  # before loading or rendering anything
+            raise BatchError(problem)
         if options.workers is not None or options.scheduler is not None:
             if _running_inside_blender(argv):
                 raise BatchError("--workers and --scheduler need the bpy wheel form: "

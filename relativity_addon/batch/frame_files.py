@@ -17,6 +17,7 @@ import math
 import os
 import re
 import struct
+import tempfile
 import zlib
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -48,6 +49,27 @@ def partial_path(path):
     directory, name = os.path.split(path)
     stem, extension = os.path.splitext(name)
     return os.path.join(directory, f".{stem}.{os.getpid()}.partial{extension}")
+
+
+def output_problem(out_path):
+    """Why no image can be written at ``out_path`` (one line), or None. Checked before anything is
+    loaded or rendered: the nearest existing folder on its path must be a folder in which a file can
+    be created (tried, not guessed from the permission bits: root may write anywhere but /proc)."""
+    out_path = os.path.abspath(out_path)
+    if os.path.isdir(out_path):
+        return f"--out {out_path} is a folder, not an image file"
+    existing = os.path.dirname(out_path)
+    while not os.path.lexists(existing):
+        existing = os.path.dirname(existing)
+    if not os.path.isdir(existing):
+        return f"cannot write --out {out_path}: {existing} is a file, not a folder"
+    try:
+        handle, probe = tempfile.mkstemp(prefix=".relativity-probe-", dir=existing)
+    except OSError as error:
+        return f"cannot write --out {out_path}: cannot create files in {existing} ({error.strerror})"
+    os.close(handle)
+    os.remove(probe)
+    return None
 
 
 def format_seconds(seconds):

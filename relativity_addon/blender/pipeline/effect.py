@@ -232,7 +232,8 @@ def object_changed(scene, obj):
 
 
 def _refused(scene, error):
-    print(f"Relativity: {error}")
+    if applied_method(scene) is not None or snapshot.in_final_render(scene):  # a scene never set up: the panel only
+        print(f"Relativity: {error}")
     _scene_status[scene.name] = (None, [str(error)])
 
 

@@ -10,20 +10,24 @@ attaching the Doppler colour to materials added since Set Up. ``render_init`` (o
 animation render) puts an Apparent Geometry scene with a moving observer behind the exact camera
 for the render, ``render_complete``/``render_cancel`` take it back to the boosted-mesh preview
 (``effect.begin_final_render``). A handler never raises: a problem
-becomes the scene's warning and, for the exact camera, a black (never a wrong) image.
+becomes the scene's warning and, for the exact camera, a black (never a wrong) image; a render of a
+set-up scene whose sync is refused is recorded in ``render_notice`` (the panel shows it, and a popup
+after the render when Blender has a window).
 """
 
 import bpy
 from bpy.app.handlers import persistent
 
-from . import effect
+from ..camera import exact_camera
+from . import effect, render_notice
 
 
 def _sync(scene, **options):
     try:
-        effect.sync(scene, **options)
+        return effect.sync(scene, **options)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
         print(f"Relativity: not synced: {type(error).__name__}: {error}")
+        return None
 
 
 @persistent
@@ -44,6 +48,26 @@ def depsgraph_update_post(scene, depsgraph=None):
 @persistent
 def render_pre(scene, _depsgraph=None):
     _sync(scene, update_geometry=False, attach_new_materials=True, before_render=True)
+    try:
+        _tell_if_refused(scene)
+    except Exception as error:  # noqa: BLE001
+        print(f"Relativity: {type(error).__name__}: {error}")
+
+
+def _tell_if_refused(scene):
+    """A set-up scene whose sync was refused renders black (exact camera) or its last valid state:
+    record why for the panel and the popup (``render_notice``)."""
+    camera_object = scene.camera
+    exact = camera_object is not None and camera_object.type == "CAMERA" and exact_camera.is_applied(camera_object.data)
+    if not exact and effect.applied_method(scene) is None:
+        render_notice.render_accepted(scene)  # never set up: an ordinary render
+        return
+    black = exact and not camera_object.data.cycles_custom.get("settings_valid", False)
+    if not black and effect.last_snapshot(scene) is not None:
+        render_notice.render_accepted(scene)
+        return
+    warnings = effect.scene_warnings(scene)
+    render_notice.render_refused(scene, warnings[0] if warnings else "the relativistic camera is invalid", black)
 
 
 @persistent
@@ -74,6 +98,7 @@ HANDLERS = (
 
 
 def register():
+    render_notice.register()
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler not in handlers:
@@ -85,3 +110,4 @@ def unregister():
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:
             handlers.remove(handler)
+    render_notice.unregister()

@@ -8,7 +8,7 @@ import math
 
 from bpy.types import Panel
 
-from ..pipeline import effect
+from ..pipeline import effect, render_notice
 
 
 def _split(layout):
@@ -46,6 +46,9 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
         if scene.relativity.method == "GEOMETRY":
             layout.prop(scene.relativity, "geometry_final_render")
             layout.label(text="The viewport shows the boosted-mesh preview", icon="INFO")
+        refused = render_notice.last_refusal(scene)
+        if refused is not None:
+            layout.label(text=f"Last render refused: {refused}", icon="ERROR")
         for warning in effect.scene_warnings(scene):
             layout.label(text=warning, icon="ERROR")
         column = layout.column(align=True)
