@@ -3,6 +3,8 @@ depsgraph handlers again, and a nested evaluation from a handler crashes Blender
 evaluates the depsgraph or steps frames runs inside :func:`computing`; handlers return at once
 while :func:`is_computing`."""
 
+from __future__ import annotations
+
 from contextlib import contextmanager
 
 _depth = 0

@@ -13,10 +13,17 @@ for the render, ``render_complete``/``render_cancel`` take it back to the booste
 becomes the scene's warning and, for the exact camera, a black (never a wrong) image.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 from bpy.app.handlers import persistent
 
 from . import effect
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Scene
 
 
 def _sync(scene, **options):
@@ -27,27 +34,27 @@ def _sync(scene, **options):
 
 
 @persistent
-def frame_change_pre(scene, _depsgraph=None):
+def frame_change_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, update_geometry=False)
 
 
 @persistent
-def frame_change_post(scene, depsgraph=None):
+def frame_change_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
-def depsgraph_update_post(scene, depsgraph=None):
+def depsgraph_update_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
-def render_pre(scene, _depsgraph=None):
+def render_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, update_geometry=False, attach_new_materials=True, before_render=True)
 
 
 @persistent
-def render_init(scene, _depsgraph=None):
+def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     try:
         effect.begin_final_render(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
@@ -55,7 +62,7 @@ def render_init(scene, _depsgraph=None):
 
 
 @persistent
-def render_end(scene, _depsgraph=None):
+def render_end(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     try:
         effect.end_final_render(scene)
     except Exception as error:  # noqa: BLE001
@@ -73,14 +80,14 @@ HANDLERS = (
 )
 
 
-def register():
+def register() -> None:
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler not in handlers:
             handlers.append(handler)
 
 
-def unregister():
+def unregister() -> None:
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:

@@ -4,7 +4,7 @@ They call ``effect.apply`` and ``effect.remove``, the entry points the batch scr
 and report a ``RelativityError`` in one line instead of leaving a half-applied scene.
 """
 
-from bpy.types import Operator
+from bpy.types import Context, Operator
 
 from ...errors import RelativityError
 from ..pipeline import effect, spectral_render
@@ -27,7 +27,7 @@ class RELATIVITY_OT_setup_scene(Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context):
         if not _poll_scene(cls, context):
             return False
         scene = context.scene
@@ -39,7 +39,7 @@ class RELATIVITY_OT_setup_scene(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context):
         scene = context.scene
         try:
             effect.apply(scene)
@@ -59,7 +59,7 @@ class RELATIVITY_OT_remove_all(Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context):
         if not _poll_scene(cls, context):
             return False
         if not effect.is_applied(context.scene):
@@ -67,7 +67,7 @@ class RELATIVITY_OT_remove_all(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context):
         removed = effect.remove(context.scene)
         self.report({"INFO"}, f"Removed the relativistic effect ({removed} item{'s' if removed != 1 else ''})")
         return {"FINISHED"}
@@ -81,7 +81,7 @@ class RELATIVITY_OT_check_animation(Operator):
     bl_options = {"REGISTER"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context):
         if not _poll_scene(cls, context):
             return False
         if context.scene.camera is None:
@@ -89,7 +89,7 @@ class RELATIVITY_OT_check_animation(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context):
         scene = context.scene
         try:
             highest = snapshot.check_animation_speed(scene)
@@ -112,7 +112,7 @@ class RELATIVITY_OT_render_spectral(Operator):
     bl_options = {"REGISTER"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context):
         if not _poll_scene(cls, context):
             return False
         try:
@@ -122,7 +122,7 @@ class RELATIVITY_OT_render_spectral(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context):
         scene = context.scene
         window_manager = context.window_manager
         passes = scene.relativity.spectral_passes
