@@ -30,7 +30,7 @@ class _RelativityPanel:
     bl_category = "Relativity"
 
     @classmethod
-    def poll(cls, context: Context):
+    def poll(cls, context: Context) -> bool:
         return context.scene is not None
 
 
@@ -166,7 +166,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
     bl_parent_id = "RELATIVITY_PT_main"
 
     @classmethod
-    def poll(cls, context: Context):
+    def poll(cls, context: Context) -> bool:
         return context.scene is not None and context.object is not None
 
     def draw(self, context: Context) -> None:
