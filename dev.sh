@@ -88,7 +88,7 @@ run_tests() {  # run_tests X.Y [pytest arguments]
     return "$status"
 }
 
-lint() {  # ruff over the whole repository, in its own venv (requirements/lint.txt)
+lint() {  # ruff, mypy and codespell over the repository, in their own venv (requirements/lint.txt)
     local venv=.venv-lint want
     [ -x "$venv/bin/python" ] || "${PYTHON311:-python3.11}" -m venv "$venv" || return 1
     want=$(sha256sum requirements/lint.txt | cut -d' ' -f1)
@@ -96,7 +96,11 @@ lint() {  # ruff over the whole repository, in its own venv (requirements/lint.t
         "$venv/bin/python" -m pip install --disable-pip-version-check -q -r requirements/lint.txt || return 1
         echo "$want" > "$venv/.requirements.sha256"
     fi
-    "$venv/bin/ruff" check .
+    local status=0
+    "$venv/bin/ruff" check . || status=1
+    "$venv/bin/mypy" || status=1  # files and levels: [tool.mypy] in pyproject.toml
+    "$venv/bin/codespell" || status=1
+    return "$status"
 }
 
 versions() {
@@ -122,8 +126,8 @@ case "${1:-}" in
         chosen=$(versions) || exit 2
         failed=0
         summary=()
-        echo "=== ruff ==="
-        if lint; then summary+=("ruff: clean"); else summary+=("ruff: FAILED"); failed=1; fi
+        echo "=== lint (ruff, mypy, codespell) ==="
+        if lint; then summary+=("lint (ruff, mypy, codespell): clean"); else summary+=("lint (ruff, mypy, codespell): FAILED"); failed=1; fi
         for version in $chosen; do
             echo "=== Blender $version ==="
             start=$SECONDS

@@ -10,6 +10,8 @@ on ID types, handlers, preset paths). Modules are registered in list order and u
 reverse, so a module may rely on everything listed before it.
 """
 
+from __future__ import annotations
+
 import importlib
 
 _MODULES = (
@@ -27,7 +29,7 @@ def _modules():
     return [importlib.import_module(f".{name}", __name__) for name in _MODULES]
 
 
-def register():
+def register() -> None:
     import bpy
 
     for module in _modules():
@@ -37,7 +39,7 @@ def register():
             module.register()
 
 
-def unregister():
+def unregister() -> None:
     import bpy
 
     for module in reversed(_modules()):

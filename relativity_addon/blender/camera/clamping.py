@@ -8,21 +8,29 @@ the user's value times the brightest ``D^4`` in any direction, ``(gamma (1 + bet
 user types meanwhile becomes the user's value; removing the effect gives the user's values back.
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING
 
 from ..common import names
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
 
 KEY = names.CLAMP_SAVED_KEY
 CLAMPS = ("sample_clamp_direct", "sample_clamp_indirect")
 
 
-def factor(snap):
+def factor(snap: Snapshot):
     if not (snap.exact_camera and snap.use_searchlight and snap.speed > 0.0):
         return 1.0
     return (snap.gamma * (1.0 + snap.speed)) ** 4
 
 
-def write(scene, snap):
+def write(scene: Scene, snap: Snapshot) -> None:
     """Scale the clamps for the snapshot (only writing what changed: a write triggers a sync)."""
     cycles = getattr(scene, "cycles", None)
     scale = factor(snap)
@@ -42,7 +50,7 @@ def write(scene, snap):
         saved[f"written {name}"] = getattr(cycles, name)
 
 
-def remove(scene):
+def remove(scene: Scene):
     """Give the user's clamps back."""
     if KEY not in scene:
         return False

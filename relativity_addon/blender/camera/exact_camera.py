@@ -19,14 +19,22 @@ the camera data (the same properties in 4.5 and 5.x), and :func:`remove` gives b
 type, so a panoramic camera comes back panoramic.
 """
 
+from __future__ import annotations
+
 import math
 import os
+from typing import TYPE_CHECKING
 
 import bpy
 
 from ...errors import RelativityError
 from ..common import compat, names, osl
 from ..scene import snapshot
+
+if TYPE_CHECKING:
+    from bpy.types import Camera, Object, Scene
+
+    from ..scene.snapshot import Snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.SHADER_TEXT)
 
@@ -90,23 +98,23 @@ def ensure_shader_text():
     return text
 
 
-def is_applied(camera_data):
+def is_applied(camera_data: Camera):
     return camera_data is not None and names.CAMERA_SAVED_STATE_KEY in camera_data
 
 
-def is_render_only(camera_data):
+def is_render_only(camera_data: Camera):
     """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
     return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
 
 
-def lens_type(camera_data):
+def lens_type(camera_data: Camera):
     """The camera's own type (PERSP, PANO, ...): the saved one while the OSL camera is applied."""
     if is_applied(camera_data):
         return camera_data[names.CAMERA_SAVED_STATE_KEY]["type"]
     return camera_data.type
 
 
-def type_problem(camera_name, camera_data):
+def type_problem(camera_name, camera_data: Camera):
     """Why the exact camera cannot replace this camera (one line), or None."""
     kind = lens_type(camera_data)
     if kind == "PERSP":
@@ -119,7 +127,7 @@ def type_problem(camera_name, camera_data):
     return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
 
 
-def lens_warnings(camera_object):
+def lens_warnings(camera_object: Object):
     """One-line notes on what the exact camera does not render for this camera (the shutter model
     read from the scene whose active camera it is)."""
     if camera_object is None or camera_object.type != "CAMERA" or not camera_object.data.dof.use_dof:
@@ -165,7 +173,7 @@ def _focus_surface_warning(scene, camera_object):
             f"(shutter time {-focus / c:.3g} s times them at the lens)")
 
 
-def stereo_eyes(scene):
+def stereo_eyes(scene: Scene):
     """Whether the scene renders Blender's stereo pair (each eye offset from the camera)."""
     render = scene.render
     return bool(render.use_multiview and render.views_format == "STEREO_3D")
@@ -184,7 +192,7 @@ def _fitted_sensor(scene, camera_data):
     return size * x_ratio / y_ratio, size
 
 
-def projection_parameters(scene, camera_data):
+def projection_parameters(scene: Scene, camera_data: Camera):
     kind = lens_type(camera_data)
     projection = PANORAMA_PROJECTIONS.get(camera_data.panorama_type, 0) if kind == "PANO" else 0
     sensor_width, sensor_height = _fitted_sensor(scene, camera_data)
@@ -205,7 +213,7 @@ def _local_to_shader(vector):
     return (vector[0], vector[1], -vector[2])
 
 
-def camera_frame_window(scene, camera_data):
+def camera_frame_window(scene: Scene, camera_data: Camera):
     """Image window of lens-centre rays on the plane at unit distance: left, right, bottom, top.
 
     Taken from Blender's own view frame, so sensor fit, aspect and lens shift match the
@@ -229,7 +237,7 @@ def camera_frame_window(scene, camera_data):
     )
 
 
-def shader_parameters(scene, camera_data, snap):
+def shader_parameters(scene: Scene, camera_data: Camera, snap: Snapshot):
     """Values for ``cycles_custom`` from the snapshot and the camera's lens and sensor."""
     left, right, bottom, top = camera_frame_window(scene, camera_data)
     unit_scale = scene.unit_settings.scale_length or 1.0
@@ -296,7 +304,7 @@ def _missing_parameters(camera_data):
     return [name for name in REQUIRED_PARAMETERS if name not in custom]
 
 
-def compile_shader(camera_data):
+def compile_shader(camera_data: Camera) -> None:
     """Compile the camera's shader; raise RelativityError on any failure or empty result."""
     try:
         errors = osl.compile_custom_camera(camera_data)
@@ -326,7 +334,7 @@ def _save_state(camera_data, render_only):
     }
 
 
-def apply(scene, snap, render_only=False):
+def apply(scene: Scene, snap: Snapshot, render_only=False):
     """Turn the snapshot's camera into the relativistic OSL camera and write its parameters
     (``render_only``: for the time of a final render). Returns the camera object;
     RelativityError (one line), with the camera restored, on failure."""
@@ -353,7 +361,7 @@ def apply(scene, snap, render_only=False):
     return camera_object
 
 
-def write(scene, snap):
+def write(scene: Scene, snap: Snapshot) -> None:
     """Write the snapshot into the applied camera (compiling the shader if it is missing)."""
     camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
@@ -377,7 +385,7 @@ def write(scene, snap):
     _write_parameters(camera_data, shader_parameters(scene, camera_data, snap))
 
 
-def invalidate(camera_object):
+def invalidate(camera_object: Object) -> None:
     """Mark the camera's parameters invalid: the shader renders black, never a wrong image."""
     if camera_object is None or camera_object.type != "CAMERA" or not is_applied(camera_object.data):
         return
@@ -389,7 +397,7 @@ def applied_cameras():
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
-def remove(camera_object):
+def remove(camera_object: Object):
     """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False

@@ -30,11 +30,20 @@ The group is inserted after every Render Layers node of the scene's compositor (
 created if the scene has none); :func:`remove_colour_stage` restores the compositor exactly.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 
 from ..common import compat, names
 from ..common.nodes import Group, Menu, Node, ensure_group, fmath, group_node, vmath
 from . import light_groups, lut_images, materials
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
 
 COMPOSITOR_GROUP = names.COMPOSITOR_GROUP
 COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
@@ -172,7 +181,7 @@ def ensure_compositor_group():
     return ensure_group(compositor_group(), *version)
 
 
-def colour_stage_values(snap):
+def colour_stage_values(snap: Snapshot):
     """Values of the compositor group's flag inputs, from the snapshot."""
     values = materials.settings_values(snap)
     values = {name: values[name] for name in VALUE_NAMES if name in values}
@@ -185,7 +194,7 @@ def colour_stage_values(snap):
 _stage_mode = {"mode": "COLOUR"}
 
 
-def set_stage_mode(mode):
+def set_stage_mode(mode) -> None:
     """Switch the stage's output for the next renders (written at the next sync)."""
     if mode not in ("COLOUR", "PASS_THROUGH"):
         raise ValueError(mode)
@@ -200,7 +209,7 @@ def _inserted_nodes(scene):
     return tree, [tree.nodes[name] for name in names if name in tree.nodes]
 
 
-def write_colour_stage(scene, snap):
+def write_colour_stage(scene: Scene, snap: Snapshot):
     """Write the effect flags into the inserted group nodes (only where they changed).
 
     ``D`` itself comes from the AOV, computed by Cycles for every frame. The flags are written
@@ -273,7 +282,7 @@ def _link_light_group_pass(tree, layers, denoiser, slot):
             tree.links.new(outputs[output_name], denoiser.inputs[input_name])
 
 
-def write_world_directions(scene, value):
+def write_world_directions(scene: Scene, value):
     """1: the samples without ln D AOV take the world image's ln D; 0: the world writes the AOV.
     False if an inserted group has no such input (a file set up before it: set up again)."""
     _tree, nodes = _inserted_nodes(scene)
@@ -286,11 +295,11 @@ def write_world_directions(scene, value):
     return True
 
 
-def is_applied(scene):
+def is_applied(scene: Scene):
     return SAVED_KEY in scene
 
 
-def apply_colour_stage(scene, snap):
+def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
     """Insert the Doppler colour group after the scene's Render Layers nodes and write its flags."""
     group = ensure_compositor_group()
     if not is_applied(scene):
@@ -338,7 +347,7 @@ def apply_colour_stage(scene, snap):
     write_colour_stage(scene, snap)
 
 
-def remove_colour_stage(scene):
+def remove_colour_stage(scene: Scene):
     """Restore the compositor (tree, links, AOVs, the compositing switch) exactly."""
     if not is_applied(scene):
         return False

@@ -7,6 +7,10 @@ after the render. What the groups compute comes from a ``snapshot.Snapshot`` thr
 group (materials) and the compositor group's flag inputs.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 
 from ...errors import RelativityError
@@ -14,8 +18,13 @@ from ..common import names
 from . import compositing, lut_images, materials, volumes, world_colour, world_sampling
 from .compositing import is_applied as compositor_applied
 
+if TYPE_CHECKING:
+    from bpy.types import Scene
 
-def apply(scene, snap):
+    from ..scene.snapshot import Snapshot
+
+
+def apply(scene: Scene, snap: Snapshot) -> None:
     """Searchlight and Doppler colour for the snapshot's render path: the materials (and, for the
     exact camera, the world and the compositor stage). RelativityError (one line) after undoing
     any partial change."""
@@ -32,7 +41,7 @@ def apply(scene, snap):
         ) from error
 
 
-def write(scene, snap, attach_new_materials=False):
+def write(scene: Scene, snap: Snapshot, attach_new_materials=False) -> None:
     """Write the snapshot's colour factors; before a render also attach materials added since."""
     if attach_new_materials:
         _attach(scene, snap)
@@ -51,7 +60,7 @@ def _attach(scene, snap):
         volumes.attach_scene(scene)
 
 
-def remove_camera_stage(scene):
+def remove_camera_stage(scene: Scene) -> None:
     """Undo what :func:`apply` adds for the exact camera only (the compositor stage and the world's
     Doppler AOV), after an Apparent Geometry final render; the materials stay attached."""
     compositing.remove_colour_stage(scene)
@@ -59,7 +68,7 @@ def remove_camera_stage(scene):
     world_sampling.release(scene.world)
 
 
-def remove(scene):
+def remove(scene: Scene) -> None:
     """Undo :func:`apply`: the compositor stage, every material and world, and the add-on's node
     groups and lookup tables once no scene uses them."""
     compositing.remove_colour_stage(scene)

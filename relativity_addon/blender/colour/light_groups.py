@@ -11,21 +11,30 @@ light group, which is only ever set where it was empty. A view layer that alread
 groups of the user's is left alone: its lamps are read in white (:func:`user_groups`).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 
 from ..common import names
 from ..scene import illuminants
 
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
+
 KEY = names.LIGHT_GROUPS_KEY
 SLOTS = names.LIT_GROUPS
 
 
-def user_groups(scene):
+def user_groups(scene: Scene):
     """Names of the light groups of ``scene``'s view layers that are not the add-on's."""
     return sorted({group.name for layer in scene.view_layers for group in layer.lightgroups} - set(SLOTS))
 
 
-def warnings(scene, snap):
+def warnings(scene: Scene, snap: Snapshot):
     """One line when blackbody lamps are read in white because the scene has its own light groups."""
     if snap.lit_groups and user_groups(scene):
         return [f"Fast colour reads the lamps in white light: the scene has its own light groups "
@@ -33,7 +42,7 @@ def warnings(scene, snap):
     return []
 
 
-def hold(scene):
+def hold(scene: Scene):
     """Add the slots' light groups to every view layer (before the compositor stage links their passes)."""
     if KEY in scene or user_groups(scene):
         return False
@@ -49,7 +58,7 @@ def _datablock(kind, name):
     return (bpy.data.objects if kind == "objects" else bpy.data.worlds).get(name)
 
 
-def assign(scene, groups):
+def assign(scene: Scene, groups):
     """Put the lamps of ``groups`` (``illuminants.LitGroup``, one per slot) into the slots' light
     groups and take every other lamp the add-on put there out again. Returns the temperature of
     each slot (0: empty)."""
@@ -82,7 +91,7 @@ def assign(scene, groups):
     return tuple(temperatures[:len(SLOTS)])
 
 
-def release(scene):
+def release(scene: Scene):
     """Give back every light group set and remove the slots' light groups."""
     if KEY not in scene:
         return False

@@ -8,6 +8,8 @@ Blender bundles numpy but not colour-science; their layouts are described in
 from the file alone: neither colour-science nor the add-on is needed to render.
 """
 
+from __future__ import annotations
+
 import bpy
 import numpy as np
 
@@ -78,7 +80,7 @@ def ensure_blackbody_lut():
     return _ensure_lut(BLACKBODY_LUT_NAME, shipped_luts.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 
 
-def ensure_illuminant_lut(name, temperature_k):
+def ensure_illuminant_lut(name: str, temperature_k):
     """The packed ``N x 3`` table ``name`` for light reflected under a blackbody at
     ``temperature_k`` (0: white), laid out as the Doppler matrix table (``physics/illuminants.py``);
     rebuilt in place (0.1-0.5 s) only when the illuminant changes, packed so that the file renders alone."""

@@ -21,7 +21,10 @@ nodes :func:`write_settings` rewrites from the snapshot at every sync (``effect.
 materials never need to be touched again after :func:`attach`.
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING
 
 import bpy
 
@@ -29,6 +32,11 @@ from ..common import names
 from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
 from ..scene import grouped_colours, sources
 from . import lut_images, spectral_nodes
+
+if TYPE_CHECKING:
+    from bpy.types import Material, Scene, World
+
+    from ..scene.snapshot import Snapshot
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
 DONE_AOV = names.COLOUR_DONE_AOV
@@ -105,7 +113,7 @@ def doppler_factor_group():
     )
 
 
-def gamut_map_group(name=None, tree_type="ShaderNodeTree"):
+def gamut_map_group(name: str | None = None, tree_type="ShaderNodeTree"):
     """``rgb' = max(Y + (rgb - Y) clamp(Y / (Y - min rgb)), 0)`` (spectral.gamut_map_linear_rec709)."""
     nodes = {
         "luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
@@ -306,7 +314,7 @@ def ensure_node_groups():
 _spectral_pass = {"wavelengths": None}
 
 
-def set_spectral_pass(wavelengths_nm):
+def set_spectral_pass(wavelengths_nm) -> None:
     """Render the next passes at these three rest-frame wavelengths (None: the fast mode again);
     takes effect at the next :func:`write_settings`."""
     _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
@@ -317,7 +325,7 @@ def spectral_pass_wavelengths():
     return _spectral_pass["wavelengths"]
 
 
-def settings_values(snap):
+def settings_values(snap: Snapshot):
     """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot`` (and the spectral pass)."""
     colour = snap.colour
     return {
@@ -332,7 +340,7 @@ def settings_values(snap):
     }
 
 
-def write_settings(snap):
+def write_settings(snap: Snapshot):
     """Write the settings (Cycles reads shader values written in render_pre for every frame)."""
     tree = bpy.data.node_groups.get(SETTINGS)
     if tree is None:
@@ -350,11 +358,11 @@ def write_settings(snap):
 
 # --- attaching to materials -----------------------------------------------------------------
 
-def is_attached(material):
+def is_attached(material: Material):
     return material is not None and ATTACHED_KEY in material
 
 
-def attach(material, temperature=None):
+def attach(material: Material, temperature=None):
     """Insert the Doppler colour group in front of every colour input of ``material``.
 
     A colour fed by a Blackbody node is shifted as a blackbody at that node's temperature. With
@@ -414,7 +422,7 @@ def _insert_aov_writer(tree):
     return {"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
 
 
-def detach(material):
+def detach(material: Material | World):
     """Remove the inserted groups and restore the original links exactly."""
     if not is_attached(material):
         return False
@@ -444,7 +452,7 @@ def _detach_records(owner, tree):
     return True
 
 
-def scene_materials(scene):
+def scene_materials(scene: Scene):
     """``(material, blackbody temperature or None)`` for every material used in ``scene``."""
     found = {}
     for obj in scene.objects:
@@ -455,13 +463,13 @@ def scene_materials(scene):
     return list(found.items())
 
 
-def attached_temperature(material):
+def attached_temperature(material: Material):
     """The object blackbody temperature ``material`` was attached with (0: none)."""
     records = material[ATTACHED_KEY]
     return float(records[0].get("object_temperature", 0.0)) if len(records) else 0.0
 
 
-def attach_scene(scene, camera_path):
+def attach_scene(scene: Scene, camera_path) -> None:
     """Attach the Doppler colour group to every material of ``scene`` (no-op for attached ones);
     on the exact camera's path the world writes the Doppler AOV too."""
     ensure_node_groups()
@@ -473,7 +481,7 @@ def attach_scene(scene, camera_path):
         attach_world(scene.world)
 
 
-def attach_world(world):
+def attach_world(world: World):
     """The world's Doppler AOV writer (muted where ``world_doppler`` gives the compositor the
     world's D) and a colour group in front of every Background colour (``world_colour`` links it
     where it changes the colour: blackbodies, spectral passes)."""
@@ -490,7 +498,7 @@ def attach_world(world):
     return True
 
 
-def detach_world(world):
+def detach_world(world: World):
     if world is None or ATTACHED_KEY not in world:
         return False
     if not isinstance(world[ATTACHED_KEY], str):
@@ -502,7 +510,7 @@ def detach_world(world):
     return True
 
 
-def detach_all():
+def detach_all() -> None:
     """Detach from every material and world (the groups and LUTs stay in the file, unused)."""
     for material in bpy.data.materials:
         detach(material)

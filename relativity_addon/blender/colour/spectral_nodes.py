@@ -14,6 +14,8 @@ settings group before each pass:
   and ``ln Y_B(T)`` from the blackbody lookup table's alpha.
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np

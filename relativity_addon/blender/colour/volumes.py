@@ -49,7 +49,10 @@ Principled Volume behind a Mix or Add shader or with a surface shader (also refu
 mode when it emits a blackbody), and Apparent Geometry's boosted meshes.
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING
 
 import bpy
 
@@ -57,6 +60,9 @@ from ..common import names
 from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
 from ..scene import sources
 from . import materials, spectral_nodes
+
+if TYPE_CHECKING:
+    from bpy.types import Material, Scene
 
 GROUP = names.VOLUME_BLACKBODY_GROUP
 NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX
@@ -173,7 +179,7 @@ def _correctable(material):
     return output, source, blackbody, intensity
 
 
-def attach(material):
+def attach(material: Material):
     """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
     (after ``materials.attach``, whose records restore it on detach). Returns whether it did."""
     if not materials.is_attached(material):
@@ -242,7 +248,7 @@ def _reads_grids(obj):
         modifier.type == "FLUID" and modifier.fluid_type == "DOMAIN" for modifier in obj.modifiers)
 
 
-def grid_materials(scene):
+def grid_materials(scene: Scene):
     """``{material: object name}`` of the materials on objects with temperature grids: their
     emission is ``Temperature x grid``, which the correction does not follow (a grid fades to 0 K
     at its edges, where Y(D T) / Y(T) of Cycles' sigma T^4 glow explodes: docs/spectral-model.md),
@@ -256,7 +262,7 @@ def grid_materials(scene):
     return found
 
 
-def attach_colours(material):
+def attach_colours(material: Material):
     """Put the volume colour group (``spectral_nodes.volume_colour_group``: unchanged outside the
     spectral passes) in front of every volume colour input of an attached ``material``
     (:data:`VOLUME_COLOURS`), recorded like ``materials.attach``'s groups. Returns whether it did."""
@@ -280,7 +286,7 @@ def attach_colours(material):
     return True
 
 
-def attach_scene(scene):
+def attach_scene(scene: Scene) -> None:
     """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
     except those on objects with temperature grids (:func:`grid_materials`); every volume colour
     made spectral for the spectral passes (:func:`attach_colours`)."""
@@ -297,7 +303,7 @@ def _emits_blackbody(node):
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
 
 
-def spectral_problem(scene):
+def spectral_problem(scene: Scene):
     """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
     that may read a temperature grid (its emission varies with the grid, which has no spectrum in
     the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
@@ -336,7 +342,7 @@ def spectral_problem(scene):
     return None
 
 
-def warnings(scene):
+def warnings(scene: Scene):
     """One line per Principled Volume blackbody on an object with temperature grids."""
     lines = []
     for material, name in grid_materials(scene).items():

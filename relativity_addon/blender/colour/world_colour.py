@@ -16,8 +16,15 @@ reaches the Background as black.) :func:`write` runs at every sync, so each spec
 the fast mode after it find the links they need; ``materials.detach`` undoes either state.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ..common import names
 from . import materials
+
+if TYPE_CHECKING:
+    from bpy.types import World
 
 
 def _colour_records(world):
@@ -39,7 +46,7 @@ def is_active(group):
     return materials.spectral_pass_wavelengths() is not None or group.inputs["Is Blackbody"].default_value > 0.0
 
 
-def write(world):
+def write(world: World) -> None:
     """Link each world colour group into its Background where :func:`is_active`, else give the
     Background its own colour; only links that differ are changed (this runs at every sync)."""
     tree = world.node_tree if world is not None else None
@@ -58,7 +65,7 @@ def write(world):
             tree.links.remove(socket.links[0])
 
 
-def linked_groups(world):
+def linked_groups(world: World):
     """The world's colour groups that feed their Background now (for tests and the docs)."""
     return [group for group, socket, _source in _colour_records(world)
             if socket.is_linked and socket.links[0].from_node == group]

@@ -24,6 +24,10 @@ the render (its percentage included), from the frame's snapshot alone, and packe
 the effect.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...physics import exposure
@@ -32,18 +36,23 @@ from ..common import names
 from ..scene import snapshot
 from . import compositing
 
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
+
 IMAGE = names.WORLD_DOPPLER_IMAGE
 AOV_NODE = f"{names.MATERIAL_NODE_PREFIX} AOV"  # materials._insert_aov_writer's node in the world
 _written = {}  # image session_uid -> the inputs its pixels were computed from
 
 
-def render_size(scene):
+def render_size(scene: Scene):
     render = scene.render
     return (max(1, int(render.resolution_x * render.resolution_percentage / 100)),
             max(1, int(render.resolution_y * render.resolution_percentage / 100)))
 
 
-def problem(scene, snap):
+def problem(scene: Scene, snap: Snapshot):
     """Why the world must write its own ``ln D`` AOV in this render (one line), or None."""
     render = scene.render
     if snap.use_time_of_flight:
@@ -94,7 +103,7 @@ def _mute_world_writer(world, mute):
         node.mute = mute
 
 
-def write(scene, snap, pixels=True):
+def write(scene: Scene, snap: Snapshot, pixels=True):
     """Bring the world's AOV writer, the compositor's switch and (with ``pixels``: before a render)
     the image up to date for ``snap`` (exact camera, compositor stage applied). Only what changed
     is written: the image costs a few tenths of a second at full HD, too much for every edit."""

@@ -11,7 +11,14 @@ constant world its Sampling is Manual at resolution ``MAP_RESOLUTION`` (a unifor
 the user's settings come back when they go. Worlds that vary (textures, sky) keep theirs.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ..common import names
+
+if TYPE_CHECKING:
+    from bpy.types import World
 
 MAP_RESOLUTION = 16
 SAVED = names.WORLD_SAMPLING_SAVED_KEY
@@ -29,7 +36,7 @@ def _constant(world):
     return background.bl_idname == "ShaderNodeBackground" and not any(socket.is_linked for socket in background.inputs)
 
 
-def hold(world):
+def hold(world: World) -> None:
     """Before the Doppler groups go into ``world``: a uniform map if the world is constant."""
     if world is None or SAVED in world or not _constant(world):
         return
@@ -40,7 +47,7 @@ def hold(world):
     settings.sample_map_resolution = MAP_RESOLUTION
 
 
-def release(world):
+def release(world: World) -> None:
     """Give the world back its sampling settings."""
     if world is None or SAVED not in world:
         return

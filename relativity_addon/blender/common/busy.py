@@ -3,13 +3,19 @@ depsgraph handlers again, and a nested evaluation from a handler crashes Blender
 evaluates the depsgraph or steps frames runs inside :func:`computing`; handlers return at once
 while :func:`is_computing`."""
 
+from __future__ import annotations
+
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
 
 _depth = 0
 
 
 @contextmanager
-def computing():
+def computing() -> Iterator[None]:
     global _depth
     _depth += 1
     try:
@@ -18,5 +24,5 @@ def computing():
         _depth -= 1
 
 
-def is_computing():
+def is_computing() -> bool:
     return _depth > 0

@@ -5,9 +5,15 @@ later release that keeps the newer API needs no change here. Each function is te
 lines in ``tests/blender/test_compat.py`` (real ``bpy``).
 """
 
+from __future__ import annotations
+
 import warnings
+from typing import TYPE_CHECKING
 
 import bpy
+
+if TYPE_CHECKING:
+    from bpy.types import Material, Scene, World
 
 
 def _modifier_inputs(modifier):
@@ -16,7 +22,7 @@ def _modifier_inputs(modifier):
     return getattr(properties, "inputs", None)
 
 
-def modifier_input(modifier, identifier):
+def modifier_input(modifier, identifier: str):
     """Value of a geometry-nodes modifier input (``identifier`` as in ``interface.items_tree``)."""
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
@@ -24,7 +30,7 @@ def modifier_input(modifier, identifier):
     return modifier.get(identifier)  # 4.5: ID properties on the modifier
 
 
-def set_modifier_input(modifier, identifier, value):
+def set_modifier_input(modifier, identifier: str, value) -> None:
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
         getattr(inputs, identifier).value = value
@@ -58,12 +64,12 @@ def _node_tree(owner):
     return owner.node_tree
 
 
-def world_node_tree(world):
+def world_node_tree(world: World):
     """The world's shader node tree, creating Blender's default one (Background) where needed."""
     return _node_tree(world)
 
 
-def material_node_tree(material):
+def material_node_tree(material: Material):
     """The material's shader node tree, creating Blender's default one (Principled) where needed."""
     return _node_tree(material)
 
@@ -90,14 +96,14 @@ def has_compositor_node_groups():
     return "compositing_node_group" in bpy.types.Scene.bl_rna.properties
 
 
-def compositor_tree(scene):
+def compositor_tree(scene: Scene):
     """The scene's compositor node tree or None (4.5: only while ``scene.use_nodes`` is on)."""
     if has_compositor_node_groups():
         return scene.compositing_node_group
     return scene.node_tree if scene.use_nodes else None
 
 
-def new_compositor_tree(scene, name):
+def new_compositor_tree(scene: Scene, name: str):
     """Give a scene with no compositor tree one that passes Render Layers to the output; return it.
 
     5.x: a new node group ``name`` ending in a Group Output, assigned to the scene. 4.5: switches
@@ -116,7 +122,7 @@ def new_compositor_tree(scene, name):
     return tree
 
 
-def restore_compositor_tree(scene, name):
+def restore_compositor_tree(scene: Scene, name: str) -> None:
     """Undo :func:`new_compositor_tree`: the tree named ``name`` ("" for none) is the scene's again
     (4.5: the scene's own tree stays, ``use_nodes`` is restored)."""
     if not has_compositor_node_groups():
@@ -135,7 +141,7 @@ def map_uv_nearest():
     return {"Interpolation": "Nearest"}, {}
 
 
-def run_main(main):
+def run_main(main) -> None:
     """Run a script's ``main()`` and end the process with its exit status.
 
     Blender 4.5's ``bpy`` wheel can deadlock in ``exit()``: a static destructor waits on its

@@ -5,6 +5,8 @@ They are read back from files saved by earlier versions, so a value here never c
 new layout gets a new version stamp instead.
 """
 
+from __future__ import annotations
+
 # --- exact camera ---------------------------------------------------------------------------
 SHADER_TEXT = "relativistic_camera.osl"  # text datablock holding the OSL camera shader
 CLAMP_SAVED_KEY = "relativity_saved_clamping"  # on the scene: the user's Cycles clamps while applied

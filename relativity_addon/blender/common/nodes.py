@@ -7,6 +7,8 @@ its input values, where a string is a link. :func:`build_group` creates or rebui
 interface drops the links of every node that uses the group).
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass, field
 
 import bpy
@@ -56,7 +58,7 @@ def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
     return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
 
 
-def group_node(group_name, inputs=None, kind="ShaderNodeGroup"):
+def group_node(group_name, inputs=None, kind: str="ShaderNodeGroup"):
     return Node(kind, inputs or {}, {"node_tree": group_name})
 
 
@@ -133,7 +135,7 @@ def ensure_group(spec, version_key, version):
     return tree
 
 
-def interface_identifier(group, name, in_out="INPUT"):
+def interface_identifier(group, name: str, in_out="INPUT"):
     """The identifier (``Socket_N``) of the group's interface socket ``name``."""
     for item in group.interface.items_tree:
         if item.item_type == "SOCKET" and item.in_out == in_out and item.name == name:
@@ -141,7 +143,7 @@ def interface_identifier(group, name, in_out="INPUT"):
     raise KeyError(name)
 
 
-def remove_unused_groups(names):
+def remove_unused_groups(names) -> None:
     """Delete the named node groups that nothing uses any more."""
     for name in names:
         tree = bpy.data.node_groups.get(name)

@@ -6,15 +6,21 @@ from PyPI ships it in ``bpy/<version>/python/lib/python3.X/site-packages`` witho
 folder, and then compilation fails and the render silently uses an empty shader.
 """
 
+from __future__ import annotations
+
 import os
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from bpy.types import Camera
 
 
 class OSLUnavailableError(RuntimeError):
     """Cycles cannot compile OSL here (no ``oslquery``, or a build without OSL)."""
 
 
-def ensure_oslquery_importable():
+def ensure_oslquery_importable() -> None:
     """Make ``import oslquery`` work, adding the wheel's bundled site-packages if needed."""
     try:
         import oslquery  # noqa: F401
@@ -41,7 +47,7 @@ def ensure_oslquery_importable():
         ) from error
 
 
-def compile_custom_camera(camera_data):
+def compile_custom_camera(camera_data: Camera):
     """Compile the camera's OSL shader with Cycles; return the list of error messages.
 
     An empty list means Cycles reported success; the caller still checks that the shader's
@@ -57,7 +63,7 @@ def compile_custom_camera(camera_data):
 
     errors = []
 
-    def report(kind, message):
+    def report(kind: str, message) -> None:
         if {"ERROR", "WARNING"} & set(kind):
             errors.append(str(message))
 

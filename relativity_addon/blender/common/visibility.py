@@ -1,8 +1,15 @@
 """Ray-visibility flags switched off while the effect is applied and given back on removal: the
 user's values are kept in an ID property on the object (so a saved file restores them too)."""
 
+from __future__ import annotations
 
-def hide(obj, key, attributes):
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from bpy.types import Object
+
+
+def hide(obj: Object, key, attributes) -> None:
     """Switch ``attributes`` (``visible_camera``, ``visible_diffuse``, ...) off, the user's values
     saved under ``key`` the first time."""
     if key not in obj:
@@ -12,13 +19,13 @@ def hide(obj, key, attributes):
             setattr(obj, name, False)
 
 
-def saved(obj, key, name):
+def saved(obj: Object, key, name: str):
     """The user's value of ``name`` (saved under ``key`` while hidden, else the object's own)."""
     values = obj.get(key)
     return bool(getattr(obj, name) if values is None else values[name])
 
 
-def restore(obj, key):
+def restore(obj: Object, key):
     """Give back the values saved under ``key``; whether there were any."""
     values = obj.get(key)
     if values is None:

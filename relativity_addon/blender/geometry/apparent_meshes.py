@@ -16,6 +16,10 @@ Errors are ``RelativityError`` with a one-line message; during handler updates t
 the object's cache (:func:`scene_errors`) and the viewport keeps the last valid state.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 import numpy as np
 
@@ -25,12 +29,17 @@ from ..scene import snapshot
 from . import modifier, motion
 from .modifier import applied_objects, object_error
 
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Object, Scene
+
+    from ..scene.snapshot import Snapshot
+
 # An edge longer than this fraction of its distance to the camera is too coarse for the
 # apparent-geometry path to curve (aberration bends straight lines; only vertices move).
 COARSE_EDGE_FRACTION = 0.25
 
 
-def object_signature(snap, obj, depsgraph=None):
+def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None):
     """Everything the object's apparent positions depend on, as a string stored with its cache."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
@@ -45,7 +54,7 @@ def object_signature(snap, obj, depsgraph=None):
     return repr(parts)
 
 
-def update_object(scene, obj, snap, depsgraph=None):
+def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None):
     """Recompute the cache of one object for the snapshot's frame. Raises RelativityError."""
     _, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
@@ -69,7 +78,7 @@ def update_object(scene, obj, snap, depsgraph=None):
     return len(local)
 
 
-def update(scene, snap, depsgraph=None, only_changed=False):
+def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed=False):
     """Recompute every object carrying the modifier (only those whose inputs changed, with
     ``only_changed``). A failure is recorded on the object's cache and printed, never raised:
     the viewport keeps the last valid state. Returns the number of objects updated."""
@@ -92,19 +101,19 @@ def update(scene, snap, depsgraph=None, only_changed=False):
     return updated
 
 
-def update_after_bake(scene, obj):
+def update_after_bake(scene: Scene, obj: Object) -> None:
     """Recompute ``obj`` right after a bake (raises, so the bake operator reports the problem)."""
     with busy.computing():
         depsgraph = bpy.context.evaluated_depsgraph_get()
         update_object(scene, obj, snapshot.read(scene, depsgraph), depsgraph)
 
 
-def scene_errors(scene):
+def scene_errors(scene: Scene):
     """One-line errors of the last update of each object (empty when every cache is current)."""
     return [error for error in map(object_error, applied_objects(scene)) if error is not None]
 
 
-def apply(scene, snap, objects=None):
+def apply(scene: Scene, snap: Snapshot, objects=None):
     """Add the modifier to ``objects`` (default: every mesh of the scene whose
     ``relativity.enabled`` is on) and compute the snapshot's frame. Returns the objects.
 
@@ -131,7 +140,7 @@ def apply(scene, snap, objects=None):
     return list(objects)
 
 
-def remove(scene, objects=None):
+def remove(scene: Scene, objects=None):
     """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
@@ -139,7 +148,7 @@ def remove(scene, objects=None):
     return restored
 
 
-def longest_edge_fraction(obj, camera_position):
+def longest_edge_fraction(obj: Object, camera_position):
     """Longest mesh edge divided by its midpoint's distance to the camera (world units)."""
     mesh = obj.data
     if len(mesh.edges) == 0 or len(mesh.edges) > 200_000:
@@ -155,7 +164,7 @@ def longest_edge_fraction(obj, camera_position):
     return float(np.max(lengths / np.maximum(distances, 1e-9)))
 
 
-def coarse_mesh_warning(obj, camera_position):
+def coarse_mesh_warning(obj: Object, camera_position):
     """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None."""
     # the modifier halves every edge once per tessellation level before moving the vertices
     fraction = longest_edge_fraction(obj, camera_position) / 2 ** obj.relativity.tessellation

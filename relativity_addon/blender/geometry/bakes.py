@@ -63,7 +63,7 @@ def _sample_frames(scene, frames, sample):
             window_manager.progress_end()
 
 
-def bake_deformation(scene, obj, frame_start=None, frame_end=None):
+def bake_deformation(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=None, frame_end=None):
     """Sample the evaluated (tessellated, deformed) world positions of ``obj`` and its origin from
     ``frame_start`` to ``frame_end`` (default: the scene's range, starting earlier by twice the
     current light-travel time to the farthest vertex) at ``relativity.samples_per_frame``
@@ -77,7 +77,7 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     fps = animation.frames_per_second(scene)
     frames, per_frame = _bake_frames(scene, obj, frame_start, frame_end)
 
-    def sample(depsgraph):
+    def sample(depsgraph: bpy.types.Depsgraph) -> None:
         rest = modifier.evaluated_rest_positions(obj, depsgraph)
         if rest is None or (samples and len(rest) != len(samples[0])):
             raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
@@ -104,7 +104,7 @@ def bake_deformation(scene, obj, frame_start=None, frame_end=None):
     return len(samples)
 
 
-def bake_motion(scene, obj, frame_start=None, frame_end=None):
+def bake_motion(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=None, frame_end=None):
     """Sample the world matrix of ``obj`` as Blender evaluates it (depsgraph: constraints, drivers,
     NLA, parents of any type, simulations) from ``frame_start`` to ``frame_end`` (default as
     :func:`bake_deformation`) at ``relativity.samples_per_frame`` sub-frames, for the rigid
@@ -144,7 +144,7 @@ class _BakeOperator:
     use_deformation = False
     baked = "samples"
 
-    def execute(self, context):
+    def execute(self, context: bpy.types.Context):
         scene, obj = context.scene, context.active_object
         if self.use_deformation:
             obj.relativity.use_deformation = True
@@ -168,7 +168,7 @@ class RELATIVITY_OT_bake_deformation(_BakeOperator, bpy.types.Operator):
     bake = staticmethod(bake_deformation)
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: bpy.types.Context):
         return _poll_mesh(cls, context)
 
 
@@ -183,7 +183,7 @@ class RELATIVITY_OT_bake_motion(_BakeOperator, bpy.types.Operator):
     bake = staticmethod(bake_motion)
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: bpy.types.Context):
         if not _poll_mesh(cls, context):
             return False
         if context.active_object.relativity.use_deformation:

@@ -11,11 +11,18 @@ with the .blend and a render farm worker needs nothing else. Motion and deformat
 kept on the cache mesh too (``bakes.py``), so they go with the effect when it is removed.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 import numpy as np
 
 from ..common import compat, names
 from ..common.nodes import Group, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Object, Scene
 
 
 def node_group_spec():
@@ -66,7 +73,7 @@ def ensure_node_group():
     return ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
 
 
-def find_modifier(obj):
+def find_modifier(obj: Object):
     for modifier in obj.modifiers:
         if modifier.type == "NODES" and modifier.node_group is not None \
                 and modifier.node_group.name == names.GEOMETRY_GROUP:
@@ -74,24 +81,24 @@ def find_modifier(obj):
     return None
 
 
-def applied_objects(scene):
+def applied_objects(scene: Scene):
     return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None]
 
 
-def cache_object(obj):
+def cache_object(obj: Object):
     modifier = find_modifier(obj)
     if modifier is None:
         return None
     return compat.modifier_input(modifier, interface_identifier(modifier.node_group, "Cache"))
 
 
-def cache_data(obj):
+def cache_data(obj: Object):
     """The cache mesh of ``obj`` (where its update state and bakes live), or None."""
     cache = cache_object(obj)
     return cache.data if cache is not None else None
 
 
-def ensure_modifier(obj):
+def ensure_modifier(obj: Object):
     """The object's modifier and cache object, created if missing. Returns (modifier, cache)."""
     group = ensure_node_group()
     modifier = find_modifier(obj)
@@ -123,7 +130,7 @@ def _shared_with_another_object(obj, cache):
     return owner is not None and owner != obj and cache_object(owner) == cache
 
 
-def bake_mesh(obj):
+def bake_mesh(obj: Object):
     """The mesh holding the object's deformation bake, or None."""
     data = cache_data(obj)
     if data is None or names.BAKE_KEY not in data:
@@ -131,7 +138,7 @@ def bake_mesh(obj):
     return bpy.data.meshes.get(data[names.BAKE_KEY]["mesh"])
 
 
-def motion_bake(obj):
+def motion_bake(obj: Object):
     """``(first frame, samples per frame, matrices (K, 4, 4) float64)`` of the object's motion
     bake, or None."""
     data = cache_data(obj)
@@ -142,7 +149,7 @@ def motion_bake(obj):
     return float(info["first_frame"]), int(info["samples_per_frame"]), matrices
 
 
-def motion_bake_range(obj):
+def motion_bake_range(obj: Object):
     """(first, last) frame of the object's motion bake, or None (reads no matrices)."""
     data = cache_data(obj)
     if data is None or names.MOTION_BAKE_KEY not in data:
@@ -152,13 +159,13 @@ def motion_bake_range(obj):
     return first, first + (len(info["matrices"]) // 16 - 1) / per_frame
 
 
-def object_error(obj):
+def object_error(obj: Object):
     """The one-line error of the object's last handler update, or None."""
     data = cache_data(obj) if find_modifier(obj) is not None else None
     return data.get(names.ERROR_KEY) or None if data is not None else None
 
 
-def remove_object_effect(obj):
+def remove_object_effect(obj: Object):
     """Remove the object's modifier, cache and bakes; the mesh data was never written."""
     modifier = find_modifier(obj)
     if modifier is None:
@@ -178,11 +185,11 @@ def remove_object_effect(obj):
     return True
 
 
-def remove_unused_group():
+def remove_unused_group() -> None:
     remove_unused_groups((names.GEOMETRY_GROUP,))
 
 
-def evaluated_rest_positions(obj, depsgraph):
+def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph):
     """The tessellated rest positions (object space, float64 ``(N, 3)``) the modifier stored on
     the evaluated mesh, or None without the attribute."""
     obj_eval = obj.evaluated_get(depsgraph)
@@ -198,7 +205,7 @@ def evaluated_rest_positions(obj, depsgraph):
     return rest.reshape(-1, 3).astype(np.float64)
 
 
-def write_cache(mesh, positions, beta):
+def write_cache(mesh, positions, beta) -> None:
     """Object-space positions ``(N, 3)`` and observer-frame velocities ``beta`` (``(N, 3)``, or
     ``(1, 3)`` shared by every point) into the cache mesh."""
     count = len(positions)

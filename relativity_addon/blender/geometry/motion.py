@@ -23,6 +23,10 @@ armatures included) plays at its proper time along its world line.
 Every function raises RelativityError (one line) for a motion it cannot show correctly.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...errors import RelativityError
@@ -31,6 +35,11 @@ from ..common import names
 from ..scene import animation
 from ..scene.snapshot import check_velocity
 from . import modifier, shape_keys
+
+if TYPE_CHECKING:
+    from bpy.types import Object, Scene
+
+    from ..scene.snapshot import Snapshot
 
 # Most samples of a keyframed object's clock table (its path from scene time 0 to the retarded times).
 CLOCK_SAMPLES = 200_000
@@ -47,7 +56,7 @@ def to_world(matrix, points):
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=True):
+def apparent_world_positions(scene: Scene, obj: Object, obj_eval: Object, rest, snap: Snapshot, shape_keys_too=True):
     """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
     points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all).
     ``shape_keys_too=False``: ``rest`` are not the mesh's points (its centre, say): rigid motion only."""
@@ -79,7 +88,7 @@ def apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=Tr
     return world, beta_seen
 
 
-def check_parent_motion(obj):
+def check_parent_motion(obj: Object) -> None:
     """RelativityError if the nearest moving mesh among the object's parents (apparent geometry on,
     Motion not Static) has another motion than the object: a child rides on its parent's world line,
     and each object's world line comes from its own settings, so they must agree (the child's own
@@ -98,7 +107,7 @@ def check_parent_motion(obj):
         parent = parent.parent
 
 
-def plays_own_animation(obj, scene):
+def plays_own_animation(obj: Object, scene: Scene):
     """Whether the object has its own animation to play on a clock of its own: keyframes that turn
     or scale it (or an object parent), or keyframed shape-key values. Objects whose keyframes are
     not their motion (:func:`animation.keyframe_motion_problem`) are left as Blender shows them."""
@@ -152,8 +161,8 @@ def _path_clock(obj, fps, step, c):
     return clock
 
 
-def proper_time_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, beta_u=None, matrix_now=None,
-                                   shape_keys_too=True):
+def proper_time_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, beta_u=None,
+                                   matrix_now=None, shape_keys_too=True):
     """An object with its own animation (:func:`plays_own_animation`: a spinning wheel, a clock's
     hands, shape keys) plays it at its proper time ``tau`` (its clock reads 0 at scene time 0),
     evaluated at each vertex's retarded time by the sampled solver.
@@ -206,8 +215,8 @@ def proper_time_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, 
     return result
 
 
-def animated_apparent_positions(obj, scene, rest_local, t_o, x_o, beta_o, c, max_tries=4, obj_eval=None,
-                                shape_keys_too=True):
+def animated_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, max_tries=4,
+                                obj_eval: Object | None = None, shape_keys_too=True):
     """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
     world matrices when it has a motion bake, else from its keyframes under its parent chain
     (:func:`animation.world_matrices`). An object whose keyframes are not its motion
@@ -256,7 +265,7 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
     return result
 
 
-def deformed_apparent_positions(obj, count, t_o, x_o, beta_o, c):
+def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
     """Apparent positions of a deforming object from its baked samples (per-vertex retarded times)."""
     mesh = modifier.bake_mesh(obj)
     if mesh is None:

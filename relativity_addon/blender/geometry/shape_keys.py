@@ -11,13 +11,19 @@ what Blender evaluated at the scene frame, so a set-up it cannot reproduce raise
 instead of showing a wrong shape.
 """
 
+from __future__ import annotations
+
 import re
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import RelativityError
 from ..common import compat
 from . import modifier
+
+if TYPE_CHECKING:
+    from bpy.types import Object
 
 _VALUE_PATH = re.compile(r'^key_blocks\["(.+)"\]\.value$')
 FRAME_SAMPLES_PER_FRAME = 16  # the values' table between the frames asked for (linear in between)
@@ -36,13 +42,13 @@ def _value_fcurves(key):
     return curves
 
 
-def has_animated_shape_keys(obj):
+def has_animated_shape_keys(obj: Object):
     """Whether keyframes change the values of the mesh's shape keys (its own animation)."""
     key = getattr(obj.data, "shape_keys", None)
     return key is not None and bool(_value_fcurves(key))
 
 
-def scene_time_reason(obj):
+def scene_time_reason(obj: Object):
     """Why ``obj``'s animated shape keys cannot be blended here at other times (one line), or None.
     The blend works on the mesh's own vertices with Blender's relative blending; otherwise the keys
     play at the scene's time (the shape Blender evaluated), which the object's warnings say."""
@@ -66,7 +72,7 @@ def scene_time_reason(obj):
     return None
 
 
-def scene_time_warning(obj):
+def scene_time_warning(obj: Object):
     """The object's warning when its animated shape keys play at the scene's time although its own
     animation runs on its proper time, or None."""
     settings = obj.relativity
@@ -140,7 +146,7 @@ class ShapeKeyMotion:
             result += row[:, None] * offset
         return result
 
-    def check(self, rest, frame):
+    def check(self, rest, frame) -> None:
         """RelativityError unless ``rest`` (the rest points Blender evaluated at ``frame``) is this
         blend at ``frame``: the shape keys are then the only thing shaping the rest points."""
         if len(rest) != len(self.base):

@@ -21,8 +21,11 @@ restores exactly that. Lamps that already use light linking (a receiver collecti
 they are, with a warning.
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
+from typing import TYPE_CHECKING
 
 import bpy
 import mathutils
@@ -35,6 +38,11 @@ from ..geometry import modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
 from . import rest_normals
+
+if TYPE_CHECKING:
+    from bpy.types import Object, Scene
+
+    from ..scene.snapshot import Snapshot
 
 KEY = names.LAMP_DOPPLER_KEY
 COPY_KEY = names.LAMP_DOPPLER_COPY_KEY
@@ -54,7 +62,7 @@ class Mover:
     beta: tuple  # scene-frame velocity there, fraction of c
 
 
-def is_copy(obj):
+def is_copy(obj: Object):
     return COPY_KEY in obj
 
 
@@ -62,7 +70,7 @@ def _skipped_lamp(obj):
     return obj.light_linking.receiver_collection is not None and KEY not in obj
 
 
-def lamps(scene):
+def lamps(scene: Scene):
     """Lamps at rest that render and that the stage can split (no light linking of their own)."""
     return [obj for obj in scene.objects
             if obj.type == "LIGHT" and not is_copy(obj) and obj.data.type in KINDS
@@ -80,7 +88,7 @@ def _local_centre(obj):
     return (co.min(axis=0) + co.max(axis=0)) / 2.0
 
 
-def movers(scene, snap):
+def movers(scene: Scene, snap: Snapshot):
     """The moving objects of the Apparent Geometry path: centre and scene-frame velocity, with
     light-travel time from the camera event and no boost (the scene frame)."""
     # the scene frame: the exact camera's meshes are there already (seen from the aperture at the
@@ -103,12 +111,12 @@ def movers(scene, snap):
     return found
 
 
-def lamp_matrix(scene, lamp, snap):
+def lamp_matrix(scene: Scene, lamp, snap: Snapshot):
     """The lamp's world matrix at the snapshot's frame (its keyframes evaluated there)."""
     return np.asarray(snapshot.camera_matrix(scene, lamp, snap.frame), dtype=np.float64)
 
 
-def incidence(matrix, kind, mover):
+def incidence(matrix, kind: str, mover):
     """The photon direction ``k`` (scene frame) from a lamp with world ``matrix`` to ``mover``'s centre."""
     if kind == "SUN":
         return -matrix[:3, 2]
@@ -118,7 +126,7 @@ def incidence(matrix, kind, mover):
     return direction
 
 
-def placement(matrix, kind, mover):
+def placement(matrix, kind: str, mover):
     """``(D, copy's world matrix)``: eq. 18's factor for the lamp's light on ``mover`` and the lamp
     turned about the centre to the direction the object sees it from in its own frame."""
     k = incidence(matrix, kind, mover)
@@ -126,7 +134,7 @@ def placement(matrix, kind, mover):
     return doppler_factor, lamp_doppler.aberrated_lamp_matrix(matrix, mover.centre, k, mover.beta)
 
 
-def copy_colour(lamp, doppler_factor, snap):
+def copy_colour(lamp, doppler_factor, snap: Snapshot):
     """The copy's colour: the lamp's colour with eq. 18's factor (its temperature folded in)."""
     light = lamp.data
     temperature = sources.light_blackbody(light)
@@ -205,7 +213,7 @@ def _follow(copy_data, light):
         _set(copy_data, key, tuple(value) if getattr(prop, "is_array", False) else value)
 
 
-def write(scene, snap):
+def write(scene: Scene, snap: Snapshot):
     """Bring the copies up to date with the snapshot (rebuilt when the lamps or moving objects
     changed, else only their colours and settings written). Nothing without moving objects or
     off the Apparent Geometry path."""
@@ -244,11 +252,11 @@ def _copy_pairs(record):
     return found
 
 
-def apply(scene, snap):
+def apply(scene: Scene, snap: Snapshot):
     return write(scene, snap)
 
 
-def remove(scene):
+def remove(scene: Scene):
     """Delete the copies, their light data and the collections; give the lamps back their own
     (empty) light linking. Returns the number of copies removed."""
     rest_normals.remove(scene)
@@ -280,7 +288,7 @@ def remove(scene):
     return len(copies)
 
 
-def warnings(scene, snap):
+def warnings(scene: Scene, snap: Snapshot):
     """What this stage does not render right, one line each."""
     if snap.method != "GEOMETRY" or not modifier.applied_objects(scene):
         return []

@@ -25,7 +25,10 @@ The face is opaque where Cycles' lamps are see-through, and an area light seen f
 face (it shows nothing there).
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING
 
 import bmesh
 import bpy
@@ -35,6 +38,11 @@ from ..colour import materials
 from ..common import compat, names, visibility
 from ..scene import snapshot, sources
 from . import moving_lights
+
+if TYPE_CHECKING:
+    from bpy.types import Object, Scene
+
+    from ..scene.snapshot import Snapshot
 
 KINDS = ("POINT", "SPOT", "AREA", "SUN")
 # A sun's face sits this far out, as a fraction of the camera's clip end: behind everything but
@@ -250,7 +258,7 @@ def _delete(face_name):
             bpy.data.materials.remove(material)
 
 
-def drawable(obj, snap):
+def drawable(obj: Object, snap: Snapshot):
     """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
     if obj.data.type not in KINDS or not _facing_camera(obj, snap):
         return None
@@ -262,7 +270,7 @@ def drawable(obj, snap):
     return colour, temperature, scale * strength
 
 
-def write(scene, snap):
+def write(scene: Scene, snap: Snapshot) -> None:
     """Faces for the lamps seen directly while the exact camera renders (none otherwise). During a
     spectral pass the lamps' colours are spectral values: the faces keep the user's colours."""
     if materials.spectral_pass_wavelengths() is not None:
@@ -293,7 +301,7 @@ def write(scene, snap):
         del scene[names.LAMP_FACES_KEY]
 
 
-def remove(scene):
+def remove(scene: Scene) -> None:
     """Delete the faces and give the lamps back their camera visibility."""
     for face_name in dict(scene.get(names.LAMP_FACES_KEY, {})).values():
         _delete(face_name)
@@ -312,7 +320,7 @@ def _has_extent(light):
     return light.type == "AREA" or light.shadow_soft_size > 0.0
 
 
-def warnings(scene, snap):
+def warnings(scene: Scene, snap: Snapshot):
     """Lamps seen directly whose colour the exact camera shifts as the pixel behind them."""
     if not snap.exact_camera:
         return []

@@ -19,8 +19,11 @@ scene frame, diffuse reflection (the albedo is the Base Color / Color of the fir
 Diffuse BSDF feeding the output), one shadow ray to a point source.
 """
 
+from __future__ import annotations
+
 import math
 import os
+from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
@@ -32,6 +35,11 @@ from ..common import names, osl
 from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Material, Scene
+
+    from ..scene.snapshot import Snapshot
+
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
 MATERIAL_KEY = names.MOVING_LIGHTS_MATERIAL_KEY
@@ -41,7 +49,7 @@ LAMP_KINDS = {"POINT", "SPOT", "SUN", "AREA"}  # by stand-in lamps (moving_lamps
 ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffuse": "Color"}
 
 
-def supported(snap):
+def supported(snap: Snapshot):
     """The snapshot's moving lights this stage renders: point and spot lights with constant
     velocity, and every kind, constant or keyframed (ANIMATION), where stand-in lamps draw them
     (:func:`uses_lamps`; a keyframed sun moves with its keyframes' velocity at the frame)."""
@@ -50,7 +58,7 @@ def supported(snap):
     return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
 
 
-def is_applied(scene):
+def is_applied(scene: Scene):
     return names.SHADING_SYSTEM_SAVED_KEY in scene
 
 
@@ -111,7 +119,7 @@ def ensure_group(light_names):
     return group
 
 
-def reception_event(snap):
+def reception_event(snap: Snapshot):
     """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame
     (``Snapshot.mesh_observer``: the exact camera's aperture centre at its shutter time; the
     boosted-mesh preview's ``(t_o, x_cam)``)."""
@@ -127,7 +135,7 @@ def spot_cone(spot_size, spot_blend):
     return cos_half, smooth
 
 
-def shader_parameters(light, snap):
+def shader_parameters(light, snap: Snapshot):
     """The script node's inputs for one light (world axes; intensity in W/sr per channel): the
     light's position at the reception event's time and that event's position."""
     cos_half, smooth = spot_cone(light.spot_size, light.spot_blend)
@@ -257,7 +265,7 @@ def _albedo_source(socket):
     return socket.links[0].from_socket if socket is not None and socket.is_linked else None
 
 
-def attach(material, group):
+def attach(material: Material, group):
     """Add the group's emission to the material's surface: ``surface + moving lights``."""
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
@@ -293,7 +301,7 @@ def attach(material, group):
     return True
 
 
-def detach(material):
+def detach(material: Material):
     """Remove the inserted nodes and link the old surface shader to the output again."""
     if material is None or MATERIAL_KEY not in material:
         return False
@@ -356,13 +364,13 @@ def _enable_osl(scene):
         scene.cycles.shading_system = True
 
 
-def uses_lamps(snap):
+def uses_lamps(snap: Snapshot):
     """Whether the moving lights are drawn by stand-in lamps (``moving_lamps.py``, with shadows
     behind Cycles' OSL camera) rather than by the material shader (with traced shadows)."""
     return snap.exact_camera
 
 
-def write(scene, snap, attach_new_materials=False, depsgraph=None):
+def write(scene: Scene, snap: Snapshot, attach_new_materials=False, depsgraph: Depsgraph | None = None):
     """Bring the moving lights up to date with the snapshot: hide the moving lights (and show
     again those no longer moving), rebuild the group when the lights changed, write every light's
     parameters and attach materials (all on the first write, then new ones on request). With no
@@ -399,11 +407,11 @@ def write(scene, snap, attach_new_materials=False, depsgraph=None):
     return group
 
 
-def apply(scene, snap):
+def apply(scene: Scene, snap: Snapshot):
     return write(scene, snap, attach_new_materials=True)
 
 
-def remove(scene):
+def remove(scene: Scene) -> None:
     """Restore everything :func:`write` changed: materials, lights, the scene's shading system;
     delete the group, the stand-in lamps and the shader texts."""
     stand_in_lamps.remove(scene)
@@ -425,7 +433,7 @@ def remove(scene):
             bpy.data.texts.remove(text)
 
 
-def warnings(scene, snap):
+def warnings(scene: Scene, snap: Snapshot):
     """What the moving-light stage does not render right, one line each."""
     drawn = {light.name for light in supported(snap)}
     found = [f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "

@@ -17,10 +17,17 @@ Everything is recorded (the mesh names on the scene, the inserted node on each m
 :func:`remove` deletes exactly that.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 import numpy as np
 
 from ..common import names, nodes
+
+if TYPE_CHECKING:
+    from bpy.types import Material, Scene
 
 KEY = names.REST_NORMAL_KEY
 ATTRIBUTE = names.REST_NORMAL_ATTRIBUTE
@@ -81,7 +88,7 @@ def _normal_inputs(tree):
             and "Normal" in node.inputs and not node.inputs["Normal"].is_linked]
 
 
-def attach(material, group):
+def attach(material: Material, group):
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
     tree = material.node_tree
@@ -98,7 +105,7 @@ def attach(material, group):
     return True
 
 
-def detach(material):
+def detach(material: Material):
     if material is None or MATERIAL_KEY not in material:
         return False
     tree = material.node_tree
@@ -109,7 +116,7 @@ def detach(material):
     return True
 
 
-def write(scene, objects):
+def write(scene: Scene, objects) -> None:
     """Rest normals for ``objects`` (the moving meshes lit by lamp copies); everything removed
     when there are none."""
     if not objects:
@@ -129,7 +136,7 @@ def write(scene, objects):
             attach(slot.material, group)
 
 
-def remove(scene):
+def remove(scene: Scene) -> None:
     """Detach the group from every material, delete the attributes the stage added and the group."""
     for material in bpy.data.materials:
         detach(material)

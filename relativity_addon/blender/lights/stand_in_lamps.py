@@ -16,9 +16,12 @@ lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the sc
 :func:`remove`; the user's light is hidden by ``moving_lights.py``.
 """
 
+from __future__ import annotations
+
 import math
 import os
 import warnings
+from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
@@ -31,6 +34,11 @@ from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_
 from ..colour import materials
 from ..common import names
 from ..scene import animation, snapshot, sources
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Scene
+
+    from ..scene.snapshot import Snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
@@ -81,7 +89,7 @@ def _shader_text():
     return text
 
 
-def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
+def view_directions(scene: Scene, snap: Snapshot, columns=32, rows=24, margin=0.05):
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
     camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame unless
     a Lorentz window keeps it, Gray eq. 6)."""
@@ -99,7 +107,7 @@ def view_directions(scene, snap, columns=32, rows=24, margin=0.05):
     return world
 
 
-def visible_points(scene, snap, depsgraph, origin):
+def visible_points(scene: Scene, snap: Snapshot, depsgraph: Depsgraph, origin):
     """Surface points the camera sees (the first hit of each ray of :func:`view_directions`)."""
     if depsgraph is None:
         try:
@@ -127,7 +135,7 @@ def _keyframe_path(obj, snap, reception_time, times):
     return animation.world_matrices(obj, frames)[:, :3, 3]
 
 
-def lamp_path(scene, snap, light, values, reception_time, points):
+def lamp_path(scene: Scene, snap: Snapshot, light, values, reception_time, points):
     """Where the stand-in lamps go: their times ``c (t - t_reception)`` on the light's path (ascending)
     and positions, for these surface points (the lit ones' retarded times; at least one lamp)."""
     camera_position = values["camera_position"]
@@ -251,7 +259,7 @@ def _positions(scene, snap, light, values, reception_time, times):
     return np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
 
 
-def write(scene, snap, lights, parameters, reception_time, depsgraph=None):
+def write(scene: Scene, snap: Snapshot, lights, parameters, reception_time, depsgraph: Depsgraph | None = None) -> None:
     """Place and set the stand-in lamps of ``lights`` (``parameters(light)``: the material
     shader's inputs, ``moving_lights.shader_parameters``; ``reception_time`` ``c (t_reception -
     t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
@@ -357,7 +365,7 @@ def _write_sun(scene, light, obj):
     _set(obj, "rotation_quaternion", tuple(rotation))
 
 
-def remove(scene):
+def remove(scene: Scene) -> None:
     """Delete every stand-in lamp and the shader text."""
     for names_of_light in _record(scene).values():
         for name in names_of_light:

@@ -15,11 +15,18 @@ set-up scene whose sync is refused is recorded in ``render_notice`` (the panel s
 after the render when Blender has a window).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import bpy
 from bpy.app.handlers import persistent
 
 from ..camera import exact_camera
 from . import effect, render_notice
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Scene
 
 
 def _sync(scene, **options):
@@ -31,22 +38,22 @@ def _sync(scene, **options):
 
 
 @persistent
-def frame_change_pre(scene, _depsgraph=None):
+def frame_change_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, update_geometry=False)
 
 
 @persistent
-def frame_change_post(scene, depsgraph=None):
+def frame_change_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
-def depsgraph_update_post(scene, depsgraph=None):
+def depsgraph_update_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, depsgraph=depsgraph)
 
 
 @persistent
-def render_pre(scene, _depsgraph=None):
+def render_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     _sync(scene, update_geometry=False, attach_new_materials=True, before_render=True)
     try:
         _tell_if_refused(scene)
@@ -71,7 +78,7 @@ def _tell_if_refused(scene):
 
 
 @persistent
-def render_init(scene, _depsgraph=None):
+def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     try:
         effect.begin_final_render(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
@@ -79,7 +86,7 @@ def render_init(scene, _depsgraph=None):
 
 
 @persistent
-def render_end(scene, _depsgraph=None):
+def render_end(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     try:
         effect.end_final_render(scene)
     except Exception as error:  # noqa: BLE001
@@ -97,7 +104,7 @@ HANDLERS = (
 )
 
 
-def register():
+def register() -> None:
     render_notice.register()
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
@@ -105,7 +112,7 @@ def register():
             handlers.append(handler)
 
 
-def unregister():
+def unregister() -> None:
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:

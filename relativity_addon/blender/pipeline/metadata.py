@@ -8,20 +8,29 @@ recoverable from any output file: divide by ``exposure``. The user's own note co
 effect is removed.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ..common import names
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
 
 SAVED_KEY = names.STAMP_SAVED_KEY
 PREFIX = "relativity:"
 
 
-def note(snap):
+def note(snap: Snapshot):
     beta = ",".join(f"{b:.9g}" for b in snap.beta)
     return (f"{PREFIX} exposure={snap.exposure:.9g} ({snap.exposure_mode.lower()}) beta={beta} "
             f"speed={snap.speed:.9g} c={snap.speed_of_light:.9g} frame={snap.frame:g} method={snap.method.lower()}"
             + (" kinematics=galilean (time of flight only, not relativity)" if snap.use_time_of_flight else ""))
 
 
-def write(scene, snap):
+def write(scene: Scene, snap: Snapshot) -> None:
     """Write the frame's note (only when it changed: a write triggers a depsgraph update)."""
     render = scene.render
     if SAVED_KEY not in scene:
@@ -33,7 +42,7 @@ def write(scene, snap):
         render.stamp_note_text = text
 
 
-def remove(scene):
+def remove(scene: Scene):
     """Give the user's note back."""
     if SAVED_KEY not in scene:
         return False

@@ -19,9 +19,12 @@ afterwards, also when a pass fails. Works from the operator (F12's sibling in th
 batch script (``--spectral N``).
 """
 
+from __future__ import annotations
+
 import os
 import tempfile
 import time
+from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
@@ -34,10 +37,15 @@ from ..geometry import modifier
 from ..scene import snapshot
 from . import effect
 
+if TYPE_CHECKING:
+    from bpy.types import Scene
+
+    from ..scene.snapshot import Snapshot
+
 IMAGE_NAME = names.SPECTRAL_IMAGE
 
 
-def ready(scene):
+def ready(scene: Scene) -> None:
     """RelativityError unless the effect is set up with the physical colour settings: the cheap
     part of :func:`check`, for the button's poll (which runs on every redraw of the panel)."""
     if effect.applied_method(scene) is None:
@@ -48,7 +56,7 @@ def ready(scene):
                               "Searchlight on (and Chang's searchlight off)")
 
 
-def check(scene):
+def check(scene: Scene) -> None:
     """RelativityError unless the scene is set up for a spectral render (walks the scene's
     objects and materials: :func:`render` runs it, the button's poll only :func:`ready`)."""
     ready(scene)
@@ -90,7 +98,7 @@ class _Saved:
         self.image = {key: getattr(settings, key) for key in ("file_format", "color_depth", "color_mode")}
         self.lights = {light.name: (tuple(light.color), light.use_temperature) for light in _scene_lights(scene)}
 
-    def restore(self):
+    def restore(self) -> None:
         scene = self.scene
         for key, value in self.render.items():
             setattr(scene.render, key, value)
@@ -102,7 +110,7 @@ class _Saved:
                 light.color, light.use_temperature = colour, use_temperature
 
 
-def pixel_log_doppler(scene, snap):
+def pixel_log_doppler(scene: Scene, snap: Snapshot):
     """``ln D`` at every pixel centre (rows bottom first, as Blender stores images)."""
     size = world_doppler.render_size(scene)
     directions = exposure.pixel_directions(snapshot.view_window(scene, scene.objects[snap.camera]), size)
@@ -141,7 +149,7 @@ def _render_exr(scene, path):
     return pixels.reshape(height, width, 4)  # bottom row first, as Blender stores images
 
 
-def render(scene, passes, progress=None):
+def render(scene: Scene, passes, progress=None):
     """Render the scene's current frame in spectral mode: ``(pixels, info)``, pixels RGBA float32
     (bottom row first, scene linear), info the Doppler range, wavelengths and time taken.
     ``progress(done, total)`` is called after each pass. RelativityError (one line) on failure."""
@@ -197,7 +205,7 @@ def render(scene, passes, progress=None):
     return pixels, info
 
 
-def store_image(pixels, name=IMAGE_NAME):
+def store_image(pixels, name: str=IMAGE_NAME):
     """Put the pixels into the float image ``name`` (made or resized as needed) and return it."""
     height, width = pixels.shape[:2]
     image = bpy.data.images.get(name)

@@ -12,6 +12,10 @@ The observer velocity from the camera's animation (``snapshot.camera_beta_at``) 
 these matrices.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
 from mathutils import Matrix
 
@@ -19,8 +23,11 @@ from ...errors import RelativityError
 from ...physics import transforms
 from ..common import compat
 
+if TYPE_CHECKING:
+    from bpy.types import Object, Scene
 
-def frames_per_second(scene):
+
+def frames_per_second(scene: Scene):
     return scene.render.fps / scene.render.fps_base
 
 
@@ -63,7 +70,7 @@ def _channels(obj, curves, path, size, frames):
     return np.stack(columns, axis=1)
 
 
-def basis_matrices(obj, frames, own_frames=None):
+def basis_matrices(obj: Object, frames, own_frames=None):
     """The object's ``matrix_basis`` at each of ``frames`` (float, sub-frames allowed) from its
     keyframes, deltas included, as float64 ``(K, 4, 4)`` (mathutils is float32). With
     ``own_frames`` (same shape), the rotation and scale channels (the object's own animation) are
@@ -95,7 +102,7 @@ def basis_matrices(obj, frames, own_frames=None):
     )
 
 
-def world_matrices(obj, frames, own_frames=None):
+def world_matrices(obj: Object, frames, own_frames=None):
     """``matrix_world`` at each of ``frames`` from keyframes alone, float64 ``(K, 4, 4)``: the
     object's basis under its object-parent chain evaluated at the same frames,
     ``parent_world @ matrix_parent_inverse @ basis`` (rotation and scale channels of every link at
@@ -115,7 +122,7 @@ def world_matrices(obj, frames, own_frames=None):
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
-def keyframes_signature(obj):
+def keyframes_signature(obj: Object):
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
     cache key; None when an F-curve has modifiers (their settings are not in the key)."""
     parts = []
@@ -134,7 +141,7 @@ def keyframes_signature(obj):
     return tuple(parts)
 
 
-def has_own_animation(obj, scene=None):
+def has_own_animation(obj: Object, scene: Scene | None = None):
     """Whether keyframes turn or scale the object (or an object parent): its own animation, which a
     CONSTANT object plays at its proper time (``world_lines``). Objects whose keyframes are not
     their motion (:func:`keyframe_motion_problem`) are left as Blender shows them."""
@@ -147,12 +154,12 @@ def has_own_animation(obj, scene=None):
     return False
 
 
-def world_matrix_at(obj, frame):
+def world_matrix_at(obj: Object, frame):
     """``matrix_world`` at ``frame`` from keyframes alone (object parents; no constraints)."""
     return Matrix(world_matrices(obj, [frame])[0].tolist())
 
 
-def keyframe_motion_problem(obj, scene=None):
+def keyframe_motion_problem(obj: Object, scene: Scene | None = None):
     """Why keyframes alone do not give the object's world matrix at other frames of ``scene`` (one
     line, naming the object or ancestor at fault), or None when :func:`world_matrices` is exact."""
     if scene is not None and scene.render.frame_map_old != scene.render.frame_map_new:
@@ -178,7 +185,7 @@ def keyframe_motion_problem(obj, scene=None):
     return None
 
 
-def check_supported(obj, scene=None):
+def check_supported(obj: Object, scene: Scene | None = None) -> None:
     """Refuse set-ups whose motion the keyframe evaluation would get wrong."""
     problem = keyframe_motion_problem(obj, scene)
     if problem is not None:

@@ -15,15 +15,22 @@ strength (the first Emission shader, or Principled BSDF emission, of its materia
 not followed), and the object's velocity for every part of it.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..common import names, visibility
 from . import sources
 
+if TYPE_CHECKING:
+    from bpy.types import Object
+
 RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 
 
-def emission_radiance(obj):
+def emission_radiance(obj: Object):
     """``(r, g, b)`` radiance of the emitter's first constant emission, or None."""
     for slot in obj.material_slots:
         material = slot.material
@@ -52,7 +59,7 @@ def _rest_colour(socket):
     return None if socket is None or socket.is_linked else socket
 
 
-def surface_area(obj, matrix):
+def surface_area(obj: Object, matrix):
     """The mesh's surface area in world units (its rest shape under the world matrix ``matrix``)."""
     mesh = obj.data
     mesh.calc_loop_triangles()
@@ -68,7 +75,7 @@ def surface_area(obj, matrix):
     return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1).sum())
 
 
-def intensity(obj, matrix):
+def intensity(obj: Object, matrix):
     """Mean radiant intensity ``L A / 4`` (W/sr per channel) of the emitter, or None."""
     radiance = emission_radiance(obj)
     if radiance is None:
@@ -77,14 +84,14 @@ def intensity(obj, matrix):
     return tuple(v * area / 4.0 for v in radiance) if area > 0.0 else None
 
 
-def is_emitter_light(obj):
+def is_emitter_light(obj: Object):
     return obj.type == "MESH" and obj.relativity.motion == "CONSTANT" and obj.relativity.lights_scene
 
 
-def hide_from_light_rays(obj):
+def hide_from_light_rays(obj: Object) -> None:
     """Camera rays only: the stand-in light carries the emitter's light (the user's values saved)."""
     visibility.hide(obj, names.EMITTER_SAVED_KEY, RAYS)
 
 
-def restore(obj):
+def restore(obj: Object):
     return visibility.restore(obj, names.EMITTER_SAVED_KEY)

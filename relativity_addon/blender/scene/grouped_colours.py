@@ -20,6 +20,8 @@ An object's blackbody temperature (``Object.relativity.temperature``) reaches th
 materials' own nodes and their pass-throughs, not colours computed inside a shared group.
 """
 
+from __future__ import annotations
+
 import bpy
 
 from ..common import names
@@ -81,7 +83,7 @@ def pass_throughs(group_tree, seen=()):
     return {identifier: next(iter(found)) for identifier, found in kinds.items() if len(found) == 1}
 
 
-def attach_groups(tree, insert, seen=()):
+def attach_groups(tree, insert, seen=()) -> None:
     """Colour groups into every user group used in ``tree`` (at any depth) not yet attached:
     ``insert(tree, node, socket, is_emission)`` puts one in and returns its record."""
     for node in user_groups(tree):
@@ -97,7 +99,7 @@ def attach_groups(tree, insert, seen=()):
         attach_groups(group_tree, insert, (*seen, group_tree.name))
 
 
-def detach_all(detach_records):
+def detach_all(detach_records) -> None:
     """Remove the colour groups from every node group: ``detach_records(owner, tree)``."""
     for group_tree in bpy.data.node_groups:
         if KEY in group_tree:

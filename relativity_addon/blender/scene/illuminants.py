@@ -19,10 +19,15 @@ groups (``light_groups.py``), whose passes the compositor reads through their ow
   temperature given.
 """
 
-from typing import NamedTuple
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple
 
 from ..common import names
 from . import grouped_colours, sources
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
 
 OWN_PREFIX = "Relativity"  # the add-on's stand-in lamps, copies and lamp faces
 STRENGTHS = {"ShaderNodeEmission": "Strength", "ShaderNodeBsdfPrincipled": "Emission Strength"}
@@ -84,7 +89,7 @@ def _candidates(scene):
     return [obj for obj in scene.objects if not obj.hide_render and not obj.name.startswith(OWN_PREFIX)]
 
 
-def lit_groups(scene):
+def lit_groups(scene: Scene):
     """The light groups of the fast mode's blackbody lamps, by *Lit By* (tuple of :class:`LitGroup`)."""
     settings = scene.relativity
     if settings.fast_illuminant == "WHITE":

@@ -12,8 +12,11 @@ units, velocities as fractions of c in world axes; ``beta_camera`` is the same v
 camera's local axes (Blender convention: the camera looks down its local -Z).
 """
 
+from __future__ import annotations
+
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +25,9 @@ from ...physics import exposure
 from ...physics.shutter import ShutterModel, image_distance
 from ..common import names
 from . import animation, emitting_meshes, illuminants, sources
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Object, Scene
 
 Vector3 = tuple[float, float, float]
 
@@ -162,7 +168,7 @@ def _finite(values):
     return all(math.isfinite(value) for value in values)
 
 
-def current_frame(scene):
+def current_frame(scene: Scene):
     return scene.frame_current + scene.frame_subframe
 
 
@@ -184,14 +190,14 @@ def check_speed_of_light(c):
     return c
 
 
-def active_camera(scene):
+def active_camera(scene: Scene):
     camera = scene.camera
     if camera is None or camera.type != "CAMERA":
         raise RelativityError(f"scene {scene.name!r} has no active camera")
     return camera
 
 
-def camera_matrix(scene, camera, frame, depsgraph=None):
+def camera_matrix(scene: Scene, camera, frame, depsgraph: Depsgraph | None = None):
     """The camera's world matrix at ``frame`` as float64 ``(4, 4)``.
 
     Blender's animation render does not re-evaluate the original camera object, so its
@@ -213,7 +219,7 @@ STEP_FRAMES = 1.0 / 64.0
 CHECK_SAMPLES_PER_FRAME = 4
 
 
-def camera_beta_at(scene, frame, camera=None):
+def camera_beta_at(scene: Scene, frame, camera=None):
     """The camera's velocity (world axes, fraction of c) at ``frame`` (float allowed), from its
     keyframes: the time derivative of its world position in scene time ``t = frame / fps``, over c
     (docs/physics.md, units), by a central difference of half-width STEP_FRAMES. A camera that its
@@ -226,7 +232,7 @@ def camera_beta_at(scene, frame, camera=None):
     return tuple(float(x) for x in (after - before) / dt / c)
 
 
-def observer_speeds(scene, frames):
+def observer_speeds(scene: Scene, frames):
     """The observer's speed ``|beta|`` at each of ``frames`` (array, sub-frames allowed): the
     setting, or the camera's keyframes (central differences, as :func:`camera_beta_at`, for all
     frames at once). RelativityError at or above the speed of light."""
@@ -258,7 +264,7 @@ def _checked_camera_speed(camera, beta, frame):
     return speed
 
 
-def check_animation_speed(scene, frame_start=None, frame_end=None):
+def check_animation_speed(scene: Scene, frame_start=None, frame_end=None):
     """Raise RelativityError naming the first frame where the camera moves at or above c.
 
     Samples every frame of [frame_start, frame_end] (default: the scene's frame range) and
@@ -272,7 +278,7 @@ def check_animation_speed(scene, frame_start=None, frame_end=None):
     return max((_checked_camera_speed(camera, camera_beta_at(scene, f, camera), f) for f in frames), default=0.0)
 
 
-def observer_velocity(scene, camera, frame):
+def observer_velocity(scene: Scene, camera, frame):
     """The observer velocity at ``frame``: the setting, or the camera's keyframed motion."""
     if scene.relativity.velocity_source == "CAMERA_ANIMATION":
         beta = camera_beta_at(scene, frame, camera)
@@ -281,7 +287,7 @@ def observer_velocity(scene, camera, frame):
     return check_velocity(scene.relativity.beta, "observer velocity beta")
 
 
-def light_render_hidden(obj):
+def light_render_hidden(obj: Object):
     """Whether the user hid the light from renders (the moving-light stage hides it too, keeping
     the user's value under ``names.LIGHT_SAVED_KEY``)."""
     saved = obj.get(names.LIGHT_SAVED_KEY)
@@ -299,7 +305,7 @@ def _keyframe_beta(scene, obj, frame, step=0.01):
     return tuple(float(v) for v in per_frame * animation.frames_per_second(scene) / c)
 
 
-def moving_lights(scene, frame, depsgraph=None):
+def moving_lights(scene: Scene, frame, depsgraph: Depsgraph | None = None):
     """Every light of ``scene`` with constant velocity or keyframed motion that renders, at ``frame``; RelativityError
     for a light at or above the speed of light."""
     found = []
@@ -344,7 +350,7 @@ def _emitter_light(scene, obj, frame, depsgraph):
 _final_renders = set()
 
 
-def begin_final_render(scene):
+def begin_final_render(scene: Scene) -> None:
     """From now on ``scene`` renders its Apparent Geometry through the exact camera: the observer's
     motion by the OSL camera (aberration, searchlight, colour, exact for lamps, shadows and the
     world, which stay in the scene frame), the moving objects at their retarded positions in the
@@ -352,15 +358,15 @@ def begin_final_render(scene):
     _final_renders.add(scene.name)
 
 
-def end_final_render(scene):
+def end_final_render(scene: Scene) -> None:
     _final_renders.discard(scene.name)
 
 
-def in_final_render(scene):
+def in_final_render(scene: Scene):
     return scene.name in _final_renders
 
 
-def view_window(scene, camera):
+def view_window(scene: Scene, camera):
     """The camera's image on the plane at unit distance: ``(left, right, bottom, top)`` in its
     local axes (Blender's own view frame: sensor fit, aspect and shift included)."""
     corners = camera.data.view_frame(scene=scene)
@@ -376,7 +382,7 @@ def world_to_camera(camera_matrix):
     return (u @ vt).T
 
 
-def frame_exposure(scene, camera, settings, beta, camera_matrix):
+def frame_exposure(scene: Scene, camera, settings, beta, camera_matrix):
     """The exposure factor of the frame (``physics.exposure.compensation``; 1 when FIXED)."""
     if settings.exposure_mode != "COMPENSATED" or not any(beta):
         return 1.0
@@ -386,7 +392,7 @@ def frame_exposure(scene, camera, settings, beta, camera_matrix):
     return exposure.compensation(beta_camera, view_window(scene, camera), aberration, power)
 
 
-def check_time_of_flight(settings, lights):
+def check_time_of_flight(settings, lights) -> None:
     """RelativityError (one line) for what time-of-flight mode (Gray Fig. 1c) cannot render: it is
     the exact camera's, for a scene at rest, and has no Lorentz transformation to window or to
     take spatial fixed points from."""
@@ -440,7 +446,7 @@ def check_detector_image(scene, camera, matrix=None):
                               f"length {f * scale:.3g} m: no image forms (Detector Plane shutter)") from None
 
 
-def read(scene, depsgraph=None) -> Snapshot:
+def read(scene: Scene, depsgraph: Depsgraph | None = None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
     cannot be rendered with correct physics."""
     settings = scene.relativity

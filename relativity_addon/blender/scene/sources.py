@@ -32,9 +32,14 @@ directly are drawn by emitter faces, ``lamp_faces.py``), and :func:`volume_black
 Principled Volume's own blackbody emission (shifted for camera rays by ``volumes.py``).
 """
 
-from typing import NamedTuple
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple
 
 from ..common import compat, names
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
 
 MIX_NODES = ("ShaderNodeMix", "ShaderNodeMixRGB")
 BLACKBODY_INTENSITY_CUTOFF = 1e-3  # below this Blender's Principled Volume emits no blackbody
@@ -71,7 +76,7 @@ def _group_output_input(group_node, identifier):
     return next((socket for socket in output.inputs if socket.identifier == identifier), None)
 
 
-def by_identifier(sockets, identifier):
+def by_identifier(sockets, identifier: str):
     return next((socket for socket in sockets if socket.identifier == identifier), None)
 
 
@@ -306,7 +311,7 @@ def light_blackbody(light):
     return source.temperature
 
 
-def scene_blackbody_lights(scene):
+def scene_blackbody_lights(scene: Scene):
     """``{light object name: temperature}`` for every light of ``scene`` that is a blackbody."""
     found = {}
     for obj in scene.objects:
@@ -365,7 +370,7 @@ def grouped_node(tree, kinds, seen=()):
     return None
 
 
-def mark_blackbody(tree, node, blackbody):
+def mark_blackbody(tree, node, blackbody) -> None:
     """Colour group ``node`` shifts its colour as a blackbody (``sources.Blackbody``)."""
     node.inputs["Is Blackbody"].default_value = 1.0
     if isinstance(blackbody.temperature, float):

@@ -7,11 +7,18 @@ observer's speed comes from ``snapshot.observer_speeds`` (the setting or the cam
 and ``physics/proper_time.py`` integrates ``dt / gamma``.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...errors import RelativityError
 from ...physics import proper_time
 from . import animation, snapshot
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
 
 SAMPLES_PER_FRAME = 4
 MAX_SAMPLES = 200_000
@@ -26,7 +33,7 @@ def _grid(scene, first_frame, last_frame):
     return frames, proper_time.proper_times(frames / fps, snapshot.observer_speeds(scene, frames))
 
 
-def proper_time_at(scene, frame):
+def proper_time_at(scene: Scene, frame):
     """The traveller's time (seconds) at ``frame`` (negative before frame 0), interpolated in a
     table of the scene's frame range sampled SAMPLES_PER_FRAME times a frame, which is computed
     again only when the motion changes (the panel shows it at every sync). RelativityError for an
@@ -44,7 +51,7 @@ def proper_time_at(scene, frame):
     return float(np.interp(frame, _cache["frames"], _cache["taus"]))
 
 
-def frames_at_proper_times(scene, taus):
+def frames_at_proper_times(scene: Scene, taus):
     """Scene frames (floats) at which the traveller's clock reads ``taus`` (seconds, >= 0)."""
     taus = np.asarray(taus, dtype=np.float64)
     if taus.min() < 0.0:

@@ -94,9 +94,9 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
 classes = (RELATIVITY_PG_object_settings,)
 
 
-def register():
+def register() -> None:
     bpy.types.Object.relativity = PointerProperty(type=RELATIVITY_PG_object_settings)
 
 
-def unregister():
+def unregister() -> None:
     del bpy.types.Object.relativity

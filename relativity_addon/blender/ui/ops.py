@@ -4,11 +4,16 @@ They call ``effect.apply`` and ``effect.remove``, the entry points the batch scr
 and report a ``RelativityError`` in one line instead of leaving a half-applied scene.
 """
 
-from bpy.types import Operator
+from typing import TYPE_CHECKING
+
+from bpy.types import Context, Operator
 
 from ...errors import RelativityError
 from ..pipeline import effect, spectral_render
 from ..scene import snapshot
+
+if TYPE_CHECKING:
+    from bpy.stub_internal.rna_enums import OperatorReturnItems
 
 
 def _poll_scene(cls, context):
@@ -27,7 +32,7 @@ class RELATIVITY_OT_setup_scene(Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         if not _poll_scene(cls, context):
             return False
         scene = context.scene
@@ -39,7 +44,7 @@ class RELATIVITY_OT_setup_scene(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context) -> "set[OperatorReturnItems]":
         scene = context.scene
         try:
             effect.apply(scene)
@@ -59,7 +64,7 @@ class RELATIVITY_OT_remove_all(Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         if not _poll_scene(cls, context):
             return False
         if not effect.is_applied(context.scene):
@@ -67,7 +72,7 @@ class RELATIVITY_OT_remove_all(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context) -> "set[OperatorReturnItems]":
         removed = effect.remove(context.scene)
         self.report({"INFO"}, f"Removed the relativistic effect ({removed} item{'s' if removed != 1 else ''})")
         return {"FINISHED"}
@@ -81,7 +86,7 @@ class RELATIVITY_OT_check_animation(Operator):
     bl_options = {"REGISTER"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         if not _poll_scene(cls, context):
             return False
         if context.scene.camera is None:
@@ -89,7 +94,7 @@ class RELATIVITY_OT_check_animation(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context) -> "set[OperatorReturnItems]":
         scene = context.scene
         try:
             highest = snapshot.check_animation_speed(scene)
@@ -112,7 +117,7 @@ class RELATIVITY_OT_render_spectral(Operator):
     bl_options = {"REGISTER"}
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         if not _poll_scene(cls, context):
             return False
         try:
@@ -122,7 +127,7 @@ class RELATIVITY_OT_render_spectral(Operator):
             return False
         return True
 
-    def execute(self, context):
+    def execute(self, context: Context) -> "set[OperatorReturnItems]":
         scene = context.scene
         window_manager = context.window_manager
         passes = scene.relativity.spectral_passes

@@ -6,7 +6,7 @@ Nothing here computes: the warnings come from the effect's last sync (``effect.s
 
 import math
 
-from bpy.types import Panel
+from bpy.types import Context, Panel
 
 from ..pipeline import effect, render_notice
 
@@ -30,7 +30,7 @@ class _RelativityPanel:
     bl_category = "Relativity"
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         return context.scene is not None
 
 
@@ -38,7 +38,7 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
     bl_idname = "RELATIVITY_PT_main"
     bl_label = "Relativity"
 
-    def draw(self, context):
+    def draw(self, context: Context) -> None:
         scene = context.scene
         layout = _split(self.layout)
         layout.menu("RELATIVITY_MT_paper_setups_presets", text="Paper Setups")
@@ -61,7 +61,7 @@ class RELATIVITY_PT_observer(_RelativityPanel, Panel):
     bl_label = "Observer"
     bl_parent_id = "RELATIVITY_PT_main"
 
-    def draw(self, context):
+    def draw(self, context: Context) -> None:
         scene = context.scene
         settings = scene.relativity
         layout = _split(self.layout)
@@ -94,7 +94,7 @@ class RELATIVITY_PT_shutter(_RelativityPanel, Panel):
     bl_label = "Camera and Shutter"
     bl_parent_id = "RELATIVITY_PT_main"
 
-    def draw(self, context):
+    def draw(self, context: Context) -> None:
         settings = context.scene.relativity
         layout = _split(self.layout)
         _preset_row(layout, "shutter", "Shutter")
@@ -117,7 +117,7 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
     bl_label = "Effects"
     bl_parent_id = "RELATIVITY_PT_main"
 
-    def draw(self, context):
+    def draw(self, context: Context) -> None:
         settings = context.scene.relativity
         layout = _split(self.layout)
         column = layout.column(heading="Effects")
@@ -169,10 +169,10 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
     bl_parent_id = "RELATIVITY_PT_main"
 
     @classmethod
-    def poll(cls, context):
+    def poll(cls, context: Context) -> bool:
         return context.scene is not None and context.object is not None
 
-    def draw(self, context):
+    def draw(self, context: Context) -> None:
         obj = context.object
         settings = obj.relativity
         layout = _split(self.layout)

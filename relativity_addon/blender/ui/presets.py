@@ -31,11 +31,11 @@ def preset_search_path():
     return None
 
 
-def preset_subdir(kind):
+def preset_subdir(kind: str):
     return f"{PRESET_ROOT}/{kind}"
 
 
-def preset_files(kind):
+def preset_files(kind: str):
     """Absolute paths of all presets of ``kind`` Blender can see, sorted by file name."""
     files = []
     for directory in bpy.utils.preset_paths(preset_subdir(kind)):
@@ -117,14 +117,14 @@ classes = (
 )
 
 
-def register():
+def register() -> None:
     global _registered_path
     path = preset_search_path()
     if path is not None and bpy.utils.register_preset_path(path):
         _registered_path = path
 
 
-def unregister():
+def unregister() -> None:
     global _registered_path
     if _registered_path is not None:
         bpy.utils.unregister_preset_path(_registered_path)

@@ -287,9 +287,9 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
 classes = (RELATIVITY_PG_scene_settings,)
 
 
-def register():
+def register() -> None:
     bpy.types.Scene.relativity = PointerProperty(type=RELATIVITY_PG_scene_settings)
 
 
-def unregister():
+def unregister() -> None:
     del bpy.types.Scene.relativity
