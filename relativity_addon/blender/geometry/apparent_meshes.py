@@ -96,7 +96,7 @@ def update_after_bake(scene, obj):
     """Recompute ``obj`` right after a bake (raises, so the bake operator reports the problem)."""
     with busy.computing():
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        update_object(scene, obj, snapshot.read(scene, depsgraph), depsgraph)
+        update_object(scene, obj, snapshot.read(scene, depsgraph, objects_for="GEOMETRY"), depsgraph)
 
 
 # Scene name -> names of meshes Set Up left out because their evaluated mesh has no vertices.

@@ -483,9 +483,11 @@ def check_time_of_flight(settings, lights):
         raise RelativityError(f"Time of Flight Only renders a scene at rest: light {lights[0].name!r} moves")
 
 
-def read(scene, depsgraph=None) -> Snapshot:
+def read(scene, depsgraph=None, objects_for=None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
-    cannot be rendered with correct physics."""
+    cannot be rendered with correct physics. ``objects_for`` checks the objects' own velocities for
+    that method instead of the scene's (the Apparent Geometry bakes read ``"GEOMETRY"``: they are
+    that path's tools, used before the method is chosen)."""
     settings = scene.relativity
     c = check_speed_of_light(settings.speed_of_light)
     camera = active_camera(scene)
@@ -505,7 +507,7 @@ def read(scene, depsgraph=None) -> Snapshot:
     time_of_flight = bool(settings.use_time_of_flight)
     if time_of_flight:
         check_time_of_flight(settings, lights)
-    check_object_velocities(scene, settings.method)
+    check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
