@@ -271,3 +271,20 @@ def test_mesh_without_vertices_is_skipped_with_a_warning(relativity_addon, facto
     assert any("'Nothing'" in warning and "no vertices" in warning for warning in warnings), warnings
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert not any("'Nothing'" in warning for warning in effect.scene_warnings(scene))
+
+
+def test_render_script_refuses_a_moving_mesh_on_the_exact_camera(relativity_addon, factory_blender, tmp_path):
+    """``examples/render.py`` on an Exact Camera file with a mesh given 0.3 c: it exits non-zero
+    naming the mesh, and writes no image (it used to render the mesh at rest and exit 0)."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    obj = _link(bpy, scene, "Sphere", _cube_mesh(bpy, "Sphere"))
+    _give_velocity(obj)
+    scene.relativity.method = "CAMERA"
+    blend = gh.ch.save_blend(bpy, tmp_path / "moving.blend")
+    out = tmp_path / "out.png"
+    result = gh.ch.run_render_script(blend, out, "--resolution=64x48", check=False)
+    print(f"render.py exit {result.returncode}: {result.stderr.strip().splitlines()[-1:]}")
+    assert result.returncode != 0
+    assert "'Sphere' has its own velocity" in result.stderr + result.stdout
+    assert not out.exists()

@@ -108,7 +108,8 @@ CASES = [
     case("CAMERA", "Blackbody", "temperature", 9000.0),
     case("CAMERA", "scene", "fast_illuminant", "BLACKBODY", base={"fast_illuminant_temperature": 2500.0}),
     case("CAMERA", "scene", "fast_illuminant_temperature", 2500.0, base={"fast_illuminant": "BLACKBODY"}),
-    case("CAMERA", "scene", "method", "GEOMETRY", objects={"Mover": CAMERA_MOVER}),  # switching the method after Set Up
+    case("CAMERA", "scene", "method", "GEOMETRY", base={"geometry_final_render": "PREVIEW"},
+         objects={"Mover": CAMERA_MOVER}),  # switching the method after Set Up
     # Apparent geometry: the scene settings that apply there, and every object setting.
     case("GEOMETRY", "scene", "speed_of_light", 15.0, base=FROM_ANIMATION),
     case("GEOMETRY", "scene", "beta", (0.4, -0.1, -0.5)),
