@@ -29,7 +29,7 @@ import bpy
 
 from ...errors import RelativityError
 from ..common import compat, names, osl
-from ..scene import snapshot
+from ..scene import lens, snapshot
 
 if TYPE_CHECKING:
     from bpy.types import Camera, Object, Scene
@@ -158,7 +158,7 @@ def _focus_surface_warning(scene, camera_object):
     except RelativityError:
         return None
     speed = math.sqrt(sum(b * b for b in beta))
-    focus = snapshot.focus_distance(camera_object)
+    focus = lens.focus_distance(camera_object)
     c = settings.speed_of_light
     if speed == 0.0 or focus is None or not (c > 0.0):
         return None

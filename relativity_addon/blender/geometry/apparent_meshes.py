@@ -25,7 +25,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ..common import busy, names
-from ..scene import snapshot
+from ..scene import moving_objects, snapshot
 from . import modifier, motion
 from .modifier import applied_objects, object_error
 
@@ -105,26 +105,59 @@ def update_after_bake(scene: Scene, obj: Object) -> None:
     """Recompute ``obj`` right after a bake (raises, so the bake operator reports the problem)."""
     with busy.computing():
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        update_object(scene, obj, snapshot.read(scene, depsgraph), depsgraph)
+        update_object(scene, obj, snapshot.read(scene, depsgraph, objects_for="GEOMETRY"), depsgraph)
+
+
+# Scene name -> names of meshes Set Up left out because their evaluated mesh has no vertices.
+_skipped_empty = {}
 
 
 def scene_errors(scene: Scene):
-    """One-line errors of the last update of each object (empty when every cache is current)."""
-    return [error for error in map(object_error, applied_objects(scene)) if error is not None]
+    """One-line errors of the last update of each object (empty when every cache is current), and
+    the meshes left out for having nothing to draw."""
+    errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
+    for name in _skipped_empty.get(scene.name, ()):
+        obj = scene.objects.get(name)
+        if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:
+            errors.append(f"Mesh {name!r} has no vertices: nothing to draw, left out of the apparent geometry")
+    return errors
+
+
+def instanced_by_moving(depsgraph, objects):
+    """The first of ``objects`` with its own velocity whose evaluated geometry draws instances or
+    other components (geometry nodes, particles, instancing) that the modifier does not move, or None."""
+    moving = {obj.name: obj for obj in objects if moving_objects.has_own_velocity(obj)}
+    if not moving:
+        return None
+    for instance in depsgraph.object_instances:
+        parent = instance.parent
+        if instance.is_instance and parent is not None and parent.original.name in moving:
+            return moving[parent.original.name]
+    return None
 
 
 def apply(scene: Scene, snap: Snapshot, objects=None):
     """Add the modifier to ``objects`` (default: every mesh of the scene whose
     ``relativity.enabled`` is on) and compute the snapshot's frame. Returns the objects.
+    Meshes whose evaluated mesh has no vertices are left out (a warning: nothing to draw).
 
-    Raises RelativityError (one line) if an object's settings are invalid; nothing is changed
-    in that case.
+    Raises RelativityError (one line) if an object's settings are invalid, or a moving mesh draws
+    instances the modifier cannot move; nothing is changed in that case.
     """
     if objects is None:
         objects = [obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled]
     for obj in objects:
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    instancer = instanced_by_moving(depsgraph, objects)
+    if instancer is not None:
+        raise RelativityError(
+            f"Mesh {instancer.name!r} draws instances or other geometry (geometry nodes, particles or instancing) "
+            "that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)")
+    empty = [obj for obj in objects if len(obj.evaluated_get(depsgraph).data.vertices) == 0]
+    objects = [obj for obj in objects if obj not in empty]
+    _skipped_empty[scene.name] = sorted({*_skipped_empty.get(scene.name, ()), *(obj.name for obj in empty)})
     try:
         with busy.computing():
             for obj in objects:
@@ -142,6 +175,8 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
 
 def remove(scene: Scene, objects=None):
     """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
+    if objects is None:
+        _skipped_empty.pop(scene.name, None)
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
     modifier.remove_unused_group()

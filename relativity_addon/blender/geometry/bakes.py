@@ -32,7 +32,7 @@ def _bake_frames(scene, obj, frame_start, frame_end):
         with busy.computing():
             depsgraph = bpy.context.evaluated_depsgraph_get()
             rest = modifier.evaluated_rest_positions(obj, depsgraph)
-        snap = snapshot.read(scene, depsgraph)
+        snap = snapshot.read(scene, depsgraph, objects_for="GEOMETRY")
         x_o, c = snap.camera_position, snap.speed_of_light
         if rest is not None and len(rest):
             world = to_world(matrix_array(obj.evaluated_get(depsgraph).matrix_world), rest)

@@ -22,9 +22,9 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import exposure
-from ...physics.shutter import ShutterModel, image_distance
+from ...physics.shutter import ShutterModel
 from ..common import names
-from . import animation, emitting_meshes, illuminants, sources
+from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Object, Scene
@@ -346,6 +346,8 @@ def _emitter_light(scene, obj, frame, depsgraph):
                         temperature=float(obj.relativity.temperature))]
 
 
+# Object types the Apparent Geometry path cannot move (their own velocity is refused, naming them)
+# and those that draw nothing in a render (a velocity there would move nothing, children included).
 # Scenes whose Apparent Geometry final render is running with the exact camera.
 _final_renders = set()
 
@@ -406,49 +408,11 @@ def check_time_of_flight(settings, lights) -> None:
         raise RelativityError(f"Time of Flight Only renders a scene at rest: light {lights[0].name!r} moves")
 
 
-def camera_lens_type(camera):
-    """The camera's own type (PERSP, PANO, ...), also while the exact camera has made it CUSTOM."""
-    saved = camera.data.get(names.CAMERA_SAVED_STATE_KEY)
-    return saved["type"] if saved is not None else camera.data.type
-
-
-def focal_length(scene, camera):
-    """The camera's focal length in scene units."""
-    return camera.data.lens * 1e-3 / (scene.unit_settings.scale_length or 1.0)
-
-
-def focus_distance(camera, matrix=None):
-    """The focus distance (scene units) of a camera with depth of field on, as Cycles takes it (a
-    focus object's distance along the view axis); None with depth of field off."""
-    dof = camera.data.dof
-    if not dof.use_dof:
-        return None
-    if dof.focus_object is None:
-        return float(dof.focus_distance)
-    matrix = np.array(camera.matrix_world if matrix is None else matrix, dtype=np.float64)
-    axis = -matrix[:3, 2] / max(np.linalg.norm(matrix[:3, 2]), 1e-30)
-    return float(axis @ (np.array(dof.focus_object.matrix_world.translation, dtype=np.float64) - matrix[:3, 3]))
-
-
-def check_detector_image(scene, camera, matrix=None):
-    """RelativityError (one line) when the detector-plane shutter has no detector: depth of field on
-    with the focus inside the focal length (the thin lens forms no real image). Depth of field off,
-    the detector is Blender's sensor at the focal length (``shutter.image_distance``)."""
-    if camera_lens_type(camera) != "PERSP":
-        return
-    focus = focus_distance(camera, matrix)
-    f = focal_length(scene, camera)
-    try:
-        image_distance(f, focus)
-    except ValueError:
-        scale = scene.unit_settings.scale_length or 1.0
-        raise RelativityError(f"Camera {camera.name!r}: focus distance {focus * scale:.3g} m is inside the focal "
-                              f"length {f * scale:.3g} m: no image forms (Detector Plane shutter)") from None
-
-
-def read(scene: Scene, depsgraph: Depsgraph | None = None) -> Snapshot:
+def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | None = None) -> Snapshot:
     """The snapshot of ``scene`` at its current frame; RelativityError (one line) if the scene
-    cannot be rendered with correct physics."""
+    cannot be rendered with correct physics. ``objects_for`` checks the objects' own velocities for
+    that method instead of the scene's (the Apparent Geometry bakes read ``"GEOMETRY"``: they are
+    that path's tools, used before the method is chosen)."""
     settings = scene.relativity
     c = check_speed_of_light(settings.speed_of_light)
     camera = active_camera(scene)
@@ -468,11 +432,12 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None) -> Snapshot:
     time_of_flight = bool(settings.use_time_of_flight)
     if time_of_flight:
         check_time_of_flight(settings, lights)
+    moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
-        check_detector_image(scene, camera, matrix)
+        lens.check_detector_image(scene, camera, matrix)
     return Snapshot(
         scene=scene.name,
         frame=frame,

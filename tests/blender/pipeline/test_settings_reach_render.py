@@ -70,6 +70,7 @@ BASE_OBJECTS = {
     "Blackbody": {"temperature": 4500.0},
     "Floor": {"tessellation": 1},
 }
+CAMERA_MOVER = {"motion": "STATIC"}
 ARBITRARY_PLANE = {"shutter_model": "ARBITRARY_PLANE", "shutter_plane_point": (0.0, 0.0, -1.0),
                    "shutter_plane_normal": (0.0, 0.0, -1.0)}
 FROM_ANIMATION = {"velocity_source": "CAMERA_ANIMATION"}
@@ -107,7 +108,8 @@ CASES = [
     case("CAMERA", "Blackbody", "temperature", 9000.0),
     case("CAMERA", "scene", "fast_illuminant", "BLACKBODY", base={"fast_illuminant_temperature": 2500.0}),
     case("CAMERA", "scene", "fast_illuminant_temperature", 2500.0, base={"fast_illuminant": "BLACKBODY"}),
-    case("CAMERA", "scene", "method", "GEOMETRY"),  # switching the method after Set Up
+    case("CAMERA", "scene", "method", "GEOMETRY", base={"geometry_final_render": "PREVIEW"},
+         objects={"Mover": CAMERA_MOVER}),  # switching the method after Set Up
     # Apparent geometry: the scene settings that apply there, and every object setting.
     case("GEOMETRY", "scene", "speed_of_light", 15.0, base=FROM_ANIMATION),
     case("GEOMETRY", "scene", "beta", (0.4, -0.1, -0.5)),
@@ -117,7 +119,8 @@ CASES = [
     case("GEOMETRY", "scene", "doppler_only_brightness", "SPECTRUM",
          base={"use_searchlight": False, "geometry_final_render": "PREVIEW"}),
     case("GEOMETRY", "scene", "velocity_source", "CAMERA_ANIMATION"),
-    case("GEOMETRY", "scene", "method", "CAMERA"),
+    case("GEOMETRY", "scene", "method", "CAMERA", base={"geometry_final_render": "PREVIEW"},
+         objects={"Mover": CAMERA_MOVER}),
     case("GEOMETRY", "Mover", "enabled", False),
     case("GEOMETRY", "Mover", "enabled", True, objects={"Mover": {"enabled": False}}),
     case("GEOMETRY", "Mover", "motion", "STATIC"),
@@ -204,8 +207,11 @@ def build_scene(bpy, method, scene_settings, object_settings):
         if name != "velocity_source":
             setattr(settings, name, value)
     settings.velocity_source = {**BASE_SCENE, **scene_settings}["velocity_source"]
-    for obj_name in set(BASE_OBJECTS) | set(object_settings):
-        values = {**BASE_OBJECTS.get(obj_name, {}), **object_settings.get(obj_name, {})}
+    # the exact camera photographs a static scene (an object's own velocity is refused there)
+    base_objects = {**BASE_OBJECTS, "Mover": {**BASE_OBJECTS["Mover"], **CAMERA_MOVER}} if method == "CAMERA" \
+        else BASE_OBJECTS
+    for obj_name in set(base_objects) | set(object_settings):
+        values = {**base_objects.get(obj_name, {}), **object_settings.get(obj_name, {})}
         for name, value in values.items():
             setattr(bpy.data.objects[obj_name].relativity, name, value)
     bpy.context.view_layer.update()

@@ -1,0 +1,93 @@
+"""Objects with their own velocity: which the render path of each Method can move, and the one-line
+refusal naming the others (read by ``snapshot.read``)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ...errors import RelativityError
+
+if TYPE_CHECKING:
+    pass
+
+
+TYPE_LABELS = {
+    "MESH": "Mesh", "CURVE": "Curve", "SURFACE": "Surface", "FONT": "Text", "META": "Metaball",
+    "POINTCLOUD": "Point cloud", "VOLUME": "Volume", "GPENCIL": "Grease pencil", "GREASEPENCIL": "Grease pencil",
+    "CURVES": "Hair curves", "EMPTY": "Empty", "CAMERA": "Camera", "SPEAKER": "Speaker",
+    "LIGHT_PROBE": "Light probe", "LIGHTPROBE": "Light probe", "ARMATURE": "Armature", "LATTICE": "Lattice",
+}
+DRAWS_NOTHING = ("EMPTY", "CAMERA", "SPEAKER", "LIGHT_PROBE", "LIGHTPROBE", "ARMATURE", "LATTICE")
+
+
+def has_own_velocity(obj):
+    """Whether the object's settings give it its own motion: ``relativity.enabled`` with Constant
+    Velocity of nonzero ``beta``, or with Animation (its keyframes or motion bake are its world
+    line). What the Apparent Geometry path moves (for meshes) and the exact camera cannot."""
+    settings = obj.relativity
+    if not settings.enabled or settings.motion == "STATIC":
+        return False
+    return settings.motion == "ANIMATION" or any(float(b) != 0.0 for b in settings.beta)
+
+
+def object_label(obj):
+    """``Text 'Name'``: the object's kind (a collection instance named so) and name."""
+    if obj.type == "EMPTY" and obj.instance_type == "COLLECTION" and obj.instance_collection is not None:
+        return f"Collection instance {obj.name!r}"
+    return f"{TYPE_LABELS.get(obj.type, obj.type.title())} {obj.name!r}"
+
+
+def draws_nothing(obj):
+    """Whether the object draws nothing in a render itself (an empty instancing a collection does)."""
+    return obj.type in DRAWS_NOTHING and not (obj.type == "EMPTY" and obj.instance_type == "COLLECTION"
+                                              and obj.instance_collection is not None)
+
+
+def _named(labels, limit=4):
+    shown = ", ".join(labels[:limit])
+    return shown + (f" and {len(labels) - limit} more" if len(labels) > limit else "")
+
+
+def mesh_instancer(obj):
+    """How a mesh draws other objects that the apparent-geometry modifier does not move (one
+    phrase), or None: rendered particle systems (hair, object or collection instances) and
+    vertex or face instancing. Geometry-nodes instances are found on the evaluated scene
+    (``apparent_meshes.apply``)."""
+    for modifier in obj.modifiers:
+        if modifier.type == "PARTICLE_SYSTEM" and modifier.show_render \
+                and modifier.particle_system.settings.render_type != "NONE":
+            return f"particle system {modifier.particle_system.name!r}"
+    if obj.instance_type in ("VERTS", "FACES") and len(obj.children):
+        return f"{obj.instance_type.lower()[:-1]} instancing"
+    return None
+
+
+def check_object_velocities(scene, method):
+    """RelativityError (one line) naming the objects whose own velocity ``method`` cannot render:
+    with the exact camera every object but lights (the moving-light stage takes those); with
+    Apparent Geometry every moving object that is not a mesh, and meshes drawing particles or
+    instances, which the modifier leaves where they are."""
+    moving = [obj for obj in scene.objects if obj.type != "LIGHT" and has_own_velocity(obj)]
+    if not moving:
+        return
+    if method == "CAMERA":
+        labels = [f"{obj.name!r}" for obj in moving]
+        subject = f"Object {labels[0]} has its own velocity" if len(labels) == 1 else \
+            f"Objects {_named(labels)} have their own velocities"
+        raise RelativityError(f"{subject}: the Exact Camera method photographs a static scene; choose Apparent "
+                              "Geometry (its final render uses the exact camera)")
+    problems = []
+    drawn = [object_label(obj) for obj in moving if obj.type != "MESH" and not draws_nothing(obj)]
+    if drawn:
+        problems.append(f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
+                        f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}")
+    for obj in moving:
+        if draws_nothing(obj):
+            problems.append(f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
+                            "meshes do not inherit it): set its Motion to Static, give moving meshes their own")
+        elif obj.type == "MESH" and (instancer := mesh_instancer(obj)) is not None:
+            problems.append(f"Mesh {obj.name!r} draws objects by its {instancer}, which cannot move on the "
+                            "Apparent Geometry path yet: make them real (Make Instances Real / Convert to Mesh)")
+    if problems:
+        raise RelativityError("; ".join(problems))
+
