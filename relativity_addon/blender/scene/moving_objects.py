@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ...errors import RelativityError
+from . import emitting_meshes
 
 if TYPE_CHECKING:
     pass
@@ -71,7 +72,10 @@ def check_object_velocities(scene, method):
     if not moving:
         return
     if method == "CAMERA":
-        labels = [f"{obj.name!r}" for obj in moving]
+        # emissive meshes with Lights the Scene are drawn by the moving-light stage, like lights
+        labels = [f"{obj.name!r}" for obj in moving if not emitting_meshes.is_emitter_light(obj)]
+        if not labels:
+            return
         subject = f"Object {labels[0]} has its own velocity" if len(labels) == 1 else \
             f"Objects {_named(labels)} have their own velocities"
         raise RelativityError(f"{subject}: the Exact Camera method photographs a static scene; choose Apparent "
