@@ -199,8 +199,20 @@ def run_child(command, out_path=None):
 
 def print_phases(blend, out_dir, method, options):
     launched = time.time()
-    _, peak, output = run_child([sys.executable, "-c", PHASES, REPO_ROOT, blend, os.path.join(out_dir, "phases.png"),
-                                 method, options.beta, str(options.samples), options.resolution])
+    _, peak, output = run_child(
+        [
+            sys.executable,
+            "-c",
+            PHASES,
+            REPO_ROOT,
+            blend,
+            os.path.join(out_dir, "phases.png"),
+            method,
+            options.beta,
+            str(options.samples),
+            options.resolution,
+        ]
+    )
     title = "plain render" if method == "plain" else f"batch script, --method {method}"
     print(f"\n{title}, one fresh process phase by phase (peak RSS {peak:.0f} MiB):")
     print(f"  {'phase':36s}{'time s':>8s}{'RSS MiB':>9s}{'peak MiB':>10s}")
@@ -228,11 +240,15 @@ def print_table(seconds, peaks):
         ratio_s = statistics.median(a / b for a, b in zip(seconds[label], plain_s, strict=True))
         extra_m = statistics.median(a - b for a, b in zip(peaks[label], plain_m, strict=True))
         ratio_m = statistics.median(a / b for a, b in zip(peaks[label], plain_m, strict=True))
-        print(f"  {label:30s}{statistics.median(seconds[label]):8.2f}{extra_s:+13.2f}{ratio_s:7.2f}"
-              f"{statistics.median(peaks[label]):10.0f}{extra_m:+7.0f}{ratio_m:7.2f}")
+        print(
+            f"  {label:30s}{statistics.median(seconds[label]):8.2f}{extra_s:+13.2f}{ratio_s:7.2f}"
+            f"{statistics.median(peaks[label]):10.0f}{extra_m:+7.0f}{ratio_m:7.2f}"
+        )
         if label != "plain render":
-            print(f"  {'':30s}{'(range':>8s}{min(seconds[label]):5.2f}-{max(seconds[label]):.2f} s, "
-                  f"{min(peaks[label]):.0f}-{max(peaks[label]):.0f} MiB)")
+            print(
+                f"  {'':30s}{'(range':>8s}{min(seconds[label]):5.2f}-{max(seconds[label]):.2f} s, "
+                f"{min(peaks[label]):.0f}-{max(peaks[label]):.0f} MiB)"
+            )
 
 
 def main():
@@ -241,11 +257,18 @@ def main():
     parser.add_argument("--resolution", default="64x48")
     parser.add_argument("--samples", type=int, default=1)
     parser.add_argument("--beta", default="0,0.48,-0.13", help="observer velocity for the batch script")
-    parser.add_argument("--grid", type=int, default=0,
-                        help="add a grid of about this many vertices to the scene (before the add-on's tessellation)")
+    parser.add_argument(
+        "--grid",
+        type=int,
+        default=0,
+        help="add a grid of about this many vertices to the scene (before the add-on's tessellation)",
+    )
     parser.add_argument("--phases", action="store_true", help="also time each phase of the batch script")
-    parser.add_argument("--as-environment", action="store_true",
-                        help="keep PYTHONDONTWRITEBYTECODE if set (default: cache bytecode, as on a user's machine)")
+    parser.add_argument(
+        "--as-environment",
+        action="store_true",
+        help="keep PYTHONDONTWRITEBYTECODE if set (default: cache bytecode, as on a user's machine)",
+    )
     options = parser.parse_args()
 
     work = tempfile.mkdtemp(prefix="batch-overhead-")
@@ -256,12 +279,21 @@ def main():
         ENV.pop("PYTHONDONTWRITEBYTECODE", None)
         ENV["PYTHONPYCACHEPREFIX"] = os.path.join(work, "pycache")
     blend = os.path.join(work, "room.blend")
-    subprocess.run([sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend,
-                    str(options.grid)],
-                   check=True, capture_output=True)
+    subprocess.run(
+        [sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend, str(options.grid)],
+        check=True,
+        capture_output=True,
+    )
     out = os.path.join(work, "frame.png")
-    common = ["--out", out, "--resolution", options.resolution, "--samples", str(options.samples),
-              f"--beta={options.beta}"]
+    common = [
+        "--out",
+        out,
+        "--resolution",
+        options.resolution,
+        "--samples",
+        str(options.samples),
+        f"--beta={options.beta}",
+    ]
     commands = {
         "plain render": [sys.executable, "-c", PLAIN_RENDER, blend, out, str(options.samples), options.resolution],
         "render.py --method camera": [sys.executable, RENDER_SCRIPT, blend, "--method", "camera", *common],
@@ -278,8 +310,10 @@ def main():
             peaks[label].append(peak)
 
     if options.repeats > 0:
-        print(f"{options.resolution}, {options.samples} sample(s), fresh process each, {options.repeats} alternating "
-              f"rounds, medians (load {os.getloadavg()[0]:.2f}):")
+        print(
+            f"{options.resolution}, {options.samples} sample(s), fresh process each, {options.repeats} alternating "
+            f"rounds, medians (load {os.getloadavg()[0]:.2f}):"
+        )
         print_table(seconds, peaks)
 
     if options.phases:

@@ -89,8 +89,10 @@ def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
     base = times[cases[0][0]]
     for label, _ in cases:
         ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
-        print(f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
-              f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})")
+        print(
+            f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
+            f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})"
+        )
 
 
 def main():
@@ -108,8 +110,11 @@ def main():
     relativity_addon.register()
     scene = build_scene(bpy, resolution, options.samples)
     out = tempfile.mkdtemp(prefix="camera-overhead-")
-    cases = (("perspective", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
-             ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)))
+    cases = (
+        ("perspective", None),
+        ("relativistic beta=0", (0.0, 0.0, 0.0)),
+        ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)),
+    )
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
     compare_cameras(bpy, scene, cases, options.repeats, out)
 

@@ -51,8 +51,9 @@ ENV.pop("PYTHONPATH", None)
 def run(command):
     """(wall seconds, stdout lines with their arrival time since launch)."""
     start = time.perf_counter()
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
-                               cwd=REPO_ROOT)
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV, cwd=REPO_ROOT
+    )
     lines = []
     for line in process.stdout:
         lines.append((time.perf_counter() - start, line.rstrip("\n")))
@@ -72,11 +73,22 @@ def seconds_of(text):
 
 
 def measure(blend, work, options, samples, rounds):
-    common = [f"--frames=1-{options.frames}", f"--resolution={options.resolution}", f"--samples={samples}",
-              "--beta=0,0.48,-0.13"]
+    common = [
+        f"--frames=1-{options.frames}",
+        f"--resolution={options.resolution}",
+        f"--samples={samples}",
+        "--beta=0,0.48,-0.13",
+    ]
     single = [sys.executable, RENDER_SCRIPT, blend, *common, f"--out={os.path.join(work, 'single', 'f.png')}"]
-    cluster = [sys.executable, RENDER_SCRIPT, blend, *common, f"--out={os.path.join(work, 'cluster', 'f.png')}",
-               f"--workers={options.workers}", "--no-resume"]
+    cluster = [
+        sys.executable,
+        RENDER_SCRIPT,
+        blend,
+        *common,
+        f"--out={os.path.join(work, 'cluster', 'f.png')}",
+        f"--workers={options.workers}",
+        "--no-resume",
+    ]
     chunk = -(-options.frames // options.workers)
     chunked = [*cluster, f"--chunk={chunk}"]
     result = {key: [] for key in ("single", "cluster", "chunked", "frame", "task", "start")}
@@ -108,20 +120,31 @@ def main():
     ENV.pop("PYTHONDONTWRITEBYTECODE", None)  # cache bytecode as on a user's machine (see batch_overhead.py)
     ENV["PYTHONPYCACHEPREFIX"] = os.path.join(work, "pycache")
     blend = os.path.join(work, "room.blend")
-    subprocess.run([sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend],
-                   check=True, capture_output=True, env=ENV)
-    print(f"{options.frames} frames of {options.resolution}, exact camera; single process (all {os.cpu_count()} "
-          f"cores) vs Dask LocalCluster of {options.workers} workers (a fresh Blender per frame); "
-          f"medians of {options.repeats} alternating rounds")
+    subprocess.run(
+        [sys.executable, "-c", BUILD_SCENE, os.path.dirname(os.path.abspath(__file__)), blend],
+        check=True,
+        capture_output=True,
+        env=ENV,
+    )
+    print(
+        f"{options.frames} frames of {options.resolution}, exact camera; single process (all {os.cpu_count()} "
+        f"cores) vs Dask LocalCluster of {options.workers} workers (a fresh Blender per frame); "
+        f"medians of {options.repeats} alternating rounds"
+    )
     chunk = -(-options.frames // options.workers)
-    print(f"  {'samples':>7s}{'single s':>10s}{'cluster s':>11s}{'ratio':>7s}{'single f/s':>12s}{'cluster f/s':>13s}"
-          f"{'frame s':>9s}{'task s':>8s}{'overhead s':>12s}{'start s':>9s}{f'chunk {chunk} s':>11s}{'ratio':>7s}")
+    print(
+        f"  {'samples':>7s}{'single s':>10s}{'cluster s':>11s}{'ratio':>7s}{'single f/s':>12s}{'cluster f/s':>13s}"
+        f"{'frame s':>9s}{'task s':>8s}{'overhead s':>12s}{'start s':>9s}{f'chunk {chunk} s':>11s}{'ratio':>7s}"
+    )
     for samples in (int(value) for value in options.samples.split(",")):
         m = measure(blend, work, options, samples, options.repeats)
-        print(f"  {samples:7d}{m['single']:10.2f}{m['cluster']:11.2f}{m['cluster'] / m['single']:7.2f}"
-              f"{options.frames / m['single']:12.2f}{options.frames / m['cluster']:13.2f}{m['frame']:9.2f}"
-              f"{m['task']:8.2f}{m['task'] - m['frame']:12.2f}{m['start']:9.2f}{m['chunked']:11.2f}"
-              f"{m['chunked'] / m['single']:7.2f}", flush=True)
+        print(
+            f"  {samples:7d}{m['single']:10.2f}{m['cluster']:11.2f}{m['cluster'] / m['single']:7.2f}"
+            f"{options.frames / m['single']:12.2f}{options.frames / m['cluster']:13.2f}{m['frame']:9.2f}"
+            f"{m['task']:8.2f}{m['task'] - m['frame']:12.2f}{m['start']:9.2f}{m['chunked']:11.2f}"
+            f"{m['chunked'] / m['single']:7.2f}",
+            flush=True,
+        )
     print(f"(load average at the end: {os.getloadavg()[0]:.2f})")
 
 

@@ -62,8 +62,9 @@ def core_throughput(count, repeats):
     rng = np.random.default_rng(1)
     points = rng.uniform(-1.0, 1.0, (count, 3)) + np.array([0.0, 0.0, -6.0])
     c, t_o, x_o = 10.0, 1.0, np.zeros(3)
-    uniform = best_time(lambda: apparent.apparent_positions_uniform(
-        t_o, x_o, points, (0.9, 0.0, 0.0), c, (0.0, 0.3, 0.0)), repeats)
+    uniform = best_time(
+        lambda: apparent.apparent_positions_uniform(t_o, x_o, points, (0.9, 0.0, 0.0), c, (0.0, 0.3, 0.0)), repeats
+    )
     # Wheel-like rigid motion: spin about z at 4 rad/s while drifting (|v| < 0.9 c); 24 fps, 8 samples a frame.
     times = np.arange(-2.0, 1.5, 1.0 / 192.0)
     angle = 4.0 * times
@@ -76,8 +77,12 @@ def core_throughput(count, repeats):
     local = points - np.array([0.0, 0.0, -6.0])
     motion = apparent.SampledRigidMotion(times, matrices, local)
     keyframed = best_time(lambda: apparent.apparent_positions_sampled(motion, t_o, x_o, c, (0.0, 0.3, 0.0)), repeats)
-    general = best_time(lambda: apparent.apparent_positions(
-        motion.positions, t_o, x_o, c, count, (0.0, 0.3, 0.0), velocity=motion.velocities), 1)
+    general = best_time(
+        lambda: apparent.apparent_positions(
+            motion.positions, t_o, x_o, c, count, (0.0, 0.3, 0.0), velocity=motion.velocities
+        ),
+        1,
+    )
     return count / uniform, count / keyframed, count / general
 
 
@@ -93,8 +98,9 @@ def addon_throughput(bpy, count, repeats):
     scene.collection.objects.link(camera)
     scene.camera = camera
     scene.relativity.speed_of_light = 10.0
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=2.0,
-                                    location=(0.0, 0.0, -6.0))
+    bpy.ops.mesh.primitive_grid_add(
+        x_subdivisions=side - 1, y_subdivisions=side - 1, size=2.0, location=(0.0, 0.0, -6.0)
+    )
     grid = bpy.context.object
     vertices = len(grid.data.vertices)
     grid.relativity.tessellation = 0
@@ -103,6 +109,7 @@ def addon_throughput(bpy, count, repeats):
     scene.relativity.method = "GEOMETRY"
     effect.apply(scene)
     depsgraph = bpy.context.evaluated_depsgraph_get()
+
     def update():
         return geometry.update_object(scene, grid, snapshot.read(scene, depsgraph), depsgraph)
 
@@ -174,17 +181,21 @@ def main():
     batch.enable_addon()
 
     grid_vertices, addon_uniform, addon_keyframed = addon_throughput(bpy, options.vertices, options.repeats)
-    print_throughput_table([
-        ("physics core, constant velocity", options.vertices, core_uniform, None),
-        ("physics core, keyframed rigid motion", options.vertices, core_keyframed, KEYFRAMED_TARGET),
-        ("add-on update, constant velocity", grid_vertices, addon_uniform, CONSTANT_VELOCITY_TARGET),
-        ("add-on update, keyframed", grid_vertices, addon_keyframed, KEYFRAMED_TARGET),
-    ])
+    print_throughput_table(
+        [
+            ("physics core, constant velocity", options.vertices, core_uniform, None),
+            ("physics core, keyframed rigid motion", options.vertices, core_keyframed, KEYFRAMED_TARGET),
+            ("add-on update, constant velocity", grid_vertices, addon_uniform, CONSTANT_VELOCITY_TARGET),
+            ("add-on update, keyframed", grid_vertices, addon_keyframed, KEYFRAMED_TARGET),
+        ]
+    )
 
     batch.enable_addon()
     plain, mesh, ratio = render_overhead(bpy, resolution, options.samples, options.repeats)
-    print(f"render {resolution[0]}x{resolution[1]}, {options.samples} samples: plain {plain:.2f} s, "
-          f"mesh path at 0.8c {mesh:.2f} s, ratio {ratio:.2f} (median of {options.repeats} alternating rounds)")
+    print(
+        f"render {resolution[0]}x{resolution[1]}, {options.samples} samples: plain {plain:.2f} s, "
+        f"mesh path at 0.8c {mesh:.2f} s, ratio {ratio:.2f} (median of {options.repeats} alternating rounds)"
+    )
 
 
 if __name__ == "__main__":

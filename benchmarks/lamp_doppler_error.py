@@ -27,8 +27,12 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from relativity_addon.physics import lamp_doppler  # noqa: E402
 
-DIRECTIONS = {"ahead": (1.0, 0.0, 0.0), "behind": (-1.0, 0.0, 0.0), "side": (0.0, -1.0, 0.0),
-              "45 deg ahead": (0.7071, -0.7071, 0.0)}
+DIRECTIONS = {
+    "ahead": (1.0, 0.0, 0.0),
+    "behind": (-1.0, 0.0, 0.0),
+    "side": (0.0, -1.0, 0.0),
+    "45 deg ahead": (0.7071, -0.7071, 0.0),
+}
 
 
 def table(beta_x, count, distances=(3.0, 10.0, 30.0)):
@@ -41,8 +45,9 @@ def table(beta_x, count, distances=(3.0, 10.0, 30.0)):
             exact = lamp_doppler.exact_irradiance(points, rest_normals, lamp, beta)
             rendered = lamp_doppler.one_factor_irradiance(points, scene_normals, lamp, (0.0, 0.0, 0.0), beta)
             rest_shaded = lamp_doppler.one_factor_irradiance(points, rest_normals, lamp, (0.0, 0.0, 0.0), beta)
-            unturned = lamp_doppler.one_factor_irradiance(points, scene_normals, lamp, (0.0, 0.0, 0.0), beta,
-                                                          aberrate=False)
+            unturned = lamp_doppler.one_factor_irradiance(
+                points, scene_normals, lamp, (0.0, 0.0, 0.0), beta, aberrate=False
+            )
             offset = points - lamp
             k = offset / np.linalg.norm(offset, axis=-1, keepdims=True)
             per_point = lamp_doppler.lamp_to_object_doppler(k, beta)
@@ -50,11 +55,18 @@ def table(beta_x, count, distances=(3.0, 10.0, 30.0)):
             lit = unturned > 0.0
             one_d = centre**2 / per_point**2 - 1.0
             weights = unturned[lit]
-            rows.append((distance, name, float(centre), float(np.max(np.abs(one_d[lit]))),
-                         float(np.sum(np.abs(one_d[lit]) * weights) / np.sum(weights)),
-                         float(np.sum(np.abs(unturned - exact)) / np.sum(exact)),
-                         float(np.sum(np.abs(rendered - exact)) / np.sum(exact)),
-                         float(np.sum(np.abs(rest_shaded - exact)) / np.sum(exact))))
+            rows.append(
+                (
+                    distance,
+                    name,
+                    float(centre),
+                    float(np.max(np.abs(one_d[lit]))),
+                    float(np.sum(np.abs(one_d[lit]) * weights) / np.sum(weights)),
+                    float(np.sum(np.abs(unturned - exact)) / np.sum(exact)),
+                    float(np.sum(np.abs(rendered - exact)) / np.sum(exact)),
+                    float(np.sum(np.abs(rest_shaded - exact)) / np.sum(exact)),
+                )
+            )
     return rows
 
 
@@ -64,12 +76,16 @@ def main():
     parser.add_argument("--count", type=int, default=20000)
     args = parser.parse_args()
     print(f"sphere of rest radius 1 at {args.beta} c, point lamp at rest at distance d")
-    print("| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | turned, contracted normals "
-          "| turned, rest normals (as rendered) |")
+    print(
+        "| d | lamp | D (centre) | D^2 spread | one D | total, lamp unturned | turned, contracted normals "
+        "| turned, rest normals (as rendered) |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for distance, name, centre, spread, one_d, unturned, total, rest in table(args.beta, args.count):
-        print(f"| {distance:g} | {name} | {centre:.3f} | {spread:.1%} | {one_d:.1%} | {unturned:.1%} | {total:.1%} "
-              f"| {rest:.1%} |")
+        print(
+            f"| {distance:g} | {name} | {centre:.3f} | {spread:.1%} | {one_d:.1%} | {unturned:.1%} | {total:.1%} "
+            f"| {rest:.1%} |"
+        )
 
 
 if __name__ == "__main__":

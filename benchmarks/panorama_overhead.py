@@ -62,9 +62,13 @@ def minimal_osl_camera(scene):
 
 def close_room(bpy):
     """Walls and a ceiling around the open scene (a 20 x 20 x 8 box on its floor)."""
-    for location, rotation in (((0, 10, 4), (math.pi / 2, 0, 0)), ((0, -10, 4), (math.pi / 2, 0, 0)),
-                               ((10, 0, 4), (0, math.pi / 2, 0)), ((-10, 0, 4), (0, math.pi / 2, 0)),
-                               ((0, 0, 8), (0, 0, 0))):
+    for location, rotation in (
+        ((0, 10, 4), (math.pi / 2, 0, 0)),
+        ((0, -10, 4), (math.pi / 2, 0, 0)),
+        ((10, 0, 4), (0, math.pi / 2, 0)),
+        ((-10, 0, 4), (0, math.pi / 2, 0)),
+        ((0, 0, 8), (0, 0, 0)),
+    ):
         bpy.ops.mesh.primitive_plane_add(size=20.0, location=location, rotation=rotation)
 
 
@@ -73,8 +77,11 @@ def main():
     parser.add_argument("--samples", type=int, default=64)
     parser.add_argument("--resolution", default="320x160")
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--types", default="EQUIRECTANGULAR,FISHEYE_EQUISOLID,STEREO",
-                        help="panorama types, and STEREO: the perspective camera's stereo pair (multiview)")
+    parser.add_argument(
+        "--types",
+        default="EQUIRECTANGULAR,FISHEYE_EQUISOLID,STEREO",
+        help="panorama types, and STEREO: the perspective camera's stereo pair (multiview)",
+    )
     parser.add_argument("--room", action="store_true", help="close the scene with walls and a ceiling")
     options = parser.parse_args()
     resolution = tuple(int(v) for v in options.resolution.lower().split("x"))
@@ -85,8 +92,11 @@ def main():
 
     relativity_addon.register()
     out = tempfile.mkdtemp(prefix="panorama-overhead-")
-    cases = (("Blender's camera", None), ("relativistic beta=0", (0.0, 0.0, 0.0)),
-             ("relativistic beta=0.5", (0.0, 0.48, -0.13)))
+    cases = (
+        ("Blender's camera", None),
+        ("relativistic beta=0", (0.0, 0.0, 0.0)),
+        ("relativistic beta=0.5", (0.0, 0.48, -0.13)),
+    )
     print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
     for panorama_type in options.types.split(","):
         scene = build_scene(bpy, resolution, options.samples)

@@ -52,11 +52,15 @@ def main():
         fast_times.append(timed_render(bpy, scene, os.path.join(out, f"{round_index}.png")))
         spectral_times.append(spectral())
     ratios = [s / f for s, f in zip(spectral_times, fast_times, strict=True)]
-    print(f"{options.resolution}, {options.samples} samples, {options.passes} passes, "
-          f"{options.repeats} alternating rounds, medians:")
+    print(
+        f"{options.resolution}, {options.samples} samples, {options.passes} passes, "
+        f"{options.repeats} alternating rounds, medians:"
+    )
     print(f"  fast (RGB) render   {statistics.median(fast_times):7.3f} s")
-    print(f"  spectral render     {statistics.median(spectral_times):7.3f} s   ratio {statistics.median(ratios):5.2f}"
-          f"   (ratios {min(ratios):.2f}-{max(ratios):.2f}; target {options.passes * 1.05:.2f})")
+    print(
+        f"  spectral render     {statistics.median(spectral_times):7.3f} s   ratio {statistics.median(ratios):5.2f}"
+        f"   (ratios {min(ratios):.2f}-{max(ratios):.2f}; target {options.passes * 1.05:.2f})"
+    )
 
 
 if __name__ == "__main__":

@@ -28,8 +28,10 @@ from pathlib import Path
 try:
     import bpy
 except ImportError:
-    sys.exit("demo_still.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
-             "or blender -b --python examples/demo_still.py -- OPTIONS")
+    sys.exit(
+        "demo_still.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+        "or blender -b --python examples/demo_still.py -- OPTIONS"
+    )
 
 EXAMPLES_DIR = Path(__file__).resolve().parent
 REPO_ROOT = EXAMPLES_DIR.parent
@@ -107,8 +109,9 @@ def main(argv=None):
     parser.add_argument("--width", type=int, default=320)
     parser.add_argument("--height", type=int, default=240)
     parser.add_argument("--samples", type=int, default=32)
-    parser.add_argument("--speed", type=float, default=0.9,
-                        help="camera speed toward the scene, fraction of c (0: photo at rest)")
+    parser.add_argument(
+        "--speed", type=float, default=0.9, help="camera speed toward the scene, fraction of c (0: photo at rest)"
+    )
     parser.add_argument("--doppler", action="store_true", help="also render the Doppler colour shift")
     args = parser.parse_args(argv)
     if not 0.0 <= args.speed < 1.0:

@@ -23,8 +23,10 @@ from pathlib import Path
 try:
     import bpy
 except ImportError:
-    sys.exit("flythrough.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
-             "or blender -b --python examples/flythrough.py -- OPTIONS")
+    sys.exit(
+        "flythrough.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+        "or blender -b --python examples/flythrough.py -- OPTIONS"
+    )
 
 EXAMPLES_DIR = Path(__file__).resolve().parent
 REPO_ROOT = EXAMPLES_DIR.parent
@@ -41,6 +43,7 @@ BLOCK_COLOURS = (scenes.RED, scenes.GREEN, scenes.BLUE, scenes.YELLOW, (0.7, 0.7
 def hyperbolic_position(t, c, acceleration, t_cruise):
     """Distance (m) at time t (s) of a world line with constant proper acceleration up to
     ``t_cruise``, then constant velocity: x = (c^2/a)(sqrt(1 + (a t / c)^2) - 1)."""
+
     def accelerating(time):
         return c * c / acceleration * (math.sqrt(1.0 + (acceleration * time / c) ** 2) - 1.0)
 
@@ -144,8 +147,15 @@ def main(argv=None):
     out_dir = Path(options.out).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     try:
-        blend = build(out_dir, options.frames, options.beta_max, options.speed_of_light,
-                      options.resolution, options.samples, searchlight=not options.no_searchlight)
+        blend = build(
+            out_dir,
+            options.frames,
+            options.beta_max,
+            options.speed_of_light,
+            options.resolution,
+            options.samples,
+            searchlight=not options.no_searchlight,
+        )
     except Exception as error:  # noqa: BLE001 - one line, never a traceback
         print(f"flythrough.py: error: {error}", file=sys.stderr)
         return 1
@@ -154,8 +164,10 @@ def main(argv=None):
         return status
     print(f"flythrough.py: saved {blend}")
     print("flythrough.py: make a video with:")
-    print(f"  ffmpeg -framerate {bpy.context.scene.render.fps} -i {out_dir / 'fly_%04d.png'} "
-          f"-c:v libx264 -pix_fmt yuv420p {out_dir / 'flythrough.mp4'}")
+    print(
+        f"  ffmpeg -framerate {bpy.context.scene.render.fps} -i {out_dir / 'fly_%04d.png'} "
+        f"-c:v libx264 -pix_fmt yuv420p {out_dir / 'flythrough.mp4'}"
+    )
     return 0
 
 

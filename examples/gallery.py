@@ -23,8 +23,10 @@ from pathlib import Path
 try:
     import bpy
 except ImportError:
-    sys.exit("gallery.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
-             "or blender -b --python examples/gallery.py -- OPTIONS")
+    sys.exit(
+        "gallery.py needs Blender's Python or the bpy module: run ./dev.sh demo (which sets up .venv-5.2), "
+        "or blender -b --python examples/gallery.py -- OPTIONS"
+    )
 import numpy as np
 
 EXAMPLES_DIR = Path(__file__).resolve().parent
@@ -150,7 +152,7 @@ def contact_sheet(out_dir, names, columns=4, tile=(240, 180)):
         bpy.data.images.remove(image)
         r, c = divmod(index, columns)
         top = (rows - 1 - r) * (th + 4) + 2  # Blender's pixel rows run bottom up
-        sheet[top:top + th, c * (tw + 4) + 2:c * (tw + 4) + 2 + tw] = pixels.reshape(th, tw, 4)
+        sheet[top : top + th, c * (tw + 4) + 2 : c * (tw + 4) + 2 + tw] = pixels.reshape(th, tw, 4)
     image = bpy.data.images.new("Contact sheet", sheet.shape[1], sheet.shape[0])
     image.colorspace_settings.name = "sRGB"
     image.pixels.foreach_set(sheet.ravel())
@@ -196,8 +198,9 @@ def main(argv=None):
     numbers = gallery_measure.measure_all(images, contexts)
     for name, values in numbers.items():
         print(f"{name}: " + "; ".join(f"{key} = {value:.4g}" for key, value in values.items()))
-    (out_dir / "measurements.json").write_text(json.dumps(
-        {"size": list(args.size), "samples": args.samples, "numbers": numbers}, indent=1) + "\n")
+    (out_dir / "measurements.json").write_text(
+        json.dumps({"size": list(args.size), "samples": args.samples, "numbers": numbers}, indent=1) + "\n"
+    )
     contact_sheet(out_dir, names)
     docs_gallery = REPO_ROOT / "docs" / "gallery"
     if names == list(FIGURES) and out_dir == docs_gallery.resolve():

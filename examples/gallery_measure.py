@@ -141,8 +141,10 @@ def street(images, contexts):
             values[f"{label} mean D"] = d[box].mean()
         out[name] = values
     if "weiskopf_fig4_street_rest" in images:
-        out["weiskopf_fig5_street_geometry"] = {"D at the image centre": d[d.shape[0] // 2, d.shape[1] // 2],
-                                                "D at the image corner": d[0, 0]}
+        out["weiskopf_fig5_street_geometry"] = {
+            "D at the image centre": d[d.shape[0] // 2, d.shape[1] // 2],
+            "D at the image corner": d[0, 0],
+        }
     return out
 
 
@@ -154,8 +156,12 @@ def _blackbody_y():
     shape = colour.SpectralShape(360, 830, 1)
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
     factors = np.linspace(0.3, 3.0, 136)
-    ys = np.array([colour.sd_to_XYZ(colour.sd_blackbody(f * SUN_TEMPERATURE, shape), cmfs,
-                                    method="Integration")[1] for f in factors])
+    ys = np.array(
+        [
+            colour.sd_to_XYZ(colour.sd_blackbody(f * SUN_TEMPERATURE, shape), cmfs, method="Integration")[1]
+            for f in factors
+        ]
+    )
     y_rest = colour.sd_to_XYZ(colour.sd_blackbody(SUN_TEMPERATURE, shape), cmfs, method="Integration")[1]
     return lambda d: np.interp(d, factors, ys) / y_rest
 
@@ -163,8 +169,13 @@ def _blackbody_y():
 def _cct(rgb):
     import colour
 
-    xyz = colour.RGB_to_XYZ(rgb, colour.RGB_COLOURSPACES["ITU-R BT.709"], illuminant=None,
-                            chromatic_adaptation_transform=None, apply_cctf_decoding=False)
+    xyz = colour.RGB_to_XYZ(
+        rgb,
+        colour.RGB_COLOURSPACES["ITU-R BT.709"],
+        illuminant=None,
+        chromatic_adaptation_transform=None,
+        apply_cctf_decoding=False,
+    )
     uv = colour.xy_to_UCS_uv(colour.XYZ_to_xy(xyz))
     return float(colour.temperature.uv_to_CCT(uv, method="Ohno 2013")[0])
 
@@ -173,8 +184,9 @@ def _sun_cores(y):
     """Per Sun (left to right): the mask of its image's inner pixels (all 3 x 3 neighbours lit)."""
     lit = y > 0.02 * y.max()
     inner = lit.copy()
-    inner[1:-1, 1:-1] = np.all([np.roll(np.roll(lit, i, 0), j, 1)[1:-1, 1:-1]
-                                for i in (-1, 0, 1) for j in (-1, 0, 1)], axis=0)
+    inner[1:-1, 1:-1] = np.all(
+        [np.roll(np.roll(lit, i, 0), j, 1)[1:-1, 1:-1] for i in (-1, 0, 1) for j in (-1, 0, 1)], axis=0
+    )
     inner[[0, -1], :] = False
     inner[:, [0, -1]] = False
     columns = inner.any(axis=0)
@@ -223,8 +235,13 @@ def suns(images, contexts):
 
 def sphere_arrays(images, contexts):
     out, radii = {}, {}
-    for name in ("gray_fig3b_aperture_plane", "gray_fig4_aperture_plane_huge", "gray_fig5_detector_plane",
-                 "gray_fig6b_phase_hologram", "gray_fig7_focus_surface"):
+    for name in (
+        "gray_fig3b_aperture_plane",
+        "gray_fig4_aperture_plane_huge",
+        "gray_fig5_detector_plane",
+        "gray_fig6b_phase_hologram",
+        "gray_fig7_focus_surface",
+    ):
         if name not in images:
             continue
         context = contexts[name]
@@ -253,8 +270,13 @@ def sphere_arrays(images, contexts):
 
 def tiles(images, contexts):
     out = {}
-    for name in ("gray_fig1a_rest", "gray_fig1b_pinhole", "gray_fig1c_time_of_flight",
-                 "gray_fig1c_time_of_flight_enlarged", "gray_fig1_wide_aperture"):
+    for name in (
+        "gray_fig1a_rest",
+        "gray_fig1b_pinhole",
+        "gray_fig1c_time_of_flight",
+        "gray_fig1c_time_of_flight_enlarged",
+        "gray_fig1_wide_aperture",
+    ):
         if name not in images:
             continue
         context, image = contexts[name], images[name]
@@ -266,9 +288,13 @@ def tiles(images, contexts):
         y = luminance(image)
         sharp = np.abs(np.diff(y, axis=1)).mean() + np.abs(np.diff(y, axis=0)).mean()
         formula = "time-of-flight formula" if context.get("time_of_flight") else "pinhole aberration formula"
-        out[name] = {"red sphere centroid x (px)": measured[0], "red sphere centroid y (px)": measured[1],
-                     f"{formula} x (px)": expected[0], f"{formula} y (px)": expected[1],
-                     "mean |luminance gradient| (per px)": sharp}
+        out[name] = {
+            "red sphere centroid x (px)": measured[0],
+            "red sphere centroid y (px)": measured[1],
+            f"{formula} x (px)": expected[0],
+            f"{formula} y (px)": expected[1],
+            "mean |luminance gradient| (per px)": sharp,
+        }
     return out
 
 
@@ -287,10 +313,13 @@ def cylinders(images, contexts):
         b, _ = spot(np.clip(moving[..., 0] - moving[..., 1], 0, None), pixel, half)
         if a is not None and b is not None:
             shifts.append(np.linalg.norm(a - b))
-    return {"gray_fig8b_fixed_point_surface": {
-        "red discs found": len(shifts),
-        "red discs in the focus plane, max shift from Fig. 8(a) (px)": max(shifts),
-        "mean |Fig. 8(b) - Fig. 8(a)|, whole image": np.abs(moving - rest).mean()}}
+    return {
+        "gray_fig8b_fixed_point_surface": {
+            "red discs found": len(shifts),
+            "red discs in the focus plane, max shift from Fig. 8(a) (px)": max(shifts),
+            "mean |Fig. 8(b) - Fig. 8(a)|, whole image": np.abs(moving - rest).mean(),
+        }
+    }
 
 
 def window_residual_pixels(context, pixels):
@@ -304,13 +333,25 @@ def window_residual_pixels(context, pixels):
     left, right, bottom, top = context["window"]
     width, height = context["size"]
     pixels = np.asarray(pixels, float)
-    view = np.stack([left + pixels[:, 0] / width * (right - left), top - pixels[:, 1] / height * (top - bottom),
-                     -np.ones(len(pixels))], axis=-1)
+    view = np.stack(
+        [
+            left + pixels[:, 0] / width * (right - left),
+            top - pixels[:, 1] / height * (top - bottom),
+            -np.ones(len(pixels)),
+        ],
+        axis=-1,
+    )
     object_points = view * PORTRAIT_FOCUS
     image_distance = 1.0 / (1.0 / (PORTRAIT_LENS_MM * 1e-3) - 1.0 / PORTRAIT_FOCUS)
     lens = np.zeros_like(object_points)
-    t_lens = lens_time("DETECTOR_PLANE", lens, object_points, c=1.0, shutter_time=context["shutter_time"],
-                       detector_point=-object_points * (image_distance / PORTRAIT_FOCUS))
+    t_lens = lens_time(
+        "DETECTOR_PLANE",
+        lens,
+        object_points,
+        c=1.0,
+        shutter_time=context["shutter_time"],
+        detector_point=-object_points * (image_distance / PORTRAIT_FOCUS),
+    )
     window_point, window_normal = fixed_point_plane(context["window_time"], GRAY_BETA, 1.0)
     _, origin, forward = lorentz_window_ray(lens, object_points, t_lens, GRAY_BETA, 1.0, window_point, window_normal)
     backdrop = origin - forward * ((origin[:, 2] + BACKDROP_DEPTH) / forward[:, 2])[:, None]
@@ -328,6 +369,8 @@ def bilinear(image, pixels):
     top = image[y0, x0] * (1 - fx) + image[y0, x0 + 1] * fx
     bottom = image[y0 + 1, x0] * (1 - fx) + image[y0 + 1, x0 + 1] * fx
     return top * (1 - fy) + bottom * fy
+
+
 def pupil_parallax(anaglyph, context, eye_separation=0.4, convergence=5.0):
     """Left-minus-right image offset of the portrait's two pupils (dark discs on the white eyes) in a
     red-cyan anaglyph (red: the left eye's view, green: the right eye's), against the off-axis pair's
@@ -350,23 +393,30 @@ def pupil_parallax(anaglyph, context, eye_separation=0.4, convergence=5.0):
         offsets.append(left - right)
         expected.append(2.0 * delta)
     offsets = np.array(offsets)
-    return {"pupils' parallax left - right, x (px), mean of two": offsets[:, 0].mean(),
-            "off-axis parallax of the pupils' depth, x (px)": float(np.mean(expected)),
-            "pupils' parallax left - right, y (px), mean of two": offsets[:, 1].mean()}
+    return {
+        "pupils' parallax left - right, x (px), mean of two": offsets[:, 0].mean(),
+        "off-axis parallax of the pupils' depth, x (px)": float(np.mean(expected)),
+        "pupils' parallax left - right, y (px), mean of two": offsets[:, 1].mean(),
+    }
 
 
 def portrait(images, contexts):
     out = {}
     for rest_name, names, label in (
-            ("gray_fig9a_rest", ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"),
-             "Fig. 9(a)"),
-            ("gray_fig11a_stereo_rest", ("gray_fig11b_stereo_moving", "gray_fig11c_stereo_lorentz_window"),
-             "Fig. 11(a)")):
+        (
+            "gray_fig9a_rest",
+            ("gray_fig9b_moving", "gray_fig9c_lorentz_window", "gray_fig10_window_detector_plane"),
+            "Fig. 9(a)",
+        ),
+        ("gray_fig11a_stereo_rest", ("gray_fig11b_stereo_moving", "gray_fig11c_stereo_lorentz_window"), "Fig. 11(a)"),
+    ):
         rest = images.get(rest_name)
         for name in names:
             if rest is not None and name in images:
-                out[name] = {f"mean |image - {label}|": np.abs(images[name] - rest).mean(),
-                             f"mean of {label}": rest.mean()}
+                out[name] = {
+                    f"mean |image - {label}|": np.abs(images[name] - rest).mean(),
+                    f"mean of {label}": rest.mean(),
+                }
     rest = images.get("gray_fig9a_rest")
     name = "gray_fig10_window_detector_plane"
     if name in out:
@@ -400,10 +450,13 @@ def portrait(images, contexts):
         right = centroid(moving[..., 1] - moving[..., 0])
         context = contexts["gray_fig11b_stereo_moving"]
         focal_px = context["size"][0] / (context["window"][1] - context["window"][0])
-        out.setdefault("gray_fig11b_stereo_moving", {}).update({
-            "left (red) minus right (cyan) patch centroid, x (px)": left[0] - right[0],
-            "left minus right patch centroid, y (px)": left[1] - right[1],
-            "off-axis parallax of a point at infinity, x (px)": -0.4 / 5.0 * focal_px})
+        out.setdefault("gray_fig11b_stereo_moving", {}).update(
+            {
+                "left (red) minus right (cyan) patch centroid, x (px)": left[0] - right[0],
+                "left minus right patch centroid, y (px)": left[1] - right[1],
+                "off-axis parallax of a point at infinity, x (px)": -0.4 / 5.0 * focal_px,
+            }
+        )
     return out
 
 

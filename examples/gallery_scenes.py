@@ -81,8 +81,10 @@ def plane(scene, name, corners, material):
 def cylinder(scene, name, location, radius, depth, material, rotation=(0.0, 0.0, 0.0)):
     import bmesh
 
-    mesh = _mesh_from_bmesh(name, lambda bm: bmesh.ops.create_cone(
-        bm, cap_ends=True, segments=32, radius1=radius, radius2=radius, depth=depth))
+    mesh = _mesh_from_bmesh(
+        name,
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=32, radius1=radius, radius2=radius, depth=depth),
+    )
     obj = _link(scene, name, mesh, material, location)
     obj.rotation_euler = rotation
     return obj
@@ -124,8 +126,13 @@ def street(scene, effect):
     for side in (-1, 1):
         for i, height in enumerate(heights):
             y = 6.0 + 9.0 * i
-            box = add_box(scene, f"House {side} {i}", (side * 9.0, y, height / 2), 1.0,
-                          materials[(i + (side > 0)) % len(materials)])
+            box = add_box(
+                scene,
+                f"House {side} {i}",
+                (side * 9.0, y, height / 2),
+                1.0,
+                materials[(i + (side > 0)) % len(materials)],
+            )
             box.scale = (6.0, 7.5, height)
             if i % 2 == 0:
                 add_sphere(scene, f"Lamp {side} {i}", (side * 5.2, y + 4.5, 4.5), 0.25, lamp)
@@ -138,9 +145,14 @@ def street(scene, effect):
     scene.collection.objects.link(sun_object)
     camera = add_camera(scene, (0.0, -3.0, 1.7), (0.0, 100.0, 3.0), lens_mm=16.0)
     moving = effect != "REST"
-    set_relativity(scene, (0.0, 0.0, -STREET_SPEED) if moving else (0.0, 0.0, 0.0),
-                   use_geometry=True, use_doppler=False, use_searchlight=effect in ("CHANG", "SEARCHLIGHT"),
-                   use_chang_searchlight=effect == "CHANG")
+    set_relativity(
+        scene,
+        (0.0, 0.0, -STREET_SPEED) if moving else (0.0, 0.0, 0.0),
+        use_geometry=True,
+        use_doppler=False,
+        use_searchlight=effect in ("CHANG", "SEARCHLIGHT"),
+        use_chang_searchlight=effect == "CHANG",
+    )
     return {"camera": camera, "beta_local": (0.0, 0.0, -STREET_SPEED if moving else 0.0)}
 
 
@@ -166,13 +178,19 @@ def suns(scene, effect):
     material = emission("Sun surface", strength=1.0, temperature=SUN_TEMPERATURE)
     for i, apparent in enumerate(SUN_APPARENT_DEG):
         angle = math.radians(_scene_angle(apparent, SUN_SPEED))
-        add_sphere(scene, f"Sun {i}", (SUN_DISTANCE * math.sin(angle), 0.0, -SUN_DISTANCE * math.cos(angle)),
-                   1.3, material)
+        add_sphere(
+            scene, f"Sun {i}", (SUN_DISTANCE * math.sin(angle), 0.0, -SUN_DISTANCE * math.cos(angle)), 1.3, material
+        )
     camera = add_camera(scene, (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), lens_mm=20.0)
     moving = effect != "REST"
-    set_relativity(scene, (SUN_SPEED, 0.0, 0.0) if moving else (0.0, 0.0, 0.0),
-                   use_geometry=True, use_doppler=True, use_searchlight=effect == "SEARCHLIGHT",
-                   doppler_only_brightness="SPECTRUM")
+    set_relativity(
+        scene,
+        (SUN_SPEED, 0.0, 0.0) if moving else (0.0, 0.0, 0.0),
+        use_geometry=True,
+        use_doppler=True,
+        use_searchlight=effect == "SEARCHLIGHT",
+        doppler_only_brightness="SPECTRUM",
+    )
     return {"camera": camera, "beta_local": (SUN_SPEED if moving else 0.0, 0.0, 0.0)}
 
 
@@ -191,8 +209,15 @@ def gray_camera(scene, lens_mm, focus=None, aperture_radius=None):
 
 
 def gray_settings(scene, moving=True, **settings):
-    set_relativity(scene, GRAY_BETA if moving else (0.0, 0.0, 0.0), speed_of_light=1.0,
-                   use_geometry=True, use_doppler=False, use_searchlight=False, **settings)
+    set_relativity(
+        scene,
+        GRAY_BETA if moving else (0.0, 0.0, 0.0),
+        speed_of_light=1.0,
+        use_geometry=True,
+        use_doppler=False,
+        use_searchlight=False,
+        **settings,
+    )
 
 
 def sphere_array_centres(model, shutter_time):
@@ -201,8 +226,7 @@ def sphere_array_centres(model, shutter_time):
     points = np.array([(x, y, -GRAY_FOCUS) for y in GRAY_GRID[::-1] for x in GRAY_GRID])
     image_distance = 1.0 / (1.0 / (GRAY_LENS_MM * 1e-3) - 1.0 / GRAY_FOCUS)
     detector = -points * (image_distance / GRAY_FOCUS)
-    t_lens = lens_time(model, np.zeros_like(points), points, c=1.0, shutter_time=shutter_time,
-                       detector_point=detector)
+    t_lens = lens_time(model, np.zeros_like(points), points, c=1.0, shutter_time=shutter_time, detector_point=detector)
     _, centres = camera_to_scene_event(t_lens - np.linalg.norm(points, axis=-1), points, np.array(GRAY_BETA), 1.0)
     return points, centres
 
@@ -230,8 +254,9 @@ def sphere_array(scene, model, aperture_radius, imaging_element="IDEAL_LENS"):
     material = emission("White", strength=1.0)
     import bmesh
 
-    mesh = _mesh_from_bmesh("Sphere", lambda bm: bmesh.ops.create_uvsphere(
-        bm, u_segments=24, v_segments=12, radius=GRAY_SPHERE_RADIUS))
+    mesh = _mesh_from_bmesh(
+        "Sphere", lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=24, v_segments=12, radius=GRAY_SPHERE_RADIUS)
+    )
     for index, centre in enumerate(centres):  # 81 objects sharing one small mesh
         if index == 0:
             _link(scene, f"S{index}", mesh, material, tuple(centre))
@@ -262,8 +287,12 @@ def tiles(scene, shutter, moving, time_of_flight=False, zoom_lens_mm=None):
         camera.data.lens = zoom_lens_mm
         camera.data.shift_x = GRAY_BETA[0] / -GRAY_BETA[2] * zoom_lens_mm / camera.data.sensor_width
     gray_settings(scene, moving, shutter_model=shutter, shutter_time=0.0, use_time_of_flight=time_of_flight)
-    return {"camera": camera, "red": ((-1.2, -0.7, -8.0), 0.8), "beta_local": GRAY_BETA if moving else (0, 0, 0),
-            "time_of_flight": time_of_flight}
+    return {
+        "camera": camera,
+        "red": ((-1.2, -0.7, -8.0), 0.8),
+        "beta_local": GRAY_BETA if moving else (0, 0, 0),
+        "time_of_flight": time_of_flight,
+    }
 
 
 FIXED_PLANE = 8.0
@@ -283,8 +312,9 @@ def cylinders(scene, moving):
     plane(scene, "Floor", [(-15, -2.0, 0), (15, -2.0, 0), (15, -2.0, -30), (-15, -2.0, -30)], floor)
     red = emission("Marker", (1.0, 0.0, 0.0), 2.0)
     for i, (x, y) in enumerate(MARKERS):
-        mesh = _mesh_from_bmesh(f"Disc {i}", lambda bm: __import__("bmesh").ops.create_circle(
-            bm, cap_ends=True, segments=32, radius=0.06))
+        mesh = _mesh_from_bmesh(
+            f"Disc {i}", lambda bm: __import__("bmesh").ops.create_circle(bm, cap_ends=True, segments=32, radius=0.06)
+        )
         _link(scene, f"Disc {i}", mesh, red, (x, y, -FIXED_PLANE))
     camera = gray_camera(scene, 50.0, FIXED_PLANE, 0.02)
     gray_settings(scene, moving, shutter_model="FIXED_POINT_SURFACE", shutter_time=0.0)
@@ -315,8 +345,12 @@ def portrait(scene, variant):
     detector-plane shutter (``lorentz_window_shutter = 'SHUTTER_MODEL'``)."""
     world(scene, (0.0, 0.0, 0.0), 0.0)
     backdrop = emission_checker("Backdrop", (0.45, 0.5, 0.55), (0.2, 0.22, 0.25), 16.0, 1.0)
-    plane(scene, "Backdrop", [(-6, -5, -BACKDROP_DEPTH), (6, -5, -BACKDROP_DEPTH), (6, 5, -BACKDROP_DEPTH),
-                              (-6, 5, -BACKDROP_DEPTH)], backdrop)
+    plane(
+        scene,
+        "Backdrop",
+        [(-6, -5, -BACKDROP_DEPTH), (6, -5, -BACKDROP_DEPTH), (6, 5, -BACKDROP_DEPTH), (-6, 5, -BACKDROP_DEPTH)],
+        backdrop,
+    )
     add_sphere(scene, "Head", (0.0, 0.35, -5.0), 0.7, emission("Skin", (0.85, 0.6, 0.48)))
     add_sphere(scene, "Hair", (0.0, 0.65, -5.15), 0.68, emission("Hair", (0.25, 0.15, 0.08)))
     white, pupil = emission("Eye", (0.95, 0.95, 0.95)), emission("Pupil", (0.02, 0.05, 0.12))
@@ -329,10 +363,20 @@ def portrait(scene, variant):
     camera = gray_camera(scene, PORTRAIT_LENS_MM, PORTRAIT_FOCUS, 0.05)
     shutter = {"shutter_model": "ARBITRARY_PLANE", "shutter_time": -1.0}
     if variant == "WINDOW_DETECTOR":
-        shutter = {"shutter_model": "DETECTOR_PLANE", "shutter_time": fig10_shutter_time(),
-                   "lorentz_window_shutter": "SHUTTER_MODEL", "lorentz_window_time": -1.0}
-    gray_settings(scene, variant != "REST", shutter_plane_point=FIG9_PLANE_POINT, shutter_plane_normal=GRAY_BETA,
-                  use_lorentz_window=variant in ("WINDOW", "WINDOW_DETECTOR"), **shutter)
+        shutter = {
+            "shutter_model": "DETECTOR_PLANE",
+            "shutter_time": fig10_shutter_time(),
+            "lorentz_window_shutter": "SHUTTER_MODEL",
+            "lorentz_window_time": -1.0,
+        }
+    gray_settings(
+        scene,
+        variant != "REST",
+        shutter_plane_point=FIG9_PLANE_POINT,
+        shutter_plane_normal=GRAY_BETA,
+        use_lorentz_window=variant in ("WINDOW", "WINDOW_DETECTOR"),
+        **shutter,
+    )
     return {"camera": camera, "shutter_time": shutter["shutter_time"], "window_time": -1.0}
 
 

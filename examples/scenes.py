@@ -75,7 +75,8 @@ def add_floor(scene, size=20.0, squares=20):
 
 def add_sphere(scene, name, location, radius, material):
     mesh = _mesh_from_bmesh(
-        name, lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=radius),
+        name,
+        lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=48, v_segments=24, radius=radius),
     )
     for polygon in mesh.polygons:
         polygon.use_smooth = True

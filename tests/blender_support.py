@@ -65,6 +65,8 @@ def install_extension_zip(zip_path, repo=EXTENSION_REPO):
     import bpy
 
     result = bpy.ops.extensions.package_install_files(
-        filepath=str(zip_path), repo=repo, enable_on_install=False,
+        filepath=str(zip_path),
+        repo=repo,
+        enable_on_install=False,
     )
     assert result == {"FINISHED"}, result

@@ -98,7 +98,11 @@ def build(output_dir=DEFAULT_OUTPUT_DIR, manifest_path=MANIFEST_PATH):
     with tempfile.TemporaryDirectory(prefix="relativity-stage-") as stage_dir:
         staged = stage_package(stage_dir, manifest_path)
         code, output = run_blender_ext(
-            "build", "--source-dir", str(staged), "--output-filepath", str(zip_path),
+            "build",
+            "--source-dir",
+            str(staged),
+            "--output-filepath",
+            str(zip_path),
         )
     if code != 0 or not zip_path.is_file():
         return None, output

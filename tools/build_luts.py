@@ -1,7 +1,7 @@
 """Compute the spectral lookup tables with colour-science and write the file the add-on ships.
 
-    .venv/bin/python tools/build_luts.py            # writes relativity_addon/data/spectral_luts.npz
-    .venv/bin/python tools/build_luts.py --check    # exits 1 if the shipped file is stale
+.venv/bin/python tools/build_luts.py            # writes relativity_addon/data/spectral_luts.npz
+.venv/bin/python tools/build_luts.py --check    # exits 1 if the shipped file is stale
 """
 
 import argparse
@@ -48,9 +48,13 @@ def stale_tables(path=shipped_luts.LUT_PATH, rtol=RTOL, atol=ATOL):
         return ["(file missing)"]
     fresh = compute_tables()
     with np.load(path) as shipped:
-        return [name for name, values in fresh.items()
-                if name not in shipped.files or shipped[name].shape != values.shape
-                or not np.allclose(shipped[name], values, rtol=rtol, atol=atol)]
+        return [
+            name
+            for name, values in fresh.items()
+            if name not in shipped.files
+            or shipped[name].shape != values.shape
+            or not np.allclose(shipped[name], values, rtol=rtol, atol=atol)
+        ]
 
 
 def main(argv=None):

@@ -93,53 +93,79 @@ def agreement(traced, rendered):
 def fig7(gs, pixels):
     """Focus-surface shutter: the 9 x 9 spheres, white where a chief ray hits one."""
     _, centres = gs.sphere_array_centres(shutter.ShutterModel.FOCUS_SURFACE, -gs.GRAY_FOCUS)
-    origins, directions = scene_rays(pixels.shape[1::-1], gs.GRAY_LENS_MM, gs.GRAY_FOCUS, "FOCUS_SURFACE",
-                                     np.array(gs.GRAY_BETA), shutter_time=-gs.GRAY_FOCUS)
+    origins, directions = scene_rays(
+        pixels.shape[1::-1],
+        gs.GRAY_LENS_MM,
+        gs.GRAY_FOCUS,
+        "FOCUS_SURFACE",
+        np.array(gs.GRAY_BETA),
+        shutter_time=-gs.GRAY_FOCUS,
+    )
     traced = np.zeros(pixels.shape[:2], bool)
     for centre in centres:
         traced |= sphere_hits(origins, directions, centre, gs.GRAY_SPHERE_RADIUS)
     share, count = agreement(traced, pixels.mean(-1) > 0.5)
-    print(f"Fig. 7: sphere pixels traced {traced.sum()}, rendered white {(pixels.mean(-1) > 0.5).sum()}; "
-          f"agreement {share:.4f} over {count} pixels away from outlines")
+    print(
+        f"Fig. 7: sphere pixels traced {traced.sum()}, rendered white {(pixels.mean(-1) > 0.5).sum()}; "
+        f"agreement {share:.4f} over {count} pixels away from outlines"
+    )
 
 
 def fig8b(gs, pixels):
     """Fixed-point-surface shutter: grey where the nearest hit is a cylinder."""
-    origins, directions = scene_rays(pixels.shape[1::-1], 50.0, gs.FIXED_PLANE, "FIXED_POINT_SURFACE",
-                                     np.array(gs.GRAY_BETA))
+    origins, directions = scene_rays(
+        pixels.shape[1::-1], 50.0, gs.FIXED_PLANE, "FIXED_POINT_SURFACE", np.array(gs.GRAY_BETA)
+    )
     nearest = np.full(pixels.shape[:2], np.inf)
     for x in (-1.5, 0.0, 1.5):
-        nearest = np.minimum(nearest, cylinder_hits(origins, directions, 1, np.array([x, 0.0, -gs.FIXED_PLANE]),
-                                                    0.08, 2.0))
+        nearest = np.minimum(
+            nearest, cylinder_hits(origins, directions, 1, np.array([x, 0.0, -gs.FIXED_PLANE]), 0.08, 2.0)
+        )
     for y in (-0.9, 0.9):
-        nearest = np.minimum(nearest, cylinder_hits(origins, directions, 0, np.array([0.0, y, -gs.FIXED_PLANE]),
-                                                    0.08, 2.5))
+        nearest = np.minimum(
+            nearest, cylinder_hits(origins, directions, 0, np.array([0.0, y, -gs.FIXED_PLANE]), 0.08, 2.5)
+        )
     floor_t, floor_point = plane_hits(origins, directions, 1, -2.0)
     on_floor = (np.abs(floor_point[..., 0]) <= 15.0) & (floor_point[..., 2] <= 0.0) & (floor_point[..., 2] >= -30.0)
     disc_t, disc_point = plane_hits(origins, directions, 2, -gs.FIXED_PLANE)
     on_disc = np.zeros(on_floor.shape, bool)
     for x, y in gs.MARKERS:
         on_disc |= (disc_point[..., 0] - x) ** 2 + (disc_point[..., 1] - y) ** 2 <= 0.06**2
-    traced = np.isfinite(nearest) & (nearest < np.where(on_floor, floor_t, np.inf)) \
+    traced = (
+        np.isfinite(nearest)
+        & (nearest < np.where(on_floor, floor_t, np.inf))
         & (nearest < np.where(on_disc, disc_t, np.inf))
+    )
     grey = (np.abs(pixels[..., 0] - pixels[..., 1]) < 0.03) & (pixels[..., 0] > 0.75)
     share, count = agreement(traced, grey)
-    print(f"Fig. 8(b): cylinder pixels traced {traced.sum()}, rendered grey {grey.sum()}; "
-          f"agreement {share:.4f} over {count} pixels away from outlines")
+    print(
+        f"Fig. 8(b): cylinder pixels traced {traced.sum()}, rendered grey {grey.sum()}; "
+        f"agreement {share:.4f} over {count} pixels away from outlines"
+    )
 
 
 def fig9b(gs, pixels):
     """Arbitrary-plane shutter at t_S = -1: where the chief rays meet the backdrop (the scene's
     extent), against the rendered non-black region (blurred: the portrait is out of focus)."""
-    origins, directions = scene_rays(pixels.shape[1::-1], 50.0, 4.4, "ARBITRARY_PLANE", np.array(gs.GRAY_BETA),
-                                     shutter_time=-1.0, plane_point=(0.111, 0.0, -1.1), plane_normal=gs.GRAY_BETA)
+    origins, directions = scene_rays(
+        pixels.shape[1::-1],
+        50.0,
+        4.4,
+        "ARBITRARY_PLANE",
+        np.array(gs.GRAY_BETA),
+        shutter_time=-1.0,
+        plane_point=(0.111, 0.0, -1.1),
+        plane_normal=gs.GRAY_BETA,
+    )
     t, point = plane_hits(origins, directions, 2, -10.0)
     traced = np.isfinite(t) & (np.abs(point[..., 0]) <= 6.0) & (np.abs(point[..., 1]) <= 5.0)
     rendered = pixels.max(-1) > 0.02
     for name, mask in (("traced backdrop", traced), ("rendered non-black", rendered)):
         rows, columns = np.nonzero(mask)
-        print(f"Fig. 9(b): {name}: {mask.sum()} px, centroid ({columns.mean() + 0.5:.1f}, {rows.mean() + 0.5:.1f}), "
-              f"x {columns.min()}-{columns.max()}, y {rows.min()}-{rows.max()}")
+        print(
+            f"Fig. 9(b): {name}: {mask.sum()} px, centroid ({columns.mean() + 0.5:.1f}, {rows.mean() + 0.5:.1f}), "
+            f"x {columns.min()}-{columns.max()}, y {rows.min()}-{rows.max()}"
+        )
 
 
 def main():
@@ -149,8 +175,11 @@ def main():
     import bpy
     import gallery_scenes as gs
 
-    for name, check in (("gray_fig7_focus_surface", fig7), ("gray_fig8b_fixed_point_surface", fig8b),
-                        ("gray_fig9b_moving", fig9b)):
+    for name, check in (
+        ("gray_fig7_focus_surface", fig7),
+        ("gray_fig8b_fixed_point_surface", fig8b),
+        ("gray_fig9b_moving", fig9b),
+    ):
         check(gs, read_png(bpy, os.path.join(options.gallery, f"{name}.png")))
 
 

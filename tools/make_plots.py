@@ -57,11 +57,14 @@ def aberration_map(plt, path, speed=0.9):
     beta = np.array([speed, 0.0, 0.0])
 
     def seen(longitude, latitude):
-        view = np.stack([np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude),
-                         np.sin(latitude)], axis=-1)
+        view = np.stack(
+            [np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude), np.sin(latitude)], axis=-1
+        )
         view_observed = -lorentz.aberrate(-view, beta)  # photons travel against the view direction
-        return (np.degrees(np.arctan2(view_observed[..., 1], view_observed[..., 0])),
-                np.degrees(np.arcsin(np.clip(view_observed[..., 2], -1.0, 1.0))))
+        return (
+            np.degrees(np.arctan2(view_observed[..., 1], view_observed[..., 0])),
+            np.degrees(np.arcsin(np.clip(view_observed[..., 2], -1.0, 1.0))),
+        )
 
     fine = np.radians(np.linspace(-179.9, 179.9, 721))
     for latitude in np.radians(np.arange(-75, 76, 15)):
@@ -92,8 +95,9 @@ def blackbody_against_doppler(plt, path, temperatures=(3000.0, 5762.0, 10000.0))
     factors = np.geomspace(0.25, 4.0, 121)
     for row, temperature in enumerate(temperatures):
         colours = np.array([_srgb(spectral.blackbody_linear_rgb(d * temperature, gamut_map=True)) for d in factors])
-        top.imshow(colours[None, :, :], extent=(np.log2(factors[0]), np.log2(factors[-1]), row, row + 0.9),
-                   aspect="auto")
+        top.imshow(
+            colours[None, :, :], extent=(np.log2(factors[0]), np.log2(factors[-1]), row, row + 0.9), aspect="auto"
+        )
         bottom.plot(factors, spectral.blackbody_luminance_ratio(temperature, factors), label=f"{temperature:g} K")
     top.set_xlim(np.log2(factors[0]), np.log2(factors[-1]))
     top.set_ylim(0, len(temperatures))

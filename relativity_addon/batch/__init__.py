@@ -75,12 +75,19 @@ def build_parser(with_blend_file):
     )
     if with_blend_file:
         parser.add_argument("blend_file", help=".blend file to render")
-    parser.add_argument("--beta", type=_vector3, help="observer velocity X,Y,Z (world axes, fraction of c); "
-                        "write --beta=-0.5,0,0 when a value starts with '-'")
-    parser.add_argument("--method", choices=("camera", "geometry"),
-                        help="render method (default: the file's setting, Exact Camera in a new file)")
-    parser.add_argument("--reference", action="store_true",
-                        help="render the file's own camera unchanged (no relativistic camera)")
+    parser.add_argument(
+        "--beta",
+        type=_vector3,
+        help="observer velocity X,Y,Z (world axes, fraction of c); write --beta=-0.5,0,0 when a value starts with '-'",
+    )
+    parser.add_argument(
+        "--method",
+        choices=("camera", "geometry"),
+        help="render method (default: the file's setting, Exact Camera in a new file)",
+    )
+    parser.add_argument(
+        "--reference", action="store_true", help="render the file's own camera unchanged (no relativistic camera)"
+    )
     parser.add_argument("--samples", type=_positive_int)
     parser.add_argument("--resolution", type=_resolution, help="WIDTHxHEIGHT in pixels")
     parser.add_argument("--out", required=True, help="output image: .png, or .exr for linear float")
@@ -88,48 +95,93 @@ def build_parser(with_blend_file):
     parser.add_argument("--no-searchlight", action="store_true")
     parser.add_argument("--no-geometry", action="store_true", help="no aberration (testing aid)")
     parser.add_argument("--lorentz-window", action="store_true")
-    parser.add_argument("--time-of-flight", action="store_true",
-                        help="light-travel time only, Galilean (Gray et al. 2020 Fig. 1c; no searchlight or Doppler)")
+    parser.add_argument(
+        "--time-of-flight",
+        action="store_true",
+        help="light-travel time only, Galilean (Gray et al. 2020 Fig. 1c; no searchlight or Doppler)",
+    )
     parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
     parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
-    parser.add_argument("--shutter-plane-point", type=_vector3, metavar="X,Y,Z",
-                        help="a point of the arbitrary shutter plane, camera-local axes (the camera looks down -Z)")
-    parser.add_argument("--shutter-plane-normal", type=_vector3, metavar="X,Y,Z",
-                        help="the arbitrary shutter plane's normal, camera-local axes")
-    parser.add_argument("--lens", choices=LENS_CHOICES,
-                        help="the detector-plane shutter's lens: ideal, or its phase hologram (Gray Fig. 6b)")
-    parser.add_argument("--window-time", type=float, metavar="T_W",
-                        help="Lorentz window in the plane of spatial fixed points for T_W (seconds), the shutter "
-                        "model timing the rays (Gray Fig. 10); implies --lorentz-window")
+    parser.add_argument(
+        "--shutter-plane-point",
+        type=_vector3,
+        metavar="X,Y,Z",
+        help="a point of the arbitrary shutter plane, camera-local axes (the camera looks down -Z)",
+    )
+    parser.add_argument(
+        "--shutter-plane-normal",
+        type=_vector3,
+        metavar="X,Y,Z",
+        help="the arbitrary shutter plane's normal, camera-local axes",
+    )
+    parser.add_argument(
+        "--lens",
+        choices=LENS_CHOICES,
+        help="the detector-plane shutter's lens: ideal, or its phase hologram (Gray Fig. 6b)",
+    )
+    parser.add_argument(
+        "--window-time",
+        type=float,
+        metavar="T_W",
+        help="Lorentz window in the plane of spatial fixed points for T_W (seconds), the shutter "
+        "model timing the rays (Gray Fig. 10); implies --lorentz-window",
+    )
     parser.add_argument("--speed-of-light", type=float, help="scene units per second")
     frames = parser.add_mutually_exclusive_group()
     frames.add_argument("--frame", type=int, help="render this frame (default: the file's current frame)")
-    frames.add_argument("--frames", type=_frame_range, help="render frames A-B (inclusive); the frame "
-                        "number is inserted before the extension of --out, or replaces a run of '#'")
-    parser.add_argument("--velocity-from-animation", action="store_true",
-                          help="observer velocity from the active camera's keyframed motion")
+    frames.add_argument(
+        "--frames",
+        type=_frame_range,
+        help="render frames A-B (inclusive); the frame "
+        "number is inserted before the extension of --out, or replaces a run of '#'",
+    )
+    parser.add_argument(
+        "--velocity-from-animation",
+        action="store_true",
+        help="observer velocity from the active camera's keyframed motion",
+    )
     parser.add_argument("--seed", type=int)
-    parser.add_argument("--stereo", choices=STEREO_CHOICES,
-                        help="render Blender's stereo pair (the camera's Stereoscopy settings): one anaglyph or "
-                        "side-by-side image, or the two views as OUT_L and OUT_R")
-    parser.add_argument("--spectral", type=_positive_int, metavar="PASSES",
-                        help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
-                        "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)")
-    parser.add_argument("--proper-time", action="store_true",
-                        help="step frames in the traveller's proper time: frame K is rendered at the scene time "
-                        "where the observer's clock (0 at frame 0) reads K / fps")
+    parser.add_argument(
+        "--stereo",
+        choices=STEREO_CHOICES,
+        help="render Blender's stereo pair (the camera's Stereoscopy settings): one anaglyph or "
+        "side-by-side image, or the two views as OUT_L and OUT_R",
+    )
+    parser.add_argument(
+        "--spectral",
+        type=_positive_int,
+        metavar="PASSES",
+        help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
+        "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)",
+    )
+    parser.add_argument(
+        "--proper-time",
+        action="store_true",
+        help="step frames in the traveller's proper time: frame K is rendered at the scene time "
+        "where the observer's clock (0 at frame 0) reads K / fps",
+    )
     parser.add_argument("--threads", type=_positive_int, help="Cycles render threads (default: all cores)")
-    parser.add_argument("--resume", action=argparse.BooleanOptionalAction,
-                        help="skip frames whose output exists and reads back as a complete image "
-                        "(default: on with --workers/--scheduler, off otherwise)")
+    parser.add_argument(
+        "--resume",
+        action=argparse.BooleanOptionalAction,
+        help="skip frames whose output exists and reads back as a complete image "
+        "(default: on with --workers/--scheduler, off otherwise)",
+    )
     cluster = parser.add_argument_group("distributed rendering (Dask; docs/farm.md)")
     where = cluster.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=_positive_int,
-                       help="render on a local Dask cluster of N worker processes, one frame task each")
+    where.add_argument(
+        "--workers",
+        type=_positive_int,
+        help="render on a local Dask cluster of N worker processes, one frame task each",
+    )
     where.add_argument("--scheduler", metavar="ADDRESS", help="render on a running Dask cluster, e.g. tcp://HOST:8786")
     cluster.add_argument("--chunk", type=_positive_int, default=1, help="frames per task (default 1)")
-    cluster.add_argument("--retries", type=int, default=2,
-                         help="times a task whose worker or Blender process died is run again (default 2)")
+    cluster.add_argument(
+        "--retries",
+        type=int,
+        default=2,
+        help="times a task whose worker or Blender process died is run again (default 2)",
+    )
     return parser
 
 
@@ -139,7 +191,7 @@ def _running_inside_blender(argv):
 
 def _split_argv(argv):
     if _running_inside_blender(argv):
-        return (argv[argv.index("--") + 1:] if "--" in argv else []), False
+        return (argv[argv.index("--") + 1 :] if "--" in argv else []), False
     return argv[1:], True
 
 
@@ -393,8 +445,12 @@ def run(argv, log=print):
             if options.reference:
                 raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
             _apply_options(scene, options)
-            scene_frames = [float(f) for f in addon_module("scene.traveller").frames_at_proper_times(
-                scene, [frame / animation_fps(scene) for frame in frames])]
+            scene_frames = [
+                float(f)
+                for f in addon_module("scene.traveller").frames_at_proper_times(
+                    scene, [frame / animation_fps(scene) for frame in frames]
+                )
+            ]
         if options.reference:
             effect.remove(scene)
             if scene.camera is None:
@@ -416,8 +472,9 @@ def run(argv, log=print):
         if complete:
             log(f"render.py: --resume: {len(complete)} of {len(paths)} frames already complete, skipped", flush=True)
         keep = [path not in complete for path in paths]
-        frames, scene_frames, paths = ([item for item, kept in zip(items, keep, strict=True) if kept]
-                                       for items in (frames, scene_frames, paths))
+        frames, scene_frames, paths = (
+            [item for item, kept in zip(items, keep, strict=True) if kept] for items in (frames, scene_frames, paths)
+        )
     started = time.monotonic()
     for done, (frame, scene_frame, path) in enumerate(zip(frames, scene_frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
@@ -445,9 +502,11 @@ def command_line():
     try:
         import bpy  # noqa: F401
     except ImportError:
-        sys.exit("render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
-                 "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
-                 "examples/render.py -- OPTIONS")
+        sys.exit(
+            "render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
+            "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
+            "examples/render.py -- OPTIONS"
+        )
     from ..blender.common import compat
 
     compat.run_main(main)
@@ -462,8 +521,9 @@ def main(argv=None):
             raise BatchError(problem)
         if options.workers is not None or options.scheduler is not None:
             if _running_inside_blender(argv):
-                raise BatchError("--workers and --scheduler need the bpy wheel form: "
-                                 "python examples/render.py FILE.blend ...")
+                raise BatchError(
+                    "--workers and --scheduler need the bpy wheel form: python examples/render.py FILE.blend ..."
+                )
             from . import farm
 
             return farm.render(options, parser)

@@ -22,8 +22,19 @@ from ..errors import BatchError
 from . import frame_files
 
 # Options of the coordinator, not passed on to the per-task batch script.
-COORDINATOR_OPTIONS = {"help", "blend_file", "out", "frame", "frames", "workers", "scheduler", "chunk", "resume",
-                       "retries", "threads"}
+COORDINATOR_OPTIONS = {
+    "help",
+    "blend_file",
+    "out",
+    "frame",
+    "frames",
+    "workers",
+    "scheduler",
+    "chunk",
+    "resume",
+    "retries",
+    "threads",
+}
 ERROR_PREFIX = "render.py: error: "
 
 # The per-task process: dies with the worker thread that started it (Linux), then runs the batch
@@ -67,7 +78,7 @@ def render_task(arguments, label):
         raise LostProcessError(f"{label}: the Blender process was killed by signal {-process.returncode}")
     reason = None
     if process.returncode != 0:
-        errors = [line[len(ERROR_PREFIX):] for line in process.stderr.splitlines() if line.startswith(ERROR_PREFIX)]
+        errors = [line[len(ERROR_PREFIX) :] for line in process.stderr.splitlines() if line.startswith(ERROR_PREFIX)]
         last = (process.stderr.strip().splitlines() or ["no output"])[-1]
         reason = errors[-1] if errors else f"exit status {process.returncode}: {last}"
     return process.returncode, reason, seconds, f"{socket.gethostname()}:{os.getpid()}"
@@ -164,12 +175,19 @@ def _connect(options, log):
     # A worker that dies while running a task counts against the task as one failure; after
     # ``retries`` more the task is given up (KilledWorker).
     with dask.config.set({"distributed.scheduler.allowed-failures": options.retries}):
-        cluster = LocalCluster(n_workers=options.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=":0" if dashboard else None, silence_logs=logging.CRITICAL)
+        cluster = LocalCluster(
+            n_workers=options.workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0" if dashboard else None,
+            silence_logs=logging.CRITICAL,
+        )
     client = Client(cluster)
-    log(f"render.py: local Dask cluster, {options.workers} worker process(es) at {cluster.scheduler_address}"
+    log(
+        f"render.py: local Dask cluster, {options.workers} worker process(es) at {cluster.scheduler_address}"
         + (f", dashboard {client.dashboard_link}" if dashboard else " (no dashboard: install bokeh for one)"),
-        flush=True)
+        flush=True,
+    )
     return client, cluster
 
 
@@ -211,13 +229,19 @@ class _Job:
         left = elapsed / done * (todo - done) if done else 0.0
         status = "failed" if any(frame in self.failed for frame in frames) else "done"
         where = f" in {frame_files.format_seconds(seconds)} on {worker}" if worker else ""
-        self.log(f"render.py: {_label(frames)} {status}{where} ({done}/{todo}; {len(self.failed)} failed), "
-                 f"about {frame_files.format_seconds(left)} left", flush=True)
+        self.log(
+            f"render.py: {_label(frames)} {status}{where} ({done}/{todo}; {len(self.failed)} failed), "
+            f"about {frame_files.format_seconds(left)} left",
+            flush=True,
+        )
 
     def summary(self, error_log):
         elapsed = time.monotonic() - self.started
-        self.log(f"render.py: {self.total} frames: {len(self.rendered)} rendered, {self.skipped} skipped "
-                 f"(already complete), {len(self.failed)} failed, in {frame_files.format_seconds(elapsed)}", flush=True)
+        self.log(
+            f"render.py: {self.total} frames: {len(self.rendered)} rendered, {self.skipped} skipped "
+            f"(already complete), {len(self.failed)} failed, in {frame_files.format_seconds(elapsed)}",
+            flush=True,
+        )
         reasons = {}
         for frame in sorted(self.failed):
             reasons.setdefault(self.failed[frame], []).append(frame)
@@ -264,8 +288,14 @@ def render(options, parser, log=print, error_log=None):
         futures = {}
         for run in chunks(todo, options.chunk):
             arguments = [*common, f"--frames={run[0]}-{run[-1]}"]
-            future = client.submit(render_task, arguments, _label(run), retries=options.retries, pure=False,
-                                   key=f"relativistic-render-{run[0]}-{run[-1]}-{os.getpid()}-{time.time_ns()}")
+            future = client.submit(
+                render_task,
+                arguments,
+                _label(run),
+                retries=options.retries,
+                pure=False,
+                key=f"relativistic-render-{run[0]}-{run[-1]}-{os.getpid()}-{time.time_ns()}",
+            )
             futures[future] = run
         for future in as_completed(futures):
             run = futures[future]

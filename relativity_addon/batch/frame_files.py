@@ -35,7 +35,7 @@ def frame_output_path(out_path, frame, several):
     if run:
         width = len(run.group(0))
         number = f"-{abs(frame):0{max(width - 1, 1)}d}" if frame < 0 else f"{frame:0{width}d}"
-        return os.path.join(directory, name[:run.start()] + number + name[run.end():])
+        return os.path.join(directory, name[: run.start()] + number + name[run.end() :])
     if not several:
         return out_path
     stem, extension = os.path.splitext(name)
@@ -110,12 +110,12 @@ def _png_problem(data):
     while True:
         if position + 8 > len(data):
             return "PNG cut short (no IEND chunk)"
-        length, kind = struct.unpack(">I4s", data[position:position + 8])
+        length, kind = struct.unpack(">I4s", data[position : position + 8])
         end = position + 8 + length + 4
         if end > len(data):
             return f"PNG cut short inside a {kind.decode('latin-1')!r} chunk"
-        body = data[position + 8:position + 8 + length]
-        (crc,) = struct.unpack(">I", data[end - 4:end])
+        body = data[position + 8 : position + 8 + length]
+        (crc,) = struct.unpack(">I", data[end - 4 : end])
         if zlib.crc32(kind + body) != crc:
             return f"PNG chunk {kind.decode('latin-1')!r} fails its CRC (corrupt)"
         if header is None:
@@ -158,8 +158,8 @@ def _exr_attributes(data):
             return attributes, position
         end = data.index(b"\0", position)
         kind = data[position:end]
-        (size,) = struct.unpack("<i", data[end + 1:end + 5])
-        value = data[end + 5:end + 5 + size]
+        (size,) = struct.unpack("<i", data[end + 1 : end + 5])
+        value = data[end + 5 : end + 5 + size]
         if size < 0 or len(value) != size:
             raise ValueError("attribute cut short")
         attributes[name.decode("latin-1")] = (kind.decode("latin-1"), value)
@@ -189,7 +189,7 @@ def _exr_problem(data):
     for offset in offsets:
         if offset < table_end or offset + 8 > len(data):
             return "OpenEXR cut short (a chunk lies past the end of the file)"
-        (size,) = struct.unpack("<i", data[offset + 4:offset + 8])
+        (size,) = struct.unpack("<i", data[offset + 4 : offset + 8])
         if size < 0 or offset + 8 + size > len(data):
             return "OpenEXR cut short inside a chunk"
         last_end = max(last_end, offset + 8 + size)

@@ -22,8 +22,9 @@ from .retarded import light_travel_time, light_travel_time_uniform
 from .validation import finite_array, speed_of_light, vector_array, velocity_array
 
 
-def boost_emission_events(tau: ArrayLike, emission_positions: ArrayLike, observer_position: ArrayLike,
-                          observer_beta: ArrayLike, c: float) -> FloatArray:
+def boost_emission_events(
+    tau: ArrayLike, emission_positions: ArrayLike, observer_position: ArrayLike, observer_beta: ArrayLike, c: float
+) -> FloatArray:
     """Emission events ``(t_o - tau, x_e)`` seen from the observer event ``(t_o, x_o)``.
 
     Boosts the relative event ``(-tau, x_e - x_o)`` into the frame moving with ``observer_beta``
@@ -51,9 +52,14 @@ def velocity_seen_by_observer(point_beta: ArrayLike, observer_beta: ArrayLike) -
     return compose_velocities(-observer_beta, point_beta)
 
 
-def apparent_positions_uniform(observer_time: float, observer_position: ArrayLike, positions_now: ArrayLike,
-                               point_beta: ArrayLike, c: float, observer_beta: ArrayLike = (0.0, 0.0, 0.0)
-                               ) -> tuple[FloatArray, FloatArray, FloatArray]:
+def apparent_positions_uniform(
+    observer_time: float,
+    observer_position: ArrayLike,
+    positions_now: ArrayLike,
+    point_beta: ArrayLike,
+    c: float,
+    observer_beta: ArrayLike = (0.0, 0.0, 0.0),
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of points in uniform motion ``x_e(t) = p + u (t - t_o)``.
 
     ``positions_now`` (``p``, shape ``(N, 3)``) are the points' positions in S at the observer's
@@ -213,9 +219,15 @@ class SampledRigidMotion:
         padded = np.concatenate([2 * affine[:1] - affine[1:2], affine, 2 * affine[-1:] - affine[-2:-1]])
         p0, p1, p2, p3 = padded[:-3], padded[1:-2], padded[2:-1], padded[3:]
         # Catmull-Rom in power form per interval: A(f) = c0 + c1 f + c2 f^2 + c3 f^3, f in [0, 1].
-        coefficients = np.stack([
-            p1, 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2),
-        ], axis=1)  # (intervals, 4, 3, 4)
+        coefficients = np.stack(
+            [
+                p1,
+                0.5 * (p2 - p0),
+                p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3,
+                0.5 * (p3 - p0) + 1.5 * (p1 - p2),
+            ],
+            axis=1,
+        )  # (intervals, 4, 3, 4)
         # Rows 3j..3j+2 of linear @ p + offset are coefficient j applied to p.
         self._coefficients = coefficients
         self._linear = np.ascontiguousarray(coefficients[..., :3].reshape(self.intervals, 12, 3))
@@ -317,12 +329,18 @@ class SampledPointMotion:
     def __init__(self, times: ArrayLike, positions: ArrayLike) -> None:
         times = finite_array(times, "times")
         positions = finite_array(positions, "positions")
-        if times.ndim != 1 or times.size < 2 or positions.ndim != 3 or positions.shape[0] != times.size \
-                or positions.shape[2] != 3:
+        if (
+            times.ndim != 1
+            or times.size < 2
+            or positions.ndim != 3
+            or positions.shape[0] != times.size
+            or positions.shape[2] != 3
+        ):
             raise ValueError("need at least 2 sample times and positions of shape (times, points, 3)")
         self.start, self.step, self.intervals = _uniform_grid(times)
         self._samples = np.concatenate(
-            [2 * positions[:1] - positions[1:2], positions, 2 * positions[-1:] - positions[-2:-1]])
+            [2 * positions[:1] - positions[1:2], positions, 2 * positions[-1:] - positions[-2:-1]]
+        )
 
     def positions_and_velocities(self, t: ArrayLike, index: ArrayLike) -> tuple[FloatArray, FloatArray]:
         index = np.asarray(index)
@@ -351,9 +369,15 @@ class SampledPointMotion:
 _BLOCK_SIZE = 1 << 14
 
 
-def apparent_positions_sampled(motion: SampledRigidMotion, observer_time: float, observer_position: ArrayLike, c: float,
-                               observer_beta: ArrayLike = (0.0, 0.0, 0.0), relative_tolerance: float = 1e-10,
-                               max_iterations: int = 30) -> tuple[FloatArray, FloatArray, FloatArray]:
+def apparent_positions_sampled(
+    motion: SampledRigidMotion,
+    observer_time: float,
+    observer_position: ArrayLike,
+    c: float,
+    observer_beta: ArrayLike = (0.0, 0.0, 0.0),
+    relative_tolerance: float = 1e-10,
+    max_iterations: int = 30,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of the points of a :class:`SampledRigidMotion` (per-point retarded times).
 
     Solves ``g(tau) = c tau - |x_o - x(t_o - tau)| = 0`` by Halley's method with the motion's own
@@ -379,9 +403,10 @@ def apparent_positions_sampled(motion: SampledRigidMotion, observer_time: float,
     start = _uniform_motion_start(motion, t_o, x_o, c)
     order = np.argsort(motion._interval_keys(motion._grid(t_o) - start / motion.step), kind="stable")
     for first in range(0, count, _BLOCK_SIZE):
-        block = order[first:first + _BLOCK_SIZE]
+        block = order[first : first + _BLOCK_SIZE]
         for index, block_tau, emitted, velocity in _retarded_emissions(
-                motion, block, start[block], t_o, x_o, c, relative_tolerance, max_iterations):
+            motion, block, start[block], t_o, x_o, c, relative_tolerance, max_iterations
+        ):
             emitted -= x_o[:, None]
             _boost_rows(block_tau, emitted, beta_o, c)
             emitted += x_o[:, None]
@@ -415,14 +440,14 @@ def _uniform_motion_start(motion, t_o, x_o, c):
     position_map[:, 3] -= x_o  # relative to the observer
     start = np.empty(len(motion.local_points))
     for first in range(0, len(start), _BLOCK_SIZE):
-        rows = motion._rows[:, first:first + _BLOCK_SIZE]
+        rows = motion._rows[:, first : first + _BLOCK_SIZE]
         velocity = velocity_map[:, :3] @ rows
         velocity += velocity_map[:, 3:]
         if np.any(_row_dot(velocity, velocity) >= c * c):
             raise ValueError("the sampled motion is not slower than light")
         relative = position_map[:, :3] @ rows
         relative += position_map[:, 3:]
-        start[first:first + _BLOCK_SIZE] = _light_travel_time_rows(relative, velocity, c)
+        start[first : first + _BLOCK_SIZE] = _light_travel_time_rows(relative, velocity, c)
     return start
 
 
@@ -474,9 +499,16 @@ def _retarded_emissions(motion, index, tau, t_o, x_o, c, relative_tolerance, max
     yield index, tau, position, rate
 
 
-def apparent_positions(world_line: WorldLine, observer_time: float, observer_position: ArrayLike, c: float, count: int,
-                       observer_beta: ArrayLike = (0.0, 0.0, 0.0), velocity: WorldLine | None = None,
-                       **solver_options: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
+def apparent_positions(
+    world_line: WorldLine,
+    observer_time: float,
+    observer_position: ArrayLike,
+    c: float,
+    count: int,
+    observer_beta: ArrayLike = (0.0, 0.0, 0.0),
+    velocity: WorldLine | None = None,
+    **solver_options: Any,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of ``count`` points on arbitrary sub-luminal world lines.
 
     ``world_line(t, index)`` returns positions ``(M, 3)`` (see :func:`retarded.light_travel_time`);
@@ -497,4 +529,3 @@ def apparent_positions(world_line: WorldLine, observer_time: float, observer_pos
         point_beta = finite_array(velocity(np.broadcast_to(t_e, (count,)), index), "velocity") / c
     beta_seen = velocity_seen_by_observer(point_beta, observer_beta)
     return apparent, tau, np.broadcast_to(beta_seen, (count, 3))
-

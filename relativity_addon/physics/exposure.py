@@ -47,8 +47,13 @@ def log_doppler(directions: ArrayLike, beta_camera: ArrayLike, aberration: bool 
     return np.log(gamma * (1.0 + bd))
 
 
-def compensation(beta_camera: ArrayLike, window: ArrayLike, aberration: bool = True, power: float = 4.0,
-                 size: tuple[int, int] = (48, 36)) -> float:
+def compensation(
+    beta_camera: ArrayLike,
+    window: ArrayLike,
+    aberration: bool = True,
+    power: float = 4.0,
+    size: tuple[int, int] = (48, 36),
+) -> float:
     """The compensated exposure ``k = exp(-power <ln D>)`` over the image (a ``size`` grid of pixel
     directions is plenty: ``ln D`` is smooth)."""
     mean = float(np.mean(log_doppler(pixel_directions(window, size), beta_camera, aberration)))
@@ -59,8 +64,15 @@ def compensation(beta_camera: ArrayLike, window: ArrayLike, aberration: bool = T
 PANORAMAS = ("EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT", "FISHEYE_EQUISOLID", "MIRRORBALL")
 
 
-def panorama_directions(kind: str, size: tuple[int, int], longitude=(-np.pi, np.pi), latitude=(-np.pi / 2, np.pi / 2),
-                        fov: float = np.pi, lens: float = 10.5, sensor=(36.0, 24.0)) -> tuple[FloatArray, np.ndarray]:
+def panorama_directions(
+    kind: str,
+    size: tuple[int, int],
+    longitude=(-np.pi, np.pi),
+    latitude=(-np.pi / 2, np.pi / 2),
+    fov: float = np.pi,
+    lens: float = 10.5,
+    sensor=(36.0, 24.0),
+) -> tuple[FloatArray, np.ndarray]:
     """Unit camera-frame directions ``(height, width, 3)`` through the pixel centres of one of
     Blender's panoramas (rows bottom first, camera looking down -Z), as Cycles maps them and the
     exact camera's shader writes them out; and the mask of pixels inside the image (a fisheye's or

@@ -75,8 +75,9 @@ def aberrated_direction(direction: ArrayLike, beta_object: ArrayLike) -> FloatAr
     return (k + along * beta - gamma * beta) / (gamma * (1.0 - bk))
 
 
-def aberrated_lamp_matrix(lamp_matrix: ArrayLike, centre: ArrayLike, direction: ArrayLike,
-                          beta_object: ArrayLike) -> FloatArray:
+def aberrated_lamp_matrix(
+    lamp_matrix: ArrayLike, centre: ArrayLike, direction: ArrayLike, beta_object: ArrayLike
+) -> FloatArray:
     """The lamp's 4x4 world matrix turned about ``centre`` so that its light arrives along the
     object-frame direction ``k'`` (:func:`aberrated_direction` of ``direction``, lamp -> centre)
     instead of ``k``: the rotation taking ``k`` to ``k'`` (smallest angle, about ``k x k'``) applied
@@ -98,8 +99,13 @@ def aberrated_lamp_matrix(lamp_matrix: ArrayLike, centre: ArrayLike, direction: 
     return matrix
 
 
-def lamp_rgb_factor(doppler: float, rgb: ArrayLike | None = None, temperature_k: float | None = None,
-                    use_doppler: bool = True, use_searchlight: bool = True) -> FloatArray:
+def lamp_rgb_factor(
+    doppler: float,
+    rgb: ArrayLike | None = None,
+    temperature_k: float | None = None,
+    use_doppler: bool = True,
+    use_searchlight: bool = True,
+) -> FloatArray:
     """Per-channel factor ``f`` (3,) so that a lamp of colour ``rgb`` (or a blackbody at
     ``temperature_k``, Blender's luminance-1 colour) with colour ``f * rgb`` lights the object
     as eq. 18 says, ``>= 0`` and finite.
@@ -117,8 +123,9 @@ def lamp_rgb_factor(doppler: float, rgb: ArrayLike | None = None, temperature_k:
         rest = _blackbody_unit_rgb(temperature_k)
         shifted = _blackbody_unit_rgb(doppler * temperature_k)
         if use_searchlight:
-            log_ratio = spectral_render.log_blackbody_luminance(doppler * temperature_k) - \
-                spectral_render.log_blackbody_luminance(temperature_k)
+            log_ratio = spectral_render.log_blackbody_luminance(
+                doppler * temperature_k
+            ) - spectral_render.log_blackbody_luminance(temperature_k)
             shifted = shifted * np.exp(min(float(log_ratio), 80.0)) / irradiance_factor(doppler)
     else:
         rest = finite_array(rgb if rgb is not None else (1.0, 1.0, 1.0), "rgb")
@@ -148,8 +155,9 @@ def _same_luminance(rgb, reference):
 # --- what one factor per lamp and object leaves out --------------------------------------------
 
 
-def exact_irradiance(points: ArrayLike, rest_normals: ArrayLike, lamp: ArrayLike, beta_object: ArrayLike,
-                     intensity: float = 1.0) -> FloatArray:
+def exact_irradiance(
+    points: ArrayLike, rest_normals: ArrayLike, lamp: ArrayLike, beta_object: ArrayLike, intensity: float = 1.0
+) -> FloatArray:
     """Eq. 18 (bolometric) per point: ``E' = D^2 cos(alpha') / r^2 I``, with ``D`` from each
     point's own direction, ``alpha'`` between the object-frame (rest) normal and the object-frame
     photon direction, ``r`` the scene-frame distance from the lamp at rest. 0 where unlit."""
@@ -163,8 +171,15 @@ def exact_irradiance(points: ArrayLike, rest_normals: ArrayLike, lamp: ArrayLike
     return irradiance_factor(doppler) * cos_object / r**2 * intensity
 
 
-def one_factor_irradiance(points: ArrayLike, scene_normals: ArrayLike, lamp: ArrayLike, centre: ArrayLike,
-                          beta_object: ArrayLike, intensity: float = 1.0, aberrate: bool = True) -> FloatArray:
+def one_factor_irradiance(
+    points: ArrayLike,
+    scene_normals: ArrayLike,
+    lamp: ArrayLike,
+    centre: ArrayLike,
+    beta_object: ArrayLike,
+    intensity: float = 1.0,
+    aberrate: bool = True,
+) -> FloatArray:
     """What the renderer computes: Cycles' scene-frame ``cos(alpha) / r^2 I`` on the scene-frame
     (contracted) surface from the lamp's copy (turned about ``centre`` to the aberrated direction
     with ``aberrate``), times ``D^2`` of the direction lamp -> ``centre``."""

@@ -42,8 +42,9 @@ def boost_event(t: ArrayLike, x: ArrayLike, beta: ArrayLike, c: float) -> tuple[
     return _boost(finite_array(t, "t"), vector_array(x, "x"), velocity_array(beta), c)
 
 
-def inverse_boost_event(t_prime: ArrayLike, x_prime: ArrayLike, beta: ArrayLike, c: float
-                        ) -> tuple[FloatArray, FloatArray]:
+def inverse_boost_event(
+    t_prime: ArrayLike, x_prime: ArrayLike, beta: ArrayLike, c: float
+) -> tuple[FloatArray, FloatArray]:
     """Event ``(t', x')`` in S' seen in S: the boost with ``-beta``.
 
     This is Gray et al. eq. (1) when S' is the camera frame and ``beta`` the camera's velocity in

@@ -36,8 +36,9 @@ class RetardedLight:
     doppler: FloatArray
 
 
-def retarded_light(surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike,
-                   light_beta: ArrayLike) -> RetardedLight:
+def retarded_light(
+    surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike, light_beta: ArrayLike
+) -> RetardedLight:
     """The light's retarded position for each surface point (closed form, a quadratic).
 
     ``surface_points`` ``(..., 3)``, ``camera_position`` and ``light_position`` ``(3,)`` (the
@@ -62,9 +63,14 @@ def retarded_light(surface_points: ArrayLike, camera_position: ArrayLike, light_
     return RetardedLight(position, distance, direction, doppler)
 
 
-def moving_point_light_irradiance(surface_points: ArrayLike, surface_normals: ArrayLike, camera_position: ArrayLike,
-                                  light_position: ArrayLike, light_beta: ArrayLike, intensity: ArrayLike
-                                  ) -> FloatArray:
+def moving_point_light_irradiance(
+    surface_points: ArrayLike,
+    surface_normals: ArrayLike,
+    camera_position: ArrayLike,
+    light_position: ArrayLike,
+    light_beta: ArrayLike,
+    intensity: ArrayLike,
+) -> FloatArray:
     """Irradiance ``E = D^4 cos(alpha) I / r^2`` (Weiskopf et al. eq. 19) from a moving point light.
 
     ``intensity`` I is the light's isotropic radiant intensity in its own frame (W/sr; a
@@ -91,18 +97,26 @@ def light_frame_direction(direction: ArrayLike, light_beta: ArrayLike) -> FloatA
     return shifted / (gamma[..., None] * (1.0 - bn))
 
 
-def irradiance_on_plane(points_along: ArrayLike, plane_height: float, camera_position: ArrayLike,
-                        light_position: ArrayLike, light_beta: ArrayLike, intensity: float) -> FloatArray:
+def irradiance_on_plane(
+    points_along: ArrayLike,
+    plane_height: float,
+    camera_position: ArrayLike,
+    light_position: ArrayLike,
+    light_beta: ArrayLike,
+    intensity: float,
+) -> FloatArray:
     """Irradiance on the horizontal plane ``z = plane_height`` (normal +Z, lit from above) at the
     points ``(x, y)`` ``(..., 2)``: the profile a camera at rest sees on a floor."""
     xy = finite_array(points_along, "points_along")
     points = np.concatenate([xy, np.full(xy.shape[:-1] + (1,), float(plane_height))], axis=-1)
-    return moving_point_light_irradiance(points, np.broadcast_to([0.0, 0.0, 1.0], points.shape), camera_position,
-                                         light_position, light_beta, intensity)
+    return moving_point_light_irradiance(
+        points, np.broadcast_to([0.0, 0.0, 1.0], points.shape), camera_position, light_position, light_beta, intensity
+    )
 
 
-def retarded_times(surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike,
-                   light_beta: ArrayLike) -> tuple[FloatArray, FloatArray]:
+def retarded_times(
+    surface_points: ArrayLike, camera_position: ArrayLike, light_position: ArrayLike, light_beta: ArrayLike
+) -> tuple[FloatArray, FloatArray]:
     """``c (t_e - t_o)`` for each surface point (the light's position then is
     ``light_position + beta c (t_e - t_o)``) and the irradiance ``D^4 / r^2`` per unit intensity
     (no cosine, no occlusion): the points' retarded times and how much light they get."""
@@ -110,12 +124,13 @@ def retarded_times(surface_points: ArrayLike, camera_position: ArrayLike, light_
     light = retarded_light(x, camera_position, light_position, light_beta)
     delay = np.linalg.norm(x - vector_array(camera_position, "camera_position"), axis=-1)
     with np.errstate(divide="ignore"):
-        irradiance = light.doppler ** 4 / light.distance ** 2
+        irradiance = light.doppler**4 / light.distance**2
     return -delay - light.distance, irradiance
 
 
-def lamp_times(times: ArrayLike, irradiance: ArrayLike, spacing: float, max_lamps: int,
-               relevance: float = 0.01) -> FloatArray:
+def lamp_times(
+    times: ArrayLike, irradiance: ArrayLike, spacing: float, max_lamps: int, relevance: float = 0.01
+) -> FloatArray:
     """Where on its path (``c (t - t_o)``, ascending) to put the point lamps that stand in for a
     moving light: evenly over the retarded times of the points that get at least ``relevance`` of
     the brightest point's irradiance, at most ``spacing`` apart (in ``c t``, a length along the path
@@ -146,8 +161,13 @@ def path_position(times: ArrayLike, path_times: ArrayLike, path_positions: Array
     return points[index] + fraction[..., None] * (points[index + 1] - points[index])
 
 
-def retarded_times_on_path(surface_points: ArrayLike, camera_position: ArrayLike, path_times: ArrayLike,
-                           path_positions: ArrayLike, iterations: int = 400) -> tuple[FloatArray, FloatArray]:
+def retarded_times_on_path(
+    surface_points: ArrayLike,
+    camera_position: ArrayLike,
+    path_times: ArrayLike,
+    path_positions: ArrayLike,
+    iterations: int = 400,
+) -> tuple[FloatArray, FloatArray]:
     """:func:`retarded_times` for a light on a sampled path (:func:`path_position`): the retarded
     time ``s = -|x - camera| - |x - x_L(s)|`` by fixed-point iteration (it contracts by the light's
     speed, which must stay below c), and ``D^4 / r^2`` with the velocity of the path's piece."""
@@ -165,5 +185,5 @@ def retarded_times_on_path(surface_points: ArrayLike, camera_position: ArrayLike
         n = (x - path_position(s, knots, points)) / r[..., None]
         gamma = 1.0 / np.sqrt(1.0 - np.sum(beta * beta, axis=-1))
         doppler = 1.0 / (gamma * (1.0 - np.sum(beta * n, axis=-1)))
-        irradiance = doppler ** 4 / r ** 2
+        irradiance = doppler**4 / r**2
     return s, irradiance

@@ -35,8 +35,9 @@ def scene_times(tau: ArrayLike, times: ArrayLike, taus: ArrayLike) -> FloatArray
     tau = np.atleast_1d(finite_array(tau, "tau"))
     taus = finite_array(taus, "taus")
     if tau.min() < taus[0] or tau.max() > taus[-1]:
-        raise ValueError(f"proper time {tau.min():.6g}..{tau.max():.6g} s outside the sampled "
-                         f"{taus[0]:.6g}..{taus[-1]:.6g} s")
+        raise ValueError(
+            f"proper time {tau.min():.6g}..{tau.max():.6g} s outside the sampled {taus[0]:.6g}..{taus[-1]:.6g} s"
+        )
     return np.interp(tau, taus, np.asarray(times, dtype=np.float64))
 
 

@@ -37,8 +37,9 @@ def chang_integrated_radiance(radiance: ArrayLike, doppler: ArrayLike) -> FloatA
     return _doppler(doppler) * finite_array(radiance, "radiance")
 
 
-def transform_spectral_radiance(emitted_spectral_radiance: Spectrum, wavelength: ArrayLike, doppler: ArrayLike
-                                ) -> FloatArray:
+def transform_spectral_radiance(
+    emitted_spectral_radiance: Spectrum, wavelength: ArrayLike, doppler: ArrayLike
+) -> FloatArray:
     """Wavelength-dependent radiance: L_lambda,obs(lambda) = D^5 L_lambda,emit(lambda D).
 
     ``emitted_spectral_radiance`` is a callable of wavelength (same units as ``wavelength``),
@@ -51,8 +52,9 @@ def transform_spectral_radiance(emitted_spectral_radiance: Spectrum, wavelength:
     return doppler**5 * emitted
 
 
-def point_light_irradiance(intensity: ArrayLike, doppler: ArrayLike, cos_incidence: ArrayLike, distance: ArrayLike
-                           ) -> FloatArray:
+def point_light_irradiance(
+    intensity: ArrayLike, doppler: ArrayLike, cos_incidence: ArrayLike, distance: ArrayLike
+) -> FloatArray:
     """Irradiance on a surface from a point light moving relative to it (Weiskopf et al. eq. 19).
 
     E = D^4 cos(alpha) / r^2 * I, with ``intensity`` I the light's (isotropic) intensity in its
@@ -66,8 +68,13 @@ def point_light_irradiance(intensity: ArrayLike, doppler: ArrayLike, cos_inciden
     return _doppler(doppler) ** 4 * np.maximum(cos_incidence, 0.0) / distance**2 * intensity
 
 
-def spectral_point_light_irradiance(emitted_spectral_intensity: Spectrum, wavelength: ArrayLike, doppler: ArrayLike,
-                                    cos_incidence: ArrayLike, distance: ArrayLike) -> FloatArray:
+def spectral_point_light_irradiance(
+    emitted_spectral_intensity: Spectrum,
+    wavelength: ArrayLike,
+    doppler: ArrayLike,
+    cos_incidence: ArrayLike,
+    distance: ArrayLike,
+) -> FloatArray:
     """Spectral irradiance from a moving point light: E_lambda = D^5 I_lambda(lambda D) cos / r^2."""
     wavelength = positive_array(wavelength, "wavelength")
     doppler = _doppler(doppler)

@@ -73,8 +73,9 @@ def contracted_rigid_samples(matrices: ArrayLike, step: float, c: float) -> tupl
     return contracted, superluminal
 
 
-def contracted_point_samples(positions: ArrayLike, origins: ArrayLike, step: float, c: float
-                             ) -> tuple[FloatArray, np.ndarray]:
+def contracted_point_samples(
+    positions: ArrayLike, origins: ArrayLike, step: float, c: float
+) -> tuple[FloatArray, np.ndarray]:
     """World positions ``(K, N, 3)`` of a deforming mesh sampled every ``step`` seconds, with the
     object's origin at ``origins`` (``(K, 3)``), contracted about the origin along its knot
     velocity (the same convention as rigid motion: the baked shape is taken as the rest shape
@@ -105,10 +106,15 @@ def check_samples_used(t_e: ArrayLike, start: float, step: float, superluminal: 
         raise ValueError(f"the sampled motion is not slower than light: its origin reaches c near t = {first:.6g} s")
 
 
-def apparent_positions_rigid_rest_shape(times: ArrayLike, matrices: ArrayLike, rest_local: ArrayLike,
-                                        observer_time: float, observer_position: ArrayLike, c: float,
-                                        observer_beta: ArrayLike = (0.0, 0.0, 0.0)
-                                        ) -> tuple[FloatArray, FloatArray, FloatArray]:
+def apparent_positions_rigid_rest_shape(
+    times: ArrayLike,
+    matrices: ArrayLike,
+    rest_local: ArrayLike,
+    observer_time: float,
+    observer_position: ArrayLike,
+    c: float,
+    observer_beta: ArrayLike = (0.0, 0.0, 0.0),
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of the rest-shape points ``rest_local`` (``(N, 3)``, object space) of a
     body whose object-to-world matrices at the uniformly spaced ``times`` are ``matrices``
     (``(K, 4, 4)``): contracted (:func:`contracted_rigid_samples`), then solved per point by
@@ -118,16 +124,22 @@ def apparent_positions_rigid_rest_shape(times: ArrayLike, matrices: ArrayLike, r
         raise ValueError("need at least 2 sample times")
     start, step, _ = _uniform_grid(times)
     contracted, superluminal = contracted_rigid_samples(matrices, step, c)
-    result = apparent_positions_sampled(SampledRigidMotion(times, contracted, rest_local), observer_time,
-                                        observer_position, c, observer_beta)
+    result = apparent_positions_sampled(
+        SampledRigidMotion(times, contracted, rest_local), observer_time, observer_position, c, observer_beta
+    )
     check_samples_used(observer_time - result[1], start, step, superluminal)
     return result
 
 
-def apparent_positions_deforming_rest_shape(times: ArrayLike, positions: ArrayLike, origins: ArrayLike,
-                                            observer_time: float, observer_position: ArrayLike, c: float,
-                                            observer_beta: ArrayLike = (0.0, 0.0, 0.0)
-                                            ) -> tuple[FloatArray, FloatArray, FloatArray]:
+def apparent_positions_deforming_rest_shape(
+    times: ArrayLike,
+    positions: ArrayLike,
+    origins: ArrayLike,
+    observer_time: float,
+    observer_position: ArrayLike,
+    c: float,
+    observer_beta: ArrayLike = (0.0, 0.0, 0.0),
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Apparent positions of a deforming mesh sampled at the uniformly spaced ``times``
     (``positions`` ``(K, N, 3)``, origin ``origins`` ``(K, 3)``), contracted by
     :func:`contracted_point_samples`, each point at its own retarded time
@@ -138,7 +150,14 @@ def apparent_positions_deforming_rest_shape(times: ArrayLike, positions: ArrayLi
     start, step, _ = _uniform_grid(times)
     contracted, superluminal = contracted_point_samples(positions, origins, step, c)
     motion = SampledPointMotion(times, contracted)
-    result = apparent_positions(motion.positions, observer_time, observer_position, c, contracted.shape[1],
-                                observer_beta, velocity=motion.velocities)
+    result = apparent_positions(
+        motion.positions,
+        observer_time,
+        observer_position,
+        c,
+        contracted.shape[1],
+        observer_beta,
+        velocity=motion.velocities,
+    )
     check_samples_used(observer_time - result[1], start, step, superluminal)
     return result

@@ -15,8 +15,13 @@ from .arrays import ArrayLike, FloatArray, WorldLine
 from .validation import finite_array, speed_of_light, vector_array, velocity_array
 
 
-def light_travel_time_uniform(observer_time: ArrayLike, observer_position: ArrayLike, emitter_position: ArrayLike,
-                              emitter_beta: ArrayLike, c: float) -> FloatArray:
+def light_travel_time_uniform(
+    observer_time: ArrayLike,
+    observer_position: ArrayLike,
+    emitter_position: ArrayLike,
+    emitter_beta: ArrayLike,
+    c: float,
+) -> FloatArray:
     """Closed-form light-travel time ``tau = t_o - t_e`` for uniform motion ``x_e(t) = p + u (t - t_o)``.
 
     ``emitter_position`` is ``p``, the emitter's position at the observer's time ``t_o`` (in the
@@ -41,16 +46,28 @@ def light_travel_time_uniform(observer_time: ArrayLike, observer_position: Array
         return np.where(a >= 0.0, (a + root) / b, q / np.where(root - a > 0.0, root - a, 1.0))
 
 
-def retarded_time_uniform(observer_time: ArrayLike, observer_position: ArrayLike, emitter_position: ArrayLike,
-                          emitter_beta: ArrayLike, c: float) -> FloatArray:
+def retarded_time_uniform(
+    observer_time: ArrayLike,
+    observer_position: ArrayLike,
+    emitter_position: ArrayLike,
+    emitter_beta: ArrayLike,
+    c: float,
+) -> FloatArray:
     """Retarded time ``t_e = t_o - tau`` for uniform motion (see :func:`light_travel_time_uniform`)."""
     tau = light_travel_time_uniform(observer_time, observer_position, emitter_position, emitter_beta, c)
     return np.asarray(observer_time, dtype=np.float64) - tau
 
 
-def light_travel_time(world_line: WorldLine, observer_time: ArrayLike, observer_position: ArrayLike, c: float, *,
-                      count: int | None = None, relative_tolerance: float = 1e-13, max_iterations: int = 100
-                      ) -> FloatArray:
+def light_travel_time(
+    world_line: WorldLine,
+    observer_time: ArrayLike,
+    observer_position: ArrayLike,
+    c: float,
+    *,
+    count: int | None = None,
+    relative_tolerance: float = 1e-13,
+    max_iterations: int = 100,
+) -> FloatArray:
     """Light-travel times ``tau = t_o - t_e`` to ``count`` points on sub-luminal world lines.
 
     ``world_line(t, index)`` returns the positions, shape ``(M, 3)``, of the points numbered
@@ -97,7 +114,8 @@ def light_travel_time(world_line: WorldLine, observer_time: ArrayLike, observer_
 
         step = tau_new - tau_prev[index]
         converged = (np.abs(g_new) <= np.maximum(relative_tolerance * c * tau_new, rounding)) | (
-            np.abs(step) <= relative_tolerance * tau_new)
+            np.abs(step) <= relative_tolerance * tau_new
+        )
         with np.errstate(divide="ignore", invalid="ignore"):
             slope = (g_new - g_prev[index]) / step
         # The slope of g lies in [c - |u|, c + |u|]: a secant slope outside (0, 2c) is noise.
@@ -113,11 +131,13 @@ def light_travel_time(world_line: WorldLine, observer_time: ArrayLike, observer_
         active = index[~converged]
     raise ValueError(
         f"retarded time did not converge for {active.size} point(s) in {max_iterations} iterations; "
-        "is the world line slower than light, and has light from it reached the observer?")
+        "is the world line slower than light, and has light from it reached the observer?"
+    )
 
 
-def retarded_time(world_line: WorldLine, observer_time: ArrayLike, observer_position: ArrayLike, c: float,
-                  **options: Any) -> FloatArray:
+def retarded_time(
+    world_line: WorldLine, observer_time: ArrayLike, observer_position: ArrayLike, c: float, **options: Any
+) -> FloatArray:
     """Retarded times ``t_e = t_o - tau`` on arbitrary world lines (see :func:`light_travel_time`)."""
     tau = light_travel_time(world_line, observer_time, observer_position, c, **options)
     return np.asarray(observer_time, dtype=np.float64) - tau

@@ -90,7 +90,8 @@ def apparent_positions_from_matrix_function(
         if high_index - low_index > max_samples:
             raise ValueError(
                 f"light-travel times span too many animation samples ({high_index - low_index + 1} > {max_samples}"
-                f" samples of {step:.4g} s, from {low:.4g} s to {high:.4g} s)")
+                f" samples of {step:.4g} s, from {low:.4g} s to {high:.4g} s)"
+            )
         times = np.arange(low_index, high_index + 1) * step
         matrices, superluminal = contracted_rigid_samples(world_matrices_at_times(times), step, c)
         result = apparent_positions_sampled(SampledRigidMotion(times, matrices, rest_local), t_o, x_o, c, beta_o)
@@ -102,4 +103,5 @@ def apparent_positions_from_matrix_function(
         low, high = min(low, t_e.min() - margin), max(high, t_e.max() + margin)
     raise ValueError(
         f"retarded times did not settle inside the sampled animation in {max_tries} windows "
-        f"(last retarded times {t_e.min():.4g}..{t_e.max():.4g} s, window {times[1]:.4g}..{times[-2]:.4g} s)")
+        f"(last retarded times {t_e.min():.4g}..{t_e.max():.4g} s, window {times[1]:.4g}..{times[-2]:.4g} s)"
+    )

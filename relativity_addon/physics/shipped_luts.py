@@ -36,4 +36,4 @@ def blackbody_rgb_lut():
 def spectral_mode_tables():
     """The CIE functions, the RGB basis and the matrices of the spectral mode (see
     ``physics.spectral_luts.spectral_mode_tables``), by name without the ``spectral_`` prefix."""
-    return {name[len("spectral_"):]: values for name, values in _tables().items() if name.startswith("spectral_")}
+    return {name[len("spectral_") :]: values for name, values in _tables().items() if name.startswith("spectral_")}

@@ -106,10 +106,19 @@ def image_distance(focal_length: float, focus_distance: float | None = None) -> 
     return 1.0 / (1.0 / f - 1.0 / u)
 
 
-def lens_time(model: ShutterModel | int | str, lens_point: ArrayLike, object_point: ArrayLike, *, c: float,
-              shutter_time: ArrayLike = 0.0, detector_point: ArrayLike | None = None, beta: ArrayLike | None = None,
-              plane_point: ArrayLike | None = None, plane_normal: ArrayLike | None = None, ideal_lens: bool = True
-              ) -> FloatArray:
+def lens_time(
+    model: ShutterModel | int | str,
+    lens_point: ArrayLike,
+    object_point: ArrayLike,
+    *,
+    c: float,
+    shutter_time: ArrayLike = 0.0,
+    detector_point: ArrayLike | None = None,
+    beta: ArrayLike | None = None,
+    plane_point: ArrayLike | None = None,
+    plane_normal: ArrayLike | None = None,
+    ideal_lens: bool = True,
+) -> FloatArray:
     """Camera time ``t_L`` at which a photo ray passes its lens point, for a shutter model.
 
     | model               | t_L                                                   |
@@ -168,8 +177,9 @@ def lens_time(model: ShutterModel | int | str, lens_point: ArrayLike, object_poi
     return t_s + a / c
 
 
-def photo_ray_in_scene(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float
-                       ) -> tuple[FloatArray, FloatArray, FloatArray]:
+def photo_ray_in_scene(
+    lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A camera-frame photo ray carried into the scene frame (Gray et al. eqs. 1 and 2).
 
     The event of the ray at ``L`` at camera time ``t_L`` maps by eq. (1); the forward direction
@@ -185,8 +195,15 @@ def photo_ray_in_scene(lens_point: ArrayLike, object_point: ArrayLike, lens_time
     return scene_time, scene_origin, _aberrate(d, -beta)
 
 
-def lorentz_window_ray(lens_point: ArrayLike, object_point: ArrayLike, lens_time: ArrayLike, beta: ArrayLike, c: float,
-                       window_point: ArrayLike, window_normal: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+def lorentz_window_ray(
+    lens_point: ArrayLike,
+    object_point: ArrayLike,
+    lens_time: ArrayLike,
+    beta: ArrayLike,
+    c: float,
+    window_point: ArrayLike,
+    window_normal: ArrayLike,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """A photo ray through a Lorentz-transformation window, carried into the scene frame.
 
     The window (Gray et al. section 4) changes a ray's direction exactly as the change of frame

@@ -226,8 +226,9 @@ def blackbody_spectral_radiance(wavelength_nm: ArrayLike, temperature_K: ArrayLi
     return radiance
 
 
-def doppler_shifted_spectral_radiance(wavelength_nm: ArrayLike, emitted_spectral_radiance: Spectrum,
-                                      doppler_factor: ArrayLike) -> FloatArray:
+def doppler_shifted_spectral_radiance(
+    wavelength_nm: ArrayLike, emitted_spectral_radiance: Spectrum, doppler_factor: ArrayLike
+) -> FloatArray:
     """Observed spectral radiance ``L_obs(lambda) = D^5 L_emit(lambda D)``.
 
     Weiskopf et al. (1999) eq. 14, written for ``D = nu_received / nu_emitted`` (their eq. 1 uses
@@ -296,9 +297,7 @@ def blackbody_luminance_ratio(temperature_K: ArrayLike, doppler_factor: ArrayLik
     observed = observed_blackbody_temperature(temperature_K, doppler_factor)
     log_emitted = _log_blackbody_luminance(temperature_K)
     if not np.all(np.isfinite(log_emitted)):
-        raise ValueError(
-            f"temperature_K too low: the visible luminance is 0 even in log space: {temperature_K!r}"
-        )
+        raise ValueError(f"temperature_K too low: the visible luminance is 0 even in log space: {temperature_K!r}")
     with np.errstate(over="ignore"):  # Beyond 1e308 (T of 1e-300 K...) the ratio is inf.
         return np.exp(_log_blackbody_luminance(observed) - log_emitted)
 

@@ -54,8 +54,9 @@ DOPPLER_LUT_LOG10_D_RANGE = (-2.0, 2.0)
 # --- Blackbody --------------------------------------------------------------------------------
 
 
-def blackbody_lut_log10_t_grid(size: int = 2048, log10_t_range: tuple[float, float] = BLACKBODY_LUT_LOG10_T_RANGE
-                               ) -> FloatArray:
+def blackbody_lut_log10_t_grid(
+    size: int = 2048, log10_t_range: tuple[float, float] = BLACKBODY_LUT_LOG10_T_RANGE
+) -> FloatArray:
     """Evenly spaced ``log10 T`` grid (K) for :func:`blackbody_rgb_lut`."""
 
     return np.linspace(log10_t_range[0], log10_t_range[1], int(size))
@@ -111,11 +112,13 @@ def sample_blackbody_rgb_lut(lut: ArrayLike, log10_t_grid: ArrayLike, temperatur
     rgb = np.stack(channels[:3], axis=-1)
     return rgb * np.exp(channels[3])[..., None]
 
+
 # --- Doppler matrix ----------------------------------------------------------------------------
 
 
-def doppler_lut_log10_d_grid(size: int = 2048, log10_d_range: tuple[float, float] = DOPPLER_LUT_LOG10_D_RANGE
-                             ) -> FloatArray:
+def doppler_lut_log10_d_grid(
+    size: int = 2048, log10_d_range: tuple[float, float] = DOPPLER_LUT_LOG10_D_RANGE
+) -> FloatArray:
     """Evenly spaced ``log10 D`` grid for :func:`doppler_matrix_lut` (default 0.01 to 100)."""
 
     return np.linspace(log10_d_range[0], log10_d_range[1], int(size))
@@ -147,8 +150,7 @@ def doppler_matrix_lut(log10_d_grid: ArrayLike | None = None) -> Float32Array:
     if not np.all(white_luminance > 0):
         bad = 10.0 ** log10_d_grid[~(white_luminance > 0)]
         raise ValueError(
-            f"doppler_matrix_lut: white underflows to black at D = {bad.min():.4g}; "
-            "use a narrower log10_d_grid"
+            f"doppler_matrix_lut: white underflows to black at D = {bad.min():.4g}; use a narrower log10_d_grid"
         )
     normalised = matrices / white_luminance[..., None, None]  # (N, 3, 3)
     log_scale = np.broadcast_to(np.log(white_luminance)[:, None, None], (len(log10_d_grid), 3, 1))
@@ -167,10 +169,7 @@ def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: ArrayLike, doppler_f
     pixels = np.asarray(lut, dtype=np.float64).reshape(3, size, 4)
     x = np.log10(doppler_factor)
     sampled = np.stack(
-        [
-            np.stack([np.interp(x, log10_d_grid, pixels[i, :, k]) for k in range(4)], axis=-1)
-            for i in range(3)
-        ],
+        [np.stack([np.interp(x, log10_d_grid, pixels[i, :, k]) for k in range(4)], axis=-1) for i in range(3)],
         axis=-2,
     )  # (..., 3, 4)
     return sampled[..., :3] * np.exp(sampled[..., :1, 3:4])

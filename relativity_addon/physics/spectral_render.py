@@ -143,7 +143,7 @@ def sample_wavelengths(doppler_min: float, doppler_max: float, passes: int) -> F
 
 def pass_wavelengths(wavelengths: ArrayLike, index: int) -> FloatArray:
     """The three wavelengths of pass ``index`` (channel ``c`` renders ``wavelengths[3 index + c]``)."""
-    return np.asarray(wavelengths, dtype=np.float64)[CHANNELS_PER_PASS * index:CHANNELS_PER_PASS * (index + 1)]
+    return np.asarray(wavelengths, dtype=np.float64)[CHANNELS_PER_PASS * index : CHANNELS_PER_PASS * (index + 1)]
 
 
 def reflectance_matrix(wavelengths_nm: ArrayLike) -> FloatArray:
@@ -218,8 +218,13 @@ def reconstruction_table(wavelengths_nm: ArrayLike, log_doppler: ArrayLike, exac
     return np.swapaxes(corrected, 1, 2)
 
 
-def reconstruct_rgb(samples: ArrayLike, log_doppler: ArrayLike, wavelengths_nm: ArrayLike, table_size: int = 512,
-                    map_to_gamut: bool = True) -> FloatArray:
+def reconstruct_rgb(
+    samples: ArrayLike,
+    log_doppler: ArrayLike,
+    wavelengths_nm: ArrayLike,
+    table_size: int = 512,
+    map_to_gamut: bool = True,
+) -> FloatArray:
     """Linear Rec.709 colour of every pixel from its samples ``D^4 L_k``, shape ``(..., K)``, and its
     ``ln D``, shape ``(...)``: ``XYZ = sum_k V_k(D) D^4 L_k`` (:func:`reconstruction_table`, tabulated on
     ``table_size`` points of ``ln D`` over the pixels' range and interpolated linearly), then RGB,

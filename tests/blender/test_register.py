@@ -47,9 +47,9 @@ def blender_state():
         for owner in PROPERTY_OWNERS
     }
     keyconfig = bpy.context.window_manager.keyconfigs.addon
-    keymap_items = sorted(
-        (km.name, kmi.idname) for km in keyconfig.keymaps for kmi in km.keymap_items
-    ) if keyconfig else []
+    keymap_items = (
+        sorted((km.name, kmi.idname) for km in keyconfig.keymaps for kmi in km.keymap_items) if keyconfig else []
+    )
     return {
         "types": sorted(dir(bpy.types)),
         "classes": registered_python_classes(),

@@ -12,9 +12,11 @@ def _direction(values):
     return v / np.linalg.norm(v)
 
 
-directions = st.tuples(
-    st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)
-).filter(lambda v: np.linalg.norm(v) > 0.1).map(_direction)
+directions = (
+    st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1))
+    .filter(lambda v: np.linalg.norm(v) > 0.1)
+    .map(_direction)
+)
 
 
 @st.composite

@@ -46,7 +46,8 @@ def test_uniform_motion_lies_on_light_cone_and_matches_closed_form(c):
     np.testing.assert_allclose(tau, tau_expected, rtol=1e-6)
     # The general solver on the same world lines agrees with the closed form within 1e-6 relative.
     general, tau_general, _ = apparent.apparent_positions(
-        lambda t, i: p[i] + ((t - t_o) * c)[:, None] * u[i], t_o, x_o, c, n)
+        lambda t, i: p[i] + ((t - t_o) * c)[:, None] * u[i], t_o, x_o, c, n
+    )
     np.testing.assert_allclose(tau_general, tau_expected, rtol=1e-6)
     scale = np.linalg.norm(general - x_o, axis=1)
     assert np.max(np.linalg.norm(general - result, axis=1) / scale) < 1e-6
@@ -98,6 +99,7 @@ def rigid_wheel(omega, radius, centre_velocity, c):
         m[..., 2, 2] = m[..., 3, 3] = 1.0
         m[..., :3, 3] = np.multiply.outer(t, centre_velocity)
         return m
+
     return matrix
 
 
@@ -115,14 +117,16 @@ def test_sampled_rotating_wheel_satisfies_light_cone_with_exact_motion(solver):
         seen, tau, beta_seen = apparent.apparent_positions_sampled(motion, t_o, x_o, c)
     else:
         seen, tau, beta_seen = apparent.apparent_positions(
-            motion.positions, t_o, x_o, c, len(local), velocity=motion.velocities)
+            motion.positions, t_o, x_o, c, len(local), velocity=motion.velocities
+        )
     t_e = t_o - tau
     exact = np.einsum("nij,nj->ni", matrix(t_e)[:, :3, :3], local) + matrix(t_e)[:, :3, 3]
     assert np.max(np.abs(light_cone_residual(x_o, tau, exact, c))) < 1e-6
     assert np.max(np.linalg.norm(seen - exact, axis=1) / (c * tau)) < 1e-6
     # Rim speed measured from the motion: |omega x r + v| / c.
-    expected_velocity = np.stack([-omega * (exact[:, 1] - 0.0), omega * (exact[:, 0] - t_e * 0.5),
-                                  np.zeros_like(t_e)], 1) + np.array([0.5, 0.0, 0.0])
+    expected_velocity = np.stack(
+        [-omega * (exact[:, 1] - 0.0), omega * (exact[:, 0] - t_e * 0.5), np.zeros_like(t_e)], 1
+    ) + np.array([0.5, 0.0, 0.0])
     # Velocities (for the Doppler shaders) come from the cubic's slope: 1e-3 of c is plenty.
     np.testing.assert_allclose(beta_seen, expected_velocity / c, atol=1e-3)
     assert np.max(np.linalg.norm(beta_seen, axis=1)) < 1.0
@@ -187,8 +191,9 @@ def test_sampled_solver_in_blocks_and_its_fallback_match_general_solver(max_iter
     motion = apparent.SampledRigidMotion(times, matrix(times), local)
     t_o, x_o = 1.0, np.array([0.0, 0.0, 6.0])
     fast = apparent.apparent_positions_sampled(motion, t_o, x_o, c, (0.0, 0.3, 0.0), max_iterations=max_iterations)
-    general = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(local), (0.0, 0.3, 0.0),
-                                          velocity=motion.velocities)
+    general = apparent.apparent_positions(
+        motion.positions, t_o, x_o, c, len(local), (0.0, 0.3, 0.0), velocity=motion.velocities
+    )
     np.testing.assert_allclose(fast[1], general[1], rtol=1e-8)
     np.testing.assert_allclose(fast[0], general[0], atol=1e-9)
     np.testing.assert_allclose(fast[2], general[2], atol=1e-9)
@@ -210,12 +215,13 @@ def test_sampled_point_motion_deforming_points_on_light_cone():
     p = RNG.uniform(-1.0, 1.0, (200, 3)) + np.array([0.0, 0.0, -6.0])
     acc = RNG.uniform(-1.0, 1.0, (200, 3))
     times = np.arange(-3.0, 0.5, 1.0 / 50.0)
-    exact = lambda t, i: p[i] + 0.5 * acc[i] * (t ** 2)[:, None]  # noqa: E731
-    samples = p[None] + 0.5 * acc[None] * (times ** 2)[:, None, None]
+    exact = lambda t, i: p[i] + 0.5 * acc[i] * (t**2)[:, None]  # noqa: E731
+    samples = p[None] + 0.5 * acc[None] * (times**2)[:, None, None]
     motion = apparent.SampledPointMotion(times, samples)
     t_o, x_o = 0.2, np.zeros(3)
-    seen, tau, beta_seen = apparent.apparent_positions(motion.positions, t_o, x_o, c, len(p),
-                                                       velocity=motion.velocities)
+    seen, tau, beta_seen = apparent.apparent_positions(
+        motion.positions, t_o, x_o, c, len(p), velocity=motion.velocities
+    )
     truth = exact(t_o - tau, np.arange(len(p)))
     # Quadratic motion is reproduced exactly by Catmull-Rom: agreement at rounding level.
     assert np.max(np.linalg.norm(seen - truth, axis=1) / (c * tau)) < 1e-9
@@ -226,5 +232,8 @@ def test_sampled_point_motion_deforming_points_on_light_cone():
 def test_contraction_matrix_is_the_contraction_about_the_origin():
     beta = np.array([0.2, -0.7, 0.4])
     points = RNG.normal(size=(20, 3))
-    np.testing.assert_allclose(points @ apparent.lorentz_contraction_matrix(beta).T,
-                               apparent.lorentz_contract(points, np.zeros(3), beta), atol=1e-14)
+    np.testing.assert_allclose(
+        points @ apparent.lorentz_contraction_matrix(beta).T,
+        apparent.lorentz_contract(points, np.zeros(3), beta),
+        atol=1e-14,
+    )

@@ -50,8 +50,9 @@ def test_moving_source_from_emission_and_arrival_events(beta_s, k):
     emission_x = emission_t[:, None] * beta_s
     a, b = far - emission_x[1:], far - emission_x[:-1]
     # |a| - |b| written without cancellation: (|a|^2 - |b|^2) / (|a| + |b|)
-    path_difference = (np.sum(-np.diff(emission_x, axis=0) * (a + b), axis=1)
-                       / (np.linalg.norm(a, axis=1) + np.linalg.norm(b, axis=1)))
+    path_difference = np.sum(-np.diff(emission_x, axis=0) * (a + b), axis=1) / (
+        np.linalg.norm(a, axis=1) + np.linalg.norm(b, axis=1)
+    )
     measured = proper_period / (np.diff(emission_t) + path_difference)
     # the photon direction at the far observer is k up to 1e-9 rad
     assert_allclose(doppler.doppler_factor_moving_source(k, beta_s), measured, rtol=1e-6)

@@ -39,16 +39,18 @@ def test_without_aberration_the_ray_is_the_scene_direction():
     beta = np.array([0.0, 0.5, -0.5])
     directions = exposure.pixel_directions(WINDOW, (5, 5))
     gamma = 1.0 / np.sqrt(1.0 - beta @ beta)
-    assert np.allclose(np.exp(exposure.log_doppler(directions, beta, aberration=False)),
-                       gamma * (1.0 + directions @ beta))
+    assert np.allclose(
+        np.exp(exposure.log_doppler(directions, beta, aberration=False)), gamma * (1.0 + directions @ beta)
+    )
 
 
 def test_compensation_undoes_the_log_average_searchlight():
     beta = (0.2, 0.0, -0.8)
     size = (48, 36)
     k = exposure.compensation(beta, WINDOW, size=size)
-    d4 = np.array([[_boost_frequency_ratio(d, beta) ** 4 for d in row]
-                   for row in exposure.pixel_directions(WINDOW, size)])
+    d4 = np.array(
+        [[_boost_frequency_ratio(d, beta) ** 4 for d in row] for row in exposure.pixel_directions(WINDOW, size)]
+    )
     assert k * np.exp(np.mean(np.log(d4))) == pytest.approx(1.0, rel=1e-9)
     assert k < 1.0, "looking ahead at 0.82c the frame is brighter: the exposure darkens it"
     assert exposure.compensation((0.0, 0.0, 0.0), WINDOW) == 1.0
@@ -83,8 +85,7 @@ def test_fisheye_equidistant_angle_grows_with_the_radius():
 
 def test_fisheye_equisolid_radius_is_two_f_sin_half_angle():
     lens, sensor = 8.0, (36.0, 24.0)
-    directions, inside = exposure.panorama_directions("FISHEYE_EQUISOLID", (12, 8), fov=np.pi, lens=lens,
-                                                      sensor=sensor)
+    directions, inside = exposure.panorama_directions("FISHEYE_EQUISOLID", (12, 8), fov=np.pi, lens=lens, sensor=sensor)
     x = ((np.arange(12) + 0.5) / 12 - 0.5) * sensor[0]
     y = ((np.arange(8) + 0.5) / 8 - 0.5) * sensor[1]
     radius = np.hypot(x[None, :], y[:, None])

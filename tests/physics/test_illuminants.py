@@ -23,8 +23,9 @@ def _observed_rgb(weights, temperature, doppler):
 def test_white_illuminant_is_the_emitter_table():
     """With 6504 K white the table is the one shipped for emitters (built with colour-science)."""
     grid = spectral_luts.doppler_lut_log10_d_grid(256)
-    np.testing.assert_allclose(illuminants.doppler_lut(grid, None), spectral_luts.doppler_matrix_lut(grid),
-                               rtol=2e-6, atol=2e-6)
+    np.testing.assert_allclose(
+        illuminants.doppler_lut(grid, None), spectral_luts.doppler_matrix_lut(grid), rtol=2e-6, atol=2e-6
+    )
 
 
 @pytest.mark.parametrize("temperature", [1800.0, 2700.0, 5762.0, 15000.0])

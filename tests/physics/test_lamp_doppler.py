@@ -60,8 +60,9 @@ def test_white_lamp_colour_is_the_shifted_spectrum(doppler):
     ``D^3 I(lambda D)`` per wavelength: its RGB is ``D^-2`` times what eq. 14's ``D^5 L(lambda D)``
     gives, which colour-science's integral (physics/spectral.py) computes."""
     factor = lamp_doppler.lamp_rgb_factor(doppler, rgb=(1.0, 1.0, 1.0))
-    np.testing.assert_allclose(factor, spectral.doppler_shift_rgb((1.0, 1.0, 1.0), doppler) / doppler**2,
-                               rtol=2e-3, atol=1e-9)
+    np.testing.assert_allclose(
+        factor, spectral.doppler_shift_rgb((1.0, 1.0, 1.0), doppler) / doppler**2, rtol=2e-3, atol=1e-9
+    )
 
 
 @pytest.mark.parametrize("temperature, doppler", [(3000.0, 1.732), (3000.0, 0.577), (5762.0, 1.5), (12000.0, 0.4)])

@@ -20,6 +20,7 @@ points = st.tuples(coordinates, coordinates, coordinates).map(np.array)
 def _bisect_emission_time(x, t_x, light_at_t_o, beta, c, t_o):
     """t_e with |x - x_L(t_e)| = c (t_x - t_e) by plain bisection (the defining equation),
     solved for tau = t_x - t_e (t_x - tau would round tau away with the real c)."""
+
     def g(tau):
         return c * tau - np.linalg.norm(x - (light_at_t_o + beta * c * ((t_x - t_o) - tau)))
 
@@ -198,5 +199,7 @@ def test_lamp_times_span_the_lit_points_evenly():
 def test_path_position_is_straight_between_and_beyond_its_samples():
     knots = np.array([-2.0, 0.0])
     points = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.0]])
-    assert_allclose(moving_lights.path_position(np.array([-1.0, -4.0, 2.0]), knots, points),
-                    [[0.5, 1.0, 0.0], [-1.0, -2.0, 0.0], [2.0, 4.0, 0.0]])
+    assert_allclose(
+        moving_lights.path_position(np.array([-1.0, -4.0, 2.0]), knots, points),
+        [[0.5, 1.0, 0.0], [-1.0, -2.0, 0.0], [2.0, 4.0, 0.0]],
+    )

@@ -71,8 +71,9 @@ def test_own_animation_at_proper_time():
     radii = np.array([0.5, 1.0, 2.0])
 
     def points(angles):
-        return np.stack([np.cos(angles)[:, None] * radii, np.sin(angles)[:, None] * radii,
-                         np.zeros((len(angles), 3))], axis=2)
+        return np.stack(
+            [np.cos(angles)[:, None] * radii, np.sin(angles)[:, None] * radii, np.zeros((len(angles), 3))], axis=2
+        )
 
     result = proper_time.own_animation_at_proper_time(times, origins[:, None, :] + points(times), origins, c)
     expected = origins[:, None, :] + points(times / gamma)
@@ -80,7 +81,8 @@ def test_own_animation_at_proper_time():
     assert np.abs(result - expected).max() < 1e-5
     # A bake starting after t = 0: the clock ran at its first rate before (tau = t / gamma still).
     late = times >= 0.5
-    result = proper_time.own_animation_at_proper_time(times[late], (origins[:, None, :] + points(times))[late],
-                                                      origins[late], c)
+    result = proper_time.own_animation_at_proper_time(
+        times[late], (origins[:, None, :] + points(times))[late], origins[late], c
+    )
     inside = times[late] / gamma >= 0.5  # arrangements from inside the samples
     assert np.abs(result - expected[late])[inside].max() < 1e-5

@@ -29,10 +29,12 @@ def test_solid_angle_ratio_is_the_jacobian_of_aberration(beta, theta, phi):
     k = sphere_point(theta, phi)
     dk_dtheta = (sphere_point(theta + h, phi) - sphere_point(theta - h, phi)) / (2 * h)
     dk_dphi = (sphere_point(theta, phi + h) - sphere_point(theta, phi - h)) / (2 * h)
-    kp_dtheta = (lorentz.aberrate(sphere_point(theta + h, phi), beta)
-                 - lorentz.aberrate(sphere_point(theta - h, phi), beta)) / (2 * h)
-    kp_dphi = (lorentz.aberrate(sphere_point(theta, phi + h), beta)
-               - lorentz.aberrate(sphere_point(theta, phi - h), beta)) / (2 * h)
+    kp_dtheta = (
+        lorentz.aberrate(sphere_point(theta + h, phi), beta) - lorentz.aberrate(sphere_point(theta - h, phi), beta)
+    ) / (2 * h)
+    kp_dphi = (
+        lorentz.aberrate(sphere_point(theta, phi + h), beta) - lorentz.aberrate(sphere_point(theta, phi - h), beta)
+    ) / (2 * h)
     jacobian = np.linalg.norm(np.cross(kp_dtheta, kp_dphi)) / np.linalg.norm(np.cross(dk_dtheta, dk_dphi))
     d = doppler.doppler_factor_moving_observer(k, beta)
     assert_allclose(radiance.received_solid_angle(1.0, d), jacobian, rtol=2e-5)
@@ -47,7 +49,8 @@ def test_blackbody_seen_at_D_T(doppler_factor, temperature):
     """D^5 B(lambda D, T) = B(lambda, D T), with colour-science's Planck law on both sides."""
     wl = np.linspace(100e-9, 5000e-9, 500)
     shifted = radiance.transform_spectral_radiance(
-        lambda w: colour.colorimetry.planck_law(w, temperature), wl, doppler_factor)
+        lambda w: colour.colorimetry.planck_law(w, temperature), wl, doppler_factor
+    )
     assert_allclose(shifted, colour.colorimetry.planck_law(wl, doppler_factor * temperature), rtol=1e-10)
 
 
@@ -55,6 +58,7 @@ def test_blackbody_seen_at_D_T(doppler_factor, temperature):
 def test_integrated_radiance_is_the_integral_of_the_spectral_law(doppler_factor):
     """Integrating D^5 L(lambda D) over lambda gives D^4 times the integral of L: the D^4 of the
     searchlight effect, and not Chang et al.'s single power of D."""
+
     def spectrum(w):
         return np.exp(-0.5 * ((w - 600e-9) / 80e-9) ** 2) + 0.3 * np.exp(-0.5 * ((w - 1.5e-6) / 0.3e-6) ** 2)
 
@@ -112,7 +116,8 @@ def test_point_light_irradiance_from_counted_photons(beta_s, k):
     psi = rng.uniform(0, 2 * np.pi, size=200_000)
     sin_t = np.sqrt(1 - cos_t**2)
     in_cone = cos_t[:, None] * basis[0] + sin_t[:, None] * (
-        np.cos(psi)[:, None] * basis[1] + np.sin(psi)[:, None] * basis[2])
+        np.cos(psi)[:, None] * basis[1] + np.sin(psi)[:, None] * basis[2]
+    )
     doppler_in_cone = doppler.doppler_factor_moving_source(in_cone, beta_s)
     expected = radiance.point_light_irradiance(1.0, doppler_in_cone, 1.0, 1.0).mean()
     assert_allclose(power, expected, rtol=4 / np.sqrt(inside.sum()))

@@ -21,19 +21,21 @@ def contract(relative, beta):
     speed = np.linalg.norm(beta, axis=-1, keepdims=True)
     bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
     along = np.sum(relative * bhat, axis=-1, keepdims=True)
-    return relative - (1.0 - np.sqrt(1.0 - speed ** 2)) * along * bhat
+    return relative - (1.0 - np.sqrt(1.0 - speed**2)) * along * bhat
 
 
 def closed_form_apparent(x_o, positions_now, u):
     """docs/physics.md, observer at rest: tau = ((D.u) + sqrt((D.u)^2 + (c^2 - u.u) D.D)) / (c^2 - u.u)
     with D = x_o - p (here with c folded into u: u in units per second, c = |u| / |beta|);
     the point is seen at p - u tau."""
+
     def solve(c):
         delta = x_o - positions_now
         a = delta @ u
         b = c * c - u @ u
         tau = (a + np.sqrt(a * a + b * np.sum(delta * delta, axis=1))) / b
         return positions_now - np.outer(tau, u), tau
+
     return solve
 
 
@@ -48,12 +50,14 @@ def rod(length=1.0, count=41, width=0.02):
 
 def keyframed(start, velocity, rotation):
     """World matrices of linear keyframes: fixed rotation and scale, origin start + v t."""
+
     def matrices(times):
         m = np.zeros((len(times), 4, 4))
         m[:, :3, :3] = rotation
         m[:, :3, 3] = start + np.multiply.outer(times, velocity)
         m[:, 3, 3] = 1.0
         return m
+
     return matrices
 
 
@@ -84,13 +88,15 @@ def test_rod_at_constant_keyframed_velocity_equals_the_closed_form(c, direction)
     scale = np.linalg.norm(positions_now - x_o, axis=1) + 1e-5 * c * step
 
     seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
-        matrices, step, local, t_o, x_o, (0.0, 0.0, 0.0), c)
+        matrices, step, local, t_o, x_o, (0.0, 0.0, 0.0), c
+    )
     assert np.max(np.linalg.norm(seen - expected, axis=1) / scale) < 1e-9
     assert np.max(c * np.abs(tau - expected_tau) / scale) < 1e-9
     np.testing.assert_allclose(beta_seen, np.broadcast_to(beta, seen.shape), atol=1e-9)
     # The CONSTANT path: the contracted mesh through apparent_positions_uniform.
     constant, _, _ = apparent.apparent_positions_uniform(
-        t_o, x_o, (apparent.lorentz_contraction_matrix(beta) @ rotation @ local.T).T + origin_now, beta, c)
+        t_o, x_o, (apparent.lorentz_contraction_matrix(beta) @ rotation @ local.T).T + origin_now, beta, c
+    )
     assert np.max(np.linalg.norm(seen - constant, axis=1) / scale) < 1e-9
 
     span = 3.0 * np.max(expected_tau) + 3 * step  # a bake over frames around the retarded times
@@ -110,7 +116,8 @@ def test_moving_observer_sees_the_constant_path_result(observer_beta):
     local = rod(length=2.0)
     now = matrices(np.array([t_o]))[0]
     constant = apparent.apparent_positions_uniform(
-        t_o, x_o, contract(local @ rotation.T, beta) + now[:3, 3], beta, c, observer_beta)
+        t_o, x_o, contract(local @ rotation.T, beta) + now[:3, 3], beta, c, observer_beta
+    )
     seen = sampling.apparent_positions_from_matrix_function(matrices, 1.0 / 24.0, local, t_o, x_o, observer_beta, c)
     scale = np.linalg.norm(constant[0] - x_o, axis=1)
     assert np.max(np.linalg.norm(seen[0] - constant[0], axis=1) / scale) < 1e-9
@@ -131,7 +138,8 @@ def test_far_rod_appears_contracted_and_stretched_by_light_travel_time():
         start = retarded + np.array([beta * distance, 0.0, 0.0])
         matrices = keyframed(start, np.array([beta * c, 0.0, 0.0]), np.eye(3))
         seen, _, _ = sampling.apparent_positions_from_matrix_function(
-            matrices, 1.0, local, 0.0, np.zeros(3), (0.0, 0.0, 0.0), c)
+            matrices, 1.0, local, 0.0, np.zeros(3), (0.0, 0.0, 0.0), c
+        )
         apparent_length = np.linalg.norm(seen[1] - seen[0])
         expected = length / gamma / (1.0 - beta * math.cos(theta))
         print(f"theta {theta:.3f}: apparent length {apparent_length:.6f}, far-field {expected:.6f}")
@@ -151,21 +159,24 @@ def test_accelerating_rod_is_contracted_with_beta_at_each_point_retarded_time():
     t_o = 20.0  # 1.0 c at t = 20: light seen now left the rod ~3-4 s earlier, at 0.8-0.85 c
 
     def exact(t):
-        origin = 0.5 * np.multiply.outer(t ** 2, acceleration)
+        origin = 0.5 * np.multiply.outer(t**2, acceleration)
         return origin, np.multiply.outer(t, acceleration) / c
 
     matrices = keyframed(np.zeros(3), np.zeros(3), np.eye(3))
     accelerated = lambda times: _translate(matrices(times), exact(np.asarray(times))[0])  # noqa: E731
     seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
-        accelerated, 1.0 / 48.0, local, t_o, x_o, (0.0, 0.0, 0.0), c)
+        accelerated, 1.0 / 48.0, local, t_o, x_o, (0.0, 0.0, 0.0), c
+    )
     t_e = t_o - tau
     origin, beta_e = exact(t_e)
     emitted = contract(local, beta_e) + origin
     residual = np.abs(np.linalg.norm(x_o - emitted, axis=1) - c * tau) / (c * tau)
     mismatch = np.linalg.norm(seen - emitted, axis=1) / (c * tau)
     speeds = np.linalg.norm(beta_e, axis=1)
-    print(f"speeds at retarded times {speeds.min():.3f}..{speeds.max():.3f} c, residual {residual.max():.1e}, "
-          f"mismatch {mismatch.max():.1e}")
+    print(
+        f"speeds at retarded times {speeds.min():.3f}..{speeds.max():.3f} c, residual {residual.max():.1e}, "
+        f"mismatch {mismatch.max():.1e}"
+    )
     assert np.ptp(speeds) > 0.03
     assert residual.max() < 1e-7 and mismatch.max() < 1e-7
     # One contraction for all points (beta of the centre's retarded time) misplaces the ends.
@@ -207,7 +218,7 @@ def test_deformation_bake_is_contracted_about_the_origin():
 def test_origin_velocities_and_contraction_matrices():
     step = 0.1
     t = step * np.arange(7)
-    origins = np.stack([t ** 2, 3.0 * t, -t ** 2 + t], axis=1)  # quadratic: central differences are exact
+    origins = np.stack([t**2, 3.0 * t, -(t**2) + t], axis=1)  # quadratic: central differences are exact
     velocities = rest_shape.origin_velocities(origins, step)
     np.testing.assert_allclose(velocities[1:-1], np.stack([2 * t, 3.0 + 0 * t, 1 - 2 * t], 1)[1:-1], atol=1e-12)
     np.testing.assert_allclose(velocities[0], (origins[1] - origins[0]) / step)  # linear end padding

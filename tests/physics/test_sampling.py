@@ -23,7 +23,7 @@ def contract(relative, beta):
     speed = np.linalg.norm(beta, axis=-1, keepdims=True)
     bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
     along = np.sum(relative * bhat, axis=-1, keepdims=True)
-    return relative - (1.0 - np.sqrt(1.0 - speed ** 2)) * along * bhat
+    return relative - (1.0 - np.sqrt(1.0 - speed**2)) * along * bhat
 
 
 def uniform_motion(start, velocity, rotation_z=0.3):
@@ -36,11 +36,13 @@ def uniform_motion(start, velocity, rotation_z=0.3):
         m[:, :3, 3] = start + np.multiply.outer(times, velocity)
         m[:, 3, 3] = 1.0
         return m
+
     return matrices
 
 
 def accelerated_spinning_motion(acceleration, omega):
     """x(t) = R_z(omega t) p + a t^2 / 2: accelerating and spinning."""
+
     def matrices(times):
         times = np.asarray(times, dtype=np.float64)
         m = np.zeros(times.shape + (4, 4))
@@ -48,8 +50,9 @@ def accelerated_spinning_motion(acceleration, omega):
         m[..., 0, 0], m[..., 0, 1] = np.cos(angle), -np.sin(angle)
         m[..., 1, 0], m[..., 1, 1] = np.sin(angle), np.cos(angle)
         m[..., 2, 2] = m[..., 3, 3] = 1.0
-        m[..., :3, 3] = 0.5 * np.multiply.outer(times ** 2, acceleration)
+        m[..., :3, 3] = 0.5 * np.multiply.outer(times**2, acceleration)
         return m
+
     return matrices
 
 
@@ -61,7 +64,8 @@ def test_uniform_motion_reproduces_the_closed_form(c, observer_beta):
     local = RNG.uniform(-1.0, 1.0, (300, 3))
     t_o, x_o = 3.0, np.array([0.0, -2.0, 1.0])
     seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
-        matrices, 1.0 / 96.0, local, t_o, x_o, observer_beta, c)
+        matrices, 1.0 / 96.0, local, t_o, x_o, observer_beta, c
+    )
     now = matrices(np.array([t_o]))[0]
     positions_now = contract(local @ now[:3, :3].T, beta) + now[:3, 3]
     expected = apparent.apparent_positions_uniform(t_o, x_o, positions_now, beta, c, observer_beta)
@@ -78,8 +82,9 @@ def test_accelerated_spinning_body_lies_on_the_light_cone():
     matrices = accelerated_spinning_motion(acceleration, omega)
     local = RNG.uniform(-1.0, 1.0, (500, 3)) + np.array([0.0, 0.0, -5.0])
     t_o, x_o = 2.0, np.array([1.0, 8.0, 0.0])
-    seen, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 1.0 / 240.0, local, t_o, x_o,
-                                                                    (0.0, 0.0, 0.0), c)
+    seen, tau, _ = sampling.apparent_positions_from_matrix_function(
+        matrices, 1.0 / 240.0, local, t_o, x_o, (0.0, 0.0, 0.0), c
+    )
     exact = matrices(t_o - tau)
     # Contracted along the origin's velocity a t_e at each point's own retarded time.
     velocity = np.multiply.outer(t_o - tau, acceleration) / c
@@ -95,12 +100,14 @@ def test_window_widens_for_a_fast_receding_body_and_gives_up_after_max_tries():
     matrices = uniform_motion(np.array([0.0, 10.0, 0.0]), np.array([0.0, 0.9, 0.0]), rotation_z=0.0)
     local = np.zeros((50, 3))
     local[:, 1] = RNG.uniform(-0.1, 0.1, 50)  # on the line of sight: c tau = 10 + y - 0.9 tau
-    _, tau, _ = sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
-                                                                 (0.0, 0.0, 0.0), c)
+    _, tau, _ = sampling.apparent_positions_from_matrix_function(
+        matrices, 0.01, local, 0.0, np.zeros(3), (0.0, 0.0, 0.0), c
+    )
     np.testing.assert_allclose(tau, (10.0 + local[:, 1] * np.sqrt(1.0 - 0.81)) / 1.9, rtol=1e-9)
     with pytest.raises(ValueError, match="did not settle"):
-        sampling.apparent_positions_from_matrix_function(matrices, 0.01, local, 0.0, np.zeros(3),
-                                                         (0.0, 0.0, 0.0), c, max_tries=1)
+        sampling.apparent_positions_from_matrix_function(
+            matrices, 0.01, local, 0.0, np.zeros(3), (0.0, 0.0, 0.0), c, max_tries=1
+        )
 
 
 def test_too_many_samples_and_bad_input_raise():
@@ -112,12 +119,19 @@ def test_too_many_samples_and_bad_input_raise():
         sampling.apparent_positions_from_matrix_function(matrices, 0.0, local, 0.0, np.zeros(3), np.zeros(3), 1.0)
     with pytest.raises(ValueError, match="slower than light"):
         sampling.apparent_positions_from_matrix_function(
-            uniform_motion(np.array([0.0, 0.0, -5.0]), np.array([2.0, 0.0, 0.0])), 0.01, local, 0.0, np.zeros(3),
-            np.zeros(3), 1.0)
+            uniform_motion(np.array([0.0, 0.0, -5.0]), np.array([2.0, 0.0, 0.0])),
+            0.01,
+            local,
+            0.0,
+            np.zeros(3),
+            np.zeros(3),
+            1.0,
+        )
 
 
 def test_no_points_give_empty_results():
     matrices = uniform_motion(np.zeros(3), np.zeros(3))
     seen, tau, beta_seen = sampling.apparent_positions_from_matrix_function(
-        matrices, 0.1, np.zeros((0, 3)), 0.0, np.ones(3), np.zeros(3), 1.0)
+        matrices, 0.1, np.zeros((0, 3)), 0.0, np.ones(3), np.zeros(3), 1.0
+    )
     assert seen.shape == (0, 3) and tau.shape == (0,) and beta_seen.shape == (0, 3)

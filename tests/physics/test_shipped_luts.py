@@ -39,8 +39,9 @@ def _stale_after(tmp_path, tables, name, change):
 
 def test_the_rounding_residual_of_gamut_mapped_zeros_is_tolerated(tmp_path, fresh_tables):
     """numpy 1.26 and 2.x differ by 0 vs 1.1e-16 in components the gamut mapping drives to zero."""
+
     def residual(table):
-        table[np.abs(table) < 1e-15] += np.float32(2.0 ** -53)
+        table[np.abs(table) < 1e-15] += np.float32(2.0**-53)
         return table
 
     assert _stale_after(tmp_path, fresh_tables, "blackbody_rgb_lut", residual) == []

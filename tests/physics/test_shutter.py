@@ -26,8 +26,9 @@ def lens_disc(radius, count=9):
 @given(velocities(0.999), vectors)
 def test_fixed_point_time_makes_eq1_the_identity(beta, x):
     t = shutter.fixed_point_time(x, beta, C)
-    assert_allclose(lorentz.camera_to_scene_event(t, x, beta, C)[1], x,
-                    atol=1e-9 * (1 + np.linalg.norm(x)) / (1 - beta @ beta))
+    assert_allclose(
+        lorentz.camera_to_scene_event(t, x, beta, C)[1], x, atol=1e-9 * (1 + np.linalg.norm(x)) / (1 - beta @ beta)
+    )
 
 
 def test_fixed_point_time_is_gray_eq4():
@@ -36,8 +37,9 @@ def test_fixed_point_time_is_gray_eq4():
     assert_allclose(shutter.fixed_point_time(x, beta, c), (1 - gamma) * (beta @ x) / (c * gamma * (beta @ beta)))
 
 
-@given(velocities(0.999).filter(lambda b: np.linalg.norm(b) > 1e-3), st.floats(-5, 5), st.floats(-3, 3),
-       st.floats(-3, 3))
+@given(
+    velocities(0.999).filter(lambda b: np.linalg.norm(b) > 1e-3), st.floats(-5, 5), st.floats(-3, 3), st.floats(-3, 3)
+)
 def test_fixed_point_plane_is_fixed_at_the_shutter_time(beta, t_s, u, v):
     point, normal = shutter.fixed_point_plane(t_s, beta, C)
     tangent = np.cross(normal, [1.0, 0, 0] if abs(normal[0]) < 0.9 else [0, 1.0, 0])
@@ -65,36 +67,47 @@ def test_each_model_meets_its_shutter_at_the_shutter_time(lens_offset, towards, 
     focus_point = np.array([0.4, 0.2, 6.0])
     detector = np.array([-0.02, -0.01, -0.05])
     assert_allclose(shutter.lens_time("PINHOLE", np.zeros(3), focus_point, c=C, shutter_time=t_s), t_s, atol=1e-12)
-    assert_allclose(shutter.lens_time(ShutterModel.APERTURE_PLANE, lens, focus_point, c=C, shutter_time=t_s), t_s,
-                    atol=1e-12)
+    assert_allclose(
+        shutter.lens_time(ShutterModel.APERTURE_PLANE, lens, focus_point, c=C, shutter_time=t_s), t_s, atol=1e-12
+    )
     # ideal lens: every ray from P reaches D at t_S after the chief ray's travel time
     t_det = shutter.lens_time("DETECTOR_PLANE", lens, focus_point, c=C, shutter_time=t_s, detector_point=detector)
     chief_travel = (np.linalg.norm(focus_point) + np.linalg.norm(detector)) / C
     assert_allclose(ray_time_at(focus_point, lens, t_det) + chief_travel, t_s, atol=1e-12)
     # phase hologram of a lens: no delay, the ray reaches D straight from L at t_S
-    t_holo = shutter.lens_time("DETECTOR_PLANE", lens, focus_point, c=C, shutter_time=t_s, detector_point=detector,
-                               ideal_lens=False)
+    t_holo = shutter.lens_time(
+        "DETECTOR_PLANE", lens, focus_point, c=C, shutter_time=t_s, detector_point=detector, ideal_lens=False
+    )
     assert_allclose(t_holo + np.linalg.norm(detector - lens) / C, t_s, atol=1e-12)
     t_focus = shutter.lens_time("FOCUS_SURFACE", lens, focus_point, c=C, shutter_time=t_s)
     assert_allclose(ray_time_at(focus_point, lens, t_focus), t_s, atol=1e-12)
     t_fixed = shutter.lens_time("FIXED_POINT_SURFACE", lens, focus_point, c=C, beta=BETA_GRAY)
-    assert_allclose(ray_time_at(focus_point, lens, t_fixed), shutter.fixed_point_time(focus_point, BETA_GRAY, C),
-                    atol=1e-12)
+    assert_allclose(
+        ray_time_at(focus_point, lens, t_fixed), shutter.fixed_point_time(focus_point, BETA_GRAY, C), atol=1e-12
+    )
 
     # arbitrary plane: find where the ray from P to L crosses it by a different route
     normal = towards if abs(towards[2]) > 0.2 else np.array([0.0, 0.3, 1.0]) / np.hypot(0.3, 1.0)
     plane_point = np.array([0.1, 0.0, 1.5])
     s = ((plane_point - focus_point) @ normal) / ((lens - focus_point) @ normal)  # P + s (L - P) on plane
     crossing = focus_point + s * (lens - focus_point)
-    t_plane = shutter.lens_time("ARBITRARY_PLANE", lens, focus_point, c=C, shutter_time=t_s,
-                                plane_point=plane_point, plane_normal=normal)
+    t_plane = shutter.lens_time(
+        "ARBITRARY_PLANE", lens, focus_point, c=C, shutter_time=t_s, plane_point=plane_point, plane_normal=normal
+    )
     assert_allclose(ray_time_at(crossing, lens, t_plane), t_s, atol=1e-9)
 
 
 def test_arbitrary_plane_in_front_is_crossed_before_the_lens():
     """The worked case that shows the sign of eq. (B5): a plane one unit in front of the lens."""
-    t = shutter.lens_time("ARBITRARY_PLANE", np.zeros(3), [0, 0, 5.0], c=2.0, shutter_time=0.0,
-                          plane_point=[0, 0, 1.0], plane_normal=[0, 0, 1.0])
+    t = shutter.lens_time(
+        "ARBITRARY_PLANE",
+        np.zeros(3),
+        [0, 0, 5.0],
+        c=2.0,
+        shutter_time=0.0,
+        plane_point=[0, 0, 1.0],
+        plane_normal=[0, 0, 1.0],
+    )
     assert_allclose(t, 0.5)
 
 
@@ -113,8 +126,9 @@ def test_scene_ray_joins_the_two_transformed_events(beta, towards, t_lens):
 
 
 def scene_rays(model, lenses, focus_point, detector, beta, t_s=0.0, ideal_lens=True):
-    times = shutter.lens_time(model, lenses, focus_point, c=C, shutter_time=t_s, detector_point=detector, beta=beta,
-                              ideal_lens=ideal_lens)
+    times = shutter.lens_time(
+        model, lenses, focus_point, c=C, shutter_time=t_s, detector_point=detector, beta=beta, ideal_lens=ideal_lens
+    )
     _, origins, directions_ = shutter.photo_ray_in_scene(lenses, focus_point, times, beta, C)
     return origins, directions_
 
@@ -143,8 +157,9 @@ def test_detector_plane_shutter_images_stigmatically_and_aperture_plane_does_not
         t_p = -np.linalg.norm(detector - np.zeros(3)) / C - np.linalg.norm(focus_point) / C
         assert_allclose(point, lorentz.camera_to_scene_event(t_p, focus_point, BETA_GRAY, C)[1], atol=1e-6)
     detector = detector_point - 0.005 * off_axis
-    _, spread_hologram = spread_of_closest_approach(*scene_rays("DETECTOR_PLANE", lenses, off_axis, detector, BETA_GRAY,
-                                                                ideal_lens=False))
+    _, spread_hologram = spread_of_closest_approach(
+        *scene_rays("DETECTOR_PLANE", lenses, off_axis, detector, BETA_GRAY, ideal_lens=False)
+    )
     assert spread_hologram > 1e-3
     _, spread_off = spread_of_closest_approach(*scene_rays("APERTURE_PLANE", lenses, off_axis, None, BETA_GRAY))
     _, spread_on = spread_of_closest_approach(*scene_rays("APERTURE_PLANE", lenses, on_axis, None, BETA_GRAY))
@@ -170,10 +185,12 @@ def test_lorentz_window_gives_the_rays_of_the_camera_at_rest():
     window_point, window_normal = shutter.fixed_point_plane(t_s, BETA_GRAY, C)
     lenses = lens_disc(0.1)
     for obj in (np.array([0.5, 0.3, 6.0]), np.array([-1.0, 0.2, 3.0])):
-        times = shutter.lens_time("ARBITRARY_PLANE", lenses, obj, c=C, shutter_time=t_s,
-                                  plane_point=window_point, plane_normal=window_normal)
-        _, origins, directions_ = shutter.lorentz_window_ray(lenses, obj, times, BETA_GRAY, C, window_point,
-                                                             window_normal)
+        times = shutter.lens_time(
+            "ARBITRARY_PLANE", lenses, obj, c=C, shutter_time=t_s, plane_point=window_point, plane_normal=window_normal
+        )
+        _, origins, directions_ = shutter.lorentz_window_ray(
+            lenses, obj, times, BETA_GRAY, C, window_point, window_normal
+        )
         at_rest = (lenses - obj) / np.linalg.norm(lenses - obj, axis=1, keepdims=True)
         assert_allclose(directions_, at_rest, atol=1e-12)
         # origins lie on the rest-frame rays: the same lines as at rest
@@ -192,8 +209,9 @@ def test_shutter_inputs_are_checked():
     with pytest.raises(ValueError, match="beta"):
         shutter.lens_time("FIXED_POINT_SURFACE", np.zeros(3), [0, 0, 1.0], c=C, beta=[0, 0, 1.0])
     with pytest.raises(ValueError, match="parallel"):
-        shutter.lens_time("ARBITRARY_PLANE", np.zeros(3), [0, 0, 1.0], c=C, plane_point=[0, 0, 1.0],
-                          plane_normal=[1.0, 0, 0])
+        shutter.lens_time(
+            "ARBITRARY_PLANE", np.zeros(3), [0, 0, 1.0], c=C, plane_point=[0, 0, 1.0], plane_normal=[1.0, 0, 0]
+        )
     with pytest.raises(ValueError, match="zero-length"):
         shutter.photo_ray_in_scene(np.zeros(3), np.zeros(3), 0.0, [0.5, 0, 0], C)
     with pytest.raises(ValueError, match="finite"):

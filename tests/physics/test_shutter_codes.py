@@ -22,8 +22,10 @@ def _shader_source():
 
 
 def test_shader_defines_one_code_per_model_equal_to_the_enum():
-    defines = {name: int(value) for name, value in
-               re.findall(r"^\s*#define\s+SHUTTER_(\w+)\s+(-?\d+)\s*$", _shader_source(), flags=re.M)}
+    defines = {
+        name: int(value)
+        for name, value in re.findall(r"^\s*#define\s+SHUTTER_(\w+)\s+(-?\d+)\s*$", _shader_source(), flags=re.M)
+    }
     assert defines == {model.name: model.value for model in ShutterModel}
 
 
@@ -37,7 +39,8 @@ def test_shader_compares_shutter_model_only_against_the_defined_codes():
     assert {operand.removeprefix("SHUTTER_") for operand in operands} <= set(SHUTTER_MODEL_NAMES)
     # The models other than the pinhole all have their own branch (the pinhole is the != test).
     assert {operand.removeprefix("SHUTTER_") for operand in operands} >= set(SHUTTER_MODEL_NAMES) - {
-        "APERTURE_PLANE"}  # aperture plane: t_L = t_S, the shader's default branch
+        "APERTURE_PLANE"
+    }  # aperture plane: t_L = t_S, the shader's default branch
     default = re.search(r"\bint\s+shutter_model\s*=\s*(\d+)", source)
     assert default and int(default.group(1)) == ShutterModel.PINHOLE
 
@@ -52,8 +55,15 @@ def test_names_are_the_enum_members_in_code_order():
 
 def test_blender_property_items_follow_the_enum_order():
     tree = ast.parse(PROPS.read_text())
-    items = next((node.value for node in tree.body if isinstance(node, ast.Assign)
-                  and any(getattr(target, "id", None) == "SHUTTER_MODEL_ITEMS" for target in node.targets)), None)
+    items = next(
+        (
+            node.value
+            for node in tree.body
+            if isinstance(node, ast.Assign)
+            and any(getattr(target, "id", None) == "SHUTTER_MODEL_ITEMS" for target in node.targets)
+        ),
+        None,
+    )
     if not isinstance(items, ast.Tuple):
         pytest.skip("props.py no longer spells SHUTTER_MODEL_ITEMS out (built from the core's enum)")
     names = tuple(ast.literal_eval(item)[0] for item in items.elts)

@@ -77,9 +77,7 @@ def test_shifted_planck_is_planck_at_DT(temperature_K, doppler_factor):
             lambda emitted_nm: colour.colorimetry.planck_law(emitted_nm * 1e-9, temperature_K),
             doppler_factor,
         )
-        expected = colour.colorimetry.planck_law(
-            wavelength_nm * 1e-9, doppler_factor * temperature_K
-        )
+        expected = colour.colorimetry.planck_law(wavelength_nm * 1e-9, doppler_factor * temperature_K)
     observed_T = spectral.observed_blackbody_temperature(temperature_K, doppler_factor)
     assert observed_T == pytest.approx(doppler_factor * temperature_K, rel=1e-15)
     np.testing.assert_allclose(shifted, expected, rtol=1e-10)
@@ -88,12 +86,8 @@ def test_shifted_planck_is_planck_at_DT(temperature_K, doppler_factor):
 def test_blackbody_spectral_radiance_broadcasts_element_wise():
     wavelength_nm = np.array([400.0, 550.0, 700.0])
     temperature_K = np.array([[1500.0], [6504.0]])
-    expected = np.array(
-        [[colour.colorimetry.planck_law(w * 1e-9, t) for w in wavelength_nm] for t in (1500, 6504)]
-    )
-    np.testing.assert_allclose(
-        spectral.blackbody_spectral_radiance(wavelength_nm, temperature_K), expected, rtol=1e-12
-    )
+    expected = np.array([[colour.colorimetry.planck_law(w * 1e-9, t) for w in wavelength_nm] for t in (1500, 6504)])
+    np.testing.assert_allclose(spectral.blackbody_spectral_radiance(wavelength_nm, temperature_K), expected, rtol=1e-12)
 
 
 @pytest.mark.parametrize("temperature_K", [1000, 1500, 2856, 4000, 5762, 6504, 10000, 3e4, 1e5])
@@ -129,10 +123,7 @@ def test_blackbody_rgb_gamut_map_only_lifts_negative_components():
 @settings(max_examples=50, deadline=None)
 @given(temperatures_K, moderate_doppler_factors)
 def test_blackbody_luminance_ratio_is_Y_DT_over_Y_T(temperature_K, doppler_factor):
-    expected = (
-        colour_blackbody_XYZ(doppler_factor * temperature_K)[1]
-        / colour_blackbody_XYZ(temperature_K)[1]
-    )
+    expected = colour_blackbody_XYZ(doppler_factor * temperature_K)[1] / colour_blackbody_XYZ(temperature_K)[1]
     ratio = spectral.blackbody_luminance_ratio(temperature_K, doppler_factor)
     assert ratio == pytest.approx(expected, rel=1e-9)
 

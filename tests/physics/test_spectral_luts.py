@@ -41,9 +41,7 @@ def test_doppler_matrix_lut_layout_and_nodes():
     matrices = spectral.doppler_rgb_matrix(10.0**grid)
     white_luminance = spectral.luminance_linear_rec709(matrices.sum(-1))
     np.testing.assert_allclose(pixels[..., 3], np.log(white_luminance)[None].repeat(3, 0), atol=1e-4)
-    np.testing.assert_allclose(
-        np.moveaxis(pixels[..., :3], 0, 1), matrices / white_luminance[:, None, None], atol=1e-6
-    )
+    np.testing.assert_allclose(np.moveaxis(pixels[..., :3], 0, 1), matrices / white_luminance[:, None, None], atol=1e-6)
 
 
 def test_doppler_matrix_lut_interpolation_error():
@@ -88,9 +86,7 @@ def test_blackbody_lut_interpolation_error():
     # The searchlight ratio from the alpha channel, as the shader computes it.
     T, D = 5762.0, np.array([0.3, 0.7, 1.5, 4.0])
     alpha = np.interp(np.log10([T, *(D * T)]), grid, lut.reshape(-1, 4)[:, 3].astype(float))
-    np.testing.assert_allclose(
-        np.exp(alpha[1:] - alpha[0]), spectral.blackbody_luminance_ratio(T, D), rtol=1e-4
-    )
+    np.testing.assert_allclose(np.exp(alpha[1:] - alpha[0]), spectral.blackbody_luminance_ratio(T, D), rtol=1e-4)
 
 
 # --- Validation ---------------------------------------------------------------------------------

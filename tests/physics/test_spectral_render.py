@@ -10,17 +10,23 @@ MU = np.geomspace(190.0, 3000.0, 97)
 
 
 def test_shipped_tables_reproduce_colour_science():
-    np.testing.assert_allclose(spectral_render.reflectance_matrix(MU), spectral.reflectance_basis_Mallett2019(MU),
-                               rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        spectral_render.reflectance_matrix(MU), spectral.reflectance_basis_Mallett2019(MU), rtol=1e-12, atol=1e-15
+    )
     np.testing.assert_allclose(spectral_render.white(MU), spectral.illuminant_white(MU), rtol=1e-9)
     temperatures = np.array([800.0, 2700.0, 5762.0, 20000.0])
-    np.testing.assert_allclose(spectral_render.blackbody_xyz(temperatures), spectral.blackbody_XYZ(temperatures),
-                               rtol=1e-9)
-    np.testing.assert_allclose(np.exp(spectral_render.log_blackbody_luminance(temperatures)),
-                               spectral.blackbody_luminance(temperatures), rtol=1e-9)
+    np.testing.assert_allclose(
+        spectral_render.blackbody_xyz(temperatures), spectral.blackbody_XYZ(temperatures), rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        np.exp(spectral_render.log_blackbody_luminance(temperatures)),
+        spectral.blackbody_luminance(temperatures),
+        rtol=1e-9,
+    )
     doppler = np.array([0.3, 0.9, 1.0, 1.7, 4.0])
-    np.testing.assert_allclose(spectral_render.doppler_rgb_matrix(doppler), spectral.doppler_rgb_matrix(doppler),
-                               rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        spectral_render.doppler_rgb_matrix(doppler), spectral.doppler_rgb_matrix(doppler), rtol=1e-9, atol=1e-12
+    )
     rgb = np.array([[0.2, -0.1, 0.5], [1.0, 0.5, 0.0], [0.0, 0.0, 0.0]])
     np.testing.assert_allclose(spectral_render.gamut_map(rgb), spectral.gamut_map_linear_rec709(rgb), atol=1e-12)
 
@@ -28,8 +34,10 @@ def test_shipped_tables_reproduce_colour_science():
 def _delta_e(rgb_a, rgb_b):
     import colour
 
-    lab = [colour.XYZ_to_Lab(spectral.linear_rec709_to_XYZ(c) / spectral.linear_rec709_to_XYZ(c)[1])
-           for c in (rgb_a, rgb_b)]
+    lab = [
+        colour.XYZ_to_Lab(spectral.linear_rec709_to_XYZ(c) / spectral.linear_rec709_to_XYZ(c)[1])
+        for c in (rgb_a, rgb_b)
+    ]
     return float(colour.delta_E(*lab, method="CIE 2000"))
 
 
@@ -40,12 +48,15 @@ def test_blackbody_seen_at_d_t(doppler, temperature):
     (docs/physics.md), at 4 passes: Delta E 2000 < 0.5, luminance within 1 %."""
     wavelengths = spectral_render.sample_wavelengths(doppler * 0.97, doppler * 1.03, 4)
     samples = doppler**4 * spectral_render.blackbody_samples(wavelengths, temperature)
-    rgb = spectral_render.reconstruct_rgb(samples[None], np.array([np.log(doppler)]), wavelengths,
-                                          map_to_gamut=False)[0]
-    expected = spectral.XYZ_to_linear_rec709(spectral.blackbody_XYZ(doppler * temperature)
-                                             / spectral.blackbody_luminance(temperature))
-    assert spectral.luminance_linear_rec709(rgb) / spectral.luminance_linear_rec709(expected) == \
-        pytest.approx(1.0, abs=0.01)
+    rgb = spectral_render.reconstruct_rgb(samples[None], np.array([np.log(doppler)]), wavelengths, map_to_gamut=False)[
+        0
+    ]
+    expected = spectral.XYZ_to_linear_rec709(
+        spectral.blackbody_XYZ(doppler * temperature) / spectral.blackbody_luminance(temperature)
+    )
+    assert spectral.luminance_linear_rec709(rgb) / spectral.luminance_linear_rec709(expected) == pytest.approx(
+        1.0, abs=0.01
+    )
     assert _delta_e(rgb, expected) < 0.5
 
 
@@ -74,8 +85,9 @@ def test_reflectance_product_two_bounces_against_direct_integration():
     grid = spectral.WAVELENGTHS_VISIBLE_NM
     expected_xyz = (doppler**5 * spectrum(grid * doppler)) @ spectral._cmfs_visible()
     wavelengths = spectral_render.sample_wavelengths(doppler, doppler, 4)
-    rgb = spectral_render.reconstruct_rgb((doppler**4 * spectrum(wavelengths))[None], np.array([np.log(doppler)]),
-                                          wavelengths, map_to_gamut=False)[0]
+    rgb = spectral_render.reconstruct_rgb(
+        (doppler**4 * spectrum(wavelengths))[None], np.array([np.log(doppler)]), wavelengths, map_to_gamut=False
+    )[0]
     expected = spectral.XYZ_to_linear_rec709(expected_xyz)
     assert _delta_e(rgb, expected) < 0.5
     assert spectral.luminance_linear_rec709(rgb) / expected_xyz[1] == pytest.approx(1.0, abs=0.01)
@@ -88,8 +100,9 @@ def test_no_nan_or_negative_pixel_for_d_from_0_01_to_100(d_range):
     low, high = d_range
     wavelengths = spectral_render.sample_wavelengths(low, high, 4)
     log_d = np.linspace(np.log(low), np.log(high), 40)
-    emitted = spectral_render.blackbody_samples(wavelengths, 5000.0) + \
-        spectral_render.emission_matrix(wavelengths) @ np.array([0.3, 0.5, 0.2])
+    emitted = spectral_render.blackbody_samples(wavelengths, 5000.0) + spectral_render.emission_matrix(
+        wavelengths
+    ) @ np.array([0.3, 0.5, 0.2])
     samples = np.exp(4.0 * log_d)[:, None] * emitted
     rgb = spectral_render.reconstruct_rgb(samples, log_d, wavelengths)
     assert np.all(np.isfinite(rgb)) and rgb.min() >= 0.0

@@ -28,8 +28,9 @@ def _scipy_rotation():
 def _hamilton(p, q):
     """Quaternion products p q of rows (w, x, y, z)."""
     pw, pv, qw, qv = p[:, :1], p[:, 1:], q[:, :1], q[:, 1:]
-    return np.concatenate([pw * qw - np.sum(pv * qv, axis=1, keepdims=True),
-                           pw * qv + qw * pv + np.cross(pv, qv)], axis=1)
+    return np.concatenate(
+        [pw * qw - np.sum(pv * qv, axis=1, keepdims=True), pw * qv + qw * pv + np.cross(pv, qv)], axis=1
+    )
 
 
 def _rodrigues(axis, angle):
@@ -128,8 +129,11 @@ def test_axis_angle_matrices_match_scipy_rotation_vectors():
     rotation = _scipy_rotation()
     angles, axes = RNG.uniform(-7, 7, 40), RNG.normal(size=(40, 3))
     unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
-    assert_allclose(transforms.axis_angle_matrices(np.column_stack([angles, axes])),
-                    rotation.from_rotvec(angles[:, None] * unit).as_matrix(), atol=1e-13)
+    assert_allclose(
+        transforms.axis_angle_matrices(np.column_stack([angles, axes])),
+        rotation.from_rotvec(angles[:, None] * unit).as_matrix(),
+        atol=1e-13,
+    )
 
 
 def test_zero_axis_is_no_rotation():

@@ -9,7 +9,7 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[2] / "relativity_addon"
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "architecture.md"
-MAX_LINES = 520  # "about 500"
+MAX_LINES = 560  # "about 500", counted after `ruff format` (which spreads long calls over lines)
 
 # The parts, lowest first, and what each may import (besides itself). The read side (scene) imports
 # no stage; the two render paths (camera, geometry) import nothing from each other; everything that
@@ -52,8 +52,12 @@ def part_of(module):
 
 def upward_imports(graph):
     """(module, imported module) pairs that break the parts' order."""
-    return sorted((module, target) for module, targets in graph.items() for target in targets
-                  if part_of(target) != part_of(module) and part_of(target) not in ALLOWED[part_of(module)])
+    return sorted(
+        (module, target)
+        for module, targets in graph.items()
+        for target in targets
+        if part_of(target) != part_of(module) and part_of(target) not in ALLOWED[part_of(module)]
+    )
 
 
 def _modules():
@@ -99,7 +103,7 @@ def _find_cycle(graph):
         stack.append(node)
         for target in sorted(graph[node]):
             if state.get(target) == "open":
-                return stack[stack.index(target):] + [target]
+                return stack[stack.index(target) :] + [target]
             if target not in state:
                 cycle = visit(target)
                 if cycle:
@@ -171,7 +175,7 @@ def _stage_names():
 
 def test_the_docs_list_the_stages_of_the_code_in_order():
     text = DOCS.read_text(encoding="utf-8")
-    table = text[text.index("## The stages"):]
+    table = text[text.index("## The stages") :]
     documented = re.findall(r"^\| \d+ \| ([^|]+?) \|", table, flags=re.M)
     assert documented == _stage_names()
 
@@ -181,10 +185,17 @@ def test_physics_core_and_errors_never_import_bpy():
     for name, path in MODULES.items():
         if name.startswith("relativity_addon.physics") or name in bpy_free:
             tree = ast.parse(path.read_text(encoding="utf-8"))
-            imported = {alias.name.split(".")[0] for node in ast.walk(tree) if isinstance(node, ast.Import)
-                        for alias in node.names}
-            imported |= {(node.module or "").split(".")[0] for node in ast.walk(tree)
-                         if isinstance(node, ast.ImportFrom) and not node.level}
+            imported = {
+                alias.name.split(".")[0]
+                for node in ast.walk(tree)
+                if isinstance(node, ast.Import)
+                for alias in node.names
+            }
+            imported |= {
+                (node.module or "").split(".")[0]
+                for node in ast.walk(tree)
+                if isinstance(node, ast.ImportFrom) and not node.level
+            }
             assert not imported & {"bpy", "mathutils", "bpy_extras"}, name
 
 

@@ -37,11 +37,14 @@ process.stdout.write(JSON.stringify({ keys, tasks }));
 
 def test_job_type_parses_as_javascript():
     import esprima  # pinned in requirements/blender-*.txt: this check runs everywhere
+
     program = esprima.parseScript(JOB_TYPE.read_text(encoding="utf-8"))
     names = {node.id.name for node in program.body if node.type == "FunctionDeclaration"}
     declared = {
         declaration.id.name
-        for node in program.body if node.type == "VariableDeclaration" for declaration in node.declarations
+        for node in program.body
+        if node.type == "VariableDeclaration"
+        for declaration in node.declarations
     }
     assert "compileJob" in names and "JOB_TYPE" in declared  # what Flamenco's job compiler calls
     with pytest.raises(esprima.Error):
@@ -54,13 +57,23 @@ def test_job_type_compiles_tasks_the_batch_script_accepts():
 
     assert subprocess.run([NODE, "--check", str(JOB_TYPE)], capture_output=True).returncode == 0
     settings = {
-        "frames": "3-12", "chunk_size": 4, "render_script": "/farm/relativity/examples/render.py",
-        "render_output_root": "/farm/out", "file_format": "exr", "beta": "0, 0.9, 0",
-        "velocity_from_animation": False, "method": "geometry", "samples": 16, "spectral_passes": 0,
-        "resume": True, "extra_args": "--seed=3  --no-searchlight", "blendfile": "/farm/shot.blend",
+        "frames": "3-12",
+        "chunk_size": 4,
+        "render_script": "/farm/relativity/examples/render.py",
+        "render_output_root": "/farm/out",
+        "file_format": "exr",
+        "beta": "0, 0.9, 0",
+        "velocity_from_animation": False,
+        "method": "geometry",
+        "samples": 16,
+        "spectral_passes": 0,
+        "resume": True,
+        "extra_args": "--seed=3  --no-searchlight",
+        "blendfile": "/farm/shot.blend",
     }
-    result = subprocess.run([NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps(settings)],
-                            capture_output=True, text=True, timeout=60)
+    result = subprocess.run(
+        [NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps(settings)], capture_output=True, text=True, timeout=60
+    )
     assert result.returncode == 0, result.stderr
     compiled = json.loads(result.stdout)
     assert set(settings) <= set(compiled["keys"])
@@ -82,6 +95,10 @@ def test_job_type_compiles_tasks_the_batch_script_accepts():
         covered += range(first, last + 1)
     assert covered == list(range(3, 13)) and len(compiled["tasks"]) == 3  # 3-6, 7-10, 11-12
 
-    bad = subprocess.run([NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps({**settings, "frames": "1,5"})],
-                         capture_output=True, text=True, timeout=60)
+    bad = subprocess.run(
+        [NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps({**settings, "frames": "1,5"})],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert bad.returncode != 0 and "frames must be FIRST-LAST" in bad.stderr

@@ -12,10 +12,10 @@ settings = scene.relativity
 # pinhole shutter at t_S = 0 (docs/camera.md, "Time of flight only").
 if scene.camera is not None:
     to_world = scene.camera.matrix_world.to_quaternion()
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = to_world @ Vector((0.1, 0.0, -0.99))
-    settings.method = 'CAMERA'
-    settings.shutter_model = 'PINHOLE'
+    settings.method = "CAMERA"
+    settings.shutter_model = "PINHOLE"
     settings.shutter_time = 0.0
     settings.use_lorentz_window = False
     settings.use_time_of_flight = True  # last: it refuses the Lorentz window

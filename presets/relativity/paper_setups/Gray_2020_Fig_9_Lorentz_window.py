@@ -14,14 +14,14 @@ settings = scene.relativity
 # at rest.
 if scene.camera is not None:
     to_world = scene.camera.matrix_world.to_quaternion()
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = to_world @ Vector((0.1, 0.0, -0.99))
-    settings.method = 'CAMERA'
+    settings.method = "CAMERA"
     settings.use_time_of_flight = False
     settings.speed_of_light = 1.0
-    settings.shutter_model = 'ARBITRARY_PLANE'
+    settings.shutter_model = "ARBITRARY_PLANE"
     settings.shutter_time = -1.0
     settings.shutter_plane_point = (0.111, 0.0, -1.1)
     settings.shutter_plane_normal = (0.1, 0.0, -0.99)
     settings.use_lorentz_window = True
-    settings.lorentz_window_shutter = 'WINDOW_PLANE'
+    settings.lorentz_window_shutter = "WINDOW_PLANE"

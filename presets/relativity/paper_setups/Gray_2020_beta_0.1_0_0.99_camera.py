@@ -10,10 +10,10 @@ settings = scene.relativity
 # camera's rotation, since scene.relativity.beta is a world vector.
 if scene.camera is not None:
     to_world = scene.camera.matrix_world.to_quaternion()
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = to_world @ Vector((0.1, 0.0, -0.99))
-    settings.method = 'CAMERA'
+    settings.method = "CAMERA"
     settings.use_time_of_flight = False
-    settings.shutter_model = 'PINHOLE'
+    settings.shutter_model = "PINHOLE"
     settings.shutter_time = 0.0
     settings.use_lorentz_window = False

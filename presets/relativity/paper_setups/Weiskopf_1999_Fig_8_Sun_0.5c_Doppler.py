@@ -8,11 +8,11 @@ settings = scene.relativity
 # rest pass by to the left (the same relative motion, the photo taken in the camera's frame).
 # "Doppler only" as the paper defines it: the shifted spectrum L(lambda D) with no further factor.
 if scene.camera is not None:
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = scene.camera.matrix_world.to_quaternion() @ Vector((0.5, 0.0, 0.0))
-    settings.method = 'CAMERA'
+    settings.method = "CAMERA"
     settings.use_time_of_flight = False
     settings.use_geometry = True
     settings.use_doppler = True
     settings.use_searchlight = False
-    settings.doppler_only_brightness = 'SPECTRUM'  # the paper's L(lambda D), no further factor
+    settings.doppler_only_brightness = "SPECTRUM"  # the paper's L(lambda D), no further factor

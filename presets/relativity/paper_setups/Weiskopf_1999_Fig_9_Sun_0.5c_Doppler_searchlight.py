@@ -7,9 +7,9 @@ settings = scene.relativity
 # camera method moves the observer instead: a camera moving at 0.5 c along its local +X sees a Sun at
 # rest pass by to the left (the same relative motion, the photo taken in the camera's frame).
 if scene.camera is not None:
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = scene.camera.matrix_world.to_quaternion() @ Vector((0.5, 0.0, 0.0))
-    settings.method = 'CAMERA'
+    settings.method = "CAMERA"
     settings.use_time_of_flight = False
     settings.use_geometry = True
     settings.use_doppler = True

@@ -1,8 +1,8 @@
 import bpy
 
 settings = bpy.context.scene.relativity
-settings.shutter_model = 'DETECTOR_PLANE'
+settings.shutter_model = "DETECTOR_PLANE"
 settings.shutter_time = 0.0
 settings.use_lorentz_window = False
-settings.lorentz_window_shutter = 'WINDOW_PLANE'
-settings.imaging_element = 'PHASE_HOLOGRAM'
+settings.lorentz_window_shutter = "WINDOW_PLANE"
+settings.imaging_element = "PHASE_HOLOGRAM"

@@ -9,5 +9,5 @@ direction = Vector(settings.beta)
 if direction.length == 0.0 and scene.camera is not None:
     direction = scene.camera.matrix_world.to_quaternion() @ Vector((0.0, 0.0, -1.0))
 if direction.length > 0.0:
-    settings.velocity_source = 'MANUAL'
+    settings.velocity_source = "MANUAL"
     settings.beta = direction.normalized() * 0.5

@@ -37,8 +37,9 @@ def write(scene: Scene, snap: Snapshot) -> None:
     if cycles is None or (KEY not in scene and scale == 1.0):
         return
     if KEY not in scene:
-        scene[KEY] = {name: getattr(cycles, name) for name in CLAMPS} | \
-            {f"written {name}": getattr(cycles, name) for name in CLAMPS}
+        scene[KEY] = {name: getattr(cycles, name) for name in CLAMPS} | {
+            f"written {name}": getattr(cycles, name) for name in CLAMPS
+        }
     saved = scene[KEY]
     for name in CLAMPS:
         current = getattr(cycles, name)

@@ -122,8 +122,10 @@ def type_problem(camera_name, camera_data: Camera):
     if kind == "PANO":
         if camera_data.panorama_type in PANORAMA_PROJECTIONS:
             return None
-        return (f"camera {camera_name!r} is a {camera_data.panorama_type} panorama: the relativistic camera "
-                "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras")
+        return (
+            f"camera {camera_name!r} is a {camera_data.panorama_type} panorama: the relativistic camera "
+            "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras"
+        )
     return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
 
 
@@ -167,10 +169,12 @@ def _focus_surface_warning(scene, camera_object):
     if moved <= 0.01 * focus:
         return None
     scale = scene.unit_settings.scale_length or 1.0
-    return (f"Camera {camera_object.name!r}: the Focus Surface shutter times rays at the focus surface "
-            f"{focus * scale:.3g} m ahead, so they reach the lens {lens_time:.3g} s after the shutter time, "
-            f"{moved * scale:.3g} m further on: nearer objects are not photographed "
-            f"(shutter time {-focus / c:.3g} s times them at the lens)")
+    return (
+        f"Camera {camera_object.name!r}: the Focus Surface shutter times rays at the focus surface "
+        f"{focus * scale:.3g} m ahead, so they reach the lens {lens_time:.3g} s after the shutter time, "
+        f"{moved * scale:.3g} m further on: nearer objects are not photographed "
+        f"(shutter time {-focus / c:.3g} s times them at the lens)"
+    )
 
 
 def stereo_eyes(scene: Scene):
@@ -371,14 +375,20 @@ def write(scene: Scene, snap: Snapshot) -> None:
         raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
     if lens_type(camera_data) == "PANO" and snap.shutter_model in LENS_SHUTTERS:
         name = snap.shutter_model.replace("_", " ").lower()
-        raise RelativityError(f"the {name} shutter needs a perspective camera's lens: camera "
-                              f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)")
+        raise RelativityError(
+            f"the {name} shutter needs a perspective camera's lens: camera "
+            f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)"
+        )
     if stereo_eyes(scene) and lens_type(camera_data) == "PANO":
-        raise RelativityError(f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
-                              "are not rendered by the relativistic camera; switch Stereoscopy off")
+        raise RelativityError(
+            f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
+            "are not rendered by the relativistic camera; switch Stereoscopy off"
+        )
     if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
-        raise RelativityError(f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
-                              "share one shutter plane; use off-axis or parallel convergence")
+        raise RelativityError(
+            f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
+            "share one shutter plane; use off-axis or parallel convergence"
+        )
     if _missing_parameters(camera_data) or not camera_data.custom_bytecode:
         ensure_shader_text()
         compile_shader(camera_data)

@@ -62,28 +62,36 @@ def _matrix_nodes(key, image_name, colour):
             texel = f"{key}_row{row}_{side}"
             # z: UV alpha
             nodes[f"{texel}_uv"] = Node("ShaderNodeCombineXYZ", {0: f"u{side}", 1: (row + 0.5) / 3.0, 2: 1.0})
-            nodes[texel] = Node("CompositorNodeMapUV", {
-                "Image": f"{key}_lut.Image", "UV": f"{texel}_uv",
-                **{name: Menu(value) for name, value in map_inputs.items()},
-            }, map_props)
+            nodes[texel] = Node(
+                "CompositorNodeMapUV",
+                {
+                    "Image": f"{key}_lut.Image",
+                    "UV": f"{texel}_uv",
+                    **{name: Menu(value) for name, value in map_inputs.items()},
+                },
+                map_props,
+            )
             nodes[f"{texel}_dot"] = vmath("DOT_PRODUCT", texel, colour)
         nodes[f"{key}_step{row}"] = fmath("SUBTRACT", f"{key}_row{row}_1_dot.Value", f"{key}_row{row}_0_dot.Value")
         nodes[f"{key}_dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"{key}_step{row}", f"{key}_row{row}_0_dot.Value")
-    nodes.update({
-        f"{key}_split0": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_0"}),
-        f"{key}_split1": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_1"}),
-        f"{key}_alpha_step": fmath("SUBTRACT", f"{key}_split1.Alpha", f"{key}_split0.Alpha"),
-        f"{key}_alpha": fmath("MULTIPLY_ADD", "frac", f"{key}_alpha_step", f"{key}_split0.Alpha"),
-        f"{key}_product": Node("ShaderNodeCombineXYZ", {0: f"{key}_dot0", 1: f"{key}_dot1", 2: f"{key}_dot2"}),
-        f"{key}_mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: f"{key}_product"}, kind="CompositorNodeGroup"),
-        # exp(E) with E = a(D) with the searchlight and Doppler, + (p - p_cam) ln D
-        f"{key}_base": Node("ShaderNodeMix", {"Factor": "group.Use Doppler", 4: colour, 5: f"{key}_mapped"},
-                            {"data_type": "VECTOR"}),
-        f"{key}_log_gain": fmath("MULTIPLY_ADD", f"{key}_alpha", "group.Spectral Searchlight", "power_term"),
-        f"{key}_safe_log_gain": fmath("MINIMUM", f"{key}_log_gain", materials.EXP_LIMIT),
-        f"{key}_gain": fmath("EXPONENT", f"{key}_safe_log_gain"),
-        f"{key}_shifted": vmath("SCALE", f"{key}_base.Result", scale=f"{key}_gain"),
-    })
+    nodes.update(
+        {
+            f"{key}_split0": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_0"}),
+            f"{key}_split1": Node("CompositorNodeSeparateColor", {0: f"{key}_row0_1"}),
+            f"{key}_alpha_step": fmath("SUBTRACT", f"{key}_split1.Alpha", f"{key}_split0.Alpha"),
+            f"{key}_alpha": fmath("MULTIPLY_ADD", "frac", f"{key}_alpha_step", f"{key}_split0.Alpha"),
+            f"{key}_product": Node("ShaderNodeCombineXYZ", {0: f"{key}_dot0", 1: f"{key}_dot1", 2: f"{key}_dot2"}),
+            f"{key}_mapped": group_node(COMPOSITOR_GAMUT_MAP, {0: f"{key}_product"}, kind="CompositorNodeGroup"),
+            # exp(E) with E = a(D) with the searchlight and Doppler, + (p - p_cam) ln D
+            f"{key}_base": Node(
+                "ShaderNodeMix", {"Factor": "group.Use Doppler", 4: colour, 5: f"{key}_mapped"}, {"data_type": "VECTOR"}
+            ),
+            f"{key}_log_gain": fmath("MULTIPLY_ADD", f"{key}_alpha", "group.Spectral Searchlight", "power_term"),
+            f"{key}_safe_log_gain": fmath("MINIMUM", f"{key}_log_gain", materials.EXP_LIMIT),
+            f"{key}_gain": fmath("EXPONENT", f"{key}_safe_log_gain"),
+            f"{key}_shifted": vmath("SCALE", f"{key}_base.Result", scale=f"{key}_gain"),
+        }
+    )
     return nodes
 
 
@@ -129,16 +137,23 @@ def compositor_group():
     nodes.update(_matrix_nodes("emit", lut_images.DOPPLER_LUT_NAME, "other"))
     for slot, image_name in enumerate(lut_images.ILLUMINANT_LUT_NAMES, start=1):
         nodes.update(_matrix_nodes(f"lit{slot}", image_name, f"group.Lit {slot}"))
-    nodes.update({
-        "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
-        "shifted": vmath("ADD", "emit_shifted", "lit_shifted"),
-        "kept": Node("ShaderNodeMix", {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
-                     {"data_type": "VECTOR", "clamp_factor": True}),
-        "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
-        "out_split": Node("ShaderNodeSeparateXYZ", {0: "kept.Result"}),
-        "out": Node("CompositorNodeCombineColor", {0: "out_split.X", 1: "out_split.Y", 2: "out_split.Z",
-                                                   3: "source_split.Alpha"}),
-    })
+    nodes.update(
+        {
+            "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
+            "shifted": vmath("ADD", "emit_shifted", "lit_shifted"),
+            "kept": Node(
+                "ShaderNodeMix",
+                {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
+                {"data_type": "VECTOR", "clamp_factor": True},
+            ),
+            "source_split": Node("CompositorNodeSeparateColor", {0: "group.Image"}),
+            "out_split": Node("ShaderNodeSeparateXYZ", {0: "kept.Result"}),
+            "out": Node(
+                "CompositorNodeCombineColor",
+                {0: "out_split.X", 1: "out_split.Y", 2: "out_split.Z", 3: "source_split.Alpha"},
+            ),
+        }
+    )
     return Group(
         COMPOSITOR_GROUP,
         "CompositorNodeTree",
@@ -224,8 +239,10 @@ def write_colour_stage(scene: Scene, snap: Snapshot):
     if _stage_mode["mode"] == "PASS_THROUGH":
         # spectral passes: the lamps' colours are spectral values now, the groups stay as they were
         # (the stage passes every part through; their denoisers still match the denoised Image)
-        temperatures = tuple(float(image.get(names.ILLUMINANT_KEY, 0.0)) if image is not None else 0.0
-                             for image in map(bpy.data.images.get, lut_images.ILLUMINANT_LUT_NAMES))
+        temperatures = tuple(
+            float(image.get(names.ILLUMINANT_KEY, 0.0)) if image is not None else 0.0
+            for image in map(bpy.data.images.get, lut_images.ILLUMINANT_LUT_NAMES)
+        )
     else:
         temperatures = light_groups.assign(scene, snap.lit_groups)
         for name, temperature in zip(lut_images.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
@@ -276,8 +293,11 @@ def _link_light_group_pass(tree, layers, denoiser, slot):
         return
     layers.update()
     outputs = layers.outputs
-    for output_name, input_name in ((f"Combined_{light_groups.SLOTS[slot - 1]}", "Image"),
-                                    ("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")):
+    for output_name, input_name in (
+        (f"Combined_{light_groups.SLOTS[slot - 1]}", "Image"),
+        ("Denoising Normal", "Normal"),
+        ("Denoising Albedo", "Albedo"),
+    ):
         if output_name in outputs:
             tree.links.new(outputs[output_name], denoiser.inputs[input_name])
 
@@ -332,16 +352,25 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
             node.name = node.label = f"{COMPOSITOR_GROUP} {layers.name}"
             node.location = (layers.location.x + 250.0, layers.location.y)
             tree.links.new(image, node.inputs["Image"])
-            for aov_name, socket_name in ((materials.DONE_AOV, "Done"), (materials.LOG_DOPPLER_AOV, "Log Doppler"),
-                                          (materials.COVERAGE_AOV, "Coverage")):
+            for aov_name, socket_name in (
+                (materials.DONE_AOV, "Done"),
+                (materials.LOG_DOPPLER_AOV, "Log Doppler"),
+                (materials.COVERAGE_AOV, "Coverage"),
+            ):
                 aov_output = layers.outputs.get(aov_name)
                 if aov_output is not None:
                     tree.links.new(aov_output, node.inputs[socket_name])
             for to_node, to_socket in targets:
                 socket = next(s for s in tree.nodes[to_node].inputs if s.identifier == to_socket)
                 tree.links.new(node.outputs["Image"], socket)
-            saved["inserted"].append({"group_node": node.name, "layers": layers.name, "targets": targets,
-                                      "denoisers": _add_denoisers(tree, layers, node)})
+            saved["inserted"].append(
+                {
+                    "group_node": node.name,
+                    "layers": layers.name,
+                    "targets": targets,
+                    "denoisers": _add_denoisers(tree, layers, node),
+                }
+            )
         scene.render.use_compositing = True
         scene[SAVED_KEY] = saved
     write_colour_stage(scene, snap)

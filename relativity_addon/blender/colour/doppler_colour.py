@@ -83,16 +83,22 @@ def remove_unused_data():
     """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
     if any(materials.is_attached(material) for material in bpy.data.materials):
         return False
-    group_names = (compositing.COMPOSITOR_GROUP, compositing.COMPOSITOR_GAMUT_MAP, volumes.GROUP,
-                   volumes.COLOUR_GROUP) + tuple(
-        builder().name for builder in reversed(materials.GROUP_BUILDERS)
-    )
+    group_names = (
+        compositing.COMPOSITOR_GROUP,
+        compositing.COMPOSITOR_GAMUT_MAP,
+        volumes.GROUP,
+        volumes.COLOUR_GROUP,
+    ) + tuple(builder().name for builder in reversed(materials.GROUP_BUILDERS))
     for name in group_names:
         tree = bpy.data.node_groups.get(name)
         if tree is not None:
             bpy.data.node_groups.remove(tree)
-    for name in (lut_images.DOPPLER_LUT_NAME, lut_images.BLACKBODY_LUT_NAME, names.WORLD_DOPPLER_IMAGE,
-                 *lut_images.ILLUMINANT_LUT_NAMES):
+    for name in (
+        lut_images.DOPPLER_LUT_NAME,
+        lut_images.BLACKBODY_LUT_NAME,
+        names.WORLD_DOPPLER_IMAGE,
+        *lut_images.ILLUMINANT_LUT_NAMES,
+    ):
         image = bpy.data.images.get(name)
         if image is not None:
             bpy.data.images.remove(image)

@@ -37,8 +37,10 @@ def user_groups(scene: Scene):
 def warnings(scene: Scene, snap: Snapshot):
     """One line when blackbody lamps are read in white because the scene has its own light groups."""
     if snap.lit_groups and user_groups(scene):
-        return [f"Fast colour reads the lamps in white light: the scene has its own light groups "
-                f"({', '.join(user_groups(scene))}); Render Spectral is exact"]
+        return [
+            f"Fast colour reads the lamps in white light: the scene has its own light groups "
+            f"({', '.join(user_groups(scene))}); Render Spectral is exact"
+        ]
     return []
 
 
@@ -88,7 +90,7 @@ def assign(scene: Scene, groups):
     if any(dict(record[kind]) != held[kind] for kind in held):
         scene[KEY] = held
     temperatures = [group.temperature for group in groups] + [0.0] * len(SLOTS)
-    return tuple(temperatures[:len(SLOTS)])
+    return tuple(temperatures[: len(SLOTS)])
 
 
 def release(scene: Scene):

@@ -32,9 +32,7 @@ BLACKBODY_LOG10_RANGE = (2.0, 6.0)
 def _packed_float_image(name, width, height, pixels):
     image = bpy.data.images.get(name)
     if image is not None and (
-        tuple(image.size) != (width, height)
-        or image.get(LAYOUT_KEY) != LAYOUT_VERSION
-        or not image.is_float
+        tuple(image.size) != (width, height) or image.get(LAYOUT_KEY) != LAYOUT_VERSION or not image.is_float
     ):
         bpy.data.images.remove(image)
         image = None

@@ -216,19 +216,28 @@ def doppler_colour_group():
         "power": fmath("SUBTRACT", "settings.Power of D", "settings.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "doppler"),
         # ordinary colour
-        "rgb_base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "matrix.Color"},
-                         {"data_type": "VECTOR"}),
+        "rgb_base": Node(
+            "ShaderNodeMix",
+            {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "matrix.Color"},
+            {"data_type": "VECTOR"},
+        ),
         "rgb_log": fmath("MULTIPLY_ADD", "matrix.Log White Luminance", "settings.Spectral Searchlight", "power_term"),
         "rgb_log_safe": fmath("MINIMUM", "rgb_log", EXP_LIMIT),
         "rgb_gain": fmath("EXPONENT", "rgb_log_safe"),
         "rgb_shifted": vmath("SCALE", "rgb_base.Result", scale="rgb_gain"),
-        "rgb_out": Node("ShaderNodeMix", {"Factor": "settings.Camera Path", 4: "rgb_shifted", 5: "group.Color"},
-                        {"data_type": "VECTOR"}),
+        "rgb_out": Node(
+            "ShaderNodeMix",
+            {"Factor": "settings.Camera Path", 4: "rgb_shifted", 5: "group.Color"},
+            {"data_type": "VECTOR"},
+        ),
         # blackbody: the LUT colour has unit luminance; keep the input colour's luminance
         "bb_luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
         "bb_shifted_colour": vmath("SCALE", "blackbody.Color", scale="bb_luminance.Value"),
-        "bb_base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "bb_shifted_colour"},
-                        {"data_type": "VECTOR"}),
+        "bb_base": Node(
+            "ShaderNodeMix",
+            {"Factor": "settings.Use Doppler", 4: "group.Color", 5: "bb_shifted_colour"},
+            {"data_type": "VECTOR"},
+        ),
         "bb_log": fmath("MULTIPLY_ADD", "blackbody.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
         "bb_log_safe": fmath("MINIMUM", "bb_log", EXP_LIMIT),
         "bb_gain": fmath("EXPONENT", "bb_log_safe"),
@@ -239,8 +248,9 @@ def doppler_colour_group():
         "unshifted": fmath("MULTIPLY", "settings.Camera Path", "other_ray"),
         "shifted_ray": fmath("SUBTRACT", 1.0, "unshifted"),
         "bb_select": fmath("MULTIPLY", "group.Is Blackbody", "shifted_ray"),
-        "fast": Node("ShaderNodeMix", {"Factor": "bb_select", 4: "rgb_out.Result", 5: "bb_out"},
-                     {"data_type": "VECTOR"}),
+        "fast": Node(
+            "ShaderNodeMix", {"Factor": "bb_select", 4: "rgb_out.Result", 5: "bb_out"}, {"data_type": "VECTOR"}
+        ),
         "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, spectral_nodes.COLOUR_LINKS),
         # A moving emitter behind the exact camera (Apparent Geometry's final render): the camera
         # applies the observer's D_o^4 only, the compositor divides by the whole D^4; the rest, D_s^4
@@ -249,8 +259,11 @@ def doppler_colour_group():
         "emitter_log_safe": fmath("MINIMUM", "emitter_log", EXP_LIMIT),
         "emitter_gain": fmath("EXPONENT", "emitter_log_safe"),
         "fast_gained": vmath("SCALE", "fast.Result", scale="emitter_gain"),
-        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "fast_gained", 5: "spectral"},
-                    {"data_type": "VECTOR"}),
+        "out": Node(
+            "ShaderNodeMix",
+            {"Factor": "settings.Spectral Pass", 4: "fast_gained", 5: "spectral"},
+            {"data_type": "VECTOR"},
+        ),
         "done_path": fmath("MULTIPLY", "group.Is Blackbody", "settings.Camera Path"),
         "done": fmath("MULTIPLY", "done_path", "light_path.Is Camera Ray"),
         "aov": Node("ShaderNodeOutputAOV", {"Value": "done"}, {"aov_name": DONE_AOV}),
@@ -358,6 +371,7 @@ def write_settings(snap: Snapshot):
 
 # --- attaching to materials -----------------------------------------------------------------
 
+
 def is_attached(material: Material):
     return material is not None and ATTACHED_KEY in material
 
@@ -385,8 +399,12 @@ def attach(material: Material, temperature=None):
     for record in records:
         record["object_temperature"] = object_temperature  # what attach_scene compares to re-attach
     material[ATTACHED_KEY] = records
-    grouped_colours.attach_groups(tree, lambda inner, target, socket, is_emission: insert_colour_group(
-        inner, group, NODE_PREFIX, target, socket, is_emission)[1])
+    grouped_colours.attach_groups(
+        tree,
+        lambda inner, target, socket, is_emission: insert_colour_group(
+            inner, group, NODE_PREFIX, target, socket, is_emission
+        )[1],
+    )
     return True
 
 
@@ -408,9 +426,13 @@ def insert_colour_group(tree, group_tree, prefix, target_node, socket, is_emissi
         sources.mark_blackbody(tree, node, blackbody)
     node.inputs["Is Emission"].default_value = 1.0 if is_emission else 0.0
     tree.links.new(node.outputs["Color"], socket)
-    return node, {"group_node": node.name, "target": target_node.name, "socket": socket.identifier,
-                  "source_node": source.node.name if source is not None else "",
-                  "source_socket": source.identifier if source is not None else ""}
+    return node, {
+        "group_node": node.name,
+        "target": target_node.name,
+        "socket": socket.identifier,
+        "source_node": source.node.name if source is not None else "",
+        "source_socket": source.identifier if source is not None else "",
+    }
 
 
 def _insert_aov_writer(tree):

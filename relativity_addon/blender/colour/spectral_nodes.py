@@ -45,6 +45,7 @@ COLOUR_INPUTS = (
 )
 COLOUR_LINKS = {name: f"group.{name}" for name, _kind, _default in COLOUR_INPUTS}
 
+
 def settings_nodes():
     """Nodes of the settings group for the spectral pass (outputs named like the nodes)."""
     nodes = {"Spectral Pass": Node("ShaderNodeValue")}
@@ -68,8 +69,9 @@ def pass_values(wavelengths_nm):
     values.update({f"Emission {i}": tuple(emission[i]) for i in range(3)})
     values["Planck Prefactors"] = tuple(np.log(PLANCK_C1 / math.pi / metres**5) + math.log(1e-9))
     values["Planck Numerators"] = tuple(PLANCK_C2 / metres)
-    return {name: tuple(float(v) for v in value) if isinstance(value, tuple) else value
-            for name, value in values.items()}
+    return {
+        name: tuple(float(v) for v in value) if isinstance(value, tuple) else value for name, value in values.items()
+    }
 
 
 def spectral_colour_group():
@@ -82,8 +84,11 @@ def spectral_colour_group():
         "ln_t": fmath("LOGARITHM", "safe_t", math.e),
         "u_t": fmath("MULTIPLY_ADD", "ln_t", scale / LN10, offset),
         "uv_t": Node("ShaderNodeCombineXYZ", {0: "u_t", 1: 0.5, 2: 0.0}),
-        "lut_t": Node("ShaderNodeTexImage", {"Vector": "uv_t"},
-                      {"image": lut_images.BLACKBODY_LUT_NAME, "interpolation": "Linear", "extension": "EXTEND"}),
+        "lut_t": Node(
+            "ShaderNodeTexImage",
+            {"Vector": "uv_t"},
+            {"image": lut_images.BLACKBODY_LUT_NAME, "interpolation": "Linear", "extension": "EXTEND"},
+        ),
         "safe_y": fmath("MAXIMUM", "luminance.Value", 1e-30),
         "ln_y": fmath("LOGARITHM", "safe_y", math.e),
         "ln_scale": fmath("SUBTRACT", "ln_y", "lut_t.Alpha"),  # ln(Y / Y_B(T))
@@ -105,15 +110,23 @@ def spectral_colour_group():
         nodes[f"ln_value{i}"] = fmath("ADD", f"ln_b_full{i}", "ln_scale")
         nodes[f"ln_value_safe{i}"] = fmath("MINIMUM", f"ln_value{i}", EXP_LIMIT)
         nodes[f"bb{i}"] = fmath("EXPONENT", f"ln_value_safe{i}")
-    nodes.update({
-        "reflectance": Node("ShaderNodeCombineXYZ", {0: "dot_r0.Value", 1: "dot_r1.Value", 2: "dot_r2.Value"}),
-        "emission": Node("ShaderNodeCombineXYZ", {0: "dot_e0.Value", 1: "dot_e1.Value", 2: "dot_e2.Value"}),
-        "blackbody": Node("ShaderNodeCombineXYZ", {0: "bb0", 1: "bb1", 2: "bb2"}),
-        "rgb": Node("ShaderNodeMix", {"Factor": "group.Is Emission", 4: "reflectance", 5: "emission"},
-                    {"data_type": "VECTOR"}),
-        "out": Node("ShaderNodeMix", {"Factor": "group.Is Blackbody", 4: "rgb.Result", 5: "blackbody"},
-                    {"data_type": "VECTOR"}),
-    })
+    nodes.update(
+        {
+            "reflectance": Node("ShaderNodeCombineXYZ", {0: "dot_r0.Value", 1: "dot_r1.Value", 2: "dot_r2.Value"}),
+            "emission": Node("ShaderNodeCombineXYZ", {0: "dot_e0.Value", 1: "dot_e1.Value", 2: "dot_e2.Value"}),
+            "blackbody": Node("ShaderNodeCombineXYZ", {0: "bb0", 1: "bb1", 2: "bb2"}),
+            "rgb": Node(
+                "ShaderNodeMix",
+                {"Factor": "group.Is Emission", 4: "reflectance", 5: "emission"},
+                {"data_type": "VECTOR"},
+            ),
+            "out": Node(
+                "ShaderNodeMix",
+                {"Factor": "group.Is Blackbody", 4: "rgb.Result", 5: "blackbody"},
+                {"data_type": "VECTOR"},
+            ),
+        }
+    )
     return Group(
         SPECTRAL_COLOUR,
         "ShaderNodeTree",
@@ -129,8 +142,11 @@ def volume_colour_group():
     nodes = {
         "settings": group_node(names.SETTINGS_GROUP),
         "spectral": group_node(SPECTRAL_COLOUR, COLOUR_LINKS),
-        "out": Node("ShaderNodeMix", {"Factor": "settings.Spectral Pass", 4: "group.Color", 5: "spectral"},
-                    {"data_type": "VECTOR"}),
+        "out": Node(
+            "ShaderNodeMix",
+            {"Factor": "settings.Spectral Pass", 4: "group.Color", 5: "spectral"},
+            {"data_type": "VECTOR"},
+        ),
     }
     return Group(
         names.VOLUME_COLOUR_GROUP,

@@ -114,8 +114,9 @@ def volume_blackbody_group():
         "shift": group_node(materials.BLACKBODY_SHIFT, {"Temperature": "group.Temperature", "Log Doppler": "ln_d"}),
         "luminance": vmath("DOT_PRODUCT", "rest", materials.LUMINANCE_WEIGHTS),
         "shifted": vmath("SCALE", "shift.Color", scale="luminance.Value"),
-        "base": Node("ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "rest", 5: "shifted"},
-                     {"data_type": "VECTOR"}),
+        "base": Node(
+            "ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "rest", 5: "shifted"}, {"data_type": "VECTOR"}
+        ),
         "power": fmath("SUBTRACT", "settings.Power of D", "settings.Camera Power"),
         "power_term": fmath("MULTIPLY", "power", "ln_d"),
         "log_gain": fmath("MULTIPLY_ADD", "shift.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
@@ -132,8 +133,10 @@ def volume_blackbody_group():
         # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
         # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
         # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
-        "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, {
-            "Color": "rest", "Temperature": "group.Temperature", "Is Blackbody": 1.0, "Is Emission": 1.0}),
+        "spectral": group_node(
+            spectral_nodes.SPECTRAL_COLOUR,
+            {"Color": "rest", "Temperature": "group.Temperature", "Is Blackbody": 1.0, "Is Emission": 1.0},
+        ),
         "spectral_out": vmath("SCALE", "spectral", scale="settings.Spectral Pass"),
         "out": vmath("ADD", "fast_out", "spectral_out"),
         "intensity": fmath("MULTIPLY", "group.Intensity", "fast"),
@@ -149,8 +152,11 @@ def volume_blackbody_group():
             ("Intensity", "NodeSocketFloat", 1.0),
             ("Tint", "NodeSocketFloat", 1.0),
         ),
-        (("Color", "NodeSocketColor", "out"), ("Done", "NodeSocketFloat", "done"),
-         ("Intensity", "NodeSocketFloat", "intensity")),
+        (
+            ("Color", "NodeSocketColor", "out"),
+            ("Done", "NodeSocketFloat", "done"),
+            ("Intensity", "NodeSocketFloat", "intensity"),
+        ),
         nodes,
     )
 
@@ -227,15 +233,26 @@ def attach(material: Material):
     for created in (group, emission, add, boundary, done):
         created.location = (output.location.x - 200.0, output.location.y - 300.0)
         created.hide = True
-    blank = {"target": "", "socket": "", "source_node": "", "source_socket": "",
-             "object_temperature": records[0]["object_temperature"] if records else 0.0}
+    blank = {
+        "target": "",
+        "socket": "",
+        "source_node": "",
+        "source_socket": "",
+        "object_temperature": records[0]["object_temperature"] if records else 0.0,
+    }
     records += [
         {**blank, "group_node": group.name},
         {**blank, "group_node": emission.name},
         {**blank, "group_node": boundary.name},
         {**blank, "group_node": done.name},
-        {**blank, "group_node": add.name, "target": output.name, "socket": output.inputs["Volume"].identifier,
-         "source_node": node.name, "source_socket": source.identifier},
+        {
+            **blank,
+            "group_node": add.name,
+            "target": output.name,
+            "socket": output.inputs["Volume"].identifier,
+            "source_node": node.name,
+            "source_socket": source.identifier,
+        },
     ]
     material[materials.ATTACHED_KEY] = records
     return True
@@ -245,7 +262,8 @@ def _reads_grids(obj):
     """Whether Cycles may multiply ``obj``'s volume Temperature by a temperature grid: a Volume
     object (OpenVDB grids) or a fluid domain (smoke and fire)."""
     return obj.type == "VOLUME" or any(
-        modifier.type == "FLUID" and modifier.fluid_type == "DOMAIN" for modifier in obj.modifiers)
+        modifier.type == "FLUID" and modifier.fluid_type == "DOMAIN" for modifier in obj.modifiers
+    )
 
 
 def grid_materials(scene: Scene):
@@ -272,12 +290,18 @@ def attach_colours(material: Material):
     if any(record["group_node"].startswith(COLOUR_PREFIX) for record in records):
         return False
     tree = material.node_tree
-    targets = [(node, node.inputs[name], emitted) for node in list(tree.nodes) for kind, inputs in VOLUME_COLOURS
-               if node.bl_idname == kind for name, emitted in inputs]
+    targets = [
+        (node, node.inputs[name], emitted)
+        for node in list(tree.nodes)
+        for kind, inputs in VOLUME_COLOURS
+        if node.bl_idname == kind
+        for name, emitted in inputs
+    ]
     if not targets:
         return False
-    group_tree = ensure_group(spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY,
-                              names.SHADER_GROUPS_VERSION)
+    group_tree = ensure_group(
+        spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION
+    )
     for target, socket, emitted in targets:
         _node, record = materials.insert_colour_group(tree, group_tree, COLOUR_PREFIX, target, socket, emitted)
         record["object_temperature"] = records[0]["object_temperature"] if records else 0.0
@@ -315,8 +339,10 @@ def spectral_problem(scene: Scene):
             continue
         grouped = sources.grouped_node(material.node_tree, VOLUME_KINDS)
         if grouped is not None:
-            return (f"Spectral colour cannot make the volume shaders inside the node group {grouped[0].name!r} "
-                    f"in material {material.name!r} spectral")
+            return (
+                f"Spectral colour cannot make the volume shaders inside the node group {grouped[0].name!r} "
+                f"in material {material.name!r} spectral"
+            )
         correctable = _correctable(material)
         corrected = correctable[1].node if correctable is not None else None
         for node in material.node_tree.nodes:
@@ -326,18 +352,23 @@ def spectral_problem(scene: Scene):
             if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:
                 continue
             if material in grids and _emits_blackbody(node):
-                return (f"Spectral colour cannot follow temperature grids: the blackbody of {where} on "
-                        f"{grids[material]!r} varies with its grid (set Blackbody Intensity to 0)")
+                return (
+                    f"Spectral colour cannot follow temperature grids: the blackbody of {where} on "
+                    f"{grids[material]!r} varies with its grid (set Blackbody Intensity to 0)"
+                )
             if material in grids and node.inputs["Color Attribute"].default_value:
                 return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
             attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
             if _emits_blackbody(node) and node != corrected and not attached:
-                return (f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint, a "
-                        "constant intensity and the Principled Volume alone on the Volume output")
+                return (
+                    f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint, a "
+                    "constant intensity and the Principled Volume alone on the Volume output"
+                )
     world = scene.world
     tree = world.node_tree if world is not None else None
-    if tree is not None and any(node.bl_idname == "ShaderNodeOutputWorld" and node.inputs["Volume"].is_linked
-                                for node in tree.nodes):
+    if tree is not None and any(
+        node.bl_idname == "ShaderNodeOutputWorld" and node.inputs["Volume"].is_linked for node in tree.nodes
+    ):
         return f"Spectral colour does not cover world volumes (world {world.name!r})"
     return None
 
@@ -348,6 +379,8 @@ def warnings(scene: Scene):
     for material, name in grid_materials(scene).items():
         node = _volume_output(material.node_tree)[1] if material.node_tree is not None else None
         if node is not None and sources.volume_blackbody(node.node) is not None:
-            lines.append(f"Volume {name!r} ({material.name!r}) may read a temperature grid: its blackbody "
-                         "keeps the RGB colour shift (grids are not shifted to D T)")
+            lines.append(
+                f"Volume {name!r} ({material.name!r}) may read a temperature grid: its blackbody "
+                "keeps the RGB colour shift (grids are not shifted to D T)"
+            )
     return lines

@@ -29,14 +29,22 @@ if TYPE_CHECKING:
 
 def _colour_records(world):
     """``(group node, Background Color socket, source socket or None)`` of each Background colour."""
-    if world is None or world.node_tree is None or names.MATERIAL_ATTACHED_KEY not in world \
-            or isinstance(world[names.MATERIAL_ATTACHED_KEY], str):
+    if (
+        world is None
+        or world.node_tree is None
+        or names.MATERIAL_ATTACHED_KEY not in world
+        or isinstance(world[names.MATERIAL_ATTACHED_KEY], str)
+    ):
         return []
     found = []
     for record in world[names.MATERIAL_ATTACHED_KEY]:
         group, socket, source = materials.resolve_record(world.node_tree, record)
-        if group is not None and socket is not None and group.node_tree is not None \
-                and group.node_tree.name == materials.DOPPLER_EMISSION:
+        if (
+            group is not None
+            and socket is not None
+            and group.node_tree is not None
+            and group.node_tree.name == materials.DOPPLER_EMISSION
+        ):
             found.append((group, socket, source))
     return found
 
@@ -67,5 +75,8 @@ def write(world: World) -> None:
 
 def linked_groups(world: World):
     """The world's colour groups that feed their Background now (for tests and the docs)."""
-    return [group for group, socket, _source in _colour_records(world)
-            if socket.is_linked and socket.links[0].from_node == group]
+    return [
+        group
+        for group, socket, _source in _colour_records(world)
+        if socket.is_linked and socket.links[0].from_node == group
+    ]

@@ -48,8 +48,10 @@ _written = {}  # image session_uid -> the inputs its pixels were computed from
 
 def render_size(scene: Scene):
     render = scene.render
-    return (max(1, int(render.resolution_x * render.resolution_percentage / 100)),
-            max(1, int(render.resolution_y * render.resolution_percentage / 100)))
+    return (
+        max(1, int(render.resolution_x * render.resolution_percentage / 100)),
+        max(1, int(render.resolution_y * render.resolution_percentage / 100)),
+    )
 
 
 def problem(scene: Scene, snap: Snapshot):
@@ -91,9 +93,14 @@ def pixel_log_doppler(projection, size, beta_camera, aberration):
         return exposure.log_doppler(exposure.pixel_directions(projection[1:], size), beta_camera, aberration)
     values = dict(projection[1:])
     directions, inside = exposure.panorama_directions(
-        kind, size, (values["longitude_min"], values["longitude_max"]),
-        (values["latitude_min"], values["latitude_max"]), values["fisheye_fov"], values["fisheye_lens"],
-        (values["sensor_width"], values["sensor_height"]))
+        kind,
+        size,
+        (values["longitude_min"], values["longitude_max"]),
+        (values["latitude_min"], values["latitude_max"]),
+        values["fisheye_fov"],
+        values["fisheye_lens"],
+        (values["sensor_width"], values["sensor_height"]),
+    )
     return np.where(inside, exposure.log_doppler(directions, beta_camera, aberration), 0.0)
 
 
@@ -128,4 +135,3 @@ def write(scene: Scene, snap: Snapshot, pixels=True):
     image.pack()  # into the .blend (as OpenEXR): the saved file renders the same without the add-on
     _written[image.session_uid] = inputs
     return True
-

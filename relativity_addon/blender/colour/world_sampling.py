@@ -41,8 +41,10 @@ def hold(world: World) -> None:
     if world is None or SAVED in world or not _constant(world):
         return
     settings = world.cycles
-    world[SAVED] = {"sampling_method": settings.sampling_method,
-                    "sample_map_resolution": settings.sample_map_resolution}
+    world[SAVED] = {
+        "sampling_method": settings.sampling_method,
+        "sample_map_resolution": settings.sample_map_resolution,
+    }
     settings.sampling_method = "MANUAL"
     settings.sample_map_resolution = MAP_RESOLUTION
 

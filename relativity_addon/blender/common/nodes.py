@@ -58,7 +58,7 @@ def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
     return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
 
 
-def group_node(group_name, inputs=None, kind: str="ShaderNodeGroup"):
+def group_node(group_name, inputs=None, kind: str = "ShaderNodeGroup"):
     return Node(kind, inputs or {}, {"node_tree": group_name})
 
 

@@ -44,11 +44,22 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     parts = [
-        snap.frame, snap.speed_of_light, snap.beta, snap.camera, snap.camera_matrix, snap.exact_camera,
+        snap.frame,
+        snap.speed_of_light,
+        snap.beta,
+        snap.camera,
+        snap.camera_matrix,
+        snap.exact_camera,
         snap.shutter_time if snap.exact_camera else 0.0,
-        tuple(map(tuple, evaluated.matrix_world)), relativity.enabled, relativity.motion, tuple(relativity.beta),
-        relativity.tessellation, relativity.samples_per_frame, snap.fps,
-        relativity.use_deformation, relativity.use_proper_time,
+        tuple(map(tuple, evaluated.matrix_world)),
+        relativity.enabled,
+        relativity.motion,
+        tuple(relativity.beta),
+        relativity.tessellation,
+        relativity.samples_per_frame,
+        snap.fps,
+        relativity.use_deformation,
+        relativity.use_proper_time,
         len(obj.data.vertices),
     ]
     return repr(parts)
@@ -86,8 +97,11 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
     with busy.computing():
         for obj in applied_objects(scene):
             data = modifier.cache_data(obj)
-            if only_changed and data is not None and \
-                    data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph):
+            if (
+                only_changed
+                and data is not None
+                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph)
+            ):
                 continue
             try:
                 update_object(scene, obj, snap, depsgraph)
@@ -154,7 +168,8 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
     if instancer is not None:
         raise RelativityError(
             f"Mesh {instancer.name!r} draws instances or other geometry (geometry nodes, particles or instancing) "
-            "that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)")
+            "that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
+        )
     empty = [obj for obj in objects if len(obj.evaluated_get(depsgraph).data.vertices) == 0]
     objects = [obj for obj in objects if obj not in empty]
     _skipped_empty[scene.name] = sorted({*_skipped_empty.get(scene.name, ()), *(obj.name for obj in empty)})
@@ -202,7 +217,7 @@ def longest_edge_fraction(obj: Object, camera_position):
 def coarse_mesh_warning(obj: Object, camera_position):
     """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None."""
     # the modifier halves every edge once per tessellation level before moving the vertices
-    fraction = longest_edge_fraction(obj, camera_position) / 2 ** obj.relativity.tessellation
+    fraction = longest_edge_fraction(obj, camera_position) / 2**obj.relativity.tessellation
     if fraction > COARSE_EDGE_FRACTION:
         return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
     return None

@@ -97,9 +97,14 @@ def bake_deformation(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=
     for i, positions in enumerate(samples):
         attribute = mesh.attributes.new(f"sample_{i:05d}", "FLOAT_VECTOR", "POINT")
         attribute.data.foreach_set("vector", positions.astype(np.float32).ravel())
-    cache.data[names.BAKE_KEY] = {"mesh": mesh.name, "start": float(frames[0] / fps), "step": 1.0 / (per_frame * fps),
-                            "samples": len(samples), "points": count,
-                            names.BAKE_ORIGINS_KEY: np.ravel(origins).tolist()}
+    cache.data[names.BAKE_KEY] = {
+        "mesh": mesh.name,
+        "start": float(frames[0] / fps),
+        "step": 1.0 / (per_frame * fps),
+        "samples": len(samples),
+        "points": count,
+        names.BAKE_ORIGINS_KEY: np.ravel(origins).tolist(),
+    }
     apparent_meshes.update_after_bake(scene, obj)
     return len(samples)
 
@@ -119,12 +124,16 @@ def bake_motion(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=None,
     geometry_modifier.show_viewport = False
     matrices = []
     try:
-        _sample_frames(scene, frames, lambda depsgraph: matrices.append(
-            matrix_array(obj.evaluated_get(depsgraph).matrix_world)))
+        _sample_frames(
+            scene, frames, lambda depsgraph: matrices.append(matrix_array(obj.evaluated_get(depsgraph).matrix_world))
+        )
     finally:
         geometry_modifier.show_viewport = shown
-    cache.data[names.MOTION_BAKE_KEY] = {"first_frame": float(frames[0]), "samples_per_frame": per_frame,
-                                   "matrices": np.ravel(matrices).tolist()}
+    cache.data[names.MOTION_BAKE_KEY] = {
+        "first_frame": float(frames[0]),
+        "samples_per_frame": per_frame,
+        "matrices": np.ravel(matrices).tolist(),
+    }
     apparent_meshes.update_after_bake(scene, obj)
     return len(matrices)
 

@@ -31,30 +31,63 @@ def node_group_spec():
     nodes = {
         "subdivide": Node("GeometryNodeSubdivideMesh", {"Mesh": "group.Geometry", "Level": "group.Tessellation"}),
         "position": Node("GeometryNodeInputPosition"),
-        "store_rest": Node("GeometryNodeStoreNamedAttribute", {
-            "Geometry": "subdivide.Mesh", "Name": Literal(names.REST_ATTRIBUTE), "Value": "position.Position",
-        }, store),
+        "store_rest": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {
+                "Geometry": "subdivide.Mesh",
+                "Name": Literal(names.REST_ATTRIBUTE),
+                "Value": "position.Position",
+            },
+            store,
+        ),
         "cache_info": Node("GeometryNodeObjectInfo", {"Object": "group.Cache"}, {"transform_space": "ORIGINAL"}),
         "cache_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "cache_info.Geometry"}, mesh_size),
         "mesh_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "store_rest.Geometry"}, mesh_size),
-        "counts_match": Node("FunctionNodeCompare", {"A": "cache_size.Point Count", "B": "mesh_size.Point Count"},
-                             {"data_type": "INT", "operation": "EQUAL"}),
+        "counts_match": Node(
+            "FunctionNodeCompare",
+            {"A": "cache_size.Point Count", "B": "mesh_size.Point Count"},
+            {"data_type": "INT", "operation": "EQUAL"},
+        ),
         "index": Node("GeometryNodeInputIndex"),
-        "sample_position": Node("GeometryNodeSampleIndex", {
-            "Geometry": "cache_info.Geometry", "Value": "position.Position", "Index": "index.Index",
-        }, store),
-        "cache_beta": Node("GeometryNodeInputNamedAttribute", {"Name": Literal(names.BETA_ATTRIBUTE)},
-                           {"data_type": "FLOAT_VECTOR"}),
-        "sample_beta": Node("GeometryNodeSampleIndex", {
-            "Geometry": "cache_info.Geometry", "Value": "cache_beta.Attribute", "Index": "index.Index",
-        }, store),
-        "set_position": Node("GeometryNodeSetPosition", {
-            "Geometry": "store_rest.Geometry", "Selection": "counts_match.Result", "Position": "sample_position.Value",
-        }),
-        "store_beta": Node("GeometryNodeStoreNamedAttribute", {
-            "Geometry": "set_position.Geometry", "Selection": "counts_match.Result",
-            "Name": Literal(names.BETA_ATTRIBUTE), "Value": "sample_beta.Value",
-        }, store),
+        "sample_position": Node(
+            "GeometryNodeSampleIndex",
+            {
+                "Geometry": "cache_info.Geometry",
+                "Value": "position.Position",
+                "Index": "index.Index",
+            },
+            store,
+        ),
+        "cache_beta": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.BETA_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
+        ),
+        "sample_beta": Node(
+            "GeometryNodeSampleIndex",
+            {
+                "Geometry": "cache_info.Geometry",
+                "Value": "cache_beta.Attribute",
+                "Index": "index.Index",
+            },
+            store,
+        ),
+        "set_position": Node(
+            "GeometryNodeSetPosition",
+            {
+                "Geometry": "store_rest.Geometry",
+                "Selection": "counts_match.Result",
+                "Position": "sample_position.Value",
+            },
+        ),
+        "store_beta": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {
+                "Geometry": "set_position.Geometry",
+                "Selection": "counts_match.Result",
+                "Name": Literal(names.BETA_ATTRIBUTE),
+                "Value": "sample_beta.Value",
+            },
+            store,
+        ),
     }
     return Group(
         names.GEOMETRY_GROUP,
@@ -75,8 +108,11 @@ def ensure_node_group():
 
 def find_modifier(obj: Object):
     for modifier in obj.modifiers:
-        if modifier.type == "NODES" and modifier.node_group is not None \
-                and modifier.node_group.name == names.GEOMETRY_GROUP:
+        if (
+            modifier.type == "NODES"
+            and modifier.node_group is not None
+            and modifier.node_group.name == names.GEOMETRY_GROUP
+        ):
             return modifier
     return None
 

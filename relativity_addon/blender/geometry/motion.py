@@ -69,11 +69,13 @@ def apparent_world_positions(scene: Scene, obj: Object, obj_eval: Object, rest, 
         world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
     elif motion == "ANIMATION":
         world, _, beta_seen = animated_apparent_positions(
-            obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too)
+            obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too
+        )
     elif motion == "CONSTANT" and plays_own_animation(obj, scene):
         beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
         world, _, beta_seen = proper_time_apparent_positions(
-            obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too)
+            obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too
+        )
     else:
         beta_u = np.zeros(3)
         if motion == "CONSTANT":
@@ -98,11 +100,11 @@ def check_parent_motion(obj: Object) -> None:
         settings = parent.relativity
         if parent.type == "MESH" and settings.enabled and settings.motion != "STATIC":
             own = obj.relativity
-            if own.motion != settings.motion or (
-                    own.motion == "CONSTANT" and tuple(own.beta) != tuple(settings.beta)):
+            if own.motion != settings.motion or (own.motion == "CONSTANT" and tuple(own.beta) != tuple(settings.beta)):
                 how = "Constant Velocity with the same velocity" if settings.motion == "CONSTANT" else "Animation"
-                raise RelativityError(f"object {obj.name!r} rides on its moving parent {parent.name!r}: "
-                                      f"set its Motion to {how}")
+                raise RelativityError(
+                    f"object {obj.name!r} rides on its moving parent {parent.name!r}: set its Motion to {how}"
+                )
             return
         parent = parent.parent
 
@@ -149,20 +151,23 @@ def _path_clock(obj, fps, step, c):
                 table["spacing"] = (high - low) / CLOCK_SAMPLES
                 first, last = int(np.floor(low / table["spacing"])), int(np.ceil(high / table["spacing"]))
             if "grid" in table:
-                points = np.concatenate([path(np.arange(first, old_first)), table["path"],
-                                         path(np.arange(old_last + 1, last + 1))])
+                points = np.concatenate(
+                    [path(np.arange(first, old_first)), table["path"], path(np.arange(old_last + 1, last + 1))]
+                )
             else:
                 points = path(np.arange(first, last + 1))
             grid = np.arange(first, last + 1) * table["spacing"]
-            table.update(indices=(first, last), grid=grid, path=points,
-                         taus=proper_time.path_proper_times(grid, points, c))
+            table.update(
+                indices=(first, last), grid=grid, path=points, taus=proper_time.path_proper_times(grid, points, c)
+            )
         return np.interp(times, table["grid"], table["taus"])
 
     return clock
 
 
-def proper_time_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, beta_u=None,
-                                   matrix_now=None, shape_keys_too=True):
+def proper_time_apparent_positions(
+    obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, beta_u=None, matrix_now=None, shape_keys_too=True
+):
     """An object with its own animation (:func:`plays_own_animation`: a spinning wheel, a clock's
     hands, shape keys) plays it at its proper time ``tau`` (its clock reads 0 at scene time 0),
     evaluated at each vertex's retarded time by the sampled solver.
@@ -198,25 +203,41 @@ def proper_time_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x
             return animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
 
     shape = None
-    if dilate and shape_keys_too and shape_keys.has_animated_shape_keys(obj) \
-            and shape_keys.scene_time_reason(obj) is None:  # else at the scene's time: the object's warnings
+    if (
+        dilate
+        and shape_keys_too
+        and shape_keys.has_animated_shape_keys(obj)
+        and shape_keys.scene_time_reason(obj) is None
+    ):  # else at the scene's time: the object's warnings
         shape = shape_keys.ShapeKeyMotion(obj)
         shape.check(rest_local, scene.frame_current + scene.frame_subframe)
     try:
         now = matrices(np.array([t_o]))[0]
         result = sampling.apparent_positions_from_matrix_function(
-            matrices, step, rest_local, t_o, x_o, beta_o, c, world_matrix_now=now)
+            matrices, step, rest_local, t_o, x_o, beta_o, c, world_matrix_now=now
+        )
         for _ in range(SHAPE_PASSES if shape is not None else 0):
             shaped = shape.positions(clock(t_o - result[1]) * fps)
             result = sampling.apparent_positions_from_matrix_function(
-                matrices, step, shaped, t_o, x_o, beta_o, c, world_matrix_now=now)
+                matrices, step, shaped, t_o, x_o, beta_o, c, world_matrix_now=now
+            )
     except ValueError as error:
         raise RelativityError(f"object {obj.name!r}: {error}") from None
     return result
 
 
-def animated_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, max_tries=4,
-                                obj_eval: Object | None = None, shape_keys_too=True):
+def animated_apparent_positions(
+    obj: Object,
+    scene: Scene,
+    rest_local,
+    t_o,
+    x_o,
+    beta_o,
+    c,
+    max_tries=4,
+    obj_eval: Object | None = None,
+    shape_keys_too=True,
+):
     """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
     world matrices when it has a motion bake, else from its keyframes under its parent chain
     (:func:`animation.world_matrices`). An object whose keyframes are not its motion
@@ -230,15 +251,25 @@ def animated_apparent_positions(obj: Object, scene: Scene, rest_local, t_o, x_o,
     if problem is not None:
         raise RelativityError(
             f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
-            "bake its motion (Bake Motion in the Relativity panel)")
+            "bake its motion (Bake Motion in the Relativity panel)"
+        )
     if obj.relativity.use_proper_time and plays_own_animation(obj, scene):
         return proper_time_apparent_positions(
-            obj, scene, rest_local, t_o, x_o, beta_o, c, shape_keys_too=shape_keys_too)
+            obj, scene, rest_local, t_o, x_o, beta_o, c, shape_keys_too=shape_keys_too
+        )
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
     try:
         return sampling.apparent_positions_from_matrix_function(
-            lambda times: animation.world_matrices(obj, times * fps), step, rest_local, t_o, x_o, beta_o, c,
-            max_tries, world_matrix_now=matrix_array(obj_eval.matrix_world))
+            lambda times: animation.world_matrices(obj, times * fps),
+            step,
+            rest_local,
+            t_o,
+            x_o,
+            beta_o,
+            c,
+            max_tries,
+            world_matrix_now=matrix_array(obj_eval.matrix_world),
+        )
     except ValueError as error:
         raise RelativityError(f"object {obj.name!r}: {error}") from None
 
@@ -253,7 +284,8 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
         if np.max(np.abs(matrices[round(index)] - now)) > 1e-5 * (1.0 + np.max(np.abs(now))):
             raise RelativityError(
                 f"object {obj.name!r} moves differently from its motion bake at frame {frame_now:g}: "
-                "bake its motion again")
+                "bake its motion again"
+            )
     start, step = first_frame / fps, 1.0 / (per_frame * fps)
     times = start + step * np.arange(len(matrices))
     result = rest_shape.apparent_positions_rigid_rest_shape(times, matrices, rest_local, t_o, x_o, c, beta_o)
@@ -261,7 +293,8 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
     if t_e.size and (t_e.min() < times[0] or t_e.max() > times[-1]):
         raise RelativityError(
             f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
-            f"baked motion {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+            f"baked motion {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range"
+        )
     return result
 
 
@@ -274,8 +307,9 @@ def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
     if info["points"] != count:
         raise RelativityError(f"object {obj.name!r}: the mesh changed since the deformation bake; bake again")
     if names.BAKE_ORIGINS_KEY not in info:
-        raise RelativityError(f"object {obj.name!r}: the deformation bake has no origin path (an earlier "
-                              "version made it); bake again")
+        raise RelativityError(
+            f"object {obj.name!r}: the deformation bake has no origin path (an earlier version made it); bake again"
+        )
     positions = np.empty((info["samples"], count * 3), dtype=np.float32)
     for i in range(info["samples"]):
         mesh.attributes[f"sample_{i:05d}"].data.foreach_get("vector", positions[i])
@@ -294,5 +328,6 @@ def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
     if t_e.min() < times[0] or t_e.max() > times[-1]:
         raise RelativityError(
             f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
-            f"baked range {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range")
+            f"baked range {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range"
+        )
     return result

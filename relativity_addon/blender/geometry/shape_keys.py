@@ -56,15 +56,19 @@ def scene_time_reason(obj: Object):
         return "Tessellation is above 0"
     modifiers = list(obj.modifiers)
     own = modifier.find_modifier(obj)
-    before = [m for m in modifiers[:modifiers.index(own) if own is not None else len(modifiers)]
-              if m.show_viewport or m.show_render]
+    before = [
+        m
+        for m in modifiers[: modifiers.index(own) if own is not None else len(modifiers)]
+        if m.show_viewport or m.show_render
+    ]
     if before:
         return f"modifier {before[0].name!r} comes before the relativity modifier"
     key = obj.data.shape_keys
     if not key.use_relative:
         return "its shape keys are absolute (Evaluation Time)"
     if key.animation_data is not None and any(
-            _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers):
+        _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers
+    ):
         return "drivers set its shape keys"
     for block in key.key_blocks:
         if block != key.reference_key and not block.mute and block.vertex_group:
@@ -76,14 +80,20 @@ def scene_time_warning(obj: Object):
     """The object's warning when its animated shape keys play at the scene's time although its own
     animation runs on its proper time, or None."""
     settings = obj.relativity
-    if not settings.use_proper_time or settings.motion == "STATIC" or settings.use_deformation \
-            or not has_animated_shape_keys(obj):
+    if (
+        not settings.use_proper_time
+        or settings.motion == "STATIC"
+        or settings.use_deformation
+        or not has_animated_shape_keys(obj)
+    ):
         return None
     reason = scene_time_reason(obj)
     if reason is None:
         return None
-    return (f"Object {obj.name!r}: its shape keys play at the scene's time, not at its proper time ({reason}; "
-            "Tessellation 0 with no modifier before the relativity one, or a deformation bake, plays them)")
+    return (
+        f"Object {obj.name!r}: its shape keys play at the scene's time, not at its proper time ({reason}; "
+        "Tessellation 0 with no modifier before the relativity one, or a deformation bake, plays them)"
+    )
 
 
 class ShapeKeyMotion:
@@ -93,8 +103,10 @@ class ShapeKeyMotion:
         key = obj.data.shape_keys
         self.name = obj.name
         if not key.use_relative:
-            raise RelativityError(f"object {obj.name!r}: absolute shape keys (Evaluation Time) are not played "
-                                  "at proper time; use relative shape keys")
+            raise RelativityError(
+                f"object {obj.name!r}: absolute shape keys (Evaluation Time) are not played "
+                "at proper time; use relative shape keys"
+            )
         count = len(obj.data.vertices)
 
         def coordinates(block):
@@ -104,17 +116,22 @@ class ShapeKeyMotion:
 
         curves = _value_fcurves(key)
         if key.animation_data is not None and any(
-                _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers):
-            raise RelativityError(f"object {obj.name!r}: drivers set its shape keys; driven shape keys are not "
-                                  "played at proper time (turn Proper Time off, or bake the deformation)")
+            _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers
+        ):
+            raise RelativityError(
+                f"object {obj.name!r}: drivers set its shape keys; driven shape keys are not "
+                "played at proper time (turn Proper Time off, or bake the deformation)"
+            )
         self.base = coordinates(key.reference_key)
         self.offsets, self.curves, self.limits, self.values = [], [], [], []
         for block in key.key_blocks:
             if block == key.reference_key or block.mute:
                 continue
             if block.vertex_group:
-                raise RelativityError(f"object {obj.name!r}: shape key {block.name!r} has a vertex group; "
-                                      "shape keys with vertex groups are not played at proper time")
+                raise RelativityError(
+                    f"object {obj.name!r}: shape key {block.name!r} has a vertex group; "
+                    "shape keys with vertex groups are not played at proper time"
+                )
             self.offsets.append(coordinates(block) - coordinates(block.relative_key))
             self.curves.append(curves.get(block.name))
             self.limits.append((block.slider_min, block.slider_max))
@@ -150,13 +167,17 @@ class ShapeKeyMotion:
         """RelativityError unless ``rest`` (the rest points Blender evaluated at ``frame``) is this
         blend at ``frame``: the shape keys are then the only thing shaping the rest points."""
         if len(rest) != len(self.base):
-            raise RelativityError(f"object {self.name!r}: its animated shape keys are played at proper time only "
-                                  "on the mesh's own vertices; set Tessellation to 0 and move modifiers after "
-                                  "the relativity modifier, or bake the deformation (Animation, Deforming), "
-                                  "or turn Proper Time off")
+            raise RelativityError(
+                f"object {self.name!r}: its animated shape keys are played at proper time only "
+                "on the mesh's own vertices; set Tessellation to 0 and move modifiers after "
+                "the relativity modifier, or bake the deformation (Animation, Deforming), "
+                "or turn Proper Time off"
+            )
         blend = self.positions(frame)
         scale = 1.0 + float(np.abs(blend).max(initial=0.0))
         if np.abs(blend - rest).max(initial=0.0) > 1e-5 * scale:
-            raise RelativityError(f"object {self.name!r}: something besides its shape keys (a modifier before the "
-                                  "relativity modifier, a driver) shapes the mesh; its shape keys cannot be played at "
-                                  "proper time (turn Proper Time off, or bake the deformation)")
+            raise RelativityError(
+                f"object {self.name!r}: something besides its shape keys (a modifier before the "
+                "relativity modifier, a driver) shapes the mesh; its shape keys cannot be played at "
+                "proper time (turn Proper Time off, or bake the deformation)"
+            )

@@ -72,10 +72,16 @@ def _skipped_lamp(obj):
 
 def lamps(scene: Scene):
     """Lamps at rest that render and that the stage can split (no light linking of their own)."""
-    return [obj for obj in scene.objects
-            if obj.type == "LIGHT" and not is_copy(obj) and obj.data.type in KINDS
-            and obj.relativity.motion == "STATIC" and not snapshot.light_render_hidden(obj)
-            and not _skipped_lamp(obj)]
+    return [
+        obj
+        for obj in scene.objects
+        if obj.type == "LIGHT"
+        and not is_copy(obj)
+        and obj.data.type in KINDS
+        and obj.relativity.motion == "STATIC"
+        and not snapshot.light_render_hidden(obj)
+        and not _skipped_lamp(obj)
+    ]
 
 
 def _local_centre(obj):
@@ -101,8 +107,9 @@ def movers(scene: Scene, snap: Snapshot):
             continue
         try:
             centre = _local_centre(obj)[None]
-            world, beta = world_lines.apparent_world_positions(scene, obj, obj, centre, at_rest_observer,
-                                                               shape_keys_too=False)
+            world, beta = world_lines.apparent_world_positions(
+                scene, obj, obj, centre, at_rest_observer, shape_keys_too=False
+            )
         except ValueError as error:
             raise RelativityError(f"object {obj.name!r}: {error}") from None
         beta = tuple(float(b) for b in np.asarray(beta)[0])
@@ -139,8 +146,12 @@ def copy_colour(lamp, doppler_factor, snap: Snapshot):
     light = lamp.data
     temperature = sources.light_blackbody(light)
     factor = lamp_doppler.lamp_rgb_factor(
-        doppler_factor, rgb=tuple(light.color), temperature_k=temperature,
-        use_doppler=snap.use_doppler, use_searchlight=snap.use_searchlight)
+        doppler_factor,
+        rgb=tuple(light.color),
+        temperature_k=temperature,
+        use_doppler=snap.use_doppler,
+        use_searchlight=snap.use_searchlight,
+    )
     colour = np.array(light.color, dtype=np.float64)
     if light.use_temperature:
         colour = colour * np.array(light.temperature_color, dtype=np.float64)
@@ -264,8 +275,11 @@ def remove(scene: Scene):
     if record is None:
         return 0
     ours = set(record["collections"])
-    mine = [obj for obj in bpy.data.objects if scene.objects.get(obj.name) is obj or obj.name in record["lamps"]
-            or obj.name in record["copies"]]
+    mine = [
+        obj
+        for obj in bpy.data.objects
+        if scene.objects.get(obj.name) is obj or obj.name in record["lamps"] or obj.name in record["copies"]
+    ]
     for lamp in mine:  # by the mark, not only the name: a lamp renamed while applied too
         if lamp.type == "LIGHT" and KEY in lamp:
             receiver = lamp.light_linking.receiver_collection
@@ -292,9 +306,14 @@ def warnings(scene: Scene, snap: Snapshot):
     """What this stage does not render right, one line each."""
     if snap.method != "GEOMETRY" or not modifier.applied_objects(scene):
         return []
-    found = [f"Light {obj.name!r} uses light linking: its light on moving objects is not Doppler shifted (eq. 18)"
-             for obj in scene.objects if obj.type == "LIGHT" and _skipped_lamp(obj) and not is_copy(obj)]
-    found += [f"Object {obj.name!r} deforms: lamps light it as if it were at rest (eq. 18 not applied)"
-              for obj in modifier.applied_objects(scene)
-              if obj.relativity.motion == "ANIMATION" and obj.relativity.use_deformation]
+    found = [
+        f"Light {obj.name!r} uses light linking: its light on moving objects is not Doppler shifted (eq. 18)"
+        for obj in scene.objects
+        if obj.type == "LIGHT" and _skipped_lamp(obj) and not is_copy(obj)
+    ]
+    found += [
+        f"Object {obj.name!r} deforms: lamps light it as if it were at rest (eq. 18 not applied)"
+        for obj in modifier.applied_objects(scene)
+        if obj.relativity.motion == "ANIMATION" and obj.relativity.use_deformation
+    ]
     return found

@@ -141,16 +141,20 @@ def _mesh(name, light, sun_distance):
     mesh[names.LAMP_FACES_KEY] = _shape_key(light, sun_distance)
     if light.type in ("POINT", "SPOT"):
         builder = bmesh.new()
-        bmesh.ops.create_uvsphere(builder, u_segments=DISC_SEGMENTS, v_segments=DISC_SEGMENTS // 2,
-                                  radius=light.shadow_soft_size)
+        bmesh.ops.create_uvsphere(
+            builder, u_segments=DISC_SEGMENTS, v_segments=DISC_SEGMENTS // 2, radius=light.shadow_soft_size
+        )
         builder.to_mesh(mesh)
         builder.free()
         return mesh
     if light.type == "SUN":  # toward the sun (local +Z), facing back along its light
         radius = sun_distance * math.tan(0.5 * light.angle)
         angles = [-2.0 * math.pi * i / DISC_SEGMENTS for i in range(DISC_SEGMENTS)]
-        mesh.from_pydata([(radius * math.cos(a), radius * math.sin(a), sun_distance) for a in angles], [],
-                         [tuple(range(DISC_SEGMENTS))])
+        mesh.from_pydata(
+            [(radius * math.cos(a), radius * math.sin(a), sun_distance) for a in angles],
+            [],
+            [tuple(range(DISC_SEGMENTS))],
+        )
         return mesh
     width = light.size
     height = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size
@@ -158,8 +162,12 @@ def _mesh(name, light, sun_distance):
         angles = [-2.0 * math.pi * i / DISC_SEGMENTS for i in range(DISC_SEGMENTS)]
         corners = [(0.5 * width * math.cos(a), 0.5 * height * math.sin(a), 0.0) for a in angles]
     else:
-        corners = [(-0.5 * width, -0.5 * height, 0.0), (-0.5 * width, 0.5 * height, 0.0),
-                   (0.5 * width, 0.5 * height, 0.0), (0.5 * width, -0.5 * height, 0.0)]
+        corners = [
+            (-0.5 * width, -0.5 * height, 0.0),
+            (-0.5 * width, 0.5 * height, 0.0),
+            (0.5 * width, 0.5 * height, 0.0),
+            (0.5 * width, -0.5 * height, 0.0),
+        ]
     mesh.from_pydata(corners, [], [tuple(range(len(corners)))])  # normal along local -Z, like the light
     return mesh
 
@@ -325,8 +333,12 @@ def warnings(scene: Scene, snap: Snapshot):
     if not snap.exact_camera:
         return []
     record = scene.get(names.LAMP_FACES_KEY, {})
-    return [f"Light {obj.name!r} is seen directly but not drawn as an emitter: its colour is shifted "
-            "with what lies behind it (docs/moving-lights.md)"
-            for obj in _candidates(scene, snap) if obj.name not in record and _has_extent(obj.data)
-            and _facing_camera(obj, snap)
-            and (obj.data.type != "SPOT" or _spot_mask(obj, Vector(snap.camera_position)) > 0.0)]
+    return [
+        f"Light {obj.name!r} is seen directly but not drawn as an emitter: its colour is shifted "
+        "with what lies behind it (docs/moving-lights.md)"
+        for obj in _candidates(scene, snap)
+        if obj.name not in record
+        and _has_extent(obj.data)
+        and _facing_camera(obj, snap)
+        and (obj.data.type != "SPOT" or _spot_mask(obj, Vector(snap.camera_position)) > 0.0)
+    ]

@@ -79,8 +79,12 @@ def _shader_text():
 
 def _new_group():
     group = bpy.data.node_groups.new(GROUP, "ShaderNodeTree")
-    group.interface.new_socket("Albedo", in_out="INPUT", socket_type="NodeSocketColor").default_value = \
-        (0.8, 0.8, 0.8, 1.0)
+    group.interface.new_socket("Albedo", in_out="INPUT", socket_type="NodeSocketColor").default_value = (
+        0.8,
+        0.8,
+        0.8,
+        1.0,
+    )
     group.interface.new_socket("Emission", in_out="OUTPUT", socket_type="NodeSocketShader")
     return group
 
@@ -172,8 +176,10 @@ def blackbody_parameters(temperature, luminance):
         "temperature": float(temperature),
         "luminance": float(luminance),
         "spectral": wavelengths is not None and temperature > 0.0,
-        **{f"wavelength_{index}": float(value)
-           for index, value in enumerate(wavelengths if wavelengths is not None else (500.0, 550.0, 600.0))},
+        **{
+            f"wavelength_{index}": float(value)
+            for index, value in enumerate(wavelengths if wavelengths is not None else (500.0, 550.0, 600.0))
+        },
         "spectral_scale": scale,
     }
 
@@ -201,7 +207,7 @@ def _set_input(socket, value):
     whose handler syncs again)."""
     current = socket.default_value
     if isinstance(value, tuple):
-        value = value + tuple(current)[len(value):]  # colour sockets carry alpha
+        value = value + tuple(current)[len(value) :]  # colour sockets carry alpha
         if all(_same(a, b) for a, b in zip(current, value, strict=True)):
             return False
     elif _same(current, value):
@@ -236,8 +242,9 @@ def _write_parameters(group, snap):
 
 
 def _material_output(tree):
-    outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial"
-               and node.target in ("ALL", "CYCLES")]
+    outputs = [
+        node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial" and node.target in ("ALL", "CYCLES")
+    ]
     active = [node for node in outputs if node.is_active_output]
     return (active or outputs or [None])[0]
 
@@ -296,8 +303,13 @@ def attach(material: Material, group):
     tree.links.new(source, add.inputs[0])
     tree.links.new(node.outputs["Emission"], add.inputs[1])
     tree.links.new(add.outputs[0], output.inputs["Surface"])
-    material[MATERIAL_KEY] = {"group_node": node.name, "add_node": add.name, "output": output.name,
-                              "source_node": source.node.name, "source_socket": source.identifier}
+    material[MATERIAL_KEY] = {
+        "group_node": node.name,
+        "add_node": add.name,
+        "output": output.name,
+        "source_node": source.node.name,
+        "source_socket": source.identifier,
+    }
     return True
 
 
@@ -314,8 +326,11 @@ def detach(material: Material):
                 tree.nodes.remove(node)
         output = tree.nodes.get(record["output"])
         source_node = tree.nodes.get(record["source_node"])
-        source = None if source_node is None else next(
-            (s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+        source = (
+            None
+            if source_node is None
+            else next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+        )
         if output is not None and source is not None:
             tree.links.new(source, output.inputs["Surface"])
     del material[MATERIAL_KEY]
@@ -395,8 +410,9 @@ def write(scene: Scene, snap: Snapshot, attach_new_materials=False, depsgraph: D
     _enable_osl(scene)
     if uses_lamps(snap):
         _silence_group(snap)  # the preview's material nodes, during an Apparent Geometry final render
-        stand_in_lamps.write(scene, snap, lights, lambda light: shader_parameters(light, snap),
-                           reception_event(snap)[0], depsgraph)
+        stand_in_lamps.write(
+            scene, snap, lights, lambda light: shader_parameters(light, snap), reception_event(snap)[0], depsgraph
+        )
         return None
     stand_in_lamps.remove(scene)  # after an Apparent Geometry final render
     group = ensure_group(light_names)
@@ -436,15 +452,22 @@ def remove(scene: Scene) -> None:
 def warnings(scene: Scene, snap: Snapshot):
     """What the moving-light stage does not render right, one line each."""
     drawn = {light.name for light in supported(snap)}
-    found = [f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "
-             "with this motion need the exact camera)" for light in snap.moving_lights if light.name not in drawn]
+    found = [
+        f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "
+        "with this motion need the exact camera)"
+        for light in snap.moving_lights
+        if light.name not in drawn
+    ]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
-        found.append("Moving lights with a moving observer: the viewport preview lights the surfaces where they "
-                     "appear; the final render is exact")
+        found.append(
+            "Moving lights with a moving observer: the viewport preview lights the surfaces where they "
+            "appear; the final render is exact"
+        )
     if supported(snap) and uses_lamps(snap):
-        found.append("Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
-                     "between neighbouring lamps (docs/moving-lights.md)")
+        found.append(
+            "Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
+            "between neighbouring lamps (docs/moving-lights.md)"
+        )
     if supported(snap) and scene.render.engine != "CYCLES":
         found.append("Moving lights need Cycles (OSL)")
     return found
-

@@ -37,19 +37,27 @@ NODE_NAME = names.REST_NORMAL_GROUP
 
 def _group_spec():
     return nodes.Group(
-        name=names.REST_NORMAL_GROUP, tree_type="ShaderNodeTree", inputs=(),
+        name=names.REST_NORMAL_GROUP,
+        tree_type="ShaderNodeTree",
+        inputs=(),
         outputs=(("Normal", "NodeSocketVector", "normal.Result"),),
         nodes={
-            "rest": nodes.Node("ShaderNodeAttribute",
-                               props={"attribute_name": ATTRIBUTE, "attribute_type": "GEOMETRY"}),
-            "world": nodes.Node("ShaderNodeVectorTransform", {0: "rest.Vector"},
-                                {"vector_type": "NORMAL", "convert_from": "OBJECT", "convert_to": "WORLD"}),
+            "rest": nodes.Node(
+                "ShaderNodeAttribute", props={"attribute_name": ATTRIBUTE, "attribute_type": "GEOMETRY"}
+            ),
+            "world": nodes.Node(
+                "ShaderNodeVectorTransform",
+                {0: "rest.Vector"},
+                {"vector_type": "NORMAL", "convert_from": "OBJECT", "convert_to": "WORLD"},
+            ),
             "length": nodes.vmath("LENGTH", "rest.Vector"),
             "present": nodes.fmath("GREATER_THAN", "length.Value", 0.5),
             "geometry": nodes.Node("ShaderNodeNewGeometry"),
-            "normal": nodes.Node("ShaderNodeMix", {"Factor": "present", 4: "geometry.Normal", 5: "world"},
-                                 {"data_type": "VECTOR"}),
-        })
+            "normal": nodes.Node(
+                "ShaderNodeMix", {"Factor": "present", 4: "geometry.Normal", 5: "world"}, {"data_type": "VECTOR"}
+            ),
+        },
+    )
 
 
 def _group():
@@ -83,9 +91,13 @@ def _write_attribute(mesh):
 
 def _normal_inputs(tree):
     """Unlinked Normal inputs of the BSDFs (and subsurface nodes) in a material's tree."""
-    return [node.inputs["Normal"] for node in tree.nodes
-            if (node.bl_idname.startswith("ShaderNodeBsdf") or node.bl_idname == "ShaderNodeSubsurfaceScattering")
-            and "Normal" in node.inputs and not node.inputs["Normal"].is_linked]
+    return [
+        node.inputs["Normal"]
+        for node in tree.nodes
+        if (node.bl_idname.startswith("ShaderNodeBsdf") or node.bl_idname == "ShaderNodeSubsurfaceScattering")
+        and "Normal" in node.inputs
+        and not node.inputs["Normal"].is_linked
+    ]
 
 
 def attach(material: Material, group):

@@ -49,14 +49,15 @@ def _cmf_defines():
     """The colour matching functions every 10 nm (360-830 nm) and XYZ -> linear Rec.709, as OSL
     macros (OSL has no global arrays): the shipped tables of the spectral mode."""
     tables = spectral_render.tables()
-    rows = (tables["cmfs_nm"] % 10.0 == 0.0)
+    rows = tables["cmfs_nm"] % 10.0 == 0.0
     cmfs = tables["cmfs"][rows]
 
     def array(values):
         return ", ".join(f"{float(v):.7g}" for v in values)
 
-    declare = " ".join(f"float CMF_{axis}[{len(cmfs)}] = {{{array(cmfs[:, index])}}};"
-                       for index, axis in enumerate("XYZ"))
+    declare = " ".join(
+        f"float CMF_{axis}[{len(cmfs)}] = {{{array(cmfs[:, index])}}};" for index, axis in enumerate("XYZ")
+    )
     declare += f" float XYZ_TO_RGB[9] = {{{array(np.asarray(tables['xyz_to_rgb']).ravel())}}};"
     return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
 
@@ -73,9 +74,11 @@ def basis_defines():
     if not (grid[0] == low and grid[-1] == high and np.allclose(np.diff(grid), step)):
         raise RelativityError("the shipped RGB basis table is not on an even grid over its band")
     values = ", ".join(f"{float(v):.9g}" for v in basis.ravel())
-    return (f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
-            f"#define WHITE_TEMPERATURE {spectral_render.WHITE_TEMPERATURE_K!r}\n"
-            f"#define BASIS_DECLARE float BASIS[{basis.size}] = {{{values}}};\n")
+    return (
+        f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
+        f"#define WHITE_TEMPERATURE {spectral_render.WHITE_TEMPERATURE_K!r}\n"
+        f"#define BASIS_DECLARE float BASIS[{basis.size}] = {{{values}}};\n"
+    )
 
 
 def _shader_text():
@@ -160,8 +163,9 @@ def lamp_path(scene: Scene, snap: Snapshot, light, values, reception_time, point
     if speed == 0.0:
         return np.zeros(1), here[None, :]
     knots = np.linspace(-reach * 2.0 / (1.0 - speed), 0.0, 513)
-    times, irradiance = retarded_times_on_path(points, camera_position, knots,
-                                               _keyframe_path(obj, snap, reception_time, knots))
+    times, irradiance = retarded_times_on_path(
+        points, camera_position, knots, _keyframe_path(obj, snap, reception_time, knots)
+    )
     times = lamp_times(times, irradiance, _spacing(times, irradiance, speed), MAX_LAMPS)
     return times, _keyframe_path(obj, snap, reception_time, times)
 
@@ -217,7 +221,7 @@ def _set(owner, key, value):
     """Write only a changed value (a write triggers a depsgraph update, whose handler syncs)."""
     current = getattr(owner, key)
     if isinstance(value, tuple):
-        value = value + tuple(current)[len(value):]
+        value = value + tuple(current)[len(value) :]
         if all(_same(a, b) for a, b in zip(current, value, strict=True)):
             return
     elif _same(current, value):
@@ -236,8 +240,10 @@ def _lamps_for(scene, light_name, count, text, kind="POINT"):
     if len(existing) != count or any(bpy.data.objects[name].data.type != kind for name in existing):
         for name in existing:
             _delete(name)
-        existing = [_new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
-                    for index in range(count)]
+        existing = [
+            _new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
+            for index in range(count)
+        ]
         record[light_name] = existing
         scene[names.MOVING_LAMPS_KEY] = record
     return [bpy.data.objects[name] for name in existing]
@@ -248,8 +254,9 @@ def _stored_times(scene, light_name):
     objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
     if not objects or any(obj is None or obj.data.type != "POINT" for obj in objects):
         return None
-    return np.array([obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["lamp_time"].default_value
-                     for obj in objects], float)
+    return np.array(
+        [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["lamp_time"].default_value for obj in objects], float
+    )
 
 
 def _positions(scene, snap, light, values, reception_time, times):
@@ -287,15 +294,32 @@ def write(scene: Scene, snap: Snapshot, lights, parameters, reception_time, deps
         last = len(times) - 1
         for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
             before, after = max(index - 1, 0), min(index + 1, last)
-            inputs = {key: values[key] for key in ("camera_position", "light_beta", "spot_axis",
-                                                    "spot_cos_half_angle", "spot_smooth", "temperature",
-                                                    "luminance", "wavelength_0", "wavelength_1", "wavelength_2",
-                                                    "spectral_scale", "basis_weights")}
+            inputs = {
+                key: values[key]
+                for key in (
+                    "camera_position",
+                    "light_beta",
+                    "spot_axis",
+                    "spot_cos_half_angle",
+                    "spot_smooth",
+                    "temperature",
+                    "luminance",
+                    "wavelength_0",
+                    "wavelength_1",
+                    "wavelength_2",
+                    "spectral_scale",
+                    "basis_weights",
+                )
+            }
             inputs["spectral"] = int(values["spectral"])
             inputs["lambert"] = int(values["lambert"])
-            inputs.update(lamp_time=float(times[index]), previous_time=float(times[before]),
-                          previous_position=tuple(positions[before]), next_time=float(times[after]),
-                          next_position=tuple(positions[after]))
+            inputs.update(
+                lamp_time=float(times[index]),
+                previous_time=float(times[before]),
+                previous_position=tuple(positions[before]),
+                next_time=float(times[after]),
+                next_position=tuple(positions[after]),
+            )
             _set(obj, "location", tuple(float(v) for v in positions[index]))
             node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
             for key, value in inputs.items():
@@ -322,8 +346,9 @@ def fast_sun(user, doppler):
     colour = np.array(user.color[:3], dtype=np.float64)
     temperature = sources.light_blackbody(user) if user.use_temperature else None
     if temperature is not None:
-        log_ratio = spectral_render.log_blackbody_luminance(doppler * temperature) \
-            - spectral_render.log_blackbody_luminance(temperature)
+        log_ratio = spectral_render.log_blackbody_luminance(
+            doppler * temperature
+        ) - spectral_render.log_blackbody_luminance(temperature)
         return tuple(colour), doppler * temperature, float(np.exp(log_ratio)) / doppler**2
     if user.use_temperature:  # a tinted blackbody: an RGB colour
         colour = colour * np.array(user.temperature_color[:3])
@@ -345,8 +370,11 @@ def _write_sun(scene, light, obj):
         stand_in[names.SUN_DOPPLER_KEY] = float(doppler)
     _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
     if materials.spectral_pass_wavelengths() is None:  # in a pass (the user's sun spectral too): they stay
-        rest = {"color": [float(v) for v in user.color[:3]], "use_temperature": bool(user.use_temperature),
-                "temperature": float(user.temperature)}
+        rest = {
+            "color": [float(v) for v in user.color[:3]],
+            "use_temperature": bool(user.use_temperature),
+            "temperature": float(user.temperature),
+        }
         saved = stand_in.get(names.SUN_REST_KEY)
         if saved is None or saved.to_dict() != rest:  # the spectrum the passes shift
             stand_in[names.SUN_REST_KEY] = rest

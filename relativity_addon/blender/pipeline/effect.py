@@ -38,8 +38,12 @@ def applied_method(scene):
     """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None (the exact
     camera of an Apparent Geometry final render does not count: it is there for the render)."""
     camera_object = scene.camera
-    if camera_object is not None and camera_object.type == "CAMERA" and exact_camera.is_applied(camera_object.data) \
-            and not exact_camera.is_render_only(camera_object.data):
+    if (
+        camera_object is not None
+        and camera_object.type == "CAMERA"
+        and exact_camera.is_applied(camera_object.data)
+        and not exact_camera.is_render_only(camera_object.data)
+    ):
         return "CAMERA"
     if modifier.applied_objects(scene):
         return "GEOMETRY"
@@ -63,10 +67,10 @@ def apply(scene, frame_range=None, objects=None):
         remove(scene)
     if snap.method == "CAMERA":
         result = exact_camera.apply(scene, snap)
-        undo = (lambda: exact_camera.remove(result))  # noqa: E731
+        undo = lambda: exact_camera.remove(result)  # noqa: E731
     else:
         result = apparent_meshes.apply(scene, snap, objects)
-        undo = (lambda: apparent_meshes.remove(scene, result))  # noqa: E731
+        undo = lambda: apparent_meshes.remove(scene, result)  # noqa: E731
     try:
         for stage in STAGES:
             stage.apply(scene, snap)
@@ -218,8 +222,12 @@ def setting_changed(scene):
 def object_changed(scene, obj):
     """Update callback of every object setting: a mesh switched on after Set Up gets the apparent
     geometry, a changed blackbody temperature re-attaches its materials, then sync. Never raises."""
-    if applied_method(scene) == "GEOMETRY" and obj.type == "MESH" and obj.relativity.enabled \
-            and modifier.find_modifier(obj) is None:
+    if (
+        applied_method(scene) == "GEOMETRY"
+        and obj.type == "MESH"
+        and obj.relativity.enabled
+        and modifier.find_modifier(obj) is None
+    ):
         try:
             apparent_meshes.apply(scene, snapshot.read(scene), [obj])
         except RelativityError as error:
@@ -270,8 +278,13 @@ def _record(scene, snap):
 
 def _mesh_warnings(obj, snap):
     """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change."""
-    inputs = (tuple(map(tuple, obj.matrix_world)), obj.data.name, len(obj.data.edges),
-              tuple(snap.camera_position), obj.relativity.tessellation)
+    inputs = (
+        tuple(map(tuple, obj.matrix_world)),
+        obj.data.name,
+        len(obj.data.edges),
+        tuple(snap.camera_position),
+        obj.relativity.tessellation,
+    )
     known = _object_warnings.get(obj.name)
     if known is not None and known[0] == inputs:
         return known

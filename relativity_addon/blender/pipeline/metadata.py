@@ -25,9 +25,11 @@ PREFIX = "relativity:"
 
 def note(snap: Snapshot):
     beta = ",".join(f"{b:.9g}" for b in snap.beta)
-    return (f"{PREFIX} exposure={snap.exposure:.9g} ({snap.exposure_mode.lower()}) beta={beta} "
-            f"speed={snap.speed:.9g} c={snap.speed_of_light:.9g} frame={snap.frame:g} method={snap.method.lower()}"
-            + (" kinematics=galilean (time of flight only, not relativity)" if snap.use_time_of_flight else ""))
+    return (
+        f"{PREFIX} exposure={snap.exposure:.9g} ({snap.exposure_mode.lower()}) beta={beta} "
+        f"speed={snap.speed:.9g} c={snap.speed_of_light:.9g} frame={snap.frame:g} method={snap.method.lower()}"
+        + (" kinematics=galilean (time of flight only, not relativity)" if snap.use_time_of_flight else "")
+    )
 
 
 def write(scene: Scene, snap: Snapshot) -> None:

@@ -52,8 +52,10 @@ def ready(scene: Scene) -> None:
         raise RelativityError("Spectral colour needs the effect: set it up first (Set Up Relativistic Render)")
     settings = scene.relativity
     if not (settings.use_doppler and settings.use_searchlight) or settings.use_chang_searchlight:
-        raise RelativityError("Spectral colour renders the physical picture: switch Doppler Colour and "
-                              "Searchlight on (and Chang's searchlight off)")
+        raise RelativityError(
+            "Spectral colour renders the physical picture: switch Doppler Colour and "
+            "Searchlight on (and Chang's searchlight off)"
+        )
 
 
 def check(scene: Scene) -> None:
@@ -68,8 +70,10 @@ def check(scene: Scene) -> None:
             raise RelativityError(f"Spectral colour with Apparent Geometry needs the exact final render: {problem}")
         moving = [obj.name for obj in modifier.applied_objects(scene) if obj.relativity.motion != "STATIC"]
         if moving:
-            raise RelativityError(f"Spectral colour with Apparent Geometry: object {moving[0]!r} moves; each "
-                                  "pixel's D is the observer's (use the fast colour for moving objects)")
+            raise RelativityError(
+                f"Spectral colour with Apparent Geometry: object {moving[0]!r} moves; each "
+                "pixel's D is the observer's (use the fast colour for moving objects)"
+            )
     problem = volumes.spectral_problem(scene)
     if problem is not None:
         raise RelativityError(problem)
@@ -126,8 +130,15 @@ def _scene_lights(scene):
     snap = effect.last_snapshot(scene)
     lights = snap.moving_lights if snap is not None else ()
     shifted = {light.name for light in lights if light.kind != "SUN"}
-    return list({obj.data for obj in scene.objects if obj.type == "LIGHT" and obj.name not in shifted
-                 and not (obj.name.startswith(names.MOVING_LAMP_PREFIX) and obj.data.type != "SUN")})
+    return list(
+        {
+            obj.data
+            for obj in scene.objects
+            if obj.type == "LIGHT"
+            and obj.name not in shifted
+            and not (obj.name.startswith(names.MOVING_LAMP_PREFIX) and obj.data.type != "SUN")
+        }
+    )
 
 
 def _render_exr(scene, path):
@@ -161,8 +172,9 @@ def render(scene: Scene, passes, progress=None):
     total = passes
     snap = effect.last_snapshot(scene)
     if snap is None:
-        raise RelativityError(effect.scene_warnings(scene)[0] if effect.scene_warnings(scene) else
-                              "the relativistic camera is not valid")
+        raise RelativityError(
+            effect.scene_warnings(scene)[0] if effect.scene_warnings(scene) else "the relativistic camera is not valid"
+        )
     log_doppler = pixel_log_doppler(scene, snap)
     try:
         with tempfile.TemporaryDirectory(prefix="relativity_spectral_") as folder:
@@ -205,7 +217,7 @@ def render(scene: Scene, passes, progress=None):
     return pixels, info
 
 
-def store_image(pixels, name: str=IMAGE_NAME):
+def store_image(pixels, name: str = IMAGE_NAME):
     """Put the pixels into the float image ``name`` (made or resized as needed) and return it."""
     height, width = pixels.shape[:2]
     image = bpy.data.images.get(name)

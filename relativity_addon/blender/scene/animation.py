@@ -32,10 +32,19 @@ def frames_per_second(scene: Scene):
 
 
 # Properties of an object whose animation moves it (what the keyframe evaluation reads).
-TRANSFORM_PATHS = frozenset((
-    "location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale",
-    "delta_location", "delta_rotation_euler", "delta_rotation_quaternion", "delta_scale",
-))
+TRANSFORM_PATHS = frozenset(
+    (
+        "location",
+        "rotation_euler",
+        "rotation_quaternion",
+        "rotation_axis_angle",
+        "scale",
+        "delta_location",
+        "delta_rotation_euler",
+        "delta_rotation_quaternion",
+        "delta_scale",
+    )
+)
 # The channels that are an object's world line; the others (rotation, scale) are its own animation,
 # which plays at its proper time (``world_lines``).
 LOCATION_PATHS = frozenset(("location", "delta_location"))
@@ -52,7 +61,8 @@ def _transform_fcurves(obj):
     return {
         (fcurve.data_path, fcurve.array_index): fcurve
         for fcurve in compat.action_fcurves(animation_data)
-        if fcurve.data_path in TRANSFORM_PATHS and not fcurve.mute
+        if fcurve.data_path in TRANSFORM_PATHS
+        and not fcurve.mute
         and (len(fcurve.keyframe_points) or len(fcurve.modifiers))
     }
 
@@ -88,13 +98,15 @@ def basis_matrices(obj: Object, frames, own_frames=None):
 
     mode = obj.rotation_mode
     if mode == "QUATERNION":
-        rotation = transforms.quaternion_matrices(channels("delta_rotation_quaternion", 4)) @ \
-            transforms.quaternion_matrices(channels("rotation_quaternion", 4))
+        rotation = transforms.quaternion_matrices(
+            channels("delta_rotation_quaternion", 4)
+        ) @ transforms.quaternion_matrices(channels("rotation_quaternion", 4))
     elif mode == "AXIS_ANGLE":
         rotation = transforms.axis_angle_matrices(channels("rotation_axis_angle", 4))
     else:
-        rotation = transforms.euler_matrices(channels("delta_rotation_euler", 3), mode) @ \
-            transforms.euler_matrices(channels("rotation_euler", 3), mode)
+        rotation = transforms.euler_matrices(channels("delta_rotation_euler", 3), mode) @ transforms.euler_matrices(
+            channels("rotation_euler", 3), mode
+        )
     return transforms.compose_basis_matrices(
         channels("location", 3) + channels("delta_location", 3),
         rotation,
@@ -132,11 +144,26 @@ def keyframes_signature(obj: Object):
             for fcurve in compat.action_fcurves(animation_data):
                 if len(fcurve.modifiers):
                     return None
-                parts.append((fcurve.data_path, fcurve.array_index, fcurve.mute, fcurve.extrapolation, tuple(
-                    (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
-                    for p in fcurve.keyframe_points)))
-        parts.append((tuple(map(tuple, obj.matrix_parent_inverse)), obj.rotation_mode, obj.parent_type,
-                      *(tuple(getattr(obj, path)) for path in sorted(TRANSFORM_PATHS))))
+                parts.append(
+                    (
+                        fcurve.data_path,
+                        fcurve.array_index,
+                        fcurve.mute,
+                        fcurve.extrapolation,
+                        tuple(
+                            (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
+                            for p in fcurve.keyframe_points
+                        ),
+                    )
+                )
+        parts.append(
+            (
+                tuple(map(tuple, obj.matrix_parent_inverse)),
+                obj.rotation_mode,
+                obj.parent_type,
+                *(tuple(getattr(obj, path)) for path in sorted(TRANSFORM_PATHS)),
+            )
+        )
         obj = obj.parent
     return tuple(parts)
 

@@ -33,9 +33,14 @@ OWN_PREFIX = "Relativity"  # the add-on's node groups and inserted nodes
 
 def user_groups(tree):
     """The group nodes of ``tree`` that hold a user's node group (not the add-on's)."""
-    return [node for node in tree.nodes
-            if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None
-            and not node.name.startswith(OWN_PREFIX) and not node.node_tree.name.startswith(OWN_PREFIX)]
+    return [
+        node
+        for node in tree.nodes
+        if node.bl_idname == "ShaderNodeGroup"
+        and node.node_tree is not None
+        and not node.name.startswith(OWN_PREFIX)
+        and not node.node_tree.name.startswith(OWN_PREFIX)
+    ]
 
 
 def _group_input(socket):
@@ -92,9 +97,11 @@ def attach_groups(tree, insert, seen=()) -> None:
             continue
         if KEY not in group_tree:
             passed = pass_throughs(group_tree)
-            records = [insert(group_tree, target, socket, is_emission)
-                       for target, socket, is_emission in list(targets(group_tree))
-                       if passed.get(_group_input(socket)) != is_emission]
+            records = [
+                insert(group_tree, target, socket, is_emission)
+                for target, socket, is_emission in list(targets(group_tree))
+                if passed.get(_group_input(socket)) != is_emission
+            ]
             group_tree[KEY] = records
         attach_groups(group_tree, insert, (*seen, group_tree.name))
 

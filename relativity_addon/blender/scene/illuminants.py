@@ -106,5 +106,5 @@ def lit_groups(scene: Scene):
     world_temperature = _world_temperature(scene.world)
     if world_temperature is not None:
         by_temperature.setdefault(world_temperature, []).append(WORLD)
-    ranked = sorted(by_temperature.items(), key=lambda item: (-len(item[1]), item[0]))[:len(names.LIT_GROUPS)]
+    ranked = sorted(by_temperature.items(), key=lambda item: (-len(item[1]), item[0]))[: len(names.LIT_GROUPS)]
     return tuple(LitGroup(temperature, tuple(sorted(members))) for temperature, members in ranked)

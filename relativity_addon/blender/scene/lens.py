@@ -51,5 +51,7 @@ def check_detector_image(scene, camera, matrix=None):
         image_distance(f, focus)
     except ValueError:
         scale = scene.unit_settings.scale_length or 1.0
-        raise RelativityError(f"Camera {camera.name!r}: focus distance {focus * scale:.3g} m is inside the focal "
-                              f"length {f * scale:.3g} m: no image forms (Detector Plane shutter)") from None
+        raise RelativityError(
+            f"Camera {camera.name!r}: focus distance {focus * scale:.3g} m is inside the focal "
+            f"length {f * scale:.3g} m: no image forms (Detector Plane shutter)"
+        ) from None

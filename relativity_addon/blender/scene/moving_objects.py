@@ -13,10 +13,23 @@ if TYPE_CHECKING:
 
 
 TYPE_LABELS = {
-    "MESH": "Mesh", "CURVE": "Curve", "SURFACE": "Surface", "FONT": "Text", "META": "Metaball",
-    "POINTCLOUD": "Point cloud", "VOLUME": "Volume", "GPENCIL": "Grease pencil", "GREASEPENCIL": "Grease pencil",
-    "CURVES": "Hair curves", "EMPTY": "Empty", "CAMERA": "Camera", "SPEAKER": "Speaker",
-    "LIGHT_PROBE": "Light probe", "LIGHTPROBE": "Light probe", "ARMATURE": "Armature", "LATTICE": "Lattice",
+    "MESH": "Mesh",
+    "CURVE": "Curve",
+    "SURFACE": "Surface",
+    "FONT": "Text",
+    "META": "Metaball",
+    "POINTCLOUD": "Point cloud",
+    "VOLUME": "Volume",
+    "GPENCIL": "Grease pencil",
+    "GREASEPENCIL": "Grease pencil",
+    "CURVES": "Hair curves",
+    "EMPTY": "Empty",
+    "CAMERA": "Camera",
+    "SPEAKER": "Speaker",
+    "LIGHT_PROBE": "Light probe",
+    "LIGHTPROBE": "Light probe",
+    "ARMATURE": "Armature",
+    "LATTICE": "Lattice",
 }
 DRAWS_NOTHING = ("EMPTY", "CAMERA", "SPEAKER", "LIGHT_PROBE", "LIGHTPROBE", "ARMATURE", "LATTICE")
 
@@ -40,8 +53,9 @@ def object_label(obj):
 
 def draws_nothing(obj):
     """Whether the object draws nothing in a render itself (an empty instancing a collection does)."""
-    return obj.type in DRAWS_NOTHING and not (obj.type == "EMPTY" and obj.instance_type == "COLLECTION"
-                                              and obj.instance_collection is not None)
+    return obj.type in DRAWS_NOTHING and not (
+        obj.type == "EMPTY" and obj.instance_type == "COLLECTION" and obj.instance_collection is not None
+    )
 
 
 def _named(labels, limit=4):
@@ -55,8 +69,11 @@ def mesh_instancer(obj):
     vertex or face instancing. Geometry-nodes instances are found on the evaluated scene
     (``apparent_meshes.apply``)."""
     for modifier in obj.modifiers:
-        if modifier.type == "PARTICLE_SYSTEM" and modifier.show_render \
-                and modifier.particle_system.settings.render_type != "NONE":
+        if (
+            modifier.type == "PARTICLE_SYSTEM"
+            and modifier.show_render
+            and modifier.particle_system.settings.render_type != "NONE"
+        ):
             return f"particle system {modifier.particle_system.name!r}"
     if obj.instance_type in ("VERTS", "FACES") and len(obj.children):
         return f"{obj.instance_type.lower()[:-1]} instancing"
@@ -76,22 +93,32 @@ def check_object_velocities(scene, method):
         labels = [f"{obj.name!r}" for obj in moving if not emitting_meshes.is_emitter_light(obj)]
         if not labels:
             return
-        subject = f"Object {labels[0]} has its own velocity" if len(labels) == 1 else \
-            f"Objects {_named(labels)} have their own velocities"
-        raise RelativityError(f"{subject}: the Exact Camera method photographs a static scene; choose Apparent "
-                              "Geometry (its final render uses the exact camera)")
+        subject = (
+            f"Object {labels[0]} has its own velocity"
+            if len(labels) == 1
+            else f"Objects {_named(labels)} have their own velocities"
+        )
+        raise RelativityError(
+            f"{subject}: the Exact Camera method photographs a static scene; choose Apparent "
+            "Geometry (its final render uses the exact camera)"
+        )
     problems = []
     drawn = [object_label(obj) for obj in moving if obj.type != "MESH" and not draws_nothing(obj)]
     if drawn:
-        problems.append(f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
-                        f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}")
+        problems.append(
+            f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
+            f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}"
+        )
     for obj in moving:
         if draws_nothing(obj):
-            problems.append(f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
-                            "meshes do not inherit it): set its Motion to Static, give moving meshes their own")
+            problems.append(
+                f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
+                "meshes do not inherit it): set its Motion to Static, give moving meshes their own"
+            )
         elif obj.type == "MESH" and (instancer := mesh_instancer(obj)) is not None:
-            problems.append(f"Mesh {obj.name!r} draws objects by its {instancer}, which cannot move on the "
-                            "Apparent Geometry path yet: make them real (Make Instances Real / Convert to Mesh)")
+            problems.append(
+                f"Mesh {obj.name!r} draws objects by its {instancer}, which cannot move on the "
+                "Apparent Geometry path yet: make them real (Make Instances Real / Convert to Mesh)"
+            )
     if problems:
         raise RelativityError("; ".join(problems))
-

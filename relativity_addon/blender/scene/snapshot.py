@@ -32,7 +32,6 @@ if TYPE_CHECKING:
 Vector3 = tuple[float, float, float]
 
 
-
 @dataclass(frozen=True)
 class ColourFactors:
     """How the materials and the compositor scale and shift colour (docs/spectral-model.md)."""
@@ -248,8 +247,9 @@ def observer_speeds(scene: Scene, frames):
     after = animation.world_matrices(camera, frames + STEP_FRAMES)[:, :3, 3]
     speeds = np.linalg.norm(after - before, axis=1) * animation.frames_per_second(scene) / (2.0 * STEP_FRAMES * c)
     if np.any(speeds >= 1.0):
-        raise RelativityError(f"camera {camera.name!r} reaches the speed of light at frame "
-                              f"{float(frames[np.argmax(speeds >= 1.0)]):g}")
+        raise RelativityError(
+            f"camera {camera.name!r} reaches the speed of light at frame {float(frames[np.argmax(speeds >= 1.0)]):g}"
+        )
     return speeds
 
 
@@ -260,7 +260,8 @@ def _checked_camera_speed(camera, beta, frame):
         where = f"frame {whole}" if frame == whole else f"frame {whole} (sub-frame {frame:g})"
         raise RelativityError(
             f"camera {camera.name!r} moves at {speed:.4g} c at {where}: "
-            "its animation must stay below the speed of light (slow it down or raise c)")
+            "its animation must stay below the speed of light (slow it down or raise c)"
+        )
     return speed
 
 
@@ -323,14 +324,23 @@ def moving_lights(scene: Scene, frame, depsgraph: Depsgraph | None = None):
         light = obj.data
         power = float(light.energy) / (4.0 * math.pi)
         spot = light.type == "SPOT"
-        colour = np.array(light.color, float) * (np.array(light.temperature_color, float) if light.use_temperature
-                                                 else 1.0)
-        found.append(MovingLight(
-            name=obj.name, kind=light.type, position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
-            intensity=tuple(power * float(v) for v in colour), axis=tuple(float(v) for v in axis),
-            spot_size=float(light.spot_size) if spot else math.pi, spot_blend=float(light.spot_blend) if spot else 0.0,
-            motion=motion, temperature=float(sources.light_blackbody(light) or 0.0),
-        ))
+        colour = np.array(light.color, float) * (
+            np.array(light.temperature_color, float) if light.use_temperature else 1.0
+        )
+        found.append(
+            MovingLight(
+                name=obj.name,
+                kind=light.type,
+                position=tuple(float(v) for v in matrix[:3, 3]),
+                beta=beta,
+                intensity=tuple(power * float(v) for v in colour),
+                axis=tuple(float(v) for v in axis),
+                spot_size=float(light.spot_size) if spot else math.pi,
+                spot_blend=float(light.spot_blend) if spot else 0.0,
+                motion=motion,
+                temperature=float(sources.light_blackbody(light) or 0.0),
+            )
+        )
     return tuple(found)
 
 
@@ -341,9 +351,19 @@ def _emitter_light(scene, obj, frame, depsgraph):
     intensity = emitting_meshes.intensity(obj, matrix)
     if intensity is None:
         return []
-    return [MovingLight(name=obj.name, kind="POINT", position=tuple(float(v) for v in matrix[:3, 3]), beta=beta,
-                        intensity=intensity, axis=(0.0, 0.0, -1.0), spot_size=math.pi, spot_blend=0.0,
-                        temperature=float(obj.relativity.temperature))]
+    return [
+        MovingLight(
+            name=obj.name,
+            kind="POINT",
+            position=tuple(float(v) for v in matrix[:3, 3]),
+            beta=beta,
+            intensity=intensity,
+            axis=(0.0, 0.0, -1.0),
+            spot_size=math.pi,
+            spot_blend=0.0,
+            temperature=float(obj.relativity.temperature),
+        )
+    ]
 
 
 # Object types the Apparent Geometry path cannot move (their own velocity is refused, naming them)
@@ -462,13 +482,15 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         use_chang_searchlight=bool(settings.use_chang_searchlight),
         exposure_mode=settings.exposure_mode,
         exposure=frame_exposure(scene, camera, settings, beta, matrix)
-        if settings.use_searchlight and not time_of_flight else 1.0,
+        if settings.use_searchlight and not time_of_flight
+        else 1.0,
         moving_lights=lights,
         doppler_only_brightness=settings.doppler_only_brightness,
         imaging_element=settings.imaging_element,
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
-        lit_groups=illuminants.lit_groups(scene) if exact_camera and settings.use_doppler and not time_of_flight
+        lit_groups=illuminants.lit_groups(scene)
+        if exact_camera and settings.use_doppler and not time_of_flight
         else (),
     )

@@ -358,8 +358,11 @@ def grouped_node(tree, kinds, seen=()):
     if tree is None or tree.name in seen:
         return None
     for node in tree.nodes:
-        if node.bl_idname != "ShaderNodeGroup" or node.node_tree is None \
-                or node.name.startswith(names.MATERIAL_NODE_PREFIX):
+        if (
+            node.bl_idname != "ShaderNodeGroup"
+            or node.node_tree is None
+            or node.name.startswith(names.MATERIAL_NODE_PREFIX)
+        ):
             continue
         inner = next((n for n in node.node_tree.nodes if n.bl_idname in kinds), None)
         if inner is None:

@@ -43,8 +43,16 @@ def proper_time_at(scene: Scene, frame):
     first = min(0.0, float(scene.frame_start), float(frame))
     last = max(1.0, float(scene.frame_end), float(frame))
     animated = camera is not None and settings.velocity_source == "CAMERA_ANIMATION"
-    key = (scene.name, first, last, settings.velocity_source, tuple(settings.beta), settings.speed_of_light,
-           animation.frames_per_second(scene), animation.keyframes_signature(camera) if animated else ())
+    key = (
+        scene.name,
+        first,
+        last,
+        settings.velocity_source,
+        tuple(settings.beta),
+        settings.speed_of_light,
+        animation.frames_per_second(scene),
+        animation.keyframes_signature(camera) if animated else (),
+    )
     if _cache.get("key") != key:
         frames, taus = _grid(scene, first, last)
         _cache.update(key=key, frames=frames, taus=taus - np.interp(0.0, frames, taus))

@@ -12,10 +12,19 @@ from .props import velocity_property
 
 MOTION_ITEMS = (
     ("STATIC", "Static", "At rest in the scene (still seen moving when the observer moves)"),
-    ("CONSTANT", "Constant Velocity", "Uniform motion with the velocity below (world axes, fraction of c); "
-     "the object is where Blender draws it at the current frame"),
-    ("ANIMATION", "Animation", "The object's animated transform at each vertex's retarded time: its keyframes "
-     "under its parents (deltas included), or its baked motion (Bake Motion) when constraints, drivers or NLA move it"),
+    (
+        "CONSTANT",
+        "Constant Velocity",
+        "Uniform motion with the velocity below (world axes, fraction of c); "
+        "the object is where Blender draws it at the current frame",
+    ),
+    (
+        "ANIMATION",
+        "Animation",
+        "The object's animated transform at each vertex's retarded time: its keyframes "
+        "under its parents (deltas included), or its baked motion (Bake Motion) when constraints, "
+        "drivers or NLA move it",
+    ),
 )
 
 

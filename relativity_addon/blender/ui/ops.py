@@ -133,8 +133,9 @@ class RELATIVITY_OT_render_spectral(Operator):
         passes = scene.relativity.spectral_passes
         window_manager.progress_begin(0, passes)
         try:
-            pixels, info = spectral_render.render(scene, passes, progress=lambda done, _total:
-                                                  window_manager.progress_update(done))
+            pixels, info = spectral_render.render(
+                scene, passes, progress=lambda done, _total: window_manager.progress_update(done)
+            )
         except RelativityError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -146,10 +147,17 @@ class RELATIVITY_OT_render_spectral(Operator):
                 area.spaces.active.image = image
                 break
         low, high = info["doppler_range"]
-        self.report({"INFO"}, f"Spectral render in image {image.name!r}: D {low:.3g} to {high:.3g}, "
-                    f"{passes} passes, {info['seconds']:.1f} s")
+        self.report(
+            {"INFO"},
+            f"Spectral render in image {image.name!r}: D {low:.3g} to {high:.3g}, "
+            f"{passes} passes, {info['seconds']:.1f} s",
+        )
         return {"FINISHED"}
 
 
-classes = (RELATIVITY_OT_setup_scene, RELATIVITY_OT_remove_all, RELATIVITY_OT_check_animation,
-           RELATIVITY_OT_render_spectral)
+classes = (
+    RELATIVITY_OT_setup_scene,
+    RELATIVITY_OT_remove_all,
+    RELATIVITY_OT_check_animation,
+    RELATIVITY_OT_render_spectral,
+)

@@ -127,8 +127,9 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row.prop(settings, "use_time_of_flight")
         time_of_flight = settings.use_time_of_flight
         if time_of_flight:
-            column.label(text="Light delay only (Galilean, Gray Fig. 1c): no contraction, searchlight or Doppler",
-                         icon="INFO")
+            column.label(
+                text="Light delay only (Galilean, Gray Fig. 1c): no contraction, searchlight or Doppler", icon="INFO"
+            )
         elif settings.method != "CAMERA":
             column.label(text="Time of Flight Only: exact camera only", icon="INFO")
         colour = column.column()
@@ -217,15 +218,20 @@ def _draw_light(layout, obj):
     if settings.motion == "CONSTANT":
         layout.prop(settings, "beta")
         if kind not in ("POINT", "SPOT"):
-            layout.label(text=f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent "
-                              "Geometry)", icon="INFO")
+            layout.label(
+                text=f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent Geometry)",
+                icon="INFO",
+            )
     elif settings.motion == "ANIMATION":
-        layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)",
-                     icon="INFO")
+        layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)", icon="INFO")
         if kind == "SUN":
             layout.label(text="A sun moves with its keyframes' velocity at the frame", icon="INFO")
 
 
 classes = (
-    RELATIVITY_PT_main, RELATIVITY_PT_observer, RELATIVITY_PT_shutter, RELATIVITY_PT_effects, RELATIVITY_PT_object,
+    RELATIVITY_PT_main,
+    RELATIVITY_PT_observer,
+    RELATIVITY_PT_shutter,
+    RELATIVITY_PT_effects,
+    RELATIVITY_PT_object,
 )

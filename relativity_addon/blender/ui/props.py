@@ -19,18 +19,27 @@ from ..pipeline import effect
 
 METHOD_ITEMS = (
     ("CAMERA", "Exact Camera", "Relativistic OSL camera: exact for scenes at rest (Gray et al. 2020)"),
-    ("GEOMETRY", "Apparent Geometry",
-     "Deform meshes to their apparent positions (retarded positions seen from the moving camera)"),
+    (
+        "GEOMETRY",
+        "Apparent Geometry",
+        "Deform meshes to their apparent positions (retarded positions seen from the moving camera)",
+    ),
 )
 
 GEOMETRY_RENDER_ITEMS = (
-    ("EXACT", "Exact Camera",
-     "Final render with a moving observer: the exact camera photographs the moving objects at their "
-     "retarded positions in the scene frame, so lamps, shadows and the world are right (Cycles, "
-     "perspective camera)"),
-    ("PREVIEW", "Boosted Meshes",
-     "Final render as the viewport preview: meshes carried into the observer frame; lamps, shadows "
-     "and the world are not transformed (not exact under lamps)"),
+    (
+        "EXACT",
+        "Exact Camera",
+        "Final render with a moving observer: the exact camera photographs the moving objects at their "
+        "retarded positions in the scene frame, so lamps, shadows and the world are right (Cycles, "
+        "perspective camera)",
+    ),
+    (
+        "PREVIEW",
+        "Boosted Meshes",
+        "Final render as the viewport preview: meshes carried into the observer frame; lamps, shadows "
+        "and the world are not transformed (not exact under lamps)",
+    ),
 )
 
 _SHUTTER_DESCRIPTIONS = {
@@ -39,7 +48,8 @@ _SHUTTER_DESCRIPTIONS = {
     "DETECTOR_PLANE": ("Detector Plane", "Every ray reaches the detector at the shutter time (ideal lens)"),
     "FOCUS_SURFACE": ("Focus Surface", "Every ray passes the focus plane at the shutter time"),
     "FIXED_POINT_SURFACE": (
-        "Fixed-Point Surface", "Each focus-plane point opens when it is a spatial fixed point of the boost (Gray eq. 4)"
+        "Fixed-Point Surface",
+        "Each focus-plane point opens when it is a spatial fixed point of the boost (Gray eq. 4)",
     ),
     "ARBITRARY_PLANE": ("Arbitrary Plane", "Every ray crosses a given plane at the shutter time (Gray eq. B5)"),
 }
@@ -48,22 +58,34 @@ SHUTTER_MODEL_ITEMS = tuple((model.name, *_SHUTTER_DESCRIPTIONS[model.name]) for
 SHUTTER_MODELS = tuple(item[0] for item in SHUTTER_MODEL_ITEMS)
 
 IMAGING_ELEMENT_ITEMS = (
-    ("IDEAL_LENS", "Ideal Lens",
-     "Every ray from an object point to its image takes the same time (equal optical path): the "
-     "detector-plane shutter is stigmatic (Gray Fig. 6a)"),
-    ("PHASE_HOLOGRAM", "Phase Hologram",
-     "A phase hologram of the lens: same ray directions, no time delays, so the detector-plane shutter "
-     "blurs (Gray Fig. 6b)"),
+    (
+        "IDEAL_LENS",
+        "Ideal Lens",
+        "Every ray from an object point to its image takes the same time (equal optical path): the "
+        "detector-plane shutter is stigmatic (Gray Fig. 6a)",
+    ),
+    (
+        "PHASE_HOLOGRAM",
+        "Phase Hologram",
+        "A phase hologram of the lens: same ray directions, no time delays, so the detector-plane shutter "
+        "blurs (Gray Fig. 6b)",
+    ),
 )
 
 WINDOW_SHUTTER_ITEMS = (
-    ("WINDOW_PLANE", "In the Window",
-     "The shutter sits in the window, the plane of spatial fixed points for the shutter time (Gray eq. 6), "
-     "and opens at the shutter time: the photo equals the photo at rest (Gray Fig. 9); the shutter model "
-     "is not used"),
-    ("SHUTTER_MODEL", "Shutter Model",
-     "The shutter model times the rays; the window stays in the plane of spatial fixed points for the "
-     "Window Time: a residual distortion unless the rays cross it at that time (Gray Fig. 10)"),
+    (
+        "WINDOW_PLANE",
+        "In the Window",
+        "The shutter sits in the window, the plane of spatial fixed points for the shutter time (Gray eq. 6), "
+        "and opens at the shutter time: the photo equals the photo at rest (Gray Fig. 9); the shutter model "
+        "is not used",
+    ),
+    (
+        "SHUTTER_MODEL",
+        "Shutter Model",
+        "The shutter model times the rays; the window stays in the plane of spatial fixed points for the "
+        "Window Time: a residual distortion unless the rays cross it at that time (Gray Fig. 10)",
+    ),
 )
 
 
@@ -230,9 +252,12 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         description="Brightness of Doppler colour without the searchlight",
         items=(
             ("REST", "Rest Brightness", "The shifted colour keeps the rest-frame brightness"),
-            ("SPECTRUM", "Shifted Spectrum",
-             "Weiskopf et al. (1999) Fig. 8: the shifted spectrum L(lambda D) with no further factor, "
-             "so a blackbody at T shows Y(D T) / (D^5 Y(T)) of its rest brightness"),
+            (
+                "SPECTRUM",
+                "Shifted Spectrum",
+                "Weiskopf et al. (1999) Fig. 8: the shifted spectrum L(lambda D) with no further factor, "
+                "so a blackbody at T shows Y(D T) / (D^5 Y(T)) of its rest brightness",
+            ),
         ),
         default="REST",
         update=_settings_changed,
@@ -242,10 +267,13 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         description="Brightness of the frame under the searchlight",
         items=(
             ("FIXED", "Fixed", "Physically honest: the searchlight brightens the front and darkens the back as it is"),
-            ("COMPENSATED", "Compensated",
-             "One factor per frame from the observer's velocity and the field of view, exp(-4 <ln D>) over the "
-             "image, so that a fly-through stays watchable; written into the output's metadata (Cycles, exact "
-             "camera)"),
+            (
+                "COMPENSATED",
+                "Compensated",
+                "One factor per frame from the observer's velocity and the field of view, exp(-4 <ln D>) over the "
+                "image, so that a fly-through stays watchable; written into the output's metadata (Cycles, exact "
+                "camera)",
+            ),
         ),
         default="FIXED",
         update=_settings_changed,
@@ -256,8 +284,12 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         "which the Doppler shift moves into view (emitters and the world seen directly are read as RGB "
         "colours in white light)",
         items=(
-            ("AUTO", "Automatic", "Each blackbody lamp (lights, blackbody emitters, a blackbody world) by its "
-             "temperature, through Cycles' light groups (two temperatures at most); other lamps in white"),
+            (
+                "AUTO",
+                "Automatic",
+                "Each blackbody lamp (lights, blackbody emitters, a blackbody world) by its "
+                "temperature, through Cycles' light groups (two temperatures at most); other lamps in white",
+            ),
             ("WHITE", "White", "Every lamp as 6504 K white light"),
             ("BLACKBODY", "Blackbody", "Every light object as a blackbody at the temperature below"),
         ),

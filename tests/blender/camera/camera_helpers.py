@@ -337,7 +337,7 @@ def tangent_plane_axis_ratio(camera, coverage):
         plane = directions / cos_axis[:, None]
         coords = np.stack([plane @ e1, plane @ e2], axis=1)
         # Area on the tangent plane = solid angle / cos^3 of the angle to its normal.
-        area = solid_angle / cos_axis ** 3
+        area = solid_angle / cos_axis**3
         mean = (coords * area[:, None]).sum(axis=0) / area.sum()
         axis = normalized(axis + mean[0] * e1 + mean[1] * e2)
     centred = coords - mean

@@ -64,8 +64,13 @@ def test_marker_positions_follow_aberration(factory_blender, tmp_path, speed, di
 
     beta_option = ",".join(f"{b:.17g}" for b in beta)
     image = ch.render_image(
-        bpy, blend, tmp_path / "markers.exr",
-        f"--beta={beta_option}", "--shutter=pinhole", "--no-searchlight", "--samples=4",
+        bpy,
+        blend,
+        tmp_path / "markers.exr",
+        f"--beta={beta_option}",
+        "--shutter=pinhole",
+        "--no-searchlight",
+        "--samples=4",
     )
     intensity = ch.luminance(image)
 

@@ -64,8 +64,10 @@ def test_compensation_scales_the_frame_by_one_factor(relativity_addon, tmp_path)
     ratio = compensated[..., :3][lit] / fixed[..., :3][lit]
     expected = _expected_exposure(bpy, scene, camera, beta)
     noted = _note_exposure(tmp_path / "compensated.exr")
-    print(f"exposure: expected {expected:.6g}, in the metadata {noted:.6g}, rendered ratio {np.median(ratio):.6g} "
-          f"(spread {ratio.min():.6g}..{ratio.max():.6g})")
+    print(
+        f"exposure: expected {expected:.6g}, in the metadata {noted:.6g}, rendered ratio {np.median(ratio):.6g} "
+        f"(spread {ratio.min():.6g}..{ratio.max():.6g})"
+    )
     assert np.allclose(ratio, noted, rtol=1e-4), "one factor for every pixel"
     assert noted == pytest.approx(expected, rel=5e-3)
     assert np.all(compensated[..., :3][~lit] == 0.0)

@@ -21,7 +21,6 @@ focus blur; its chief rays are the ones the spheres were placed for):
   except the central sphere (near the optical axis) and the one near the direction of beta.
 """
 
-
 import numpy as np
 
 import camera_helpers as ch
@@ -79,8 +78,11 @@ def _build_array(bpy, tmp_path, model, shutter_time):
 
 
 def _render(bpy, blend, out, *options):
-    return ch.luminance(ch.render_image(bpy, blend, out, BETA_OPTION, "--speed-of-light=1",
-                                        "--no-searchlight", "--no-doppler", "--seed=1", *options))
+    return ch.luminance(
+        ch.render_image(
+            bpy, blend, out, BETA_OPTION, "--speed-of-light=1", "--no-searchlight", "--no-doppler", "--seed=1", *options
+        )
+    )
 
 
 def _spots(image, pixels):
@@ -115,17 +117,21 @@ def test_detector_plane_shutter_keeps_the_sphere_array_sharp(factory_blender, tm
     bpy = factory_blender
     blend, pixels, camera = _build_array(bpy, tmp_path, ShutterModel.DETECTOR_PLANE, DETECTOR_SHUTTER_TIME)
     pinhole = _render(bpy, blend, tmp_path / "pinhole.exr", "--shutter=pinhole")
-    detector = _render(bpy, blend, tmp_path / "detector.exr", "--shutter=detector_plane",
-                       f"--shutter-time={DETECTOR_SHUTTER_TIME!r}")
+    detector = _render(
+        bpy, blend, tmp_path / "detector.exr", "--shutter=detector_plane", f"--shutter-time={DETECTOR_SHUTTER_TIME!r}"
+    )
     pin_centres, pin_radii = _spots(pinhole, pixels)
     det_centres, det_radii = _spots(detector, pixels)
-    pinhole_error = _check_pinhole_photo(camera, sphere_centres(ShutterModel.DETECTOR_PLANE,
-                                                                DETECTOR_SHUTTER_TIME)[1], pin_centres)
+    pinhole_error = _check_pinhole_photo(
+        camera, sphere_centres(ShutterModel.DETECTOR_PLANE, DETECTOR_SHUTTER_TIME)[1], pin_centres
+    )
     ratio = det_radii / pin_radii
     grid_error = np.linalg.norm(det_centres - pixels, axis=1)
-    print(f"detector plane: RMS radius pinhole {pin_radii.mean():.2f} px, detector {det_radii.mean():.2f} px, "
-          f"ratio median {np.median(ratio):.3f} max {ratio.max():.3f}; spot to grid pixel max "
-          f"{grid_error.max():.2f} px; pinhole to aberration formula max {pinhole_error:.2f} px")
+    print(
+        f"detector plane: RMS radius pinhole {pin_radii.mean():.2f} px, detector {det_radii.mean():.2f} px, "
+        f"ratio median {np.median(ratio):.3f} max {ratio.max():.3f}; spot to grid pixel max "
+        f"{grid_error.max():.2f} px; pinhole to aberration formula max {pinhole_error:.2f} px"
+    )
     # Stigmatic image: every sphere is imaged at the pixel conjugate to its grid point P (the
     # square array), and its spot is as small as in the pinhole photo. Tolerance 10%: the
     # sphere's surface lies up to about D * radius (D ~ 20 ahead) off the camera-frame focus
@@ -150,9 +156,11 @@ def test_aperture_plane_shutter_blurs_the_sphere_array(factory_blender, tmp_path
     assert beta_index == 4 * 9 + 8
     mirror_index = 4 * 9
     others = [i for i in range(81) if i not in (centre_index, beta_index)]
-    print(f"aperture plane: RMS radius / pinhole: centre {ratio[centre_index]:.2f}, along beta "
-          f"{ratio[beta_index]:.2f} (mirror {ratio[mirror_index]:.2f}), others min {ratio[others].min():.2f} "
-          f"median {np.median(ratio[others]):.2f}")
+    print(
+        f"aperture plane: RMS radius / pinhole: centre {ratio[centre_index]:.2f}, along beta "
+        f"{ratio[beta_index]:.2f} (mirror {ratio[mirror_index]:.2f}), others min {ratio[others].min():.2f} "
+        f"median {np.median(ratio[others]):.2f}"
+    )
     print(np.array2string(ratio.reshape(9, 9), precision=2))
     # Relativistic coma: blurred spots (the windows cut the longest streaks, so these ratios
     # are lower bounds), except on the optical axis and, relatively, along beta (Gray sec. 3A).
@@ -172,19 +180,36 @@ def test_phase_hologram_blurs_the_sphere_array(factory_blender, tmp_path):
     bpy = factory_blender
     points, centres = sphere_centres(ShutterModel.DETECTOR_PLANE, DETECTOR_SHUTTER_TIME)
     detector = -points * (IMAGE_DISTANCE / FOCUS_DISTANCE)
-    chief = {ideal: lens_time(ShutterModel.DETECTOR_PLANE, np.zeros_like(points), points, c=1.0,
-                              shutter_time=DETECTOR_SHUTTER_TIME, detector_point=detector, ideal_lens=ideal)
-             for ideal in (True, False)}
+    chief = {
+        ideal: lens_time(
+            ShutterModel.DETECTOR_PLANE,
+            np.zeros_like(points),
+            points,
+            c=1.0,
+            shutter_time=DETECTOR_SHUTTER_TIME,
+            detector_point=detector,
+            ideal_lens=ideal,
+        )
+        for ideal in (True, False)
+    }
     np.testing.assert_allclose(chief[False], chief[True], atol=1e-12)
     blend, pixels, camera = _build_array(bpy, tmp_path, ShutterModel.DETECTOR_PLANE, DETECTOR_SHUTTER_TIME)
     pinhole = _render(bpy, blend, tmp_path / "pinhole.exr", "--shutter=pinhole")
-    hologram = _render(bpy, blend, tmp_path / "hologram.exr", "--shutter=detector_plane", "--lens=phase-hologram",
-                       f"--shutter-time={DETECTOR_SHUTTER_TIME!r}")
+    hologram = _render(
+        bpy,
+        blend,
+        tmp_path / "hologram.exr",
+        "--shutter=detector_plane",
+        "--lens=phase-hologram",
+        f"--shutter-time={DETECTOR_SHUTTER_TIME!r}",
+    )
     _, pin_radii = _spots(pinhole, pixels)
     _, holo_radii = _spots(hologram, pixels)
     ratio = holo_radii / pin_radii
-    print(f"phase hologram: RMS radius / pinhole: median {np.median(ratio):.2f}, min {ratio.min():.2f}, "
-          f"centre {ratio[4 * 9 + 4]:.2f}, max {ratio.max():.2f}")
+    print(
+        f"phase hologram: RMS radius / pinhole: median {np.median(ratio):.2f}, min {ratio.min():.2f}, "
+        f"centre {ratio[4 * 9 + 4]:.2f}, max {ratio.max():.2f}"
+    )
     print(np.array2string(ratio.reshape(9, 9), precision=2))
     # The ideal lens keeps every spot within 10 % of the pinhole's (test above); the hologram
     # blurs every one of them (the windows cut the largest blur, so these ratios are lower bounds).

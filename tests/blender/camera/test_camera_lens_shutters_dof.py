@@ -71,8 +71,10 @@ def test_detector_plane_without_depth_of_field_is_the_pinhole_photo_from_the_det
     origin = ch.gamma_of(beta) * beta * -FOCAL_LENGTH
     expected = ch.aberrated_outline_centroid(camera.project_direction, camera.location + origin, CENTER, RADIUS, beta)
     expected_pinhole = ch.expected_sphere_centroid(camera, CENTER, RADIUS, beta)
-    print(f"0.5c, depth of field off: pinhole total {pinhole_total:.2f} centroid {pinhole_centre}, detector plane "
-          f"total {detector_total:.2f} centroid {detector_centre}; expected {expected} (pinhole {expected_pinhole})")
+    print(
+        f"0.5c, depth of field off: pinhole total {pinhole_total:.2f} centroid {pinhole_centre}, detector plane "
+        f"total {detector_total:.2f} centroid {detector_centre}; expected {expected} (pinhole {expected_pinhole})"
+    )
     assert detector_total > 0.9 * pinhole_total > 0.0
     assert np.linalg.norm(detector_centre - expected) < 0.3
     assert np.linalg.norm(detector_centre - pinhole_centre) < 0.2
@@ -83,6 +85,7 @@ def test_detector_plane_preset_without_depth_of_field_is_not_blank(addon, factor
     bpy = factory_blender
     scene, _ = _scene(bpy, use_dof=False)
     import runpy
+
     preset = ch.REPO_ROOT / "presets" / "relativity" / "shutter" / "Detector_plane_ideal_lens.py"
     bpy.context.scene.relativity.beta = (0.0, 0.0, -0.9)
     runpy.run_path(str(preset), init_globals={"bpy": bpy})
@@ -104,8 +107,10 @@ def test_detector_plane_focus_inside_the_focal_length_is_refused(addon, factory_
     scene, _ = _scene(bpy, use_dof=True, focus=0.03)
     scene.relativity.beta = (0.0, 0.0, -0.5)
     scene.relativity.shutter_model = "DETECTOR_PLANE"
-    message = ("Camera 'Camera': focus distance 0.03 m is inside the focal length 0.05 m: no image forms "
-               "(Detector Plane shutter)")
+    message = (
+        "Camera 'Camera': focus distance 0.03 m is inside the focal length 0.05 m: no image forms "
+        "(Detector Plane shutter)"
+    )
     with pytest.raises(RelativityError) as error:
         snapshot.read(scene)
     assert str(error.value) == message
@@ -147,8 +152,10 @@ def test_focus_surface_shutter_past_the_scene_is_black_and_says_why(addon, facto
     on_time = ch.render_exr(bpy, scene, tmp_path / "on_time.exr")
     late_total, on_time_total = _measure(late)[1], _measure(on_time)[1]
     gamma_beta = 0.9 / math.sqrt(1.0 - 0.81)
-    print(f"focus surface 0.9c, focus 5: t_S = 0 total {late_total:.3f} (lens event {gamma_beta * 5:.2f} on, "
-          f"past the sphere at 5), t_S = -5/c total {on_time_total:.2f}; warnings {warnings}")
+    print(
+        f"focus surface 0.9c, focus 5: t_S = 0 total {late_total:.3f} (lens event {gamma_beta * 5:.2f} on, "
+        f"past the sphere at 5), t_S = -5/c total {on_time_total:.2f}; warnings {warnings}"
+    )
     assert late_total == 0.0
     assert on_time_total > 5.0
     assert len(warnings) == 1 and "10.3 m further on" in warnings[0]

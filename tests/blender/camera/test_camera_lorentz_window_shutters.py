@@ -30,8 +30,7 @@ FOCUS = 5.0
 FOCAL_LENGTH = LENS_MM * 1e-3
 IMAGE_DISTANCE = 1.0 / (1.0 / FOCAL_LENGTH - 1.0 / FOCUS)
 # Markers: rest pixel (x, y) and depth; spread over the frame and 3-6 units away.
-MARKERS = [(28, 24, 3.5), (80, 28, 5.0), (132, 24, 4.0), (28, 96, 4.5), (132, 96, 3.0), (56, 62, 6.0),
-           (106, 62, 3.5)]
+MARKERS = [(28, 24, 3.5), (80, 28, 5.0), (132, 24, 4.0), (28, 96, 4.5), (132, 96, 3.0), (56, 62, 6.0), (106, 62, 3.5)]
 RADIUS = 0.04
 HALF_WINDOW = 7
 WINDOW_POINT, WINDOW_NORMAL = fixed_point_plane(WINDOW_TIME, BETA, 1.0)
@@ -46,8 +45,14 @@ def _window_ray_origin(camera, pixel):
     d = camera.pixel_direction(*pixel)
     object_point = d * (FOCUS / -d[2])
     detector = -object_point * (IMAGE_DISTANCE / FOCUS)
-    t_lens = lens_time(ShutterModel.DETECTOR_PLANE, np.zeros(3), object_point, c=1.0,
-                       shutter_time=DETECTOR_SHUTTER_TIME, detector_point=detector)
+    t_lens = lens_time(
+        ShutterModel.DETECTOR_PLANE,
+        np.zeros(3),
+        object_point,
+        c=1.0,
+        shutter_time=DETECTOR_SHUTTER_TIME,
+        detector_point=detector,
+    )
     _, origin, forward = lorentz_window_ray(np.zeros(3), object_point, t_lens, BETA, 1.0, WINDOW_POINT, WINDOW_NORMAL)
     return origin, -forward
 
@@ -108,13 +113,30 @@ def test_window_with_detector_plane_shutter_leaves_a_residual_distortion(factory
     common = ("--speed-of-light=1", "--no-searchlight", "--no-doppler", "--seed=2")
     moving = ("--beta=0.1,0,-0.99", f"--window-time={WINDOW_TIME!r}")
     rest = ch.luminance(ch.render_image(bpy, blend, tmp_path / "rest.exr", "--beta=0,0,0", *common))
-    plane = ch.luminance(ch.render_image(bpy, blend, tmp_path / "plane.exr", *moving, *common,
-                                         "--shutter=arbitrary_plane", f"--shutter-time={WINDOW_TIME!r}",
-                                         _vector_option("--shutter-plane-point", WINDOW_POINT),
-                                         _vector_option("--shutter-plane-normal", WINDOW_NORMAL)))
-    detector = ch.luminance(ch.render_image(bpy, blend, tmp_path / "detector.exr", *moving, *common,
-                                            "--shutter=detector_plane",
-                                            f"--shutter-time={DETECTOR_SHUTTER_TIME!r}"))
+    plane = ch.luminance(
+        ch.render_image(
+            bpy,
+            blend,
+            tmp_path / "plane.exr",
+            *moving,
+            *common,
+            "--shutter=arbitrary_plane",
+            f"--shutter-time={WINDOW_TIME!r}",
+            _vector_option("--shutter-plane-point", WINDOW_POINT),
+            _vector_option("--shutter-plane-normal", WINDOW_NORMAL),
+        )
+    )
+    detector = ch.luminance(
+        ch.render_image(
+            bpy,
+            blend,
+            tmp_path / "detector.exr",
+            *moving,
+            *common,
+            "--shutter=detector_plane",
+            f"--shutter-time={DETECTOR_SHUTTER_TIME!r}",
+        )
+    )
     rest_pixels = np.array([camera.project_direction(m) for m in markers])
     expected = np.array([expected_pixel(camera, m) for m in markers])
     at_rest = _centroids(rest, rest_pixels)
@@ -124,10 +146,12 @@ def test_window_with_detector_plane_shutter_leaves_a_residual_distortion(factory
     residual = measured - at_rest
     predicted = expected - rest_pixels
     error = np.linalg.norm(residual - predicted, axis=1)
-    print(f"window, eq. 6 plane shutter: marker shift max {plane_shift.max():.4f} px, mean |image - rest| "
-          f"{np.abs(plane - rest).mean():.2e}; detector-plane shutter: residual shifts "
-          f"{np.array2string(np.linalg.norm(residual, axis=1), precision=2)} px, predicted "
-          f"{np.array2string(np.linalg.norm(predicted, axis=1), precision=2)} px, max error {error.max():.3f} px")
+    print(
+        f"window, eq. 6 plane shutter: marker shift max {plane_shift.max():.4f} px, mean |image - rest| "
+        f"{np.abs(plane - rest).mean():.2e}; detector-plane shutter: residual shifts "
+        f"{np.array2string(np.linalg.norm(residual, axis=1), precision=2)} px, predicted "
+        f"{np.array2string(np.linalg.norm(predicted, axis=1), precision=2)} px, max error {error.max():.3f} px"
+    )
     # Shutter in the window plane at t_W: the photo at rest (Fig. 9), to the pixel noise.
     assert plane_shift.max() < 0.02
     assert np.abs(plane - rest).mean() < 1e-4

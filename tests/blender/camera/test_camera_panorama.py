@@ -27,8 +27,12 @@ def equirectangular_pixel(direction_local, size, longitude=(-math.pi, math.pi), 
     lon = math.atan2(x, -z)
     lat = math.asin(max(-1.0, min(1.0, y)))
     width, height = size
-    return np.array([(lon - longitude[0]) / (longitude[1] - longitude[0]) * width,
-                     (latitude[1] - lat) / (latitude[1] - latitude[0]) * height])
+    return np.array(
+        [
+            (lon - longitude[0]) / (longitude[1] - longitude[0]) * width,
+            (latitude[1] - lat) / (latitude[1] - latitude[0]) * height,
+        ]
+    )
 
 
 def equirectangular_direction(px, py, size):
@@ -60,13 +64,15 @@ def equidistant_direction(px, py, size, fov):
 
 def expected_centroid(project, camera_rotation, center, radius, camera_location, beta, samples=360):
     """Area centroid (pixels) of a sphere's image: its cone of rays, aberrated, projected."""
-    return ch.aberrated_outline_centroid(lambda view: project(camera_rotation.T @ view), camera_location,
-                                         center, radius, beta, samples)
+    return ch.aberrated_outline_centroid(
+        lambda view: project(camera_rotation.T @ view), camera_location, center, radius, beta, samples
+    )
 
 
 def _panorama_scene(bpy, panorama_type, resolution, samples=2, fov=math.pi):
-    scene, camera_object = ch.new_scene(bpy, resolution=resolution, samples=samples,
-                                        rotation_euler=CAMERA_ROTATION, location=CAMERA_LOCATION)
+    scene, camera_object = ch.new_scene(
+        bpy, resolution=resolution, samples=samples, rotation_euler=CAMERA_ROTATION, location=CAMERA_LOCATION
+    )
     data = camera_object.data
     data.type = "PANO"
     data.panorama_type = panorama_type
@@ -127,10 +133,15 @@ def _render_in_process(bpy, scene, path, seed):
 # --- tests -----------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("panorama_type,resolution", [
-    ("EQUIRECTANGULAR", (128, 64)), ("FISHEYE_EQUIDISTANT", (96, 72)),
-    ("FISHEYE_EQUISOLID", (96, 72)), ("MIRRORBALL", (96, 72)),
-])
+@pytest.mark.parametrize(
+    "panorama_type,resolution",
+    [
+        ("EQUIRECTANGULAR", (128, 64)),
+        ("FISHEYE_EQUIDISTANT", (96, 72)),
+        ("FISHEYE_EQUISOLID", (96, 72)),
+        ("MIRRORBALL", (96, 72)),
+    ],
+)
 def test_rest_equals_blender_panorama(addon, factory_blender, tmp_path, panorama_type, resolution):
     """At beta = 0 the exact camera is Blender's own panoramic camera (non-square frames check the
     fisheye's aspect and sensor fit). Rendered in the test process (the batch script's path is
@@ -141,8 +152,16 @@ def test_rest_equals_blender_panorama(addon, factory_blender, tmp_path, panorama
     rng = np.random.default_rng(7)
     for index in range(30):
         direction = ch.normalized(rng.normal(size=3))
-        ch.add_sphere(bpy, scene, np.array(CAMERA_LOCATION) + DISTANCE * direction, 0.9, material,
-                      name=f"S{index}", segments=16, rings=8)
+        ch.add_sphere(
+            bpy,
+            scene,
+            np.array(CAMERA_LOCATION) + DISTANCE * direction,
+            0.9,
+            material,
+            name=f"S{index}",
+            segments=16,
+            rings=8,
+        )
     reference = _render_in_process(bpy, scene, tmp_path / "ref0.exr", seed=0)
     other_seed = _render_in_process(bpy, scene, tmp_path / "ref1.exr", seed=1)
     addon.apply(scene)  # beta = 0, pinhole shutter (the settings' defaults)
@@ -169,8 +188,9 @@ def test_equirectangular_markers_over_the_sphere_follow_aberration(factory_blend
     markers = _markers(bpy, scene, rotation, beta, apparent, pixel_angle=2.0 * math.pi / size[0])
     blend = ch.save_blend(bpy, tmp_path / "equirect.blend")
     beta_option = ",".join(f"{b:.17g}" for b in beta)
-    image = ch.render_image(bpy, blend, tmp_path / "equirect.exr", f"--beta={beta_option}",
-                            "--shutter=pinhole", "--no-searchlight")
+    image = ch.render_image(
+        bpy, blend, tmp_path / "equirect.exr", f"--beta={beta_option}", "--shutter=pinhole", "--no-searchlight"
+    )
     errors = _measure(ch.luminance(image), markers, lambda d: equirectangular_pixel(d, size), rotation, beta, 14)
     print(f"equirectangular 0.9c: max error {errors.max():.3f} px, mean {errors.mean():.3f} px")
     assert errors.max() < 1.0, f"position errors (px): {np.round(errors, 3)}"
@@ -182,14 +202,18 @@ def test_fisheye_markers_follow_aberration(factory_blender, tmp_path):
     size, fov = (240, 240), math.radians(240.0)
     scene, _camera, rotation = _panorama_scene(bpy, "FISHEYE_EQUIDISTANT", size, samples=2, fov=fov)
     beta = 0.9 * ch.normalized(BETA_DIRECTION)
-    pixels = [(120.0, 120.0)] + [(120.0 + r * math.cos(a), 120.0 - r * math.sin(a))
-                                  for r in (45.0, 95.0) for a in np.linspace(0.3, 0.3 + 2 * math.pi, 5, endpoint=False)]
+    pixels = [(120.0, 120.0)] + [
+        (120.0 + r * math.cos(a), 120.0 - r * math.sin(a))
+        for r in (45.0, 95.0)
+        for a in np.linspace(0.3, 0.3 + 2 * math.pi, 5, endpoint=False)
+    ]
     apparent = [equidistant_direction(px, py, size, fov) for px, py in pixels]
     markers = _markers(bpy, scene, rotation, beta, apparent, pixel_angle=fov / size[0])
     blend = ch.save_blend(bpy, tmp_path / "fisheye.blend")
     beta_option = ",".join(f"{b:.17g}" for b in beta)
-    image = ch.render_image(bpy, blend, tmp_path / "fisheye.exr", f"--beta={beta_option}",
-                            "--shutter=pinhole", "--no-searchlight")
+    image = ch.render_image(
+        bpy, blend, tmp_path / "fisheye.exr", f"--beta={beta_option}", "--shutter=pinhole", "--no-searchlight"
+    )
     errors = _measure(ch.luminance(image), markers, lambda d: equidistant_pixel(d, size, fov), rotation, beta, 12)
     print(f"fisheye equidistant 0.9c: max error {errors.max():.3f} px, mean {errors.mean():.3f} px")
     assert errors.max() < 1.0, f"position errors (px): {np.round(errors, 3)}"
@@ -208,16 +232,23 @@ def test_panorama_searchlight_ratio_is_doppler_fourth_power(factory_blender, tmp
     dopplers = [ch.doppler_factor(-ch.scene_direction_for_apparent(rotation @ a, beta), beta) for a in apparent]
     blend = ch.save_blend(bpy, tmp_path / "emitters.blend")
     beta_option = ",".join(f"{b:.17g}" for b in beta)
-    image = ch.render_image(bpy, blend, tmp_path / "emitters.exr", f"--beta={beta_option}", "--shutter=pinhole",
-                            "--no-doppler", "--samples=4")
+    image = ch.render_image(
+        bpy,
+        blend,
+        tmp_path / "emitters.exr",
+        f"--beta={beta_option}",
+        "--shutter=pinhole",
+        "--no-doppler",
+        "--samples=4",
+    )
     intensity = ch.luminance(image)
-    ys, xs = np.mgrid[0:intensity.shape[0], 0:intensity.shape[1]]
+    ys, xs = np.mgrid[0 : intensity.shape[0], 0 : intensity.shape[1]]
     radiances = [intensity[np.hypot(xs + 0.5 - px, ys + 0.5 - py) < 4.0].mean() for px, py in pixels]
     measured = radiances[0] / radiances[1]
     expected = (dopplers[0] / dopplers[1]) ** 4
     print(f"D = {dopplers[0]:.4f}, {dopplers[1]:.4f}; ratio measured {measured:.4f}, expected {expected:.4f}")
     for radiance, doppler in zip(radiances, dopplers, strict=True):
-        assert radiance == pytest.approx(doppler ** 4, rel=0.02)
+        assert radiance == pytest.approx(doppler**4, rel=0.02)
     assert measured == pytest.approx(expected, rel=0.02)
     assert abs(math.log(expected)) > 0.5, "test emitters must differ clearly in D"
 
@@ -228,9 +259,18 @@ def test_panorama_camera_restored_and_lens_models_refused(addon, factory_blender
     scene, camera_object, _rotation = _panorama_scene(bpy, "FISHEYE_EQUISOLID", (64, 48), fov=math.radians(190.0))
     data = camera_object.data
     data.latitude_min, data.longitude_max = -0.7, 2.5
-    settings = {name: getattr(data, name) for name in (
-        "panorama_type", "fisheye_fov", "fisheye_lens", "latitude_min", "latitude_max", "longitude_min",
-        "longitude_max")}
+    settings = {
+        name: getattr(data, name)
+        for name in (
+            "panorama_type",
+            "fisheye_fov",
+            "fisheye_lens",
+            "latitude_min",
+            "latitude_max",
+            "longitude_min",
+            "longitude_max",
+        )
+    }
     scene.relativity.beta = (0.0, 0.6, 0.0)
     addon.apply(scene)
     custom = data.cycles_custom

@@ -27,12 +27,14 @@ def test_sphere_outline_stays_circular_at_0_9c(factory_blender, tmp_path):
     doppler = ch.doppler_factor(-view_scene, beta)
     distance = 6.0
     radius = distance * math.sin(25.0 / focal_px * doppler)
-    ch.add_sphere(bpy, scene, camera.location + distance * view_scene, radius, ch.emission_material(bpy),
-                  segments=128, rings=64)
+    ch.add_sphere(
+        bpy, scene, camera.location + distance * view_scene, radius, ch.emission_material(bpy), segments=128, rings=64
+    )
     blend = ch.save_blend(bpy, tmp_path / "sphere.blend")
 
-    image = ch.render_image(bpy, blend, tmp_path / "sphere.exr", "--beta=0.9,0,0", "--shutter=pinhole",
-                            "--no-searchlight")
+    image = ch.render_image(
+        bpy, blend, tmp_path / "sphere.exr", "--beta=0.9,0,0", "--shutter=pinhole", "--no-searchlight"
+    )
     coverage = np.clip(ch.luminance(image), 0.0, 1.0)
     assert coverage.max() > 0.99, "sphere not fully resolved"
     ratio, axis = ch.tangent_plane_axis_ratio(camera, coverage)

@@ -11,8 +11,11 @@ import camera_helpers as ch
 def _lit_scene(bpy, use_dof):
     """A small lit room-corner: diffuse floor and wall, a cube, an emitter, a point light."""
     scene, camera = ch.new_scene(
-        bpy, resolution=(160, 120), samples=8,
-        rotation_euler=(math.radians(75.0), 0.0, math.radians(20.0)), location=(1.5, -6.0, 2.0),
+        bpy,
+        resolution=(160, 120),
+        samples=8,
+        rotation_euler=(math.radians(75.0), 0.0, math.radians(20.0)),
+        location=(1.5, -6.0, 2.0),
     )
     camera.data.lens = 35.0
     camera.data.shift_x = 0.07
@@ -78,21 +81,24 @@ def test_searchlight_ratio_is_doppler_fourth_power(factory_blender, tmp_path):
         emitters.append((np.array(pixel), doppler))
     blend = ch.save_blend(bpy, tmp_path / "emitters.blend")
     beta_option = ",".join(f"{b:.17g}" for b in beta)
-    image = ch.render_image(bpy, blend, tmp_path / "emitters.exr", f"--beta={beta_option}", "--shutter=pinhole",
-                             "--no-doppler")  # integrated radiance: D^4 holds with colours unshifted
+    image = ch.render_image(
+        bpy, blend, tmp_path / "emitters.exr", f"--beta={beta_option}", "--shutter=pinhole", "--no-doppler"
+    )  # integrated radiance: D^4 holds with colours unshifted
     intensity = ch.luminance(image)
 
-    ys, xs = np.mgrid[0:intensity.shape[0], 0:intensity.shape[1]]
+    ys, xs = np.mgrid[0 : intensity.shape[0], 0 : intensity.shape[1]]
     radiances = []
     for pixel, _doppler in emitters:
         inside = np.hypot(xs + 0.5 - pixel[0], ys + 0.5 - pixel[1]) < 4.0
         radiances.append(intensity[inside].mean())
     measured = radiances[0] / radiances[1]
     expected = (emitters[0][1] / emitters[1][1]) ** 4
-    print(f"D = {emitters[0][1]:.4f}, {emitters[1][1]:.4f}; radiances {radiances}; "
-          f"ratio measured {measured:.4f}, expected D^4 ratio {expected:.4f}")
+    print(
+        f"D = {emitters[0][1]:.4f}, {emitters[1][1]:.4f}; radiances {radiances}; "
+        f"ratio measured {measured:.4f}, expected D^4 ratio {expected:.4f}"
+    )
     # Each emitter alone: radiance = D^4 times the emitted radiance (1).
     for radiance, (_, doppler) in zip(radiances, emitters, strict=True):
-        assert radiance == pytest.approx(doppler ** 4, rel=0.02)
+        assert radiance == pytest.approx(doppler**4, rel=0.02)
     assert measured == pytest.approx(expected, rel=0.02)
     assert abs(math.log(expected)) > 0.5, "test emitters must differ clearly in D"

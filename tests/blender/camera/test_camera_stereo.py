@@ -66,8 +66,16 @@ def test_vertical_disparity_follows_aberration_per_eye(factory_blender, tmp_path
         markers.append((center, radius))
     blend = ch.save_blend(bpy, tmp_path / "stereo.blend")
     beta = ",".join(f"{b:.17g}" for b in GRAY_BETA)
-    ch.run_render_script(blend, tmp_path / "pair.png", f"--beta={beta}", "--shutter=pinhole", "--shutter-time=-1",
-                         "--speed-of-light=1", "--no-searchlight", "--stereo=views")
+    ch.run_render_script(
+        blend,
+        tmp_path / "pair.png",
+        f"--beta={beta}",
+        "--shutter=pinhole",
+        "--shutter-time=-1",
+        "--speed-of-light=1",
+        "--no-searchlight",
+        "--stereo=views",
+    )
 
     measured, expected, naive = {}, {}, {}
     for eye, offset in eyes.items():
@@ -87,9 +95,11 @@ def test_vertical_disparity_follows_aberration_per_eye(factory_blender, tmp_path
     disparity = np.array([m_l[1] - m_r[1] for m_l, m_r in zip(measured["L"], measured["R"], strict=True)])
     disparity_expected = np.array([e_l[1] - e_r[1] for e_l, e_r in zip(expected["L"], expected["R"], strict=True)])
     disparity_naive = np.array([e_l[1] - e_r[1] for e_l, e_r in zip(naive["L"], naive["R"], strict=True)])
-    print(f"per-eye position error max {max(errors):.3f} px; vertical disparity measured "
-          f"{np.round(disparity, 2)} expected {np.round(disparity_expected, 2)} "
-          f"(own-origin eyes would give {np.round(disparity_naive, 2)})")
+    print(
+        f"per-eye position error max {max(errors):.3f} px; vertical disparity measured "
+        f"{np.round(disparity, 2)} expected {np.round(disparity_expected, 2)} "
+        f"(own-origin eyes would give {np.round(disparity_naive, 2)})"
+    )
     assert max(errors) < 0.5
     assert np.abs(disparity - disparity_expected).max() < 0.5
     assert np.abs(disparity_expected).max() > 2.0, "the setup must show vertical parallax"
@@ -126,10 +136,20 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
     # pair too. An eye with its own plane (through its own pinhole) would not be.
     rotation = np.array(camera_object.matrix_world.to_3x3())
     point, normal = fixed_point_plane(-1.0, rotation.T @ GRAY_BETA, 1.0)
-    plane = (f"--shutter-plane-point={','.join(repr(float(v)) for v in point)}",
-             f"--shutter-plane-normal={','.join(repr(float(v)) for v in normal)}")
-    ch.run_render_script(blend, tmp_path / "shutter.png", *common, f"--beta={beta}", "--window-time=-1",
-                         "--shutter=arbitrary_plane", *plane, "--stereo=views")
+    plane = (
+        f"--shutter-plane-point={','.join(repr(float(v)) for v in point)}",
+        f"--shutter-plane-normal={','.join(repr(float(v)) for v in normal)}",
+    )
+    ch.run_render_script(
+        blend,
+        tmp_path / "shutter.png",
+        *common,
+        f"--beta={beta}",
+        "--window-time=-1",
+        "--shutter=arbitrary_plane",
+        *plane,
+        "--stereo=views",
+    )
     shutter_pair = [_read_png(bpy, tmp_path / f"shutter_{eye}.png") for eye in "LR"]
     (rest_l, rest_r), (window_l, window_r) = pairs
     # Side by side (not squeezed): the left view, then the right one, in one image twice as wide.
@@ -142,8 +162,10 @@ def test_lorentz_window_pair_equals_rest_pair(factory_blender, tmp_path):
     anaglyph_difference = np.abs(anaglyphs[1] - anaglyphs[0]).mean()
     parallax = np.abs(rest_l - rest_r).mean()
     shutter_differences = [np.abs(shutter_pair[0] - rest_l).mean(), np.abs(shutter_pair[1] - rest_r).mean()]
-    print(f"|window - rest| per eye {differences}, anaglyph {anaglyph_difference:.2g}; |L - R| at rest {parallax:.3f}; "
-          f"window with the plane shutter: |pair - rest| per eye {shutter_differences}")
+    print(
+        f"|window - rest| per eye {differences}, anaglyph {anaglyph_difference:.2g}; |L - R| at rest {parallax:.3f}; "
+        f"window with the plane shutter: |pair - rest| per eye {shutter_differences}"
+    )
     assert max(shutter_differences) < 1e-3
     assert rest_l.mean() > 0.005 and rest_r.mean() > 0.005
     assert parallax > 0.01, "the eyes must see different images"
@@ -163,8 +185,9 @@ def test_stereo_settings_reach_the_camera_and_toe_in_is_refused(factory_blender)
     bpy = factory_blender
     relativity_addon.register()
     try:
-        scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1, rotation_euler=ROTATION,
-                                            location=(1.0, -2.0, 0.5))
+        scene, camera_object = ch.new_scene(
+            bpy, resolution=(64, 48), samples=1, rotation_euler=ROTATION, location=(1.0, -2.0, 0.5)
+        )
         scene.relativity.beta = tuple(0.5 * GRAY_BETA)
         effect.apply(scene)
         custom = camera_object.data.cycles_custom

@@ -68,8 +68,9 @@ def expected_image(camera, event, centre, radius, beta, samples=720):
 @pytest.mark.parametrize("speed,direction,shutter_time,c", CASES)
 def test_markers_follow_light_delay_without_aberration(factory_blender, tmp_path, speed, direction, shutter_time, c):
     bpy = factory_blender
-    scene, camera_object = ch.new_scene(bpy, resolution=RESOLUTION, rotation_euler=CAMERA_ROTATION,
-                                        location=CAMERA_LOCATION)
+    scene, camera_object = ch.new_scene(
+        bpy, resolution=RESOLUTION, rotation_euler=CAMERA_ROTATION, location=CAMERA_LOCATION
+    )
     camera = ch.pinhole_model(bpy, scene, camera_object)
     beta = speed * ch.normalized(camera.local_to_world(direction))
     event = camera.location + beta * c * shutter_time  # Galilean: x = x' + v t'
@@ -90,8 +91,15 @@ def test_markers_follow_light_delay_without_aberration(factory_blender, tmp_path
 
     beta_option = ",".join(f"{b:.17g}" for b in beta)
     image = ch.render_image(
-        bpy, blend, tmp_path / "markers.exr", f"--beta={beta_option}", "--shutter=pinhole",
-        f"--shutter-time={shutter_time!r}", f"--speed-of-light={c!r}", "--time-of-flight", "--samples=4",
+        bpy,
+        blend,
+        tmp_path / "markers.exr",
+        f"--beta={beta_option}",
+        "--shutter=pinhole",
+        f"--shutter-time={shutter_time!r}",
+        f"--speed-of-light={c!r}",
+        "--time-of-flight",
+        "--samples=4",
     )
     intensity = ch.luminance(image)
 
@@ -108,8 +116,10 @@ def test_markers_follow_light_delay_without_aberration(factory_blender, tmp_path
         relativistic = camera.project_direction(ch.apparent_view_direction(centre, event, beta))
         if rest is not None and relativistic is not None:
             same_sense.append(float((measured - rest) @ (relativistic - rest)))
-    print(f"|beta|={speed}, t_S={shutter_time}: max error {max(errors):.3f} px, mean {np.mean(errors):.3f} px; "
-          f"centroid to the chosen pixel max {max(chosen):.3f} px; {len(same_sense)} shifts compared")
+    print(
+        f"|beta|={speed}, t_S={shutter_time}: max error {max(errors):.3f} px, mean {np.mean(errors):.3f} px; "
+        f"centroid to the chosen pixel max {max(chosen):.3f} px; {len(same_sense)} shifts compared"
+    )
     assert max(errors) < 0.5, f"position errors (px): {np.round(errors, 3)}"
     assert len(same_sense) >= 5 and min(same_sense) > 0.0, same_sense
 
@@ -134,9 +144,11 @@ def test_rest_colours_and_refusals(factory_blender):
         snap = snapshot.read(scene)
         assert snap.use_time_of_flight and not snap.use_searchlight and not snap.use_doppler
         assert snap.exposure == 1.0
-        for name, value, message in (("use_lorentz_window", True, "Lorentz window"),
-                                     ("shutter_model", "FIXED_POINT_SURFACE", "fixed points"),
-                                     ("method", "GEOMETRY", "exact camera")):
+        for name, value, message in (
+            ("use_lorentz_window", True, "Lorentz window"),
+            ("shutter_model", "FIXED_POINT_SURFACE", "fixed points"),
+            ("method", "GEOMETRY", "exact camera"),
+        ):
             default = getattr(settings, name)
             setattr(settings, name, value)
             with pytest.raises(RelativityError, match=message):

@@ -31,8 +31,17 @@ def emitter_scene(bpy, samples=16, resolution=RESOLUTION):
     return scene, camera
 
 
-def add_emitter_plane(bpy, scene, name, x_range, y_range, colour=(0.5, 0.5, 0.5), beta=(0.0, 0.0, 0.0),
-                      temperature=None, depth=PLANE_DEPTH):
+def add_emitter_plane(
+    bpy,
+    scene,
+    name,
+    x_range,
+    y_range,
+    colour=(0.5, 0.5, 0.5),
+    beta=(0.0, 0.0, 0.0),
+    temperature=None,
+    depth=PLANE_DEPTH,
+):
     """A flat emitter facing the camera (which looks down -Z from the origin).
 
     ``beta`` becomes the point attribute ``relativity_beta`` (velocity relative to the observer,
@@ -153,8 +162,11 @@ def linear_rec709_to_xyz(rgb):
     import colour
 
     return colour.RGB_to_XYZ(
-        np.asarray(rgb, float), colour.RGB_COLOURSPACES["ITU-R BT.709"], illuminant=None,
-        chromatic_adaptation_transform=None, apply_cctf_decoding=False,
+        np.asarray(rgb, float),
+        colour.RGB_COLOURSPACES["ITU-R BT.709"],
+        illuminant=None,
+        chromatic_adaptation_transform=None,
+        apply_cctf_decoding=False,
     )
 
 

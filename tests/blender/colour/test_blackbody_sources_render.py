@@ -70,8 +70,14 @@ def _glow_group(bpy):
 def _colour_group(material):
     """The colour group in front of the material's emission: in its own tree, else in its group's."""
     trees = [material.node_tree] + [n.node_tree for n in material.node_tree.nodes if n.bl_idname == "ShaderNodeGroup"]
-    return next(node for tree in trees for node in tree.nodes if node.bl_idname == "ShaderNodeGroup"
-                and node.node_tree is not None and node.node_tree.name == "Relativity Doppler Colour")
+    return next(
+        node
+        for tree in trees
+        for node in tree.nodes
+        if node.bl_idname == "ShaderNodeGroup"
+        and node.node_tree is not None
+        and node.node_tree.name == "Relativity Doppler Colour"
+    )
 
 
 @pytest.mark.parametrize("variants", [VARIANTS, GROUPED_VARIANTS], ids=["traced", "grouped"])

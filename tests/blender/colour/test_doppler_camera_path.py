@@ -22,8 +22,9 @@ def _wall_scene(bpy, tmp_path, colour=COLOUR, temperature=None, name="wall", **s
     """One big emitter wall at z = -5 (covers the aberrated view at every speed used here);
     ``settings`` go into ``scene.relativity`` (needs the add-on registered)."""
     scene, camera = dh.emitter_scene(bpy)
-    dh.add_emitter_plane(bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), colour, beta=None,
-                         temperature=temperature)
+    dh.add_emitter_plane(
+        bpy, scene, "Wall", (-400.0, 400.0), (-400.0, 400.0), colour, beta=None, temperature=temperature
+    )
     for key, value in settings.items():
         setattr(scene.relativity, key, value)
     blend = ch.save_blend(bpy, tmp_path / f"{name}.blend")
@@ -81,8 +82,7 @@ def test_searchlight_ratio_without_doppler_colour(relativity_addon, factory_blen
     """D^4 (Weiskopf et al.); with Chang et al.'s labelled comparison option, one power of D."""
     bpy = factory_blender
     name = "chang" if chang else "grey"
-    scene, camera, blend = _wall_scene(bpy, tmp_path, colour=(0.5, 0.5, 0.5), name=name,
-                                       use_chang_searchlight=chang)
+    scene, camera, blend = _wall_scene(bpy, tmp_path, colour=(0.5, 0.5, 0.5), name=name, use_chang_searchlight=chang)
     beta = (0.6, 0.0, 0.0)
     image = _render(bpy, blend, tmp_path / f"{name}.exr", beta, "--no-doppler")
     d = _camera_frame_doppler(bpy, scene, camera, beta)
@@ -90,8 +90,10 @@ def test_searchlight_ratio_without_doppler_colour(relativity_addon, factory_blen
     measured = image[bright][..., 1].mean() / image[dim][..., 1].mean()
     d4_ratio = (d[bright] ** 4).mean() / (d[dim] ** 4).mean()
     expected = d[bright].mean() / d[dim].mean() if chang else d4_ratio
-    print(f"D {d[bright].mean():.4f} vs {d[dim].mean():.4f}: ratio {measured:.4f}, expected {expected:.4f}, "
-          f"D^4 ratio {d4_ratio:.4f}")
+    print(
+        f"D {d[bright].mean():.4f} vs {d[dim].mean():.4f}: ratio {measured:.4f}, expected {expected:.4f}, "
+        f"D^4 ratio {d4_ratio:.4f}"
+    )
     assert d4_ratio > 1.5
     assert measured == pytest.approx(expected, rel=0.02)
     if chang:
@@ -135,8 +137,9 @@ def test_deep_shift_is_finite(factory_blender, tmp_path, beta_z, lit):
     bpy = factory_blender
     scene, camera = dh.emitter_scene(bpy, samples=2)
     for i, colour in enumerate(((1.0, 1.0, 1.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))):
-        wall = dh.add_emitter_plane(bpy, scene, f"Wall{i}", (-400.0 + 266.0 * i, -134.0 + 266.0 * i),
-                                    (-400.0, 400.0), colour, beta=None)
+        wall = dh.add_emitter_plane(
+            bpy, scene, f"Wall{i}", (-400.0 + 266.0 * i, -134.0 + 266.0 * i), (-400.0, 400.0), colour, beta=None
+        )
         if lit and i == 1:
             wall.data.materials[0] = ch.diffuse_material(bpy, "Diffuse", (0.8, 0.5, 0.2))
     if lit:
@@ -144,8 +147,7 @@ def test_deep_shift_is_finite(factory_blender, tmp_path, beta_z, lit):
         light.size, light.energy, light.use_temperature, light.temperature = 20.0, 2000.0, True, 1500.0
         scene.collection.objects.link(bpy.data.objects.new("Lamp", light))
         scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.2, 0.2, 0.2, 1.0)
-    dh.add_emitter_plane(bpy, scene, "Sun", (-0.2, 0.2), (-0.2, 0.2), beta=None, temperature=5762.0,
-                         depth=4.0)
+    dh.add_emitter_plane(bpy, scene, "Sun", (-0.2, 0.2), (-0.2, 0.2), beta=None, temperature=5762.0, depth=4.0)
     blend = ch.save_blend(bpy, tmp_path / "deep.blend")
     image = _render(bpy, blend, tmp_path / "deep.exr", (0.0, 0.0, beta_z))
     d = _camera_frame_doppler(bpy, scene, camera, (0.0, 0.0, beta_z))

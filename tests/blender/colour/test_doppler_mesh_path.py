@@ -32,7 +32,7 @@ def _apply(addon, scene):
 
 
 def _region(image, rows, cols):
-    return image[rows[0]:rows[1], cols[0]:cols[1]].reshape(-1, 3)
+    return image[rows[0] : rows[1], cols[0] : cols[1]].reshape(-1, 3)
 
 
 def test_identity_at_rest_and_hue_direction(relativity_addon, factory_blender, tmp_path):
@@ -97,8 +97,9 @@ def test_blackbody_seen_at_dt(relativity_addon, factory_blender, tmp_path, d_tar
     temperature = 5762.0
     beta = dh.beta_for_doppler(d_target)
     dh.add_emitter_plane(bpy, scene, "Sun", (-0.6, 0.6), (-0.6, 0.6), beta=beta, temperature=temperature)
-    dh.add_emitter_plane(bpy, scene, "SunAtRest", (1.0, 1.8), (-0.6, 0.6), beta=(0.0, 0.0, 0.0),
-                         temperature=temperature)
+    dh.add_emitter_plane(
+        bpy, scene, "SunAtRest", (1.0, 1.8), (-0.6, 0.6), beta=(0.0, 0.0, 0.0), temperature=temperature
+    )
     _apply(relativity_addon, scene)
     image = dh.render(bpy, scene, tmp_path / "sun.exr")
     d = dh.source_doppler_factor(dh.pixel_photon_directions(bpy, scene, camera), beta)
@@ -110,10 +111,13 @@ def test_blackbody_seen_at_dt(relativity_addon, factory_blender, tmp_path, d_tar
     # Luminance: Y(DT)/Y(T) relative to the identical emitter at rest.
     rest = image[22:26, 54:58].reshape(-1, 3).mean(axis=0)
     measured_ratio = dh.linear_rec709_to_xyz(rendered)[1] / dh.linear_rec709_to_xyz(rest)[1]
-    expected_ratio = dh.blackbody_xyz_colour_science(d_mean * temperature)[1] / dh.blackbody_xyz_colour_science(
-        temperature)[1]
-    print(f"D = {d_mean:.4f}: Delta E 2000 = {delta_e:.3f}; Y ratio {measured_ratio:.4f} vs {expected_ratio:.4f} "
-          f"(D^4 = {d_mean ** 4:.4f})")
+    expected_ratio = (
+        dh.blackbody_xyz_colour_science(d_mean * temperature)[1] / dh.blackbody_xyz_colour_science(temperature)[1]
+    )
+    print(
+        f"D = {d_mean:.4f}: Delta E 2000 = {delta_e:.3f}; Y ratio {measured_ratio:.4f} vs {expected_ratio:.4f} "
+        f"(D^4 = {d_mean**4:.4f})"
+    )
     assert delta_e < 1.0
     assert measured_ratio == pytest.approx(expected_ratio, rel=0.02)
 
@@ -130,8 +134,16 @@ def test_deep_shift_sweep_is_finite(relativity_addon, factory_blender, tmp_path)
             # Velocity along the line of sight to the quad's centre: D there is the target.
             toward_camera = -np.array([x0 + 0.185, y0 + 0.3, -dh.PLANE_DEPTH])
             toward_camera /= np.linalg.norm(toward_camera)
-            dh.add_emitter_plane(bpy, scene, f"E{i}{j}", (x0, x0 + 0.37), (y0, y0 + 0.6), colour or (1.0, 1.0, 1.0),
-                                 dh.beta_for_doppler(d, toward_camera), temperature=None if colour else 5762.0)
+            dh.add_emitter_plane(
+                bpy,
+                scene,
+                f"E{i}{j}",
+                (x0, x0 + 0.37),
+                (y0, y0 + 0.6),
+                colour or (1.0, 1.0, 1.0),
+                dh.beta_for_doppler(d, toward_camera),
+                temperature=None if colour else 5762.0,
+            )
     _apply(relativity_addon, scene)
     image = dh.render(bpy, scene, tmp_path / "sweep.exr")
     print("sweep: min", image.min(), "max", image.max())

@@ -23,8 +23,9 @@ WINDOW = (slice(22, 26), slice(30, 34))
 @pytest.mark.parametrize("beta_z", [-0.5, 0.5], ids=["approaching", "receding"])
 def test_doppler_only_spectrum_and_rest_brightness(relativity_addon, factory_blender, tmp_path, beta_z):
     bpy = factory_blender
-    scene, camera, blend = _wall_scene(bpy, tmp_path, temperature=TEMPERATURE, name="spectrum",
-                                       doppler_only_brightness="SPECTRUM")
+    scene, camera, blend = _wall_scene(
+        bpy, tmp_path, temperature=TEMPERATURE, name="spectrum", doppler_only_brightness="SPECTRUM"
+    )
     scene.relativity.doppler_only_brightness = "REST"
     rest_blend = ch.save_blend(bpy, tmp_path / "rest_brightness.blend")
     beta = (0.0, 0.0, beta_z)
@@ -41,10 +42,14 @@ def test_doppler_only_spectrum_and_rest_brightness(relativity_addon, factory_ble
     expected = y_dt / (d**5 * y_t)
     measured = y(spectrum) / y(at_rest)
     kept = y(rest_brightness) / y(at_rest)
-    delta_e = dh.delta_e_2000_normalised(dh.linear_rec709_to_xyz(spectrum[WINDOW].reshape(-1, 3).mean(0)),
-                                         dh.blackbody_xyz_colour_science(d * TEMPERATURE))
-    print(f"D = {d:.4f}: SPECTRUM Y ratio {measured:.4f} vs Y(DT)/(D^5 Y(T)) {expected:.4f} "
-          f"(D^-5 = {d**-5:.4f}, Y(DT)/Y(T) = {y_dt / y_t:.4f}); REST {kept:.4f}; Delta E 2000 {delta_e:.3f}")
+    delta_e = dh.delta_e_2000_normalised(
+        dh.linear_rec709_to_xyz(spectrum[WINDOW].reshape(-1, 3).mean(0)),
+        dh.blackbody_xyz_colour_science(d * TEMPERATURE),
+    )
+    print(
+        f"D = {d:.4f}: SPECTRUM Y ratio {measured:.4f} vs Y(DT)/(D^5 Y(T)) {expected:.4f} "
+        f"(D^-5 = {d**-5:.4f}, Y(DT)/Y(T) = {y_dt / y_t:.4f}); REST {kept:.4f}; Delta E 2000 {delta_e:.3f}"
+    )
     assert abs(expected - 1.0) > 0.2  # the two definitions differ here
     assert measured == pytest.approx(expected, rel=0.02)
     assert kept == pytest.approx(1.0, rel=0.02)

@@ -19,22 +19,30 @@ EXIT_WORKER = "import os\nsys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"
 
 def _signature(bpy, scene):
     """Everything the stage touches, as comparable plain data."""
+
     def tree_signature(tree):
         if tree is None:
             return None
         nodes = sorted((node.name, node.bl_idname) for node in tree.nodes)
-        links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
-                       for link in tree.links)
+        links = sorted(
+            (link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+            for link in tree.links
+        )
         drivers = [] if tree.animation_data is None else sorted(f.data_path for f in tree.animation_data.drivers)
         return nodes, links, drivers, tree.animation_data is not None
 
     return {
-        "materials": {m.name: (tree_signature(m.node_tree), sorted(compat.custom_property_keys(m)))
-                      for m in bpy.data.materials},
-        "worlds": {w.name: (tree_signature(w.node_tree), sorted(compat.custom_property_keys(w)))
-                   for w in bpy.data.worlds},
-        "compositor": (compat.compositor_tree(scene).name if compat.compositor_tree(scene) else None,
-                       tree_signature(compat.compositor_tree(scene)), scene.render.use_compositing),
+        "materials": {
+            m.name: (tree_signature(m.node_tree), sorted(compat.custom_property_keys(m))) for m in bpy.data.materials
+        },
+        "worlds": {
+            w.name: (tree_signature(w.node_tree), sorted(compat.custom_property_keys(w))) for w in bpy.data.worlds
+        },
+        "compositor": (
+            compat.compositor_tree(scene).name if compat.compositor_tree(scene) else None,
+            tree_signature(compat.compositor_tree(scene)),
+            scene.render.use_compositing,
+        ),
         "aovs": {v.name: sorted(a.name for a in v.aovs) for v in scene.view_layers},
         "node_groups": sorted(g.name for g in bpy.data.node_groups),
         "images": sorted(i.name for i in bpy.data.images),
@@ -138,8 +146,7 @@ def test_colour_stage_failure_is_one_line_and_leaves_scene_untouched(factory_ble
         "    effect.apply(scene)\n"
         "except effect.RelativityError as error:\n"
         "    print('ERROR:' + str(error))\n"
-        f"bpy.ops.wm.save_as_mainfile(filepath={str(tmp_path / 'after.blend')!r})\n"
-        + EXIT_WORKER
+        f"bpy.ops.wm.save_as_mainfile(filepath={str(tmp_path / 'after.blend')!r})\n" + EXIT_WORKER
     )
     result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]

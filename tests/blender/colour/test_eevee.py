@@ -20,8 +20,16 @@ def _scene(bpy, addon):
     scene.relativity.speed_of_light = C
     # Placed where they are at the camera's time, so that light-travel time shows them in view.
     seen = np.array([-0.4, 0.3, -4.0])
-    ball = ch.add_sphere(bpy, scene, seen + [0.9 * np.linalg.norm(seen), 0.0, 0.0], 0.8,
-                         ch.emission_material(bpy, "Ball"), name="Ball", segments=48, rings=24)
+    ball = ch.add_sphere(
+        bpy,
+        scene,
+        seen + [0.9 * np.linalg.norm(seen), 0.0, 0.0],
+        0.8,
+        ch.emission_material(bpy, "Ball"),
+        name="Ball",
+        segments=48,
+        rings=24,
+    )
     ball.active_material.node_tree.nodes["Emission"].inputs["Color"].default_value = (0.3, 0.6, 0.2, 1.0)
     ball.relativity.motion = "CONSTANT"
     ball.relativity.beta = (0.9, 0.0, 0.0)
@@ -53,8 +61,10 @@ def test_eevee_shows_the_cycles_image(relativity_addon, factory_blender, tmp_pat
     brightness = cycles.max()
     covered_cycles, covered_eevee = ch.luminance(cycles) > 1e-4 * brightness, ch.luminance(eevee) > 1e-4 * brightness
     inside, around = _erode(covered_cycles), ~_erode(~covered_cycles)
-    print(f"covered: Cycles {covered_cycles.sum()}, EEVEE {covered_eevee.sum()} pixels; EEVEE misses "
-          f"{(inside & ~covered_eevee).sum()} inner pixels, adds {(covered_eevee & ~around).sum()} outer ones")
+    print(
+        f"covered: Cycles {covered_cycles.sum()}, EEVEE {covered_eevee.sum()} pixels; EEVEE misses "
+        f"{(inside & ~covered_eevee).sum()} inner pixels, adds {(covered_eevee & ~around).sum()} outer ones"
+    )
     assert inside.sum() > 800
     assert np.all(covered_eevee[inside]) and not np.any(covered_eevee & ~around)
 
@@ -62,7 +72,9 @@ def test_eevee_shows_the_cycles_image(relativity_addon, factory_blender, tmp_pat
     inside &= covered_eevee
     error = np.abs(eevee[inside] - cycles[inside]).sum(-1) / cycles[inside].sum(-1)
     hue_spread = np.ptp(cycles[inside][:, 2] / cycles[inside][:, 0])
-    print(f"{inside.sum()} inner pixels: colour error mean {error.mean():.4f}, max {error.max():.4f}; "
-          f"b/r spread {hue_spread:.2f}")
+    print(
+        f"{inside.sum()} inner pixels: colour error mean {error.mean():.4f}, max {error.max():.4f}; "
+        f"b/r spread {hue_spread:.2f}"
+    )
     assert hue_spread > 0.2  # the Doppler shift varies across the image: the test sees the shaders
     assert error.mean() < 0.02 and np.percentile(error, 95) < 0.05

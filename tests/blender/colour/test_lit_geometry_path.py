@@ -39,8 +39,9 @@ def _pool(luminance):
     mask = luminance > 0.5 * peak
     rows, columns = np.nonzero(mask)
     weights = luminance[mask]
-    return np.array([np.average(columns + 0.5, weights=weights), np.average(rows + 0.5, weights=weights)]), \
-        float(weights.mean())
+    return np.array([np.average(columns + 0.5, weights=weights), np.average(rows + 0.5, weights=weights)]), float(
+        weights.mean()
+    )
 
 
 def _render(bpy, scene, method, tmp_path, final_render="EXACT"):
@@ -63,13 +64,16 @@ def test_pool_of_light_matches_the_exact_camera(relativity_addon, tmp_path):
     preview_centre, preview_level = _pool(_render(bpy, scene, "GEOMETRY", tmp_path, "PREVIEW"))
     offset = np.linalg.norm(mesh_centre - exact_centre)
     preview_offset = np.linalg.norm(preview_centre - exact_centre)
-    print(f"pool: exact camera {exact_centre} level {exact_level:.4g}; Apparent Geometry {mesh_centre} "
-          f"(offset {offset:.2f} px, level ratio {mesh_level / exact_level:.4f}); boosted-mesh preview "
-          f"{preview_centre} (offset {preview_offset:.1f} px, level ratio {preview_level / exact_level:.3f})")
+    print(
+        f"pool: exact camera {exact_centre} level {exact_level:.4g}; Apparent Geometry {mesh_centre} "
+        f"(offset {offset:.2f} px, level ratio {mesh_level / exact_level:.4f}); boosted-mesh preview "
+        f"{preview_centre} (offset {preview_offset:.1f} px, level ratio {preview_level / exact_level:.3f})"
+    )
     assert offset < 2.0
     assert mesh_level / exact_level == pytest.approx(1.0, abs=0.10)
-    assert preview_offset > 5.0 or abs(preview_level / exact_level - 1.0) > 0.2, \
+    assert preview_offset > 5.0 or abs(preview_level / exact_level - 1.0) > 0.2, (
         "the preview lights the meshes where they appear: it must differ"
+    )
 
 
 def test_final_render_restores_the_preview(relativity_addon, tmp_path):
@@ -115,8 +119,9 @@ def test_panoramic_final_render_matches_the_exact_camera(relativity_addon, tmp_p
     assert (scene.camera.data.type, scene.camera.data.panorama_type) == ("PANO", "EQUIRECTANGULAR")
     level = exact.mean()
     difference, preview_difference = np.abs(mesh - exact).mean() / level, np.abs(preview - exact).mean() / level
-    print(f"equirectangular: mean |Apparent Geometry - exact| / mean {difference:.4f}, "
-          f"preview {preview_difference:.3f}")
+    print(
+        f"equirectangular: mean |Apparent Geometry - exact| / mean {difference:.4f}, preview {preview_difference:.3f}"
+    )
     assert level > 1e-3, "the pool must be in the panorama"
     assert difference < 0.02
     assert preview_difference > 0.2, "the preview lights the meshes where they appear: it must differ"

@@ -55,8 +55,13 @@ def _wall_under_blackbody_lamp(bpy, samples=32):
     """A white diffuse wall at z = -5 facing the camera, lit by a large emitting panel with a
     Blackbody node behind the camera (invisible to camera rays)."""
     scene, camera = dh.emitter_scene(bpy, samples=samples, resolution=RESOLUTION)
-    _quad(bpy, scene, "Wall", [(-40, -40, -5), (40, -40, -5), (40, 40, -5), (-40, 40, -5)],
-          _diffuse(bpy, "White", (1.0, 1.0, 1.0)))
+    _quad(
+        bpy,
+        scene,
+        "Wall",
+        [(-40, -40, -5), (40, -40, -5), (40, 40, -5), (-40, 40, -5)],
+        _diffuse(bpy, "White", (1.0, 1.0, 1.0)),
+    )
     lamp_material = ch.emission_material(bpy, "Lamp", strength=1.0)
     tree = lamp_material.node_tree
     blackbody = tree.nodes.new("ShaderNodeBlackbody")
@@ -101,22 +106,27 @@ def test_wall_under_blackbody_lamp_is_a_blackbody_at_d_t(relativity_addon, tmp_p
     _set_up(bpy, scene, beta, method)
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     y_lamp = dh.blackbody_xyz_colour_science(LAMP_TEMPERATURE)[1]
-    expected = np.mean([dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * y_rest for d in doppler],
-                       axis=0)
+    expected = np.mean(
+        [dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * y_rest for d in doppler], axis=0
+    )
 
     spectral, info = _render_spectral(bpy, relativity_addon, scene)
     measured = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
     delta_e = dh.delta_e_2000_normalised(measured, expected)
-    print(f"D in [{info['doppler_range'][0]:.3f}, {info['doppler_range'][1]:.3f}]; spectral: Delta E {delta_e:.2f}, "
-          f"Y / expected {measured[1] / expected[1]:.4f}")
+    print(
+        f"D in [{info['doppler_range'][0]:.3f}, {info['doppler_range'][1]:.3f}]; spectral: Delta E {delta_e:.2f}, "
+        f"Y / expected {measured[1] / expected[1]:.4f}"
+    )
     assert delta_e < 2.0
     assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
 
     # The fast mode reads the wall's light as reflected under the lamp's 2700 K (Lit By: Automatic,
     # illuminants.py): exact for a white wall (before, Delta E 26 and 13 % of the luminance)
     fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
-    print(f"fast (RGB) mode: Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, "
-          f"Y / expected {fast[1] / expected[1]:.4f}")
+    print(
+        f"fast (RGB) mode: Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, "
+        f"Y / expected {fast[1] / expected[1]:.4f}"
+    )
     assert dh.delta_e_2000_normalised(fast, expected) < 2.0
     assert fast[1] / expected[1] == pytest.approx(1.0, abs=0.05)
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
@@ -193,18 +203,26 @@ def _grouped_diffuse(bpy, name, colour, style):
 
 def _node_group_state(bpy):
     """Every user node group's nodes and links, to compare before and after the effect."""
-    return {group.name: (sorted(node.name for node in group.nodes),
-                         sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name,
-                                 link.to_socket.identifier) for link in group.links))
-            for group in bpy.data.node_groups if not group.name.startswith("Relativity")}
+    return {
+        group.name: (
+            sorted(node.name for node in group.nodes),
+            sorted(
+                (link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+                for link in group.links
+            ),
+        )
+        for group in bpy.data.node_groups
+        if not group.name.startswith("Relativity")
+    }
 
 
 # Patches whose Diffuse BSDF sits in a node group (the white one stays ungrouped).
 GROUPED = {"Red": "inner", "Green": "nested", "Blue": "passed"}
 
 
-@pytest.mark.parametrize("speed, grouped", [(0.3, False), (0.6, False), (0.6, True)],
-                         ids=["0.3c", "0.6c", "0.6c-grouped"])
+@pytest.mark.parametrize(
+    "speed, grouped", [(0.3, False), (0.6, False), (0.6, True)], ids=["0.3c", "0.6c", "0.6c-grouped"]
+)
 def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed, grouped):
     """Up-sampled RGB patches under a sun with its own temperature: spectral mode within Delta E 2
     of the same spectra (reflectance basis times Planck) shifted and integrated here. Grouped:
@@ -215,8 +233,13 @@ def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed, gr
     for name, (colour, (x, y)) in PATCHES.items():
         corners = [(x - 1, y - 1, -5), (x + 1, y - 1, -5), (x + 1, y + 1, -5), (x - 1, y + 1, -5)]
         style = GROUPED.get(name) if grouped else None
-        _quad(bpy, scene, name, corners,
-              _grouped_diffuse(bpy, name, colour, style) if style else _diffuse(bpy, name, colour))
+        _quad(
+            bpy,
+            scene,
+            name,
+            corners,
+            _grouped_diffuse(bpy, name, colour, style) if style else _diffuse(bpy, name, colour),
+        )
     groups_before = _node_group_state(bpy)
     _sun(bpy, scene)
     rest_windows = _patch_windows(bpy, scene, camera, (0.0, 0.0, 0.0))
@@ -241,9 +264,11 @@ def test_colour_patches_under_a_5762_k_sun(relativity_addon, tmp_path, speed, gr
         measured = _xyz(spectral[window].reshape(-1, 3)).mean(axis=0)
         fast_xyz = _xyz(fast[window].reshape(-1, 3)).mean(axis=0)
         delta_e = dh.delta_e_2000_normalised(measured, expected)
-        print(f"{speed}c {name}: D {doppler[window].mean():.3f}, spectral Delta E {delta_e:.2f}, "
-              f"Y/expected {measured[1] / expected[1]:.3f}; fast Delta E "
-              f"{dh.delta_e_2000_normalised(fast_xyz, expected):.2f}, Y/expected {fast_xyz[1] / expected[1]:.3f}")
+        print(
+            f"{speed}c {name}: D {doppler[window].mean():.3f}, spectral Delta E {delta_e:.2f}, "
+            f"Y/expected {measured[1] / expected[1]:.3f}; fast Delta E "
+            f"{dh.delta_e_2000_normalised(fast_xyz, expected):.2f}, Y/expected {fast_xyz[1] / expected[1]:.3f}"
+        )
         assert delta_e < 2.0
         assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
         # fast mode, lit by the sun's 5762 K: the colour right; the luminance off by Cycles' RGB
@@ -263,24 +288,37 @@ def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):
     scene, camera = dh.emitter_scene(bpy, samples=64, resolution=RESOLUTION)
     scene.cycles.max_bounces = 1
     scene.cycles.diffuse_bounces = 1
-    wall = _quad(bpy, scene, "Wall", [(-3, -3, -5), (3, -3, -5), (3, 3, -5), (-3, 3, -5)],
-                 _diffuse(bpy, "WallColour", (1.0, 1.0, 1.0)))
-    reflector = _quad(bpy, scene, "Reflector", [(-20, -20, 2), (-20, 20, 2), (20, 20, 2), (20, -20, 2)],
-                      _diffuse(bpy, "ReflectorColour", (1.0, 1.0, 1.0)))
+    wall = _quad(
+        bpy,
+        scene,
+        "Wall",
+        [(-3, -3, -5), (3, -3, -5), (3, 3, -5), (-3, 3, -5)],
+        _diffuse(bpy, "WallColour", (1.0, 1.0, 1.0)),
+    )
+    reflector = _quad(
+        bpy,
+        scene,
+        "Reflector",
+        [(-20, -20, 2), (-20, 20, 2), (20, 20, 2), (20, -20, 2)],
+        _diffuse(bpy, "ReflectorColour", (1.0, 1.0, 1.0)),
+    )
     reflector.visible_camera = False
     _sun(bpy, scene, direction_z=1.0, temperature=4000.0, strength=20.0)
     white_rest = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)[1]
     assert white_rest > 0.01, "the wall must be lit through the reflector"
     wall_colour, reflector_colour = (0.2, 0.5, 0.8), (0.9, 0.6, 0.2)
     wall.data.materials[0].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = (*wall_colour, 1.0)
-    reflector.data.materials[0].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = \
-        (*reflector_colour, 1.0)
+    reflector.data.materials[0].node_tree.nodes["Diffuse BSDF"].inputs["Color"].default_value = (*reflector_colour, 1.0)
     wavelengths, cmfs = _cmfs()
     scale = white_rest / (_planck(wavelengths, 4000.0) @ cmfs[:, 1])
 
     def spectrum(mu):
-        return (scale * _mallett_reflectance(wall_colour, mu) * _mallett_reflectance(reflector_colour, mu)
-                * _planck(mu, 4000.0))
+        return (
+            scale
+            * _mallett_reflectance(wall_colour, mu)
+            * _mallett_reflectance(reflector_colour, mu)
+            * _planck(mu, 4000.0)
+        )
 
     beta = (0.0, 0.0, -0.5)
     _set_up(bpy, scene, beta)
@@ -290,8 +328,10 @@ def test_two_bounces_between_coloured_surfaces(relativity_addon, tmp_path):
     measured = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
     fast = _xyz(_render_f12(bpy, scene, tmp_path, "fast")[CENTRE].reshape(-1, 3)).mean(axis=0)
     delta_e = dh.delta_e_2000_normalised(measured, expected)
-    print(f"two bounces: spectral Delta E {delta_e:.2f}, Y/expected {measured[1] / expected[1]:.3f}; "
-          f"fast Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, Y/expected {fast[1] / expected[1]:.3f}")
+    print(
+        f"two bounces: spectral Delta E {delta_e:.2f}, Y/expected {measured[1] / expected[1]:.3f}; "
+        f"fast Delta E {dh.delta_e_2000_normalised(fast, expected):.2f}, Y/expected {fast[1] / expected[1]:.3f}"
+    )
     assert delta_e < 2.0
     assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)
     assert dh.delta_e_2000_normalised(fast, expected) < 2.0  # read as lit by the sun's 4000 K
@@ -304,8 +344,13 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     renders with one lamp on): Delta E 2000 < 2, luminance within 5 %."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=32, resolution=RESOLUTION)
-    _quad(bpy, scene, "Wall", [(-40, -40, -5), (40, -40, -5), (40, 40, -5), (-40, 40, -5)],
-          _diffuse(bpy, "White", (1.0, 1.0, 1.0)))
+    _quad(
+        bpy,
+        scene,
+        "Wall",
+        [(-40, -40, -5), (40, -40, -5), (40, 40, -5), (-40, 40, -5)],
+        _diffuse(bpy, "White", (1.0, 1.0, 1.0)),
+    )
     lamps = {}
     for name, temperature, x in (("Warm", 2700.0, -3.0), ("Cool", 5000.0, 3.0)):
         light = bpy.data.lights.new(name, "AREA")
@@ -339,9 +384,16 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     _set_up(bpy, scene, beta)
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     spectra = {"Warm": 2700.0, "Cool": 5000.0, "Sky": 6504.0}  # the sky's grey: the emitters' 6504 K white
-    expected = np.mean([sum(parts[name] * dh.blackbody_xyz_colour_science(d * t)
-                            / dh.blackbody_xyz_colour_science(t)[1] for name, t in spectra.items())
-                        for d in doppler], axis=0)
+    expected = np.mean(
+        [
+            sum(
+                parts[name] * dh.blackbody_xyz_colour_science(d * t) / dh.blackbody_xyz_colour_science(t)[1]
+                for name, t in spectra.items()
+            )
+            for d in doppler
+        ],
+        axis=0,
+    )
     tree = dh.addon_module(relativity_addon, "common.compat").compositor_tree(scene)
     denoisers = [node for node in tree.nodes if node.bl_idname == "CompositorNodeDenoise"]
     assert len(denoisers) == 2 and all(node.inputs["Image"].is_linked for node in denoisers)
@@ -357,23 +409,29 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     scene.cycles.use_denoising = False
     raw = _xyz(_render_f12(bpy, scene, tmp_path, "raw")[CENTRE].reshape(-1, 3))
     spreads = [pixels[:, 1].std() / pixels[:, 1].mean() for pixels in (denoised, raw)]
-    print(f"4 samples, denoised: Delta E {dh.delta_e_2000_normalised(denoised.mean(axis=0), expected):.2f}, "
-          f"Y / expected {denoised.mean(axis=0)[1] / expected[1]:.4f}; pixel spread {spreads[0]:.4f} "
-          f"against {spreads[1]:.4f} not denoised")
+    print(
+        f"4 samples, denoised: Delta E {dh.delta_e_2000_normalised(denoised.mean(axis=0), expected):.2f}, "
+        f"Y / expected {denoised.mean(axis=0)[1] / expected[1]:.4f}; pixel spread {spreads[0]:.4f} "
+        f"against {spreads[1]:.4f} not denoised"
+    )
     assert dh.delta_e_2000_normalised(denoised.mean(axis=0), expected) < 2.0
     assert spreads[0] < 0.5 * spreads[1]
     scene.cycles.use_denoising, scene.cycles.samples = True, 32  # the spectral passes, denoised
     spectral, _info = _render_spectral(bpy, relativity_addon, scene)
     spectral_xyz = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
-    print(f"spectral, denoised: Delta E {dh.delta_e_2000_normalised(spectral_xyz, expected):.2f}, "
-          f"Y / expected {spectral_xyz[1] / expected[1]:.4f}")
+    print(
+        f"spectral, denoised: Delta E {dh.delta_e_2000_normalised(spectral_xyz, expected):.2f}, "
+        f"Y / expected {spectral_xyz[1] / expected[1]:.4f}"
+    )
     assert dh.delta_e_2000_normalised(spectral_xyz, expected) < 2.0
     assert spectral_xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05)
     scene.cycles.use_denoising = False
     scene.relativity.fast_illuminant = "WHITE"
     white = _xyz(_render_f12(bpy, scene, tmp_path, "white")[CENTRE].reshape(-1, 3)).mean(axis=0)
-    print(f"read in white: Delta E {dh.delta_e_2000_normalised(white, expected):.2f}, "
-          f"Y / expected {white[1] / expected[1]:.4f}")
+    print(
+        f"read in white: Delta E {dh.delta_e_2000_normalised(white, expected):.2f}, "
+        f"Y / expected {white[1] / expected[1]:.4f}"
+    )
     assert dh.delta_e_2000_normalised(white, expected) > 5.0
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert all(lamp.lightgroup == "" for lamp, _t in lamps.values()) and scene.world.lightgroup == ""
@@ -430,12 +488,14 @@ def test_batch_script_spectral_option(relativity_addon, tmp_path):
     blend = ch.save_blend(bpy, tmp_path / "lit.blend")
     rest = _xyz(_render_f12(bpy, scene, tmp_path, "rest")[CENTRE].reshape(-1, 3)).mean(axis=0)
     beta = (0.0, 0.0, -0.6)
-    image = ch.render_image(bpy, blend, tmp_path / "spectral.exr", "--beta=0,0,-0.6", "--speed-of-light=1",
-                            "--spectral=3")
+    image = ch.render_image(
+        bpy, blend, tmp_path / "spectral.exr", "--beta=0,0,-0.6", "--speed-of-light=1", "--spectral=3"
+    )
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     y_lamp = dh.blackbody_xyz_colour_science(LAMP_TEMPERATURE)[1]
-    expected = np.mean([dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * rest[1]
-                        for d in doppler], axis=0)
+    expected = np.mean(
+        [dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * rest[1] for d in doppler], axis=0
+    )
     measured = _xyz(image[CENTRE].reshape(-1, 3)).mean(axis=0)
     assert dh.delta_e_2000_normalised(measured, expected) < 2.0
     assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)

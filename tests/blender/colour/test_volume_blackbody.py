@@ -25,8 +25,9 @@ BETA = (0.0, 0.0, -0.5)
 
 def _scene(bpy):
     scene, camera = dh.emitter_scene(bpy, samples=32, resolution=RESOLUTION)
-    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
-                         temperature=TEMPERATURE)
+    dh.add_emitter_plane(
+        bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None, temperature=TEMPERATURE
+    )
     material = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
     dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), material)
     return scene, camera, material
@@ -39,8 +40,10 @@ def _xyz(image, window):
 def _expected(doppler, y_rest):
     """Mean XYZ of blackbodies at ``D T``, each scaled to its ``y_rest`` times ``Y(D T) / Y(T)``."""
     y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
-    return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y
-                    for d, y in zip(doppler, y_rest, strict=True)], axis=0)
+    return np.mean(
+        [dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in zip(doppler, y_rest, strict=True)],
+        axis=0,
+    )
 
 
 def _slab_path_ratio(bpy, scene, camera):
@@ -55,8 +58,10 @@ def test_principled_volume_blackbody_is_seen_at_d_t(relativity_addon, tmp_path):
     bpy = __import__("bpy")
     scene, camera, material = _scene(bpy)
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
-    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1]
-              for name, window in (("volume", VOLUME), ("mesh", MESH))}
+    y_rest = {
+        name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1]
+        for name, window in (("volume", VOLUME), ("mesh", MESH))
+    }
     assert y_rest["volume"].min() > 0.5 and y_rest["mesh"].min() > 0.5
     links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
 
@@ -78,8 +83,10 @@ def test_principled_volume_blackbody_is_seen_at_d_t(relativity_addon, tmp_path):
         measured[name] = xyz
         delta_e = dh.delta_e_2000_normalised(xyz, expected)
         ratio = xyz[1] / expected[1]
-        print(f"{name}: D {doppler[window].mean():.3f}, path {np.mean(path[name]):.4f}, Delta E {delta_e:.3f}, "
-              f"Y / expected {ratio:.4f}")
+        print(
+            f"{name}: D {doppler[window].mean():.3f}, path {np.mean(path[name]):.4f}, Delta E {delta_e:.3f}, "
+            f"Y / expected {ratio:.4f}"
+        )
         assert delta_e < 1.0, name
         assert ratio == pytest.approx(1.0, abs=0.02), name
     between = dh.delta_e_2000_normalised(measured["volume"], measured["mesh"])

@@ -64,15 +64,17 @@ def _spectral(addon, scene, passes=PASSES):
     return pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
 
 
-
 def _compare(label, doppler, xyz, fast_xyz, expected):
     """Spectral mode within Delta E 2 and 5 % of ``expected`` (asserted); the fast mode's Delta E."""
     delta_e, fast_delta_e = dh.delta_e_2000_normalised(xyz, expected), dh.delta_e_2000_normalised(fast_xyz, expected)
-    print(f"{label}: D {doppler:.3f}, spectral Delta E {delta_e:.3f}, Y/expected {xyz[1] / expected[1]:.4f}; "
-          f"fast Delta E {fast_delta_e:.3f}, Y/expected {fast_xyz[1] / expected[1]:.4f}")
+    print(
+        f"{label}: D {doppler:.3f}, spectral Delta E {delta_e:.3f}, Y/expected {xyz[1] / expected[1]:.4f}; "
+        f"fast Delta E {fast_delta_e:.3f}, Y/expected {fast_xyz[1] / expected[1]:.4f}"
+    )
     assert delta_e < 2.0, label
     assert xyz[1] / expected[1] == pytest.approx(1.0, abs=0.05), label
     return fast_delta_e
+
 
 def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path):
     """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh, a blue emitter behind
@@ -82,8 +84,9 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
     fast mode's done mask keeps it at its rest colour)."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
-    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
-                         temperature=TEMPERATURE)
+    dh.add_emitter_plane(
+        bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None, temperature=TEMPERATURE
+    )
     dh.add_emitter_plane(bpy, scene, "Behind", (-5.0, -0.5), (-3.0, -0.5), colour=BEHIND, beta=None, depth=7.0)
     gas = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
     dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), gas)
@@ -108,8 +111,13 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
     measured = {}
     for name, window in windows.items():
         gas_path = path[window].ravel() if name != "mesh" else 1.0
-        expected = np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in
-                            zip(doppler[window].ravel(), y_rest[name] * gas_path, strict=True)], axis=0)
+        expected = np.mean(
+            [
+                dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y
+                for d, y in zip(doppler[window].ravel(), y_rest[name] * gas_path, strict=True)
+            ],
+            axis=0,
+        )
         if name == "volume + blue emitter":
             expected += np.mean([dh.observed_xyz(blue, d) for d in doppler[window].ravel()], axis=0)
         measured[name] = _xyz(spectral, window)
@@ -129,11 +137,17 @@ def _slab_scene(bpy, scattering):
     wall.visible_volume_scatter = False
     if scattering:
         _border(scene, LEFT[0])
-    principled = dh.volume_material(bpy, "Principled", Color=SCATTER_COLOUR if scattering else (0.0, 0.0, 0.0),
-                                    Density=DENSITY, Absorption_Color=PRINCIPLED_ABSORPTION)
+    principled = dh.volume_material(
+        bpy,
+        "Principled",
+        Color=SCATTER_COLOUR if scattering else (0.0, 0.0, 0.0),
+        Density=DENSITY,
+        Absorption_Color=PRINCIPLED_ABSORPTION,
+    )
     kind = "ShaderNodeVolumeScatter" if scattering else "ShaderNodeVolumeAbsorption"
-    other = dh.volume_material(bpy, "Other", kind, Color=SCATTER_COLOUR if scattering else ABSORPTION_COLOUR,
-                               Density=DENSITY)
+    other = dh.volume_material(
+        bpy, "Other", kind, Color=SCATTER_COLOUR if scattering else ABSORPTION_COLOUR, Density=DENSITY
+    )
     if not scattering:  # the Volume Absorption also glows: an Emission node beside it (Add Shader)
         tree = other.node_tree
         glow, add = tree.nodes.new("ShaderNodeEmission"), tree.nodes.new("ShaderNodeAddShader")
@@ -174,9 +188,14 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
     trees = [bpy.data.materials[name].node_tree for name in ("Principled", "Other")]
 
     def state():
-        return [(sorted((link.from_node.name, link.to_node.name) for link in tree.links), len(tree.nodes),
-                 [tuple(socket.default_value) for node in tree.nodes for socket in node.inputs
-                  if socket.type == "RGBA"]) for tree in trees]
+        return [
+            (
+                sorted((link.from_node.name, link.to_node.name) for link in tree.links),
+                len(tree.nodes),
+                [tuple(socket.default_value) for node in tree.nodes for socket in node.inputs if socket.type == "RGBA"],
+            )
+            for tree in trees
+        ]
 
     before = state()
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
@@ -203,8 +222,13 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
             extinction = _extinction(lambda rgb: dh.mallett_reflectance(rgb, mu), scattering)[side]
             return _through(wall(mu), glow(mu) if glows else 0.0, extinction, path)
 
-        expected = np.mean([dh.observed_xyz(lambda mu, path=path: transmitted(mu, path=path), d)
-                            for d, path in zip(doppler[window].ravel(), length[window].ravel(), strict=True)], axis=0)
+        expected = np.mean(
+            [
+                dh.observed_xyz(lambda mu, path=path: transmitted(mu, path=path), d)
+                for d, path in zip(doppler[window].ravel(), length[window].ravel(), strict=True)
+            ],
+            axis=0,
+        )
         fast_delta_e = _compare(side, doppler[window].mean(), _xyz(spectral, window), _xyz(fast, window), expected)
         # The fast mode: the RGB model's error only. Before the coverage AOV the samples scattered in
         # the volume diluted the pixel's ln D (Delta E 13 on 5.2, 38-44 on 4.5, Y 0.68).

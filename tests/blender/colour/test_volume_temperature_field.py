@@ -80,12 +80,19 @@ def test_node_driven_temperature_is_seen_at_d_t_per_point(relativity_addon, tmp_
     for name, (temperature, window) in HALVES.items():
         xyz = _xyz(moving, window).mean(axis=0)
         y_t = dh.blackbody_xyz_colour_science(temperature)[1]
-        expected = np.mean([dh.blackbody_xyz_colour_science(d * temperature) / y_t * y for d, y in
-                            zip(doppler[window].ravel(), y_rest[name] * path[window].ravel(), strict=True)], axis=0)
+        expected = np.mean(
+            [
+                dh.blackbody_xyz_colour_science(d * temperature) / y_t * y
+                for d, y in zip(doppler[window].ravel(), y_rest[name] * path[window].ravel(), strict=True)
+            ],
+            axis=0,
+        )
         delta_e = dh.delta_e_2000_normalised(xyz, expected)
         ratio = xyz[1] / expected[1]
-        print(f"{name} ({temperature:.0f} K): D {doppler[window].mean():.3f}, Delta E {delta_e:.3f}, "
-              f"Y / expected {ratio:.4f}")
+        print(
+            f"{name} ({temperature:.0f} K): D {doppler[window].mean():.3f}, Delta E {delta_e:.3f}, "
+            f"Y / expected {ratio:.4f}"
+        )
         assert delta_e < 2.0, name
         assert ratio == pytest.approx(1.0, abs=0.05), name
 

@@ -72,8 +72,10 @@ def _assert_shifted(image, d, colour=COLOUR, tolerance=0.01):
 
 
 def _signature(tree):
-    links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
-                   for link in tree.links)
+    links = sorted(
+        (link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+        for link in tree.links
+    )
     return sorted(node.name for node in tree.nodes), links
 
 
@@ -96,8 +98,11 @@ def _assert_world_writes_no_aov(addon, scene):
     """The world's ln D comes from the compositor's direction image, not from an AOV writer."""
     world_doppler = dh.addon_module(addon, "colour.world_doppler")
     assert scene.world.node_tree.nodes[world_doppler.AOV_NODE].mute
-    stage = next(node for node in dh.addon_module(addon, "common.compat").compositor_tree(scene).nodes
-                 if node.bl_idname == "CompositorNodeGroup")
+    stage = next(
+        node
+        for node in dh.addon_module(addon, "common.compat").compositor_tree(scene).nodes
+        if node.bl_idname == "CompositorNodeGroup"
+    )
     assert stage.inputs["World Directions"].default_value == 1.0
 
 

@@ -77,7 +77,7 @@ def contract(relative, beta):
     speed = np.linalg.norm(beta, axis=-1, keepdims=True)
     bhat = np.divide(beta, speed, out=np.zeros_like(beta), where=speed > 0)
     along = np.sum(relative * bhat, axis=-1, keepdims=True)
-    return relative - (1.0 - np.sqrt(1.0 - speed ** 2)) * along * bhat
+    return relative - (1.0 - np.sqrt(1.0 - speed**2)) * along * bhat
 
 
 def _frame_set_time(scene, t, fps):
@@ -134,20 +134,31 @@ def file_fingerprint(bpy):
     """What the effect and its bakes may touch, as one string: every object (transform, parent,
     modifiers, constraints, ID properties), every mesh (vertices, attributes, ID properties), the
     node groups, and the scene frame."""
+
     def idprops(owner):
         return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
-    objects = [(o.name, tuple(map(tuple, o.matrix_world)), o.parent.name if o.parent else "", repr(o.data),
-                [(m.name, m.type, m.show_viewport) for m in o.modifiers], [c.name for c in o.constraints], idprops(o))
-               for o in bpy.data.objects]
+    objects = [
+        (
+            o.name,
+            tuple(map(tuple, o.matrix_world)),
+            o.parent.name if o.parent else "",
+            repr(o.data),
+            [(m.name, m.type, m.show_viewport) for m in o.modifiers],
+            [c.name for c in o.constraints],
+            idprops(o),
+        )
+        for o in bpy.data.objects
+    ]
     meshes = []
     for mesh in bpy.data.meshes:
         co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
         mesh.vertices.foreach_get("co", co)
         meshes.append((mesh.name, co.tobytes().hex(), sorted(a.name for a in mesh.attributes), idprops(mesh)))
     scene = bpy.context.scene
-    return repr((objects, meshes, sorted(g.name for g in bpy.data.node_groups),
-                 scene.frame_current, scene.frame_subframe))
+    return repr(
+        (objects, meshes, sorted(g.name for g in bpy.data.node_groups), scene.frame_current, scene.frame_subframe)
+    )
 
 
 class _RecordingLayout:
@@ -184,8 +195,9 @@ def keyframe_linear(obj, path, index, points):
     for frame, value in points:
         getattr(obj, path)[index] = value
         obj.keyframe_insert(path, index=index, frame=frame)
-    fcurve = next(f for f in compat.action_fcurves(obj.animation_data)
-                  if f.data_path == path and f.array_index == index)
+    fcurve = next(
+        f for f in compat.action_fcurves(obj.animation_data) if f.data_path == path and f.array_index == index
+    )
     for point in fcurve.keyframe_points:
         point.interpolation = "LINEAR"
     fcurve.extrapolation = "LINEAR"

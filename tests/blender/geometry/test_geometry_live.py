@@ -11,8 +11,7 @@ from geometry_helpers import ch
 def _scene(bpy):
     scene, camera_object = ch.new_scene(bpy, resolution=(64, 48), samples=1)
     scene.relativity.speed_of_light = 4.0
-    obj = ch.add_sphere(bpy, scene, (0.0, 0.0, -5.0), 1.0, ch.emission_material(bpy), name="Ball",
-                        segments=16, rings=8)
+    obj = ch.add_sphere(bpy, scene, (0.0, 0.0, -5.0), 1.0, ch.emission_material(bpy), name="Ball", segments=16, rings=8)
     return scene, camera_object, obj
 
 
@@ -91,8 +90,16 @@ def test_relativity_beta_reaches_the_shader(relativity_addon, factory_blender, t
     scene.relativity.geometry_final_render = final_render
     blend = ch.save_blend(bpy, tmp_path / "beta.blend")
     # colour and brightness effects off: the material shows the attribute itself
-    image = ch.render_image(bpy, blend, tmp_path / "beta.exr", "--method=geometry", "--beta=0,0.2,0",
-                            "--resolution=64x48", "--no-doppler", "--no-searchlight")
+    image = ch.render_image(
+        bpy,
+        blend,
+        tmp_path / "beta.exr",
+        "--method=geometry",
+        "--beta=0,0.2,0",
+        "--resolution=64x48",
+        "--no-doppler",
+        "--no-searchlight",
+    )
     lit = image.sum(-1) > 0.05
     assert lit.sum() > 50
     colour = np.median(image[lit], axis=0)

@@ -63,13 +63,17 @@ def _measure(bpy, scene, camera_object, obj, with_beta=False, remove=True):
     t_e = t_o - np.linalg.norm(x_a - x_o, axis=1) / C
     x_e = gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e, FPS, c=C)
     residual, mismatch = gh.retarded_residuals(x_a, x_e, x_o)
-    print(f"{obj.name}: max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
-          f"retarded frames {t_e.min() * FPS:.3f}..{t_e.max() * FPS:.3f}")
+    print(
+        f"{obj.name}: max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
+        f"retarded frames {t_e.min() * FPS:.3f}..{t_e.max() * FPS:.3f}"
+    )
     if not with_beta:
         return residual, mismatch, t_e, x_e
     dt = 2e-3
-    velocity = (gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e + dt, FPS, c=C)
-                - gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e - dt, FPS, c=C)) / (2 * dt)
+    velocity = (
+        gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e + dt, FPS, c=C)
+        - gh.world_lines_by_frame_set(bpy, scene, obj, rest, t_e - dt, FPS, c=C)
+    ) / (2 * dt)
     return residual, mismatch, t_e, x_e, beta_seen, velocity / C
 
 
@@ -154,7 +158,8 @@ def test_keyframe_matrices_match_blender(relativity_addon, factory_blender):
             obj.delta_rotation_quaternion = rng.normal(size=4)
             obj.delta_scale = rng.uniform(0.5, 1.5, 3)
             rotation = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}.get(
-                obj.rotation_mode, "rotation_euler")
+                obj.rotation_mode, "rotation_euler"
+            )
             for frame in (1, 7, 15):
                 obj.location, obj.scale = rng.normal(size=3), rng.uniform(0.5, 2.0, 3)
                 obj.delta_location = rng.normal(size=3)

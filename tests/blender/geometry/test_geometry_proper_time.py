@@ -139,8 +139,10 @@ def test_clock_hand_shows_proper_time(relativity_addon, tmp_path, speed):
     expected = _angle(centre_x, tip_x)
     _, tip_scene_time, t_e = _expected(bpy, scene, camera, p0, beta, dilation=False)
     undilated = _angle(centre_x, tip_scene_time)
-    print(f"{speed}c: hand at {measured:.2f} deg in the render, {expected:.2f} deg expected (proper time "
-          f"{tau:.3f} s at the retarded time {t_e:.3f} s); without time dilation {undilated:.2f} deg")
+    print(
+        f"{speed}c: hand at {measured:.2f} deg in the render, {expected:.2f} deg expected (proper time "
+        f"{tau:.3f} s at the retarded time {t_e:.3f} s); without time dilation {undilated:.2f} deg"
+    )
     assert abs(measured - expected) < 1.0
     if speed > 0.0:
         assert abs(undilated - expected) > 10.0, "time dilation must be visible in this set-up"

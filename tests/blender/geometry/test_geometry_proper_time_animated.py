@@ -154,6 +154,7 @@ def _expected(bpy, scene, camera, centre, velocity, tip_offset, clock):
     """Image angle of the tip about the centre: ``centre(t)`` the world line, ``velocity(t)`` its
     velocity (the face's contraction), ``tip_offset(tau)`` the tip in the face's rest frame at its
     proper time ``tau = clock(t)``. Also returns the tip's retarded time and proper time."""
+
     def tip(t):
         beta = velocity(t) / C
         speed2 = beta @ beta
@@ -162,8 +163,9 @@ def _expected(bpy, scene, camera, centre, velocity, tip_offset, clock):
         return centre(t) + contraction @ tip_offset(clock(t))
 
     model = ch.pinhole_model(bpy, scene, camera)
-    pixels = [model.project_direction(f(_retarded(f, FRAME / FPS, model.location)) - model.location)
-              for f in (centre, tip)]
+    pixels = [
+        model.project_direction(f(_retarded(f, FRAME / FPS, model.location)) - model.location) for f in (centre, tip)
+    ]
     t_tip = _retarded(tip, FRAME / FPS, model.location)
     return _angle(*pixels), t_tip, clock(t_tip)
 
@@ -190,8 +192,10 @@ def _spin(tau):
 
 
 def _compare(measured, expected, undilated, label, t_e, tau):
-    print(f"{label}: tip at {measured:.2f} deg in the render, {expected:.2f} deg expected (proper time {tau:.4f} s "
-          f"at the retarded time {t_e:.4f} s); at scene time {undilated:.2f} deg")
+    print(
+        f"{label}: tip at {measured:.2f} deg in the render, {expected:.2f} deg expected (proper time {tau:.4f} s "
+        f"at the retarded time {t_e:.4f} s); at scene time {undilated:.2f} deg"
+    )
     assert abs(measured - expected) < 1.0
     assert abs(undilated - expected) > 10.0, "time dilation must be visible in this set-up"
 

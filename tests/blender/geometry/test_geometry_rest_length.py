@@ -95,10 +95,12 @@ def test_constant_and_keyframed_rod_have_the_same_contracted_length(relativity_a
     focal_px = camera.size[0] / (camera.window[1] - camera.window[0])
     far_field = SIZE[0] * math.sqrt(1.0 - 0.81) / (1.0 - 0.9 * cos_theta) * focal_px / abs(now[2])
     uncontracted = float(np.ptp(_expected_corners_px(camera, now, contracted=False)[:, 0]))
-    print(f"rod length: CONSTANT {lengths['CONSTANT'][0]:.2f} px ({lengths['CONSTANT'][1]} columns lit), "
-          f"ANIMATION {lengths['ANIMATION'][0]:.2f} px ({lengths['ANIMATION'][1]} columns lit), "
-          f"expected {expected:.2f} px (far-field estimate {far_field:.2f}, uncontracted {uncontracted:.2f}); "
-          f"plateau heights {lengths['CONSTANT'][2]:.2f} / {lengths['ANIMATION'][2]:.2f} px")
+    print(
+        f"rod length: CONSTANT {lengths['CONSTANT'][0]:.2f} px ({lengths['CONSTANT'][1]} columns lit), "
+        f"ANIMATION {lengths['ANIMATION'][0]:.2f} px ({lengths['ANIMATION'][1]} columns lit), "
+        f"expected {expected:.2f} px (far-field estimate {far_field:.2f}, uncontracted {uncontracted:.2f}); "
+        f"plateau heights {lengths['CONSTANT'][2]:.2f} / {lengths['ANIMATION'][2]:.2f} px"
+    )
     assert abs(lengths["CONSTANT"][0] - lengths["ANIMATION"][0]) < 1.0
     assert abs(lengths["CONSTANT"][0] - expected) < 1.0
     assert abs(lengths["ANIMATION"][0] - expected) < 1.0
@@ -156,8 +158,10 @@ def test_moving_deforming_mesh_is_contracted_about_its_origin(relativity_addon, 
         uncontracted[i] = matrix[:3, :3] @ deformed + origins[2]
     scene.frame_set(frame)
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
-    print(f"moving deforming cube: max position mismatch {mismatch.max():.2e}, retarded frames "
-          f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
+    print(
+        f"moving deforming cube: max position mismatch {mismatch.max():.2e}, retarded frames "
+        f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}"
+    )
     assert mismatch.max() < 1e-6
     # The contraction is not negligible here: (1 - 1/gamma) of each vertex's ~0.9 m from the origin.
     assert np.max(np.linalg.norm(x_e - uncontracted, axis=1)) > 0.1

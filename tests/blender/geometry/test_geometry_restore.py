@@ -44,8 +44,7 @@ def _state_hash(bpy, obj):
 def _scene_with_mesh(bpy):
     scene, _ = ch.new_scene(bpy, resolution=(64, 48), samples=1)
     scene.relativity.speed_of_light = 3.0
-    obj = ch.add_sphere(bpy, scene, (0.0, 0.0, -5.0), 1.0, ch.emission_material(bpy), name="Ball",
-                        segments=16, rings=8)
+    obj = ch.add_sphere(bpy, scene, (0.0, 0.0, -5.0), 1.0, ch.emission_material(bpy), name="Ball", segments=16, rings=8)
     obj.modifiers.new("Bevel", "BEVEL")
     obj.relativity.motion = "CONSTANT"
     obj.relativity.beta = (0.8, 0.0, 0.0)

@@ -73,8 +73,10 @@ def test_rotating_wheel_rim_at_0_9c(relativity_addon, factory_blender):
     t_e = t_o - tau
     tilt = np.array([[1, 0, 0], [0, math.cos(0.3), -math.sin(0.3)], [0, math.sin(0.3), math.cos(0.3)]])
     a = omega * t_e
-    spun = np.stack([np.cos(a) * rest[:, 0] - np.sin(a) * rest[:, 1],
-                     np.sin(a) * rest[:, 0] + np.cos(a) * rest[:, 1], rest[:, 2]], axis=1)
+    spun = np.stack(
+        [np.cos(a) * rest[:, 0] - np.sin(a) * rest[:, 1], np.sin(a) * rest[:, 0] + np.cos(a) * rest[:, 1], rest[:, 2]],
+        axis=1,
+    )
     x_e = spun @ tilt.T + np.array(wheel.location)
     residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - C * tau) / (C * tau)
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
@@ -116,8 +118,10 @@ def test_accelerated_keyframed_path(relativity_addon, factory_blender):
     x_e = gh.world_lines_by_frame_set(bpy, scene, box, rest, t_e, FPS, c=C)
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
     residual = np.abs(np.linalg.norm(x_o - x_e, axis=1) - C * tau) / (C * tau)
-    print(f"max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
-          f"retarded frames {t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
+    print(
+        f"max light-cone residual {residual.max():.2e}, max position mismatch {mismatch.max():.2e}, "
+        f"retarded frames {t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}"
+    )
     assert residual.max() < 1e-6
     assert mismatch.max() < 1e-6
     assert np.ptp(t_e) * FPS > 0.5
@@ -164,8 +168,10 @@ def test_deforming_mesh_from_baked_evaluated_positions(relativity_addon, factory
         scene.frame_set(whole, subframe=t * FPS - whole)
         x_e[i] = gh.evaluated_attribute(bpy, blob, "relativity_rest")[i] + np.array(blob.location)
     mismatch = np.linalg.norm(x_a - x_e, axis=1) / (C * tau)
-    print(f"deforming: max position mismatch {mismatch.max():.2e}, retarded frames "
-          f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}")
+    print(
+        f"deforming: max position mismatch {mismatch.max():.2e}, retarded frames "
+        f"{t_e.min() * FPS:.2f}..{t_e.max() * FPS:.2f}"
+    )
     assert mismatch.max() < 1e-6
     speeds = np.linalg.norm(x_e - _ev_points_at(bpy, scene, blob, t_e - 1e-3), axis=1) / 1e-3
     assert speeds.max() > 0.1 * C  # the deformation is fast enough to matter

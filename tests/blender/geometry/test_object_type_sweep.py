@@ -131,8 +131,23 @@ def _make(bpy, scene, kind):
     raise AssertionError(kind)
 
 
-NOT_MESHES = ("CURVE", "SURFACE", "FONT", "META", "POINTCLOUD", "VOLUME", "GREASEPENCIL", "CURVES", "EMPTY",
-              "COLLECTION_INSTANCE", "CAMERA", "SPEAKER", "LIGHT_PROBE", "ARMATURE", "LATTICE")
+NOT_MESHES = (
+    "CURVE",
+    "SURFACE",
+    "FONT",
+    "META",
+    "POINTCLOUD",
+    "VOLUME",
+    "GREASEPENCIL",
+    "CURVES",
+    "EMPTY",
+    "COLLECTION_INSTANCE",
+    "CAMERA",
+    "SPEAKER",
+    "LIGHT_PROBE",
+    "ARMATURE",
+    "LATTICE",
+)
 MESH_INSTANCERS = ("PARTICLES", "VERTEX_INSTANCES", "NODE_INSTANCES")
 
 
@@ -234,8 +249,10 @@ def test_moving_mesh_is_at_its_retarded_position(relativity_addon, factory_blend
     x_e = matrix[:3, 3] + gh.contract(rest @ matrix[:3, :3].T, beta) - beta[None] * C * t_delay[:, None]
     residual, mismatch = gh.retarded_residuals(x_a, x_e, x_o)
     shift = np.mean(x_a[:, 0] - (rest @ matrix[:3, :3].T + matrix[:3, 3])[:, 0])
-    print(f"mesh: mean x shift {shift:.4f} units, max light-cone residual {residual.max():.2e}, "
-          f"max mismatch {mismatch.max():.2e}")
+    print(
+        f"mesh: mean x shift {shift:.4f} units, max light-cone residual {residual.max():.2e}, "
+        f"max mismatch {mismatch.max():.2e}"
+    )
     assert shift < -0.3 * 6.0 * 0.9  # seen where it was about |x|/c earlier: beta c |x| / c = 0.3 |x|
     assert residual.max() < 1e-5 and mismatch.max() < 1e-5
 

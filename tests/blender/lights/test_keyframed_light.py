@@ -84,17 +84,19 @@ def test_keyframed_light_follows_its_keyframes(relativity_addon, factory_blender
     jump = int(np.argmax(np.abs(np.diff(expected)))) + 1
     kink_x = floor.LAMP[0] + FAST * C * (KINK_FRAME - FRAME) / FPS
     lamp_x = np.sort([obj.location.x for obj in scene.objects if obj.type == "LIGHT" and not obj.hide_render])
-    chord = lamp_x[np.searchsorted(lamp_x, kink_x) - 1:np.searchsorted(lamp_x, kink_x) + 1]
+    chord = lamp_x[np.searchsorted(lamp_x, kink_x) - 1 : np.searchsorted(lamp_x, kink_x) + 1]
     retarded_x = _path(_retarded(points))[0][floor.ROWS, :, 0].mean(0)
     away = (retarded_x < chord[0]) | (retarded_x > chord[-1])
     error = np.abs(measured - expected)[away].max() / peak
     chord_error = np.abs(measured - expected)[~away].mean() / peak
     ratio, expected_ratio = (measured[jump + 3] / measured[jump - 4]), (expected[jump + 3] / expected[jump - 4])
-    print(f"keyframed light: peak {peak:.3f} at {np.argmax(expected)} (rendered {measured.max():.3f} at "
-          f"{np.argmax(measured)}); max error {error:.4f} of the peak off the lamps' piece across the kink "
-          f"({np.sum(~away)} px, mean error {chord_error:.4f} there); jump at pixel {jump}, "
-          f"across it {ratio:.3f} (expected {expected_ratio:.3f}); a constant {FAST}c light differs "
-          f"by {np.abs(constant - expected).max() / peak:.3f} of the peak")
+    print(
+        f"keyframed light: peak {peak:.3f} at {np.argmax(expected)} (rendered {measured.max():.3f} at "
+        f"{np.argmax(measured)}); max error {error:.4f} of the peak off the lamps' piece across the kink "
+        f"({np.sum(~away)} px, mean error {chord_error:.4f} there); jump at pixel {jump}, "
+        f"across it {ratio:.3f} (expected {expected_ratio:.3f}); a constant {FAST}c light differs "
+        f"by {np.abs(constant - expected).max() / peak:.3f} of the peak"
+    )
     assert error < 0.05
     assert np.sum(~away) < 20
     assert abs(ratio - expected_ratio) < 0.15 * expected_ratio  # 4 px before the jump: on the piece across the kink

@@ -50,8 +50,13 @@ def _module(name):
 
 
 def _scene(bpy, beta=BETA, samples=16, temperature=None):
-    scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=samples, location=(0.0, -CAMERA_DISTANCE, 0.0),
-                                 rotation_euler=(math.pi / 2.0, 0.0, 0.0))
+    scene, camera = ch.new_scene(
+        bpy,
+        resolution=RESOLUTION,
+        samples=samples,
+        location=(0.0, -CAMERA_DISTANCE, 0.0),
+        rotation_euler=(math.pi / 2.0, 0.0, 0.0),
+    )
     camera.data.lens = LENS
     camera.data.sensor_width = SENSOR
     camera.data.sensor_fit = "HORIZONTAL"
@@ -95,7 +100,7 @@ def _edge(image):
     """The image column of the cube's front edge: the largest brightness step along the middle row."""
     row = ch.luminance(image)[image.shape[0] // 2]
     lit = np.nonzero(row > 0.02 * row.max())[0]
-    steps = np.abs(np.diff(row[lit.min() + 2:lit.max() - 1]))
+    steps = np.abs(np.diff(row[lit.min() + 2 : lit.max() - 1]))
     edge = lit.min() + 2 + int(np.argmax(steps))
     y = ch.luminance(image)
     rows = np.nonzero(np.minimum(y[:, edge - 3], y[:, edge + 3]) > 0.02 * y.max())[0]
@@ -106,8 +111,9 @@ def _faces(image, edges):
     """Mean RGB of the face lit from ahead (right of the front edge: +X) and of the face lit from
     behind (left), two pixels away from every edge, over the rows where both are lit."""
     edge, left, right, band = edges
-    return image[band, edge + 2:right - 1].reshape(-1, 3).mean(axis=0), \
-        image[band, left + 2:edge - 1].reshape(-1, 3).mean(axis=0)
+    return image[band, edge + 2 : right - 1].reshape(-1, 3).mean(axis=0), image[band, left + 2 : edge - 1].reshape(
+        -1, 3
+    ).mean(axis=0)
 
 
 def _renders(bpy, scene, monkeypatch, tmp_path):
@@ -154,8 +160,10 @@ def _face_predictions():
     camera = np.array([0.0, -CAMERA_DISTANCE, 0.0])
     centre = _apparent(origin[None])[0]
     result = []
-    for normal, lamp in (((math.sin(theta), -math.cos(theta), 0.0), (LAMP_DISTANCE, 0.0, 0.0)),
-                         ((-math.cos(theta), -math.sin(theta), 0.0), (-LAMP_DISTANCE, 0.0, 0.0))):
+    for normal, lamp in (
+        ((math.sin(theta), -math.cos(theta), 0.0), (LAMP_DISTANCE, 0.0, 0.0)),
+        ((-math.cos(theta), -math.sin(theta), 0.0), (-LAMP_DISTANCE, 0.0, 0.0)),
+    ):
         normal, lamp = np.array(normal), np.array(lamp)
         along = np.cross(normal, (0.0, 0.0, 1.0))
         rest = np.array([normal, normal + 0.01 * along, normal + (0.0, 0.0, 0.01)])  # centre and two neighbours
@@ -179,7 +187,7 @@ def _face_predictions():
 
 def _at_column(image, column):
     """Luminance at a (fractional) image column, linearly between pixel centres, over the middle rows."""
-    rows = ch.luminance(image)[RESOLUTION[1] // 2 - 4:RESOLUTION[1] // 2 + 4].mean(axis=0)
+    rows = ch.luminance(image)[RESOLUTION[1] // 2 - 4 : RESOLUTION[1] // 2 + 4].mean(axis=0)
     return float(np.interp(column, np.arange(RESOLUTION[0]) + 0.5, rows))
 
 
@@ -193,17 +201,21 @@ def test_lit_sides_follow_eq_18_brightness(relativity_addon, factory_blender, tm
     image = ch.read_exr(bpy, tmp_path / "with.exr")
     (column_a, exact_a, apparent_a), (column_b, exact_b, apparent_b) = _face_predictions()
     seen_a, seen_b = _at_column(image, column_a), _at_column(image, column_b)
-    print(f"face centres: ahead {seen_a:.4f} (eqs. 18 and 14 {exact_a:.4f}; apparent-face cosine {apparent_a:.4f}), "
-          f"behind {seen_b:.4f} ({exact_b:.4f}; {apparent_b:.4f}); side ratio {seen_a / seen_b:.4f}, "
-          f"eqs. 18 and 14 {exact_a / exact_b:.4f}, apparent-face cosine {apparent_a / apparent_b:.4f}")
+    print(
+        f"face centres: ahead {seen_a:.4f} (eqs. 18 and 14 {exact_a:.4f}; apparent-face cosine {apparent_a:.4f}), "
+        f"behind {seen_b:.4f} ({exact_b:.4f}; {apparent_b:.4f}); side ratio {seen_a / seen_b:.4f}, "
+        f"eqs. 18 and 14 {exact_a / exact_b:.4f}, apparent-face cosine {apparent_a / apparent_b:.4f}"
+    )
     assert seen_a == pytest.approx(exact_a, rel=0.03)
     assert seen_b == pytest.approx(exact_b, rel=0.03)
     assert seen_a / seen_b == pytest.approx(exact_a / exact_b, rel=0.03)
     gain_ahead = ch.luminance(ahead) / ch.luminance(ahead0)
     gain_behind = ch.luminance(behind) / ch.luminance(behind0)
     ratio, ratio0 = ch.luminance(ahead) / ch.luminance(behind), ch.luminance(ahead0) / ch.luminance(behind0)
-    print(f"gain ahead {gain_ahead:.4f} (D^2 = {D_AHEAD**2:.4f}), behind {gain_behind:.4f} "
-          f"(D^2 = {D_BEHIND**2:.4f}); side ratio {ratio:.4f} with eq. 18, {ratio0:.4f} without")
+    print(
+        f"gain ahead {gain_ahead:.4f} (D^2 = {D_AHEAD**2:.4f}), behind {gain_behind:.4f} "
+        f"(D^2 = {D_BEHIND**2:.4f}); side ratio {ratio:.4f} with eq. 18, {ratio0:.4f} without"
+    )
     assert gain_ahead == pytest.approx(D_AHEAD**2, rel=0.03)
     assert gain_behind == pytest.approx(D_BEHIND**2, rel=0.03)
     assert ratio / ratio0 == pytest.approx((D_AHEAD / D_BEHIND) ** 2, rel=0.04)
@@ -227,11 +239,18 @@ def test_lit_sides_follow_eq_18_colour(relativity_addon, factory_blender, tmp_pa
             rest = spectral.blackbody_linear_rgb(temperature, gamut_map=True)
             shifted = spectral.blackbody_linear_rgb(doppler * temperature, gamut_map=True)
             y_ratio = spectral.blackbody_luminance_ratio(temperature, doppler)
-            expected = shifted / spectral.luminance_linear_rec709(shifted) * y_ratio / doppler**2 \
+            expected = (
+                shifted
+                / spectral.luminance_linear_rec709(shifted)
+                * y_ratio
+                / doppler**2
                 / (rest / spectral.luminance_linear_rec709(rest))
+            )
         gain = face / face0
-        print(f"{temperature} {name}: D {doppler:.4f}, channel gains {np.round(gain, 4)}, "
-              f"expected {np.round(expected, 4)}")
+        print(
+            f"{temperature} {name}: D {doppler:.4f}, channel gains {np.round(gain, 4)}, "
+            f"expected {np.round(expected, 4)}"
+        )
         np.testing.assert_allclose(gain, expected, rtol=0.03)
 
 
@@ -250,17 +269,33 @@ def test_object_at_rest_renders_as_without_the_effect(relativity_addon, factory_
 def _state(bpy):
     return {
         "objects": sorted(obj.name for obj in bpy.data.objects),
-        "lights": sorted((light.name, tuple(light.color), light.energy, light.use_temperature)
-                         for light in bpy.data.lights),
+        "lights": sorted(
+            (light.name, tuple(light.color), light.energy, light.use_temperature) for light in bpy.data.lights
+        ),
         "collections": sorted(collection.name for collection in bpy.data.collections),
-        "linking": sorted((obj.name, str(obj.light_linking.receiver_collection),
-                           str(obj.light_linking.blocker_collection), tuple(k for k in obj.keys() if k != "relativity"))
-                          for obj in bpy.data.objects),
+        "linking": sorted(
+            (
+                obj.name,
+                str(obj.light_linking.receiver_collection),
+                str(obj.light_linking.blocker_collection),
+                tuple(k for k in obj.keys() if k != "relativity"),
+            )
+            for obj in bpy.data.objects
+        ),
         "scene keys": sorted(bpy.context.scene.keys()),
-        "meshes": sorted((mesh.name, tuple(attribute.name for attribute in mesh.attributes),
-                          mesh.attributes.active_index) for mesh in bpy.data.meshes),
-        "materials": sorted((material.name, tuple(sorted(node.name for node in material.node_tree.nodes)),
-                             len(material.node_tree.links), tuple(material.keys())) for material in bpy.data.materials),
+        "meshes": sorted(
+            (mesh.name, tuple(attribute.name for attribute in mesh.attributes), mesh.attributes.active_index)
+            for mesh in bpy.data.meshes
+        ),
+        "materials": sorted(
+            (
+                material.name,
+                tuple(sorted(node.name for node in material.node_tree.nodes)),
+                len(material.node_tree.links),
+                tuple(material.keys()),
+            )
+            for material in bpy.data.materials
+        ),
         "node groups": sorted(group.name for group in bpy.data.node_groups),
     }
 
@@ -345,8 +380,11 @@ def test_keyframed_motion_gives_the_constant_velocity_factor(relativity_addon, f
             fcurve.extrapolation = "LINEAR"
             scene.frame_set(scene.frame_current)
         _module("pipeline.effect").apply(scene)
-        colours[motion] = {obj.name: (tuple(obj.data.color), tuple(obj.matrix_world.translation))
-                           for obj in scene.objects if _module("lights.lamps_on_moving_objects").is_copy(obj)}
+        colours[motion] = {
+            obj.name: (tuple(obj.data.color), tuple(obj.matrix_world.translation))
+            for obj in scene.objects
+            if _module("lights.lamps_on_moving_objects").is_copy(obj)
+        }
         _module("pipeline.effect").remove(scene)
     assert set(colours["CONSTANT"]) == set(colours["ANIMATION"]) and len(colours["CONSTANT"]) == 2
     for name, (colour, position) in colours["CONSTANT"].items():

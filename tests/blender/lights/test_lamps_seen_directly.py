@@ -25,8 +25,9 @@ BETA = (0.0, 0.0, -0.5)
 
 def _scene(bpy, kind):
     scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
-    dh.add_emitter_plane(bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None,
-                         temperature=TEMPERATURE)
+    dh.add_emitter_plane(
+        bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None, temperature=TEMPERATURE
+    )
     light = bpy.data.lights.new("Lamp", kind)
     light.energy = 100.0
     light.use_temperature = True
@@ -94,7 +95,6 @@ def test_visible_blackbody_lamp_is_seen_at_d_t_like_an_emitter(relativity_addon,
     assert lamp.visible_camera
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp Face")]
     assert not [material for material in bpy.data.materials if material.name.startswith("Relativity Lamp Face")]
-
 
 
 def test_visible_sun_disc_is_seen_at_d_t(relativity_addon, tmp_path):

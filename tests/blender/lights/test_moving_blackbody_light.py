@@ -75,8 +75,9 @@ def _compare(image, expected, doppler, label):
     return results
 
 
-def test_floor_under_a_moving_blackbody_lamp_is_lit_by_the_blackbody_at_d_t(relativity_addon, factory_blender,
-                                                                            tmp_path):
+def test_floor_under_a_moving_blackbody_lamp_is_lit_by_the_blackbody_at_d_t(
+    relativity_addon, factory_blender, tmp_path
+):
     bpy = factory_blender
     scene, camera, lamp = _scene(bpy)
     mp._effect().apply(scene)
@@ -134,8 +135,10 @@ def test_moving_blackbody_lamp_seen_by_a_moving_observer(relativity_addon, facto
     spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, info = spectral_render.render(scene, PASSES + 1)
     spectral = pixels[::-1, :, :3].astype(float)
-    print(f"D_o {observer_doppler[ROWS].min():.3f} .. {observer_doppler[ROWS].max():.3f}; "
-          f"D_L {lamp_doppler[ROWS].min():.3f} .. {lamp_doppler[ROWS].max():.3f}")
+    print(
+        f"D_o {observer_doppler[ROWS].min():.3f} .. {observer_doppler[ROWS].max():.3f}; "
+        f"D_L {lamp_doppler[ROWS].min():.3f} .. {lamp_doppler[ROWS].max():.3f}"
+    )
     label = f"moving observer, spectral mode, {PASSES + 1} passes"
     for _d, delta_e, ratio in _compare(spectral, expected, total, label):
         assert delta_e < 1.0

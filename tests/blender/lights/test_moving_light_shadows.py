@@ -62,9 +62,11 @@ def measure(image, points, lit, source, label):
     one_lamp_offsets = np.concatenate([first_one - first_exact, last_one - last_exact])
     one_lamp_error = np.nanmean(np.abs(one_lamp_offsets[np.r_[rows, rows]]))
     wrong = int((((image < 0.5 * lit) != shadowed) & floor_px & (lit > 0.05 * peak)).sum())
-    print(f"{label}: away from the shadow: mean error {clear_error:.4f} of the peak; shadow deficit {deficit:.3f} "
-          f"of the exact; edges along the rows: mean {edge_error:.1f} px off (one lamp per frame: "
-          f"{one_lamp_error:.1f} px); {wrong} px dark/lit wrong of {shadowed.sum()} in the exact shadow")
+    print(
+        f"{label}: away from the shadow: mean error {clear_error:.4f} of the peak; shadow deficit {deficit:.3f} "
+        f"of the exact; edges along the rows: mean {edge_error:.1f} px off (one lamp per frame: "
+        f"{one_lamp_error:.1f} px); {wrong} px dark/lit wrong of {shadowed.sum()} in the exact shadow"
+    )
     return clear_error, deficit, edge_error, one_lamp_error, wrong, int(shadowed.sum())
 
 
@@ -78,7 +80,8 @@ def test_shadow_behind_the_exact_camera(relativity_addon, factory_blender, tmp_p
     points = floor._floor_points(bpy, scene, camera)
     lit, source, _ = floor._expected_radiance(points, floor.BETA)
     clear_error, deficit, edge_error, one_lamp_error, _wrong, _size = measure(
-        image, points, lit, source, f"{len(stand_ins)} stand-in lamps")
+        image, points, lit, source, f"{len(stand_ins)} stand-in lamps"
+    )
     assert 2 <= len(stand_ins) <= 16
     assert clear_error < 0.02
     assert abs(deficit - 1.0) < 0.2

@@ -61,8 +61,9 @@ def _reference(bpy, scene, camera, time, position):
     seen, doppler = [], []
     for offset in ((x, y) for y in SUBPIXELS for x in SUBPIXELS):
         points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER, offset, position)
-        seen.append(observer_doppler**4 * mp._expected_radiance(points, mp.BETA, reception_time=time,
-                                                                camera=position)[0])
+        seen.append(
+            observer_doppler**4 * mp._expected_radiance(points, mp.BETA, reception_time=time, camera=position)[0]
+        )
         doppler.append(observer_doppler)
     return np.mean(seen, axis=0), np.mean(doppler, axis=0)
 
@@ -77,8 +78,10 @@ def _compare(image, expected, label):
     error = max(np.abs(profile - wanted).max(), np.abs(across - across_wanted).max()) / wanted.max()
     peak = np.array([int(np.argmax(profile)), int(np.argmax(across))])
     expected_peak = np.array([int(np.argmax(wanted)), int(np.argmax(across_wanted))])
-    print(f"{label}: peak {wanted.max():.3f} (rendered {profile.max():.3f}); profile error {error:.4f} of the "
-          f"peak; pool at {peak} (expected {expected_peak})")
+    print(
+        f"{label}: peak {wanted.max():.3f} (rendered {profile.max():.3f}); profile error {error:.4f} of the "
+        f"peak; pool at {peak} (expected {expected_peak})"
+    )
     return error, np.abs(peak - expected_peak).max()
 
 
@@ -88,7 +91,7 @@ def _check(image, expected, observer_doppler, label):
     assert offset <= 2
     # the test tells the searchlight applied once from none or twice
     for power, wrong in ((0, "no searchlight"), (8, "D_o^8")):
-        assert _compare(image, expected * observer_doppler**(power - 4), f"{label}, {wrong}")[0] > 0.5
+        assert _compare(image, expected * observer_doppler ** (power - 4), f"{label}, {wrong}")[0] > 0.5
 
 
 def test_moving_lamp_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp_path):
@@ -119,8 +122,10 @@ def test_stand_ins_span_what_the_moving_camera_sees(relativity_addon, factory_bl
     irradiance = lamp_doppler**4 / np.sum((points - source) ** 2, axis=-1)
     wanted = source[irradiance >= 0.01 * irradiance.max()][:, 0]
     placed = [obj.location.x for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")]
-    print(f"window {window}: stand-ins from x = {min(placed):.2f} to {max(placed):.2f}; the seen floor's retarded "
-          f"positions {wanted.min():.2f} .. {wanted.max():.2f}")
+    print(
+        f"window {window}: stand-ins from x = {min(placed):.2f} to {max(placed):.2f}; the seen floor's retarded "
+        f"positions {wanted.min():.2f} .. {wanted.max():.2f}"
+    )
     assert min(placed) < wanted.min() + 0.1 and max(placed) > wanted.max() - 0.1
     assert min(placed) > wanted.min() - 1.0 and max(placed) < wanted.max() + 1.0  # the grid is 5 % wider
 
@@ -131,8 +136,9 @@ def test_moving_emitter_seen_by_a_moving_observer(relativity_addon, factory_blen
     bpy = factory_blender
     scene, camera, _sphere = em._scene(bpy, lights_scene=True)
     image, expected, observer_doppler = _observe(bpy, scene, camera, tmp_path, "emitter")
-    _check(image, expected * em.RADIANCE * np.pi * em.RADIUS**2 / (mp.POWER / (4.0 * np.pi)), observer_doppler,
-           "emitter")
+    _check(
+        image, expected * em.RADIANCE * np.pi * em.RADIUS**2 / (mp.POWER / (4.0 * np.pi)), observer_doppler, "emitter"
+    )
 
 
 def test_shutter_time_with_a_moving_observer(relativity_addon, factory_blender, tmp_path):
@@ -162,7 +168,8 @@ def test_shadow_seen_by_a_moving_observer(relativity_addon, factory_blender, tmp
     points, observer_doppler = bb._observed_floor_points(bpy, scene, camera, OBSERVER)
     lit, source, _d = mp._expected_radiance(points, mp.BETA)
     clear_error, deficit, edge_error, one_lamp_error, wrong, size = sh.measure(
-        image, points, observer_doppler**4 * lit, source, "moving observer")
+        image, points, observer_doppler**4 * lit, source, "moving observer"
+    )
     assert clear_error < 0.02
     assert abs(deficit - 1.0) < 0.4
     assert edge_error < 0.5 * one_lamp_error

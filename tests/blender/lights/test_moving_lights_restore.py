@@ -18,14 +18,19 @@ def _module(name):
 def _signature(bpy, scene):
     def tree(material):
         nodes = sorted((node.name, node.bl_idname) for node in material.node_tree.nodes)
-        links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
-                       for link in material.node_tree.links)
+        links = sorted(
+            (link.from_node.name, link.from_socket.identifier, link.to_node.name, link.to_socket.identifier)
+            for link in material.node_tree.links
+        )
         return nodes, links, sorted(compat.custom_property_keys(material))
 
     return {
         "materials": {material.name: tree(material) for material in bpy.data.materials},
-        "lights": {obj.name: (obj.hide_render, sorted(compat.custom_property_keys(obj)))
-                   for obj in bpy.data.objects if obj.type == "LIGHT"},
+        "lights": {
+            obj.name: (obj.hide_render, sorted(compat.custom_property_keys(obj)))
+            for obj in bpy.data.objects
+            if obj.type == "LIGHT"
+        },
         "osl": scene.cycles.shading_system,
         "groups": sorted(group.name for group in bpy.data.node_groups),
         "texts": sorted(text.name for text in bpy.data.texts),
@@ -46,16 +51,21 @@ def test_apply_then_remove_restores_everything(relativity_addon, factory_blender
     floor = bpy.data.materials["White"]
     assert lamp.hide_render and scene.cycles.shading_system
     if method == "GEOMETRY":  # the material shader
-        assert any(node.bl_idname == "ShaderNodeScript"
-                   for node in bpy.data.node_groups["Relativity Moving Lights"].nodes)
-        assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
+        assert any(
+            node.bl_idname == "ShaderNodeScript" for node in bpy.data.node_groups["Relativity Moving Lights"].nodes
+        )
+        assert (
+            floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname
             == "ShaderNodeAddShader"
+        )
     else:  # stand-in lamps with a light shader; the materials are left alone
         stand_ins = [obj for obj in scene.objects if obj.type == "LIGHT" and obj is not lamp]
         assert len(stand_ins) >= 2
         assert all(any(node.bl_idname == "ShaderNodeScript" for node in obj.data.node_tree.nodes) for obj in stand_ins)
-        assert floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname \
+        assert (
+            floor.node_tree.nodes["Material Output"].inputs["Surface"].links[0].from_node.bl_idname
             == "ShaderNodeBsdfDiffuse"
+        )
     effect.remove(scene)
     assert _signature(bpy, scene) == before
 

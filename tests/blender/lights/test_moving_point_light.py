@@ -79,8 +79,9 @@ def _floor_scene(bpy, beta=BETA, occluder=False, samples=16, method="CAMERA", ki
 
 def _quad(bpy, scene, name, centre, half, material):
     mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata([(-half, -half, 0.0), (half, -half, 0.0), (half, half, 0.0), (-half, half, 0.0)], [],
-                     [(0, 1, 2, 3)])
+    mesh.from_pydata(
+        [(-half, -half, 0.0), (half, -half, 0.0), (half, half, 0.0), (-half, half, 0.0)], [], [(0, 1, 2, 3)]
+    )
     mesh.materials.append(material)
     obj = bpy.data.objects.new(name, mesh)
     obj.location = centre
@@ -133,8 +134,9 @@ def _blocked(start, end):
     """Whether the segment start -> end crosses the occluder square (z = const plane)."""
     s = (OCCLUDER_CENTRE[2] - start[..., 2]) / (end[..., 2] - start[..., 2])
     hit = start + s[..., None] * (end - start)
-    inside = (np.abs(hit[..., 0] - OCCLUDER_CENTRE[0]) < OCCLUDER_HALF) & \
-        (np.abs(hit[..., 1] - OCCLUDER_CENTRE[1]) < OCCLUDER_HALF)
+    inside = (np.abs(hit[..., 0] - OCCLUDER_CENTRE[0]) < OCCLUDER_HALF) & (
+        np.abs(hit[..., 1] - OCCLUDER_CENTRE[1]) < OCCLUDER_HALF
+    )
     return inside & (s > 0.0) & (s < 1.0)
 
 
@@ -157,8 +159,10 @@ def test_floor_profile_follows_eq_19_with_retarded_positions(relativity_addon, f
     expected_profile = expected[ROWS].mean(0)
     peak = expected_profile.max()
     error = np.abs(measured_profile - expected_profile)
-    print(f"peak {peak:.3f} (rendered {measured_profile.max():.3f}); max error {error.max() / peak:.4f} of the peak,"
-          f" D over the view {d.min():.3f} .. {d.max():.3f}")
+    print(
+        f"peak {peak:.3f} (rendered {measured_profile.max():.3f}); max error {error.max() / peak:.4f} of the peak,"
+        f" D over the view {d.min():.3f} .. {d.max():.3f}"
+    )
     assert error.max() < 0.05 * peak
 
     # the pool of light lies behind the drawn lamp (retardation, camera delay included) ...
@@ -180,8 +184,10 @@ def test_floor_profile_follows_eq_19_with_retarded_positions(relativity_addon, f
     offsets = np.arange(5, 40)
     measured_asymmetry = measured_profile[measured_peak + offsets] / measured_profile[measured_peak - offsets]
     expected_asymmetry = expected_profile[expected_peak + offsets] / expected_profile[expected_peak - offsets]
-    print(f"ahead / behind the peak at 5..40 px: {measured_asymmetry.min():.3f} .. {measured_asymmetry.max():.3f}"
-          f" (expected {expected_asymmetry.min():.3f} .. {expected_asymmetry.max():.3f})")
+    print(
+        f"ahead / behind the peak at 5..40 px: {measured_asymmetry.min():.3f} .. {measured_asymmetry.max():.3f}"
+        f" (expected {expected_asymmetry.min():.3f} .. {expected_asymmetry.max():.3f})"
+    )
     assert np.all(np.abs(measured_asymmetry - expected_asymmetry) < 0.1 * expected_asymmetry)
 
 
@@ -206,9 +212,11 @@ def test_occluder_shadow_falls_where_the_retarded_position_says(relativity_addon
     judged = ~seen & ~edge
     dark = image < 0.5 * lit
     wrong = (dark != shadowed) & judged
-    print(f"shadow: {shadowed.sum()} px expected, {(dark & judged & ~shadowed).sum()} dark outside it, "
-          f"{(~dark & judged & shadowed).sum()} lit inside it; a lamp at rest would shade {static_shadow.sum()} px, "
-          f"{(static_shadow & shadowed).sum()} of them the same")
+    print(
+        f"shadow: {shadowed.sum()} px expected, {(dark & judged & ~shadowed).sum()} dark outside it, "
+        f"{(~dark & judged & shadowed).sum()} lit inside it; a lamp at rest would shade {static_shadow.sum()} px, "
+        f"{(static_shadow & shadowed).sum()} of them the same"
+    )
     assert shadowed[judged].sum() > 100
     assert wrong.sum() <= 0.01 * judged.sum()
     assert (static_shadow & shadowed).sum() < 0.2 * shadowed.sum()  # the retarded shadow is elsewhere
@@ -234,8 +242,10 @@ def test_at_rest_matches_blenders_own_light(relativity_addon, factory_blender, t
     blender = _render(bpy, scene, tmp_path / "blender.exr")
     lit = blender[..., 1] > 0.1 * blender[..., 1].max()
     ratio = ours[lit].mean() / blender[lit].mean()
-    print(f"{method} {kind}: moving-light shader / Blender's lamp over {lit.sum()} lit px: {ratio:.4f}, "
-          f"largest difference {np.abs(ours[lit] - blender[lit]).max() / blender[lit].max():.2e} of the peak")
+    print(
+        f"{method} {kind}: moving-light shader / Blender's lamp over {lit.sum()} lit px: {ratio:.4f}, "
+        f"largest difference {np.abs(ours[lit] - blender[lit]).max() / blender[lit].max():.2e} of the peak"
+    )
     assert ratio == pytest.approx(1.0, abs=0.03)
     assert np.abs(ours[lit] - blender[lit]).max() < 0.05 * blender[lit].max()
 
@@ -267,9 +277,11 @@ def test_moving_spot_light_cone_is_aberrated(relativity_addon, factory_blender, 
     at_rest_cone = radiance * _spot_mask(n, np.array([1e-12, 0.0, 0.0]))
     error = np.abs(image - expected)
     inner = (slice(2, -2), slice(2, -2))  # a cone edge inside a pixel is averaged over it: judged by the mean
-    print(f"spot: peak {expected.max():.3f}; mean error {error[inner].mean() / expected.max():.4f}, "
-          f"max {error[inner].max() / expected.max():.4f} of the peak; lit px {np.sum(expected > 0)} "
-          f"(cone not aberrated: {np.sum(at_rest_cone > 0)})")
+    print(
+        f"spot: peak {expected.max():.3f}; mean error {error[inner].mean() / expected.max():.4f}, "
+        f"max {error[inner].max() / expected.max():.4f} of the peak; lit px {np.sum(expected > 0)} "
+        f"(cone not aberrated: {np.sum(at_rest_cone > 0)})"
+    )
     assert np.abs(image[ROWS].mean(0) - expected[ROWS].mean(0)).max() < 0.05 * expected.max()
     assert error[inner].mean() < 0.005 * expected.max()
     assert np.abs(image - at_rest_cone)[inner].mean() > 4.0 * error[inner].mean()
@@ -287,8 +299,10 @@ def test_shutter_time_is_when_the_camera_receives_the_light(relativity_addon, fa
     expected, _, _ = _expected_radiance(points, BETA, reception_time=0.15)
     at_t_o, _, _ = _expected_radiance(points, BETA)
     measured, later, earlier = image[ROWS].mean(0), expected[ROWS].mean(0), at_t_o[ROWS].mean(0)
-    print(f"shutter time: peak at {np.argmax(measured)} (expected {np.argmax(later)}, {np.argmax(earlier)} at t_o); "
-          f"max error {np.abs(measured - later).max() / later.max():.4f} of the peak")
+    print(
+        f"shutter time: peak at {np.argmax(measured)} (expected {np.argmax(later)}, {np.argmax(earlier)} at t_o); "
+        f"max error {np.abs(measured - later).max() / later.max():.4f} of the peak"
+    )
     assert np.abs(measured - later).max() < 0.05 * later.max()
     assert np.argmax(later) - np.argmax(earlier) > 10
 
@@ -308,12 +322,15 @@ def test_apparent_geometry_final_render_with_a_moving_observer(relativity_addon,
         images[method] = _render(bpy, scene, tmp_path / f"{method}.exr")[..., :3]
         assert np.all(np.isfinite(images[method])) and images[method].min() >= 0.0
         if method == "GEOMETRY":
-            assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")], \
+            assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")], (
                 "the stand-in lamps are gone after the render"
+            )
         bpy.ops.relativity.remove_all()
     exact, mesh = images["CAMERA"], images["GEOMETRY"]
     difference = np.abs(mesh - exact).mean() / exact.mean()
-    print(f"moving lamp, observer at {observer}: Apparent Geometry vs exact camera, mean |difference| "
-          f"{difference:.4f} of the mean")
+    print(
+        f"moving lamp, observer at {observer}: Apparent Geometry vs exact camera, mean |difference| "
+        f"{difference:.4f} of the mean"
+    )
     assert exact.mean() > 1e-3
     assert difference < 0.03

@@ -49,9 +49,11 @@ def test_moving_sun_is_aberrated_and_d_squared_brighter(relativity_addon, factor
     judged = ~seen & ~edge
     brightness = image[judged & ~shadow].mean() / lit
     wrong = ((image < 0.5 * lit) != shadow) & judged
-    print(f"sun at 0.5c: k = {np.round(k, 4)}, D = {d:.4f}; floor {brightness:.4f} of D^2 E cos / pi "
-          f"(at rest: {1.0 / (d * d * -k[2]):.4f}); shadow {shadow.sum()} px, {wrong.sum()} judged px wrong; "
-          f"an unaberrated shadow shares {(shadow & at_rest_shadow).sum()} px")
+    print(
+        f"sun at 0.5c: k = {np.round(k, 4)}, D = {d:.4f}; floor {brightness:.4f} of D^2 E cos / pi "
+        f"(at rest: {1.0 / (d * d * -k[2]):.4f}); shadow {shadow.sum()} px, {wrong.sum()} judged px wrong; "
+        f"an unaberrated shadow shares {(shadow & at_rest_shadow).sum()} px"
+    )
     assert brightness == pytest.approx(1.0, abs=0.01)
     assert wrong.sum() <= 0.02 * shadow.sum()
     # Its colour: the white's spectrum shifted by D (the physics core's colour-science model).
@@ -59,8 +61,10 @@ def test_moving_sun_is_aberrated_and_d_squared_brighter(relativity_addon, factor
 
     lit_rgb = rendered[..., :3][judged & ~shadow].mean(axis=0)
     colour_error = np.abs(lit_rgb / lit_rgb.sum() - (shifted := doppler_shift_rgb((1.0, 1.0, 1.0), d)) / shifted.sum())
-    print(f"floor colour {np.round(lit_rgb / lit_rgb.sum(), 4)}, white shifted {np.round(shifted / shifted.sum(), 4)}"
-          f" (XYZ {np.round(linear_rec709_to_XYZ(shifted), 3)})")
+    print(
+        f"floor colour {np.round(lit_rgb / lit_rgb.sum(), 4)}, white shifted {np.round(shifted / shifted.sum(), 4)}"
+        f" (XYZ {np.round(linear_rec709_to_XYZ(shifted), 3)})"
+    )
     assert colour_error.max() < 0.01
     assert (shadow & at_rest_shadow).sum() < 0.7 * shadow.sum()
 
@@ -85,8 +89,10 @@ def test_area_light_at_rest_against_blenders_own(relativity_addon, factory_blend
     lit = blender > 0.1 * blender.max()
     ratio = ours[lit].mean() / blender[lit].mean()
     largest = np.abs(ours - blender)[lit].max() / blender.max()
-    print(f"area light {size} m at 1 m: centre point / Blender's area light over {lit.sum()} px: mean {ratio:.4f}, "
-          f"largest difference {largest:.4f} of the peak")
+    print(
+        f"area light {size} m at 1 m: centre point / Blender's area light over {lit.sum()} px: mean {ratio:.4f}, "
+        f"largest difference {largest:.4f} of the peak"
+    )
     assert ratio == pytest.approx(1.0, abs=0.02 if size < 0.5 else 0.06)
     assert largest < (0.05 if size < 0.5 else 0.4)  # a 1 m panel 1 m above the floor is no point
 
@@ -136,9 +142,11 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     y_ratio = blackbody[1] / dh.blackbody_xyz_colour_science(temperature)[1]
     expected_y = floor.ALBEDO / math.pi * SUN_STRENGTH * (-k[2]) * y_ratio / (d * d)
     delta_e = dh.delta_e_2000_normalised(floor_xyz, blackbody)
-    print(f"sun at 0.5c, D = {d:.4f}: floor Delta E {delta_e:.3f} from the blackbody at D T, "
-          f"Y / expected {floor_xyz[1] / expected_y:.4f}; at T: Delta E "
-          f"{dh.delta_e_2000_normalised(floor_xyz, dh.blackbody_xyz_colour_science(temperature)):.2f}")
+    print(
+        f"sun at 0.5c, D = {d:.4f}: floor Delta E {delta_e:.3f} from the blackbody at D T, "
+        f"Y / expected {floor_xyz[1] / expected_y:.4f}; at T: Delta E "
+        f"{dh.delta_e_2000_normalised(floor_xyz, dh.blackbody_xyz_colour_science(temperature)):.2f}"
+    )
     assert delta_e < 1.0
     assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
     assert tuple(sun.data.color) == (1.0, 1.0, 1.0) and sun.data.use_temperature, "the user's sun is restored"
@@ -173,7 +181,9 @@ def test_keyframed_sun_moves_with_its_keyframes_velocity(relativity_addon, facto
     d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
     bpy.context.view_layer.update()
     direction = -np.array(stand_in.matrix_world.to_3x3().col[2])
-    print(f"keyframed sun: stand-in direction {np.round(direction, 4)} (k {np.round(k, 4)}), "
-          f"strength {stand_in.data.energy:.4f} (D^2 E {d * d * SUN_STRENGTH:.4f})")
+    print(
+        f"keyframed sun: stand-in direction {np.round(direction, 4)} (k {np.round(k, 4)}), "
+        f"strength {stand_in.data.energy:.4f} (D^2 E {d * d * SUN_STRENGTH:.4f})"
+    )
     assert np.allclose(direction, k, atol=1e-4)
     assert stand_in.data.energy == pytest.approx(d * d * SUN_STRENGTH, rel=1e-4)

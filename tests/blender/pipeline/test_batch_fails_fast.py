@@ -54,16 +54,24 @@ runpy.run_path(script, run_name="__main__")
 """
 
 
-@pytest.mark.parametrize("script, options", [
-    ("render.py", ["scene.blend", "--out=out.png"]),
-    ("demo_still.py", ["--out=out.png"]),
-    ("flythrough.py", []),
-    ("gallery.py", []),
-])
+@pytest.mark.parametrize(
+    "script, options",
+    [
+        ("render.py", ["scene.blend", "--out=out.png"]),
+        ("demo_still.py", ["--out=out.png"]),
+        ("flythrough.py", []),
+        ("gallery.py", []),
+    ],
+)
 def test_examples_without_bpy_say_what_to_run(script, options, tmp_path):
     path = wh.REPO_ROOT / "examples" / script
-    result = subprocess.run([sys.executable, "-c", BLOCK_BPY, str(path), *options], capture_output=True,
-                            text=True, timeout=120, cwd=tmp_path)
+    result = subprocess.run(
+        [sys.executable, "-c", BLOCK_BPY, str(path), *options],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+    )
     assert result.returncode == 1, (result.returncode, result.stderr[-2000:])
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "needs Blender's Python or the bpy module" in lines[0], result.stderr[-2000:]

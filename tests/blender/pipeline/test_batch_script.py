@@ -23,8 +23,9 @@ def plain_blend(factory_blender, tmp_path):
 
 
 def test_frames_written_with_numbers_and_progress(plain_blend, tmp_path):
-    result = wh.run_render_script(plain_blend, "--frames", "2-4", "--beta=0,0,-0.5", "--samples=1",
-                                  f"--out={tmp_path / 'out' / 'shot.png'}")
+    result = wh.run_render_script(
+        plain_blend, "--frames", "2-4", "--beta=0,0,-0.5", "--samples=1", f"--out={tmp_path / 'out' / 'shot.png'}"
+    )
     assert result.returncode == 0, result.stderr[-2000:]
     for frame in (2, 3, 4):
         assert (tmp_path / "out" / f"shot_{frame:04d}.png").is_file()
@@ -36,8 +37,9 @@ def test_frames_written_with_numbers_and_progress(plain_blend, tmp_path):
     assert progress[-1].split("about ")[1].startswith("0.0 s left")
 
     # A run of '#' is replaced by the zero-padded frame number (Blender's convention), EXR output.
-    result = wh.run_render_script(plain_blend, "--frame=3", "--beta=0,0,-0.5", "--samples=1",
-                                  f"--out={tmp_path / 'hash' / 'f_###.exr'}")
+    result = wh.run_render_script(
+        plain_blend, "--frame=3", "--beta=0,0,-0.5", "--samples=1", f"--out={tmp_path / 'hash' / 'f_###.exr'}"
+    )
     assert result.returncode == 0, result.stderr[-2000:]
     assert (tmp_path / "hash" / "f_003.exr").is_file()
 
@@ -134,15 +136,18 @@ def test_bad_options_fail_with_one_line(plain_blend, tmp_path, options, reason):
 def test_missing_out_bad_extension_missing_file_and_camera(plain_blend, tmp_path, factory_blender):
     wh.assert_fails_with(wh.run_render_script(plain_blend, "--beta=0,0,-0.5"), "--out")
     wh.assert_fails_with(wh.run_render_script(plain_blend, f"--out={tmp_path / 'x.jpg'}"), ".png or .exr")
-    wh.assert_fails_with(wh.run_render_script(tmp_path / "nope.blend", f"--out={tmp_path / 'x.png'}"),
-                         "no such .blend file")
+    wh.assert_fails_with(
+        wh.run_render_script(tmp_path / "nope.blend", f"--out={tmp_path / 'x.png'}"), "no such .blend file"
+    )
     bpy = factory_blender
     wh.new_scene(bpy, with_camera=False)
     no_camera = wh.save_blend(bpy, tmp_path / "no_camera.blend")
-    wh.assert_fails_with(wh.run_render_script(no_camera, "--beta=0,0,-0.5", f"--out={tmp_path / 'x.png'}"),
-                         "no active camera")
-    wh.assert_fails_with(wh.run_render_script(no_camera, "--velocity-from-animation",
-                                              f"--out={tmp_path / 'x.png'}"), "no active camera")
+    wh.assert_fails_with(
+        wh.run_render_script(no_camera, "--beta=0,0,-0.5", f"--out={tmp_path / 'x.png'}"), "no active camera"
+    )
+    wh.assert_fails_with(
+        wh.run_render_script(no_camera, "--velocity-from-animation", f"--out={tmp_path / 'x.png'}"), "no active camera"
+    )
 
 
 def test_animation_faster_than_light_is_refused_with_its_frame(factory_blender, tmp_path):
@@ -161,8 +166,9 @@ def test_animation_faster_than_light_is_refused_with_its_frame(factory_blender, 
     assert "1.2 c" in wh.error_lines(result)[0]
     assert not list(tmp_path.glob("fast*.png"))
     # The slow part alone renders; the fast part alone is refused at its first frame.
-    result = wh.run_render_script(blend, "--velocity-from-animation", light, "--frames=1-5", "--samples=1",
-                                  f"--out={out}")
+    result = wh.run_render_script(
+        blend, "--velocity-from-animation", light, "--frames=1-5", "--samples=1", f"--out={out}"
+    )
     assert result.returncode == 0, result.stderr[-2000:]
     result = wh.run_render_script(blend, "--velocity-from-animation", light, "--frame=8", f"--out={out}")
     wh.assert_fails_with(result, "at frame 8")
@@ -179,12 +185,23 @@ def test_options_reach_the_scene(factory_blender):
     try:
         scene, _, _ = wh.new_scene(bpy)
         parser = batch.build_parser(with_blend_file=False)
-        options = parser.parse_args([
-            "--out=x.exr", "--beta=0.1,0.2,-0.3", "--method=camera", "--shutter=DETECTOR_PLANE",
-            "--shutter-time=-2.5", "--speed-of-light=7", "--no-doppler", "--no-searchlight",
-            "--no-geometry", "--lorentz-window", "--lens=phase-hologram", "--shutter-plane-point=0.5,0,-2",
-            "--shutter-plane-normal=0,0.6,-0.8",
-        ])
+        options = parser.parse_args(
+            [
+                "--out=x.exr",
+                "--beta=0.1,0.2,-0.3",
+                "--method=camera",
+                "--shutter=DETECTOR_PLANE",
+                "--shutter-time=-2.5",
+                "--speed-of-light=7",
+                "--no-doppler",
+                "--no-searchlight",
+                "--no-geometry",
+                "--lorentz-window",
+                "--lens=phase-hologram",
+                "--shutter-plane-point=0.5,0,-2",
+                "--shutter-plane-normal=0,0.6,-0.8",
+            ]
+        )
         batch._apply_options(scene, options)
         settings = scene.relativity
         assert tuple(settings.beta) == pytest.approx((0.1, 0.2, -0.3))
@@ -248,8 +265,15 @@ def test_frame_whose_geometry_update_fails_is_not_rendered(relativity_addon, fac
     wh.keyframe_camera_path(sphere, [(1, (x, y, z)), (3, (x + 0.2, y, z)), (6, (x + 15.2, y, z))])
     blend = wh.save_blend(bpy, tmp_path / "fast_object.blend")
     out = tmp_path / "fast_object.png"
-    result = wh.run_render_script(blend, "--method=geometry", "--beta=0,0,0", "--speed-of-light=100",
-                                  "--frames=1-6", "--samples=1", f"--out={out}")
+    result = wh.run_render_script(
+        blend,
+        "--method=geometry",
+        "--beta=0,0,0",
+        "--speed-of-light=100",
+        "--frames=1-6",
+        "--samples=1",
+        f"--out={out}",
+    )
     wh.assert_fails_with(result, "frame ")
     line = wh.error_lines(result)[0]
     print(line)

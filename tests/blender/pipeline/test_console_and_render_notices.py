@@ -82,8 +82,10 @@ def test_f12_refused_after_set_up_is_shown_in_the_panel(relativity_addon, factor
     assert notice._pending.empty()
     assert notice._popup("title", "reason") is None  # no window in background: nothing to show it in
     log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
-    assert any(e[0] == "label" and e[2] == "ERROR" and e[1].startswith("Last render refused: ")
-               and "must be below 1" in e[1] for e in log), log
+    assert any(
+        e[0] == "label" and e[2] == "ERROR" and e[1].startswith("Last render refused: ") and "must be below 1" in e[1]
+        for e in log
+    ), log
 
     scene.relativity.beta = (0.0, 0.0, -0.5)
     assert bpy.ops.render.render() == {"FINISHED"}

@@ -102,8 +102,9 @@ def test_four_frames_on_two_workers_equal_one_process_and_resume(moving_blend, t
 
     # The single-process script resumes too (--resume): nothing left to render, nothing touched.
     def identities():
-        return {name: (os.stat(cluster.parent / name).st_ino, os.stat(cluster.parent / name).st_mtime_ns)
-                for name in names}
+        return {
+            name: (os.stat(cluster.parent / name).st_ino, os.stat(cluster.parent / name).st_mtime_ns) for name in names
+        }
 
     kept = identities()
     result = wh.run_render_script(moving_blend, *common, f"--out={cluster}", "--resume")
@@ -146,8 +147,10 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
             time.sleep(0.02)
         if victim is None:
             stdout, stderr = process.communicate(timeout=180) if process.poll() is None else process.communicate()
-            pytest.fail(f"no task process seen rendering (job exit {process.returncode}); "
-                        f"stdout: {stdout[-1500:]} stderr: {stderr[-1500:]}")
+            pytest.fail(
+                f"no task process seen rendering (job exit {process.returncode}); "
+                f"stdout: {stdout[-1500:]} stderr: {stderr[-1500:]}"
+            )
         assert "distributed" in " ".join(victim.cmdline()) or "multiprocessing" in " ".join(victim.cmdline())
         victim.send_signal(signal.SIGKILL)
         # Its Blender process dies with it at once (it had about a second of rendering left), so
@@ -197,9 +200,13 @@ def running_cluster(tmp_path):
             except (FileNotFoundError, ValueError, KeyError):  # not yet written, or half
                 time.sleep(0.1)
         assert address, "the scheduler wrote no address"
-        started.append(subprocess.Popen(
-            [*dask, "worker", address, "--nworkers=2", "--nthreads=1", "--no-dashboard"],
-            env={**env, "PYTHONPATH": str(wh.REPO_ROOT)}, **quiet))
+        started.append(
+            subprocess.Popen(
+                [*dask, "worker", address, "--nworkers=2", "--nthreads=1", "--no-dashboard"],
+                env={**env, "PYTHONPATH": str(wh.REPO_ROOT)},
+                **quiet,
+            )
+        )
         yield address
     finally:
         for process in reversed(started):
@@ -222,8 +229,17 @@ def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path, ru
     wh.keyframe_camera_path(camera, [(1, (0, 0, 0)), (2.5, (0, 0, -0.15)), (3.5, (0, 0, -0.65)), (5, (0, 0, -0.8))])
     blend = wh.save_blend(bpy, tmp_path / "fast.blend")
     out = tmp_path / "out" / "f.exr"
-    result = wh.run_render_script(blend, "--frames=2-4", "--velocity-from-animation", "--speed-of-light=10",
-                                  "--samples=1", *TINY, f"--out={out}", f"--scheduler={running_cluster}", "--threads=1")
+    result = wh.run_render_script(
+        blend,
+        "--frames=2-4",
+        "--velocity-from-animation",
+        "--speed-of-light=10",
+        "--samples=1",
+        *TINY,
+        f"--out={out}",
+        f"--scheduler={running_cluster}",
+        "--threads=1",
+    )
     assert result.returncode == 1, result.stderr[-3000:]
     assert f"Dask scheduler {running_cluster}" in result.stdout
     errors = wh.error_lines(result)
@@ -245,16 +261,32 @@ def test_task_options_chunks_and_output_names():
     """Every option a task repeats survives the round trip through its command line; frames are
     cut into runs of consecutive frames; names are those of a single-process --frames render."""
     parser = batch.build_parser(with_blend_file=True)
-    argv = ["x.blend", "--out=o/f.png", "--frames=1-9", "--workers=3", "--chunk=2", "--beta=-0.1,0.25,0.5",
-            "--method=geometry", "--samples=7", "--resolution=40x30", "--no-doppler", "--shutter=detector_plane",
-            "--shutter-time=0.5", "--speed-of-light=3", "--seed=4", "--lorentz-window", "--spectral=2"]
+    argv = [
+        "x.blend",
+        "--out=o/f.png",
+        "--frames=1-9",
+        "--workers=3",
+        "--chunk=2",
+        "--beta=-0.1,0.25,0.5",
+        "--method=geometry",
+        "--samples=7",
+        "--resolution=40x30",
+        "--no-doppler",
+        "--shutter=detector_plane",
+        "--shutter-time=0.5",
+        "--speed-of-light=3",
+        "--seed=4",
+        "--lorentz-window",
+        "--spectral=2",
+    ]
     options = parser.parse_args(argv)
     again = parser.parse_args(["x.blend", "--out=o/f.png", *farm.task_options(parser, options)])
     for key, value in vars(options).items():
         if key not in farm.COORDINATOR_OPTIONS:
             assert getattr(again, key) == value, key
-    assert not any(text.startswith(("--workers", "--chunk", "--frames", "--out")) for text in
-                   farm.task_options(parser, options))
+    assert not any(
+        text.startswith(("--workers", "--chunk", "--frames", "--out")) for text in farm.task_options(parser, options)
+    )
     assert farm.chunks([1, 2, 3, 4, 5, 7, 8], 2) == [[1, 2], [3, 4], [5], [7, 8]]
     assert farm.chunks([1, 2, 3], 1) == [[1], [2], [3]]
     pattern = farm.output_pattern("/a/shot.png", several=True)
@@ -265,9 +297,11 @@ def test_task_options_chunks_and_output_names():
 
 
 def test_single_process_path_imports_no_dask():
-    code = ("import sys; from relativity_addon import batch; from relativity_addon.batch import farm; "
-            "batch.parse(['render.py', 'x.blend', '--out=x.png', '--workers=2']); "
-            "found = sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed', 'bpy')); "
-            "print(found); sys.exit(bool(found))")
+    code = (
+        "import sys; from relativity_addon import batch; from relativity_addon.batch import farm; "
+        "batch.parse(['render.py', 'x.blend', '--out=x.png', '--workers=2']); "
+        "found = sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed', 'bpy')); "
+        "print(found); sys.exit(bool(found))"
+    )
     result = wh.run_python(code)
     assert result.returncode == 0, result.stderr

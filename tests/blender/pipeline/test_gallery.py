@@ -34,11 +34,17 @@ def _y(temperature):
 
 
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
-    names = subprocess.run([sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True,
-                           timeout=120, env=wh._env()).stdout.split()
+    names = subprocess.run(
+        [sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True, timeout=120, env=wh._env()
+    ).stdout.split()
     assert len(names) == 26
-    result = subprocess.run([sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48",
-                             "--samples=2"], capture_output=True, text=True, timeout=600, env=wh._env())
+    result = subprocess.run(
+        [sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48", "--samples=2"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=wh._env(),
+    )
     assert result.returncode == 0, result.stderr[-2000:]
     for name in names:
         image = wh.read_image(factory_blender, tmp_path / f"{name}.png")
@@ -66,8 +72,9 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
         ratio = _y(d * TEMPERATURE) / _y(TEMPERATURE)
         assert fig8[f"{sun} brightness / rest"] == pytest.approx(ratio / d**5, rel=0.05), sun
         if f"{sun} mean D" in fig9:
-            assert fig9[f"{sun} brightness / rest"] == pytest.approx(_y(fig9[f"{sun} mean D"] * TEMPERATURE)
-                                                                      / _y(TEMPERATURE), rel=0.05), sun
+            assert fig9[f"{sun} brightness / rest"] == pytest.approx(
+                _y(fig9[f"{sun} mean D"] * TEMPERATURE) / _y(TEMPERATURE), rel=0.05
+            ), sun
     assert min(ds) < 0.8 and max(ds) > 1.1
 
     # Gray Fig. 1(b): a sphere where aberration puts it; Figs. 4-5: coma versus sharp
@@ -91,11 +98,16 @@ def test_gallery_renders_every_figure(factory_blender, tmp_path):
     assert window["mean |image - Fig. 9(a)|"] < 0.05 * moving["mean |image - Fig. 9(a)|"]
     # Fig. 10: the window with the detector-plane shutter undoes the distortion only imperfectly
     fig10 = numbers["gray_fig10_window_detector_plane"]
-    assert 10 * window["mean |image - Fig. 9(a)|"] < fig10["mean |image - Fig. 9(a)|"] \
+    assert (
+        10 * window["mean |image - Fig. 9(a)|"]
+        < fig10["mean |image - Fig. 9(a)|"]
         < 0.5 * moving["mean |image - Fig. 9(a)|"]
+    )
     # ... where the physics core's window rays put the backdrop
-    assert fig10["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"] \
+    assert (
+        fig10["strips: mean |Fig. 10 - Fig. 9(a) moved by the physics core|"]
         < 0.5 * fig10["strips: mean |Fig. 10 - Fig. 9(a)|"]
+    )
     # Gray Fig. 11: the stereo pair through the window is the pair at rest
     window, moving = numbers["gray_fig11c_stereo_lorentz_window"], numbers["gray_fig11b_stereo_moving"]
     assert window["mean |image - Fig. 11(a)|"] < 0.05 * moving["mean |image - Fig. 11(a)|"]

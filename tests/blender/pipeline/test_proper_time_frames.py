@@ -33,8 +33,9 @@ def test_frames_step_in_proper_time(relativity_addon, factory_blender, tmp_path)
     scene.relativity.speed_of_light = C
     scene.frame_end = 120
     blend = wh.save_blend(bpy, tmp_path / "accelerating.blend")
-    result = wh.run_render_script(blend, f"--out={tmp_path / 'f.png'}", "--frames=70-72", "--proper-time",
-                                  "--velocity-from-animation")
+    result = wh.run_render_script(
+        blend, f"--out={tmp_path / 'f.png'}", "--frames=70-72", "--proper-time", "--velocity-from-animation"
+    )
     assert result.returncode == 0, result.stderr[-2000:]
     for k in (70, 71, 72):
         header = (tmp_path / f"f_{k:04d}.png").read_bytes()
@@ -43,9 +44,11 @@ def test_frames_step_in_proper_time(relativity_addon, factory_blender, tmp_path)
         expected_time = C / ACCELERATION * math.sinh(ACCELERATION * tau / C)
         curves = ch.compat.action_fcurves(camera.animation_data)
         z_at_frame = next(f for f in curves if f.data_path == "location" and f.array_index == 2).evaluate(scene_frame)
-        print(f"frame {k}: traveller {tau:.4f} s, rendered at scene frame {scene_frame:.4f} "
-              f"(t {scene_frame / FPS:.5f} s, expected {expected_time:.5f} s); camera z {z_at_frame:.4f} "
-              f"(world line {_z(expected_time):.4f})")
+        print(
+            f"frame {k}: traveller {tau:.4f} s, rendered at scene frame {scene_frame:.4f} "
+            f"(t {scene_frame / FPS:.5f} s, expected {expected_time:.5f} s); camera z {z_at_frame:.4f} "
+            f"(world line {_z(expected_time):.4f})"
+        )
         assert scene_frame / FPS == pytest.approx(expected_time, abs=2e-3)
         assert z_at_frame == pytest.approx(_z(expected_time), abs=2e-2)
         assert scene_frame > k + 25, "the traveller's clock runs slow: scene frames run ahead"

@@ -71,16 +71,20 @@ BASE_OBJECTS = {
     "Floor": {"tessellation": 1},
 }
 CAMERA_MOVER = {"motion": "STATIC"}
-ARBITRARY_PLANE = {"shutter_model": "ARBITRARY_PLANE", "shutter_plane_point": (0.0, 0.0, -1.0),
-                   "shutter_plane_normal": (0.0, 0.0, -1.0)}
+ARBITRARY_PLANE = {
+    "shutter_model": "ARBITRARY_PLANE",
+    "shutter_plane_point": (0.0, 0.0, -1.0),
+    "shutter_plane_normal": (0.0, 0.0, -1.0),
+}
 FROM_ANIMATION = {"velocity_source": "CAMERA_ANIMATION"}
 
 
 def case(method, target, name, value, base=None, objects=None, label=None):
     """One setting change: ``target`` is "scene" (scene.relativity) or an object's name."""
     label = label or f"{name}={value}"
-    return pytest.param(method, dict(base or {}), dict(objects or {}), target, name, value,
-                        id=f"{method}-{target}-{label}")
+    return pytest.param(
+        method, dict(base or {}), dict(objects or {}), target, name, value, id=f"{method}-{target}-{label}"
+    )
 
 
 CASES = [
@@ -91,13 +95,28 @@ CASES = [
     case("CAMERA", "scene", "shutter_time", 0.2),
     case("CAMERA", "scene", "shutter_model", "ARBITRARY_PLANE", base={"shutter_plane_point": (0.0, 0.0, -4.0)}),
     case("CAMERA", "scene", "shutter_plane_point", (0.0, 0.0, -4.0), base=ARBITRARY_PLANE),
-    case("CAMERA", "scene", "shutter_plane_normal", (0.6, 0.0, -0.8), base={**ARBITRARY_PLANE,
-         "shutter_plane_point": (0.0, 0.0, -4.0)}),
+    case(
+        "CAMERA",
+        "scene",
+        "shutter_plane_normal",
+        (0.6, 0.0, -0.8),
+        base={**ARBITRARY_PLANE, "shutter_plane_point": (0.0, 0.0, -4.0)},
+    ),
     case("CAMERA", "scene", "use_lorentz_window", True),
-    case("CAMERA", "scene", "lorentz_window_shutter", "SHUTTER_MODEL",
-         base={"use_lorentz_window": True, "shutter_time": 0.2}),
-    case("CAMERA", "scene", "lorentz_window_time", -0.2,
-         base={"use_lorentz_window": True, "lorentz_window_shutter": "SHUTTER_MODEL"}),
+    case(
+        "CAMERA",
+        "scene",
+        "lorentz_window_shutter",
+        "SHUTTER_MODEL",
+        base={"use_lorentz_window": True, "shutter_time": 0.2},
+    ),
+    case(
+        "CAMERA",
+        "scene",
+        "lorentz_window_time",
+        -0.2,
+        base={"use_lorentz_window": True, "lorentz_window_shutter": "SHUTTER_MODEL"},
+    ),
     case("CAMERA", "scene", "use_geometry", False),
     case("CAMERA", "scene", "use_time_of_flight", True),
     case("CAMERA", "scene", "use_doppler", False),
@@ -108,19 +127,36 @@ CASES = [
     case("CAMERA", "Blackbody", "temperature", 9000.0),
     case("CAMERA", "scene", "fast_illuminant", "BLACKBODY", base={"fast_illuminant_temperature": 2500.0}),
     case("CAMERA", "scene", "fast_illuminant_temperature", 2500.0, base={"fast_illuminant": "BLACKBODY"}),
-    case("CAMERA", "scene", "method", "GEOMETRY", base={"geometry_final_render": "PREVIEW"},
-         objects={"Mover": CAMERA_MOVER}),  # switching the method after Set Up
+    case(
+        "CAMERA",
+        "scene",
+        "method",
+        "GEOMETRY",
+        base={"geometry_final_render": "PREVIEW"},
+        objects={"Mover": CAMERA_MOVER},
+    ),  # switching the method after Set Up
     # Apparent geometry: the scene settings that apply there, and every object setting.
     case("GEOMETRY", "scene", "speed_of_light", 15.0, base=FROM_ANIMATION),
     case("GEOMETRY", "scene", "beta", (0.4, -0.1, -0.5)),
     case("GEOMETRY", "scene", "use_doppler", False),
     case("GEOMETRY", "scene", "use_searchlight", False),
     case("GEOMETRY", "scene", "use_chang_searchlight", True),
-    case("GEOMETRY", "scene", "doppler_only_brightness", "SPECTRUM",
-         base={"use_searchlight": False, "geometry_final_render": "PREVIEW"}),
+    case(
+        "GEOMETRY",
+        "scene",
+        "doppler_only_brightness",
+        "SPECTRUM",
+        base={"use_searchlight": False, "geometry_final_render": "PREVIEW"},
+    ),
     case("GEOMETRY", "scene", "velocity_source", "CAMERA_ANIMATION"),
-    case("GEOMETRY", "scene", "method", "CAMERA", base={"geometry_final_render": "PREVIEW"},
-         objects={"Mover": CAMERA_MOVER}),
+    case(
+        "GEOMETRY",
+        "scene",
+        "method",
+        "CAMERA",
+        base={"geometry_final_render": "PREVIEW"},
+        objects={"Mover": CAMERA_MOVER},
+    ),
     case("GEOMETRY", "Mover", "enabled", False),
     case("GEOMETRY", "Mover", "enabled", True, objects={"Mover": {"enabled": False}}),
     case("GEOMETRY", "Mover", "motion", "STATIC"),
@@ -182,13 +218,15 @@ def build_scene(bpy, method, scene_settings, object_settings):
 
     wh.add_sphere(bpy, scene, (-1.3, 0.5, -5.0), 0.45, _emitter(bpy, "Red", (1.0, 0.1, 0.05), 2.0), name="Red")
     wh.add_sphere(bpy, scene, (1.3, 0.5, -5.0), 0.45, _emitter(bpy, "Green", (0.1, 1.0, 0.2), 2.0), name="Green")
-    wh.add_sphere(bpy, scene, (0.0, -0.3, -6.0), 0.5, _emitter(bpy, "Blackbody", (1.0, 1.0, 1.0), 1.0),
-                  name="Blackbody")
+    wh.add_sphere(
+        bpy, scene, (0.0, -0.3, -6.0), 0.5, _emitter(bpy, "Blackbody", (1.0, 1.0, 1.0), 1.0), name="Blackbody"
+    )
     wh.add_sphere(bpy, scene, (0.0, 1.0, -4.5), 0.35, _emitter(bpy, "Mover", (0.2, 0.3, 1.0), 2.0), name="Mover")
 
     mesh = bpy.data.meshes.new("Floor")
-    mesh.from_pydata([(-4.0, -1.2, -1.5), (4.0, -1.2, -1.5), (4.0, -1.2, -11.0), (-4.0, -1.2, -11.0)], [],
-                     [(0, 1, 2, 3)])
+    mesh.from_pydata(
+        [(-4.0, -1.2, -1.5), (4.0, -1.2, -1.5), (4.0, -1.2, -11.0), (-4.0, -1.2, -11.0)], [], [(0, 1, 2, 3)]
+    )
     mesh.materials.append(ch.diffuse_material(bpy, "Floor", (0.8, 0.8, 0.8)))
     floor = bpy.data.objects.new("Floor", mesh)
     scene.collection.objects.link(floor)
@@ -208,8 +246,9 @@ def build_scene(bpy, method, scene_settings, object_settings):
             setattr(settings, name, value)
     settings.velocity_source = {**BASE_SCENE, **scene_settings}["velocity_source"]
     # the exact camera photographs a static scene (an object's own velocity is refused there)
-    base_objects = {**BASE_OBJECTS, "Mover": {**BASE_OBJECTS["Mover"], **CAMERA_MOVER}} if method == "CAMERA" \
-        else BASE_OBJECTS
+    base_objects = (
+        {**BASE_OBJECTS, "Mover": {**BASE_OBJECTS["Mover"], **CAMERA_MOVER}} if method == "CAMERA" else BASE_OBJECTS
+    )
     for obj_name in set(base_objects) | set(object_settings):
         values = {**base_objects.get(obj_name, {}), **object_settings.get(obj_name, {})}
         for name, value in values.items():
@@ -259,16 +298,19 @@ def test_identical_set_ups_render_identically(relativity_addon, factory_blender,
     scene = build_scene(bpy, method, {}, {})
     set_up(bpy)
     rebuilt = render(bpy, scene, tmp_path / "rebuilt.exr")
-    print(f"{method}: mean {first.mean():.4f}, max {first.max():.3f}; same set-up rendered again "
-          f"{difference(first, again):.2e}, rebuilt {difference(first, rebuilt):.2e}")
+    print(
+        f"{method}: mean {first.mean():.4f}, max {first.max():.3f}; same set-up rendered again "
+        f"{difference(first, again):.2e}, rebuilt {difference(first, rebuilt):.2e}"
+    )
     assert first.mean() > 0.02 and first.max() > 0.5  # the scene is in view
     assert difference(first, again) <= SAME
     assert difference(first, rebuilt) <= SAME
 
 
 @pytest.mark.parametrize("method, base, objects, target, name, value", CASES)
-def test_changed_setting_reaches_next_render(relativity_addon, factory_blender, tmp_path, method, base, objects,
-                                             target, name, value):
+def test_changed_setting_reaches_next_render(
+    relativity_addon, factory_blender, tmp_path, method, base, objects, target, name, value
+):
     bpy = factory_blender
     scene = build_scene(bpy, method, base, objects)
     set_up(bpy)
@@ -294,4 +336,5 @@ def test_changed_setting_reaches_next_render(relativity_addon, factory_blender, 
         f"after changing {name} to {value!r} in the panel, F12 renders {stale:.3g} (mean |difference|) away from "
         f"a fresh set-up with that setting (the change itself is {changed:.3g}; "
         f"after vs before {difference(after, before):.3g}; mean pixel before {before.mean():.3g}, after "
-        f"{after.mean():.3g}, fresh {fresh.mean():.3g})")
+        f"{after.mean():.3g}, fresh {fresh.mean():.3g})"
+    )

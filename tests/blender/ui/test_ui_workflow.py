@@ -67,20 +67,42 @@ def draw_panel(bpy, idname, scene, obj=None):
 
 def fingerprint(bpy):
     """Everything the add-on may touch, as one string (compared before apply and after remove)."""
+
     def idprops(owner):
         return repr(sorted((key, repr(owner[key])) for key in compat.custom_property_keys(owner)))
 
     cameras = []
     for data in bpy.data.cameras:
-        cameras.append((data.name, data.type, data.custom_mode, data.lens, repr(data.custom_shader),
-                        data.custom_filepath, data.custom_bytecode, idprops(data), idprops(data.cycles_custom)))
+        cameras.append(
+            (
+                data.name,
+                data.type,
+                data.custom_mode,
+                data.lens,
+                repr(data.custom_shader),
+                data.custom_filepath,
+                data.custom_bytecode,
+                idprops(data),
+                idprops(data.cycles_custom),
+            )
+        )
     objects = []
     for obj in bpy.data.objects:
-        objects.append((obj.name, obj.type, tuple(map(tuple, obj.matrix_world)), repr(obj.data),
-                        tuple((m.name, m.type) for m in obj.modifiers), idprops(obj)))
+        objects.append(
+            (
+                obj.name,
+                obj.type,
+                tuple(map(tuple, obj.matrix_world)),
+                repr(obj.data),
+                tuple((m.name, m.type) for m in obj.modifiers),
+                idprops(obj),
+            )
+        )
     meshes = [(m.name, len(m.vertices), m.vertices[0].co[:] if len(m.vertices) else ()) for m in bpy.data.meshes]
-    names = {kind: sorted(item.name for item in getattr(bpy.data, kind))
-             for kind in ("texts", "node_groups", "materials", "worlds", "scenes")}
+    names = {
+        kind: sorted(item.name for item in getattr(bpy.data, kind))
+        for kind in ("texts", "node_groups", "materials", "worlds", "scenes")
+    }
     # Rendering adds the "Render Result" image: that is Blender's, not the add-on's.
     names["images"] = sorted(image.name for image in bpy.data.images if image.type == "IMAGE")
     scene = bpy.context.scene
@@ -221,8 +243,9 @@ def test_time_of_flight_says_what_it_leaves_out(relativity_addon, factory_blende
     scene.relativity.use_time_of_flight = True
     bpy.context.view_layer.update()
     log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
-    assert any(e[0] == "label" and e[2] == "ERROR" and "Time of Flight Only is for the exact camera" in e[1]
-               for e in log)
+    assert any(
+        e[0] == "label" and e[2] == "ERROR" and "Time of Flight Only is for the exact camera" in e[1] for e in log
+    )
 
 
 def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_addon, factory_blender):
@@ -231,8 +254,12 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     camera.rotation_euler = (1.2, 0.1, -0.7)
     bpy.context.view_layer.update()
     settings = scene.relativity
-    menus = {"speed": "RELATIVITY_MT_speed_presets", "speed_of_light": "RELATIVITY_MT_speed_of_light_presets",
-             "shutter": "RELATIVITY_MT_shutter_presets", "paper_setups": "RELATIVITY_MT_paper_setups_presets"}
+    menus = {
+        "speed": "RELATIVITY_MT_speed_presets",
+        "speed_of_light": "RELATIVITY_MT_speed_of_light_presets",
+        "shutter": "RELATIVITY_MT_shutter_presets",
+        "paper_setups": "RELATIVITY_MT_paper_setups_presets",
+    }
     found = {}
     for kind, menu in menus.items():
         directories = bpy.utils.preset_paths(f"relativity/{kind}")
@@ -275,8 +302,15 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     # Fig. 10: the window stays in that plane (the plane of fixed points for t_W = -1), the
     # detector-plane shutter times the rays; its shutter time gives the axial chief ray Fig. 9's
     # lens time (Gray's caption), checked with the physics core's lens times.
-    fig9_lens_time = lens_time("ARBITRARY_PLANE", np.zeros(3), np.array([0.0, 0.0, -1e3]), c=1.0,
-                               shutter_time=settings.shutter_time, plane_point=point, plane_normal=normal)
+    fig9_lens_time = lens_time(
+        "ARBITRARY_PLANE",
+        np.zeros(3),
+        np.array([0.0, 0.0, -1e3]),
+        c=1.0,
+        shutter_time=settings.shutter_time,
+        plane_point=point,
+        plane_normal=normal,
+    )
     load("paper_setups", "Gray_2020_Fig_10_Lorentz_window_detector_plane.py")
     assert settings.use_lorentz_window and settings.lorentz_window_shutter == "SHUTTER_MODEL"
     assert settings.lorentz_window_time == -1.0 and settings.shutter_model == "DETECTOR_PLANE"
@@ -284,20 +318,35 @@ def test_every_shipped_preset_loads_and_gray_velocity_is_converted(relativity_ad
     data = camera.data
     focus = data.dof.focus_distance if data.dof.use_dof else math.inf
     image_distance = 1.0 / (1.0 / (data.lens * 1e-3) - 1.0 / focus)
-    fig10_lens_time = lens_time("DETECTOR_PLANE", np.zeros(3), np.array([0.0, 0.0, -1e3]), c=1.0,
-                                shutter_time=settings.shutter_time, detector_point=np.array([0.0, 0.0, image_distance]))
+    fig10_lens_time = lens_time(
+        "DETECTOR_PLANE",
+        np.zeros(3),
+        np.array([0.0, 0.0, -1e3]),
+        c=1.0,
+        shutter_time=settings.shutter_time,
+        detector_point=np.array([0.0, 0.0, image_distance]),
+    )
     assert fig10_lens_time == pytest.approx(fig9_lens_time, abs=1e-6)
     # The shutter panel shows the lens for the detector plane and the window's settings.
     shown = [entry[1] for entry in draw_panel(bpy, "RELATIVITY_PT_shutter", scene) if entry[0] == "prop"]
-    assert shown == ["shutter_model", "shutter_time", "imaging_element", "use_lorentz_window",
-                     "lorentz_window_shutter", "lorentz_window_time"]
+    assert shown == [
+        "shutter_model",
+        "shutter_time",
+        "imaging_element",
+        "use_lorentz_window",
+        "lorentz_window_shutter",
+        "lorentz_window_time",
+    ]
     assert not settings.use_time_of_flight
     # Fig. 11: the same with Blender's stereo pair, eyes 0.4 apart converging at 5, as an anaglyph.
     load("paper_setups", "Gray_2020_Fig_11_stereo_Lorentz_window.py")
     np.testing.assert_allclose(beta_local, rotation.T @ np.array(settings.beta), atol=1e-6)
     stereo = camera.data.stereo
-    assert (stereo.convergence_mode, stereo.interocular_distance, stereo.convergence_distance) == \
-        ("OFFAXIS", pytest.approx(0.4), pytest.approx(5.0))
+    assert (stereo.convergence_mode, stereo.interocular_distance, stereo.convergence_distance) == (
+        "OFFAXIS",
+        pytest.approx(0.4),
+        pytest.approx(5.0),
+    )
     assert scene.render.use_multiview and scene.render.views_format == "STEREO_3D"
     assert scene.render.image_settings.stereo_3d_format.display_mode == "ANAGLYPH"
 
