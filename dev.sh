@@ -88,7 +88,7 @@ run_tests() {  # run_tests X.Y [pytest arguments]
     return "$status"
 }
 
-lint() {  # ruff, mypy and codespell over the repository, in their own venv (requirements/lint.txt)
+lint() {  # ruff (check and format), mypy and codespell over the repository, in their own venv (requirements/lint.txt)
     local venv=.venv-lint want
     [ -x "$venv/bin/python" ] || "${PYTHON311:-python3.11}" -m venv "$venv" || return 1
     want=$(sha256sum requirements/lint.txt | cut -d' ' -f1)
@@ -98,6 +98,7 @@ lint() {  # ruff, mypy and codespell over the repository, in their own venv (req
     fi
     local status=0
     "$venv/bin/ruff" check . || status=1
+    "$venv/bin/ruff" format --check . || status=1
     "$venv/bin/mypy" || status=1  # files and levels: [tool.mypy] in pyproject.toml
     "$venv/bin/codespell" || status=1
     return "$status"
@@ -126,8 +127,8 @@ case "${1:-}" in
         chosen=$(versions) || exit 2
         failed=0
         summary=()
-        echo "=== lint (ruff, mypy, codespell) ==="
-        if lint; then summary+=("lint (ruff, mypy, codespell): clean"); else summary+=("lint (ruff, mypy, codespell): FAILED"); failed=1; fi
+        echo "=== lint (ruff check and format, mypy, codespell) ==="
+        if lint; then summary+=("lint (ruff check and format, mypy, codespell): clean"); else summary+=("lint (ruff check and format, mypy, codespell): FAILED"); failed=1; fi
         for version in $chosen; do
             echo "=== Blender $version ==="
             start=$SECONDS
