@@ -30,6 +30,7 @@ import bpy
 from ...errors import RelativityError
 from ..common import compat, names, osl
 from ..scene import lens, snapshot
+from ..scene.lens import PANORAMA_PROJECTIONS, lens_type, projection_parameters, stereo_eyes
 
 if TYPE_CHECKING:
     from bpy.types import Camera, Object, Scene
@@ -76,7 +77,6 @@ REQUIRED_PARAMETERS = (
 
 
 # Blender's panorama types the shader renders -> its PROJECTION_* code (0 is the perspective camera).
-PANORAMA_PROJECTIONS = {"EQUIRECTANGULAR": 1, "FISHEYE_EQUIDISTANT": 2, "FISHEYE_EQUISOLID": 3, "MIRRORBALL": 4}
 # Shutter models defined by a thin lens's geometry (detector, focus distance): perspective only.
 LENS_SHUTTERS = ("DETECTOR_PLANE", "FOCUS_SURFACE", "FIXED_POINT_SURFACE")
 
@@ -105,13 +105,6 @@ def is_applied(camera_data: Camera):
 def is_render_only(camera_data: Camera):
     """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
     return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
-
-
-def lens_type(camera_data: Camera):
-    """The camera's own type (PERSP, PANO, ...): the saved one while the OSL camera is applied."""
-    if is_applied(camera_data):
-        return camera_data[names.CAMERA_SAVED_STATE_KEY]["type"]
-    return camera_data.type
 
 
 def type_problem(camera_name, camera_data: Camera):
@@ -175,42 +168,6 @@ def _focus_surface_warning(scene, camera_object):
         f"{moved * scale:.3g} m further on: nearer objects are not photographed "
         f"(shutter time {-focus / c:.3g} s times them at the lens)"
     )
-
-
-def stereo_eyes(scene: Scene):
-    """Whether the scene renders Blender's stereo pair (each eye offset from the camera)."""
-    render = scene.render
-    return bool(render.use_multiview and render.views_format == "STEREO_3D")
-
-
-def _fitted_sensor(scene, camera_data):
-    """Sensor width and height (mm) as Blender fits them to the image (fisheye equisolid)."""
-    render = scene.render
-    x_ratio = render.resolution_x * render.pixel_aspect_x
-    y_ratio = render.resolution_y * render.pixel_aspect_y
-    fit = camera_data.sensor_fit
-    horizontal = x_ratio > y_ratio if fit == "AUTO" else fit == "HORIZONTAL"
-    size = camera_data.sensor_height if fit == "VERTICAL" else camera_data.sensor_width
-    if horizontal:
-        return size, size * y_ratio / x_ratio
-    return size * x_ratio / y_ratio, size
-
-
-def projection_parameters(scene: Scene, camera_data: Camera):
-    kind = lens_type(camera_data)
-    projection = PANORAMA_PROJECTIONS.get(camera_data.panorama_type, 0) if kind == "PANO" else 0
-    sensor_width, sensor_height = _fitted_sensor(scene, camera_data)
-    return {
-        "projection": projection,
-        "longitude_min": camera_data.longitude_min,
-        "longitude_max": camera_data.longitude_max,
-        "latitude_min": camera_data.latitude_min,
-        "latitude_max": camera_data.latitude_max,
-        "fisheye_fov": camera_data.fisheye_fov,
-        "fisheye_lens": camera_data.fisheye_lens,
-        "sensor_width": sensor_width,
-        "sensor_height": sensor_height,
-    }
 
 
 def _local_to_shader(vector):

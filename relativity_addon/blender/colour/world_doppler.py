@@ -31,9 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...physics import exposure
-from ..camera import exact_camera
 from ..common import names
-from ..scene import snapshot
 from . import compositing
 
 if TYPE_CHECKING:
@@ -59,30 +57,23 @@ def problem(scene: Scene, snap: Snapshot):
     render = scene.render
     if snap.use_time_of_flight:
         return "time-of-flight rays leave along d - beta"
-    if exact_camera.stereo_eyes(scene):
+    if snap.stereo:
         return "a stereo pair's eyes look along shifted directions"
     if render.use_border and render.use_crop_to_border:
         return "the render is cropped to its border"
-    data = scene.objects[snap.camera].data
-    kind = exact_camera.lens_type(data)
-    if kind == "PANO" and (data.panorama_type not in exposure.PANORAMAS or data.shift_x or data.shift_y):
-        return "a panorama with a lens shift"
-    if kind not in ("PERSP", "PANO"):
+    kind = snap.projection[0]
+    if kind in exposure.PANORAMAS:
+        values = dict(snap.projection[1:])
+        return "a panorama with a lens shift" if values["shift_x"] or values["shift_y"] else None
+    if kind != "PERSP":
         return f"a {kind} camera"
     return None
 
 
 def _inputs(scene, snap):
     """What the image depends on: camera type and projection, size, velocity, aberration."""
-    camera_object = scene.objects[snap.camera]
-    data = camera_object.data
-    if exact_camera.lens_type(data) == "PANO":
-        parameters = exact_camera.projection_parameters(scene, data)
-        projection = (data.panorama_type, *sorted((key, float(value)) for key, value in parameters.items()))
-    else:
-        projection = ("PERSP", *snapshot.view_window(scene, camera_object))
     aberration = bool(snap.use_geometry and not snap.use_lorentz_window)
-    return projection, render_size(scene), tuple(float(b) for b in snap.beta_camera), aberration
+    return snap.projection, render_size(scene), tuple(float(b) for b in snap.beta_camera), aberration
 
 
 def pixel_log_doppler(projection, size, beta_camera, aberration):

@@ -33,7 +33,7 @@ from ...physics.lorentz import aberrate, camera_to_scene_direction
 from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
 from ..colour import materials
 from ..common import names
-from ..scene import animation, snapshot, sources
+from ..scene import animation, lens, sources
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Scene
@@ -96,7 +96,7 @@ def view_directions(scene: Scene, snap: Snapshot, columns=32, rows=24, margin=0.
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
     camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame unless
     a Lorentz window keeps it, Gray eq. 6)."""
-    left, right, bottom, top = snapshot.view_window(scene, scene.objects[snap.camera])
+    left, right, bottom, top = lens.view_window(scene, scene.objects[snap.camera])
     widen_x, widen_y = margin * (right - left), margin * (top - bottom)
     x = np.linspace(left - widen_x, right + widen_x, columns)
     y = np.linspace(bottom - widen_y, top + widen_y, rows)

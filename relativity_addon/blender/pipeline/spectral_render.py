@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 
 from ...errors import RelativityError
-from ...physics import exposure, spectral_render
+from ...physics import spectral_render
 from ..colour import compositing, materials, volumes, world_doppler
 from ..common import names
 from ..geometry import modifier
@@ -115,10 +115,11 @@ class _Saved:
 
 
 def pixel_log_doppler(scene: Scene, snap: Snapshot):
-    """``ln D`` at every pixel centre (rows bottom first, as Blender stores images)."""
+    """``ln D`` at every pixel centre (rows bottom first, as Blender stores images), for the
+    snapshot's projection: a perspective view window or one of the exact camera's panoramas."""
+    aberration = bool(snap.use_geometry and not snap.use_lorentz_window)
     size = world_doppler.render_size(scene)
-    directions = exposure.pixel_directions(snapshot.view_window(scene, scene.objects[snap.camera]), size)
-    return exposure.log_doppler(directions, snap.beta_camera, snap.use_geometry and not snap.use_lorentz_window)
+    return world_doppler.pixel_log_doppler(snap.projection, size, snap.beta_camera, aberration)
 
 
 def _scene_lights(scene):

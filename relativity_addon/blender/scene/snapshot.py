@@ -97,6 +97,10 @@ class Snapshot:
     # the fast mode's blackbody lamps by temperature (illuminants.LitGroup): their light groups'
     # passes are read through their own tables (light_groups.py)
     lit_groups: tuple = ()
+    # the camera's image (``lens.projection``: the perspective view window or a panorama's
+    # parameters) and whether it renders a stereo pair: stages take these, not the camera anew
+    projection: tuple = ()
+    stereo: bool = False
 
     @property
     def time(self) -> float:
@@ -388,15 +392,6 @@ def in_final_render(scene: Scene):
     return scene.name in _final_renders
 
 
-def view_window(scene: Scene, camera):
-    """The camera's image on the plane at unit distance: ``(left, right, bottom, top)`` in its
-    local axes (Blender's own view frame: sensor fit, aspect and shift included)."""
-    corners = camera.data.view_frame(scene=scene)
-    xs = [corner.x / -corner.z for corner in corners]
-    ys = [corner.y / -corner.z for corner in corners]
-    return min(xs), max(xs), min(ys), max(ys)
-
-
 def world_to_camera(camera_matrix):
     """Rotation ``(3, 3)`` taking world vectors to the axes of a camera with world matrix
     ``camera_matrix`` (4x4): the nearest rotation (polar decomposition), scale and shear removed."""
@@ -411,7 +406,7 @@ def frame_exposure(scene: Scene, camera, settings, beta, camera_matrix):
     beta_camera = world_to_camera(camera_matrix) @ np.array(beta)
     aberration = settings.use_geometry and not settings.use_lorentz_window
     power = 1.0 if settings.use_chang_searchlight else 4.0
-    return exposure.compensation(beta_camera, view_window(scene, camera), aberration, power)
+    return exposure.compensation(beta_camera, lens.view_window(scene, camera), aberration, power)
 
 
 def check_time_of_flight(settings, lights) -> None:
@@ -493,4 +488,6 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         lit_groups=illuminants.lit_groups(scene)
         if exact_camera and settings.use_doppler and not time_of_flight
         else (),
+        projection=lens.projection(scene, camera),
+        stereo=lens.stereo_eyes(scene),
     )

@@ -201,6 +201,33 @@ def test_spectral_render_of_a_coloured_world(relativity_addon):
     assert d.max() / d.min() > 1.3
 
 
+def test_spectral_render_of_a_world_through_a_panorama(relativity_addon):
+    """An equirectangular camera's spectral passes weigh each pixel with its own direction's ``D``
+    (the panorama's, not a perspective view window's): ``D^5 S(lambda D)`` per pixel."""
+    bpy = __import__("bpy")
+    width, height = 64, 32
+    scene, camera, _background = _world_scene(bpy, resolution=(width, height))
+    camera.data.type = "PANO"
+    camera.data.panorama_type = "EQUIRECTANGULAR"
+    beta = (0.3, 0.0, -0.6)
+    _set_up(bpy, scene, beta)
+    pixels, _info = dh.addon_module(relativity_addon, "pipeline.spectral_render").render(scene, 3)
+    image = pixels[::-1, :, :3].astype(float)  # top row first
+    d = _doppler(_equirectangular_directions(width, height), beta)
+    spectrum = dh.emitted_spectrum(COLOUR)
+    # ahead (the view axis is the image centre), to the side, behind (the left edge), up and down
+    patches = [(slice(14, 18), slice(30, 34)), (slice(14, 18), slice(46, 50)), (slice(14, 18), slice(1, 4))]
+    patches += [(slice(5, 8), slice(20, 24)), (slice(24, 27), slice(40, 44))]
+    for rows, cols in patches:
+        expected = np.mean([dh.observed_xyz(spectrum, value) for value in d[rows, cols].ravel()], axis=0)
+        measured = dh.linear_rec709_to_xyz(image[rows, cols].reshape(-1, 3).mean(0))
+        delta_e = dh.delta_e_2000_normalised(measured, expected)
+        print(f"D {d[rows, cols].mean():.3f}: Delta E {delta_e:.2f}, Y/expected {measured[1] / expected[1]:.3f}")
+        assert delta_e < 2.0
+        assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.08)
+    assert d.max() / d.min() > 3.0
+
+
 def test_stereo_pair_keeps_the_world_aov_writer(relativity_addon):
     """Each eye of Blender's stereo pair looks along its own shifted directions: the world writes its
     ln D AOV there, and the compositor divides the AOV by the coverage."""
