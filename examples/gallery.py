@@ -3,7 +3,8 @@
     python examples/gallery.py [--only NAME[,NAME...]] [--size 320x240] [--samples 32] [--out docs/gallery]
 
 Writes ``OUT/NAME.png`` for every figure of Weiskopf et al. (1999) and Gray et al. (2020) that
-the add-on can render (``--list`` names them), ``OUT/contact_sheet.png``, the numbers measured on
+the add-on can render (``--list`` names them; ``--list-file PATH`` writes the names to PATH, one a
+line, away from the log lines Blender prints), ``OUT/contact_sheet.png``, the numbers measured on
 the renders (``OUT/measurements.json``, also printed) and, when every figure was rendered into
 docs/gallery, ``docs/gallery.md``. The measurements are made on the linear (EXR) render, the PNG
 is its Standard view transform at the family's exposure; expected values come from
@@ -174,7 +175,13 @@ def main(argv=None):
     parser.add_argument("--samples", type=int, default=32)
     parser.add_argument("--out", default=str(REPO_ROOT / "docs" / "gallery"))
     parser.add_argument("--list", action="store_true", help="print the figure names and exit")
+    parser.add_argument(
+        "--list-file", help="write the figure names to this file, one a line, and exit (for scripts: no log lines)"
+    )
     args = parser.parse_args(argv)
+    if args.list_file:
+        Path(args.list_file).write_text("".join(f"{name}\n" for name in FIGURES))
+        return 0
     if args.list:
         print("\n".join(FIGURES))
         return 0
