@@ -21,6 +21,7 @@ failure, which Blender would not do on its own.
 
 import argparse
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -49,6 +50,13 @@ def _raise(ex):
 
 def enable_addon():
     """Register the add-on from this checkout; raises if its register() fails."""
+    package = sys.modules.get("relativity_addon")
+    if package is not None and not hasattr(package, "__time__"):
+        # Imported before (scenes.py, compat.run_main), not by addon_utils: without the load time
+        # it stamps on modules it imports, enable() takes the package for changed on disk and
+        # reloads its __init__ ("module changed on disk ... reloading"). Blender's addon_utils
+        # stamps its own bl_pkg the same way.
+        package.__time__ = os.path.getmtime(package.__file__)
     if addon_utils.enable("relativity_addon", default_set=False, handle_error=_raise) is None:
         raise RuntimeError("could not enable relativity_addon")
 
