@@ -66,6 +66,49 @@ def _y(temperature):
     return colour.sd_to_XYZ(colour.sd_blackbody(temperature, shape), cmfs, method="Integration")[1]
 
 
+CONTACT_SHEET = """
+import json, sys
+from pathlib import Path
+import bpy
+import numpy as np
+out = Path(sys.argv[1])
+sys.argv = ["gallery.py"]
+sys.path.insert(0, "examples")
+import gallery
+names = list(gallery.FIGURES)
+for index, name in enumerate(names):  # flat tiles, each its own dark colour
+    image = bpy.data.images.new(name, 24, 18)
+    image.pixels.foreach_set(np.tile([(index + 1) / 64, 0.1, 0.3, 1.0], 24 * 18).astype(np.float32))
+    image.filepath_raw = str(out / f"{name}.png")
+    image.file_format = "PNG"
+    image.save()
+gallery.contact_sheet(out, names)
+(out / "names.json").write_text(json.dumps(names))
+"""
+
+
+def test_contact_sheet_labels_every_panel(factory_blender, tmp_path):
+    """Below each panel, light text as wide as the figure's name is long (the panels are flat dark
+    colours here, so only a label can put light pixels under them)."""
+    result = wh.run_python(CONTACT_SHEET, tmp_path)
+    assert result.returncode == 0, result.stderr[-2000:]
+    names = json.loads((tmp_path / "names.json").read_text())
+    sheet = wh.read_image(factory_blender, tmp_path / "contact_sheet.png")[..., :3]
+    ink = sheet.min(axis=-1) > 0.5
+    widths = []
+    for name in names:
+        colour = wh.read_image(factory_blender, tmp_path / f"{name}.png")[0, 0, :3]
+        panel = (np.abs(sheet - colour) < 0.5 / 255).all(axis=-1)
+        rows, columns = np.nonzero(panel)
+        assert rows.size > 1000, name  # the panel, scaled up
+        below = ink[rows.max() + 1 : rows.max() + 19, columns.min() : columns.max() + 1]
+        assert below.sum() > 30, f"no label under {name}"
+        inked = np.nonzero(below.any(axis=0))[0]
+        widths.append(inked.max() - inked.min())
+    lengths = [len(name) for name in names]
+    assert np.corrcoef(lengths, widths)[0, 1] > 0.95, list(zip(names, widths, strict=True))
+
+
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
     names = _figure_names([sys.executable], tmp_path)
     assert len(names) == 26
