@@ -2,7 +2,7 @@
 # Development entry point. Supported Blender lines: 4.5 LTS (bpy 4.5, CPython 3.11) and
 # 5.2 LTS (bpy 5.2, CPython 3.13); each has its pins in requirements/blender-X.Y.txt and its own
 # virtual environment .venv-X.Y.
-#   ./dev.sh demo   set up .venv-5.2, render the demo still to out/demo.png
+#   ./dev.sh demo   set up .venv-5.2, render the README's demo image (three panels) to out/demo.png
 #   ./dev.sh test   run ruff, then set up each venv and run the whole suite on every supported version, one
 #                   after the other (extra arguments go to pytest); non-zero if any version fails
 # BLENDER=4.5 or BLENDER=5.2 picks one version (e.g. BLENDER=5.2 ./dev.sh test -k register).
@@ -120,7 +120,7 @@ case "${1:-}" in
         version=${BLENDER:-5.2}
         BLENDER=$version versions >/dev/null || exit 2
         setup "$version"
-        ".venv-$version/bin/python" examples/demo_still.py --out out/demo.png
+        ".venv-$version/bin/python" examples/demo_still.py --panels --out out/demo.png
         ;;
     test)
         shift

@@ -1,6 +1,7 @@
 """Render the demo still: a small scene built from scratch, photographed by the relativistic camera.
 
     python examples/demo_still.py --out out/demo.png [--speed 0.9] [--doppler] [--samples 32] [--width 320 --height 240]
+    python examples/demo_still.py --out out/demo.png --panels   (the README's image: the three side by side)
 
 The camera flies toward the scene at ``--speed`` (fraction of c, along its view direction; 0
 renders the photo at rest). Aberration pulls the view toward the direction of motion, so the
@@ -12,6 +13,8 @@ lens replaces the 28 mm one when moving, to frame the shrunken view. Doppler col
 which RGB says little about. The spectral model (docs/spectral-model.md) holds reflectances
 flat outside 420-655 nm, so every surface takes the blue of the shifted white light and only
 its brightness tells the colours apart (the red sphere, bright in the infrared, stays bright).
+``--panels`` renders three stills, at rest (``--speed 0``), moving, and moving with ``--doppler``,
+and writes them side by side, 4 px of white between them, as in the README (``./dev.sh demo``).
 
 Runs on the ``bpy`` wheel (Cycles on the CPU, no GPU needed). The add-on is enabled straight from
 this checkout (repository root on ``sys.path``, ``addon_utils.enable("relativity_addon")``), so the
@@ -21,7 +24,9 @@ failure, which Blender would not do on its own.
 
 import argparse
 import math
+import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -38,6 +43,7 @@ REPO_ROOT = EXAMPLES_DIR.parent
 sys.path[:0] = [str(REPO_ROOT), str(EXAMPLES_DIR)]
 
 import addon_utils  # noqa: E402  (ships with bpy, importable once bpy is)
+import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from scenes import build_demo_scene  # noqa: E402
@@ -49,6 +55,13 @@ def _raise(ex):
 
 def enable_addon():
     """Register the add-on from this checkout; raises if its register() fails."""
+    package = sys.modules.get("relativity_addon")
+    if package is not None and not hasattr(package, "__time__"):
+        # Imported before (scenes.py, compat.run_main), not by addon_utils: without the load time
+        # it stamps on modules it imports, enable() takes the package for changed on disk and
+        # reloads its __init__ ("module changed on disk ... reloading"). Blender's addon_utils
+        # stamps its own bl_pkg the same way.
+        package.__time__ = os.path.getmtime(package.__file__)
     if addon_utils.enable("relativity_addon", default_set=False, handle_error=_raise) is None:
         raise RuntimeError("could not enable relativity_addon")
 
@@ -103,6 +116,37 @@ def render_demo(out_path, width=320, height=240, samples=32, speed=0.9, doppler=
     return out_path
 
 
+def _read_pixels(path):
+    image = bpy.data.images.load(str(path), check_existing=False)
+    width, height = image.size
+    pixels = np.empty(width * height * 4, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)
+
+
+def render_panels(out_path, width=320, height=240, samples=32, speed=0.9, gap=4):
+    """The README's demo image: at rest, at ``speed``, and at ``speed`` with Doppler colour, side
+    by side with ``gap`` px of white between them, in ``out_path`` (PNG); return the path."""
+    out_path = Path(out_path).resolve()
+    with tempfile.TemporaryDirectory() as work_dir:
+        runs = (("rest", 0.0, False), ("moving", speed, False), ("doppler", speed, True))
+        paths = [render_demo(Path(work_dir) / f"{name}.png", width, height, samples, v, d) for name, v, d in runs]
+        panels = [_read_pixels(path) for path in paths]
+    sheet = np.ones((height, 3 * width + 2 * gap, 4), dtype=np.float32)
+    for index, panel in enumerate(panels):
+        left = index * (width + gap)
+        sheet[:, left : left + width] = panel
+    image = bpy.data.images.new("Demo panels", sheet.shape[1], sheet.shape[0])
+    image.colorspace_settings.name = "sRGB"
+    image.pixels.foreach_set(sheet.ravel())
+    image.filepath_raw = str(out_path)
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+    return out_path
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out/demo.png", help="PNG file to write")
@@ -113,12 +157,24 @@ def main(argv=None):
         "--speed", type=float, default=0.9, help="camera speed toward the scene, fraction of c (0: photo at rest)"
     )
     parser.add_argument("--doppler", action="store_true", help="also render the Doppler colour shift")
+    parser.add_argument(
+        "--panels",
+        action="store_true",
+        help="at rest, moving and moving with --doppler side by side (the README's image)",
+    )
     args = parser.parse_args(argv)
     if not 0.0 <= args.speed < 1.0:
         parser.error(f"--speed must be in [0, 1), got {args.speed}")
+    if args.panels and (args.doppler or not args.speed):
+        parser.error(
+            "--panels renders the rest, moving and --doppler stills itself: give a --speed above 0, no --doppler"
+        )
 
     start = time.perf_counter()
-    out_path = render_demo(args.out, args.width, args.height, args.samples, args.speed, args.doppler)
+    if args.panels:
+        out_path = render_panels(args.out, args.width, args.height, args.samples, args.speed)
+    else:
+        out_path = render_demo(args.out, args.width, args.height, args.samples, args.speed, args.doppler)
     print(f"wrote {out_path} ({time.perf_counter() - start:.1f} s)")
     return 0
 

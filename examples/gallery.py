@@ -3,7 +3,8 @@
     python examples/gallery.py [--only NAME[,NAME...]] [--size 320x240] [--samples 32] [--out docs/gallery]
 
 Writes ``OUT/NAME.png`` for every figure of Weiskopf et al. (1999) and Gray et al. (2020) that
-the add-on can render (``--list`` names them), ``OUT/contact_sheet.png``, the numbers measured on
+the add-on can render (``--list`` names them; ``--list-file PATH`` writes the names to PATH, one a
+line, away from the log lines Blender prints), ``OUT/contact_sheet.png``, the numbers measured on
 the renders (``OUT/measurements.json``, also printed) and, when every figure was rendered into
 docs/gallery, ``docs/gallery.md``. The measurements are made on the linear (EXR) render, the PNG
 is its Standard view transform at the family's exposure; expected values come from
@@ -138,11 +139,40 @@ def view_window(scene, camera):
     return min(xs), max(xs), min(ys), max(ys)
 
 
-def contact_sheet(out_dir, names, columns=4, tile=(240, 180)):
-    """The PNGs side by side (row by row in ``names`` order) in ``contact_sheet.png``."""
+def _label(text, width, height, size=11):
+    """``text`` in white on black, drawn with Blender's own font: float RGBA [row (bottom first),
+    column, channel], ``width`` x ``height``; the font shrinks until the text fits."""
+    import blf
+    import imbuf
+
+    font = 0  # Blender's default font, loaded in background mode too
+    buffer = imbuf.new((width, height))
+    with blf.bind_imbuf(font, buffer):
+        blf.size(font, size)
+        while size > 6 and blf.dimensions(font, text)[0] > width - 4:
+            size -= 1
+            blf.size(font, size)
+        blf.color(font, 1.0, 1.0, 1.0, 1.0)
+        blf.position(font, 2, (height - blf.dimensions(font, "fig")[1]) // 2 + 1, 0)
+        blf.draw_buffer(font, text)
+    with tempfile.TemporaryDirectory() as work_dir:  # an ImBuf's pixels are read through a file
+        path = Path(work_dir) / "label.png"
+        imbuf.write(buffer, filepath=str(path))
+        image = bpy.data.images.load(str(path), check_existing=False)
+        pixels = np.empty(width * height * 4, dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+        bpy.data.images.remove(image)
+    coverage = pixels.reshape(height, width, 4)[..., 3:]  # the glyphs' alpha over a transparent buffer
+    return np.concatenate([np.repeat(coverage, 3, axis=-1), np.ones_like(coverage)], axis=-1)
+
+
+def contact_sheet(out_dir, names, columns=4, tile=(240, 180), label_height=14):
+    """The PNGs side by side (row by row in ``names`` order), each with its name below it, in
+    ``contact_sheet.png``."""
     rows = math.ceil(len(names) / columns)
     tw, th = tile
-    sheet = np.zeros((rows * (th + 4), columns * (tw + 4), 4), dtype=np.float32)
+    cell_w, cell_h = tw + 4, th + label_height + 4
+    sheet = np.zeros((rows * cell_h, columns * cell_w, 4), dtype=np.float32)
     sheet[..., 3] = 1.0
     for index, name in enumerate(names):
         image = bpy.data.images.load(str(Path(out_dir) / f"{name}.png"), check_existing=False)
@@ -151,8 +181,10 @@ def contact_sheet(out_dir, names, columns=4, tile=(240, 180)):
         image.pixels.foreach_get(pixels)
         bpy.data.images.remove(image)
         r, c = divmod(index, columns)
-        top = (rows - 1 - r) * (th + 4) + 2  # Blender's pixel rows run bottom up
-        sheet[top : top + th, c * (tw + 4) + 2 : c * (tw + 4) + 2 + tw] = pixels.reshape(th, tw, 4)
+        bottom = (rows - 1 - r) * cell_h + 2  # Blender's pixel rows run bottom up
+        left = c * cell_w + 2
+        sheet[bottom : bottom + label_height, left : left + tw] = _label(name, tw, label_height)
+        sheet[bottom + label_height : bottom + label_height + th, left : left + tw] = pixels.reshape(th, tw, 4)
     image = bpy.data.images.new("Contact sheet", sheet.shape[1], sheet.shape[0])
     image.colorspace_settings.name = "sRGB"
     image.pixels.foreach_set(sheet.ravel())
@@ -174,7 +206,13 @@ def main(argv=None):
     parser.add_argument("--samples", type=int, default=32)
     parser.add_argument("--out", default=str(REPO_ROOT / "docs" / "gallery"))
     parser.add_argument("--list", action="store_true", help="print the figure names and exit")
+    parser.add_argument(
+        "--list-file", help="write the figure names to this file, one a line, and exit (for scripts: no log lines)"
+    )
     args = parser.parse_args(argv)
+    if args.list_file:
+        Path(args.list_file).write_text("".join(f"{name}\n" for name in FIGURES))
+        return 0
     if args.list:
         print("\n".join(FIGURES))
         return 0

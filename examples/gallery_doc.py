@@ -55,7 +55,10 @@ FIGURES = [
     (
         "weiskopf_sun_rest",
         f"{W99} Figs. 8-9, reference",
-        "The five Suns seen at rest (not a figure of the paper; the reference for the brightness ratios).",
+        "The Suns seen at rest from the same place (not a figure of the paper; the reference for the "
+        "brightness ratios: at rest every Sun is equally bright). Without aberration they lie further left, "
+        "at -57, -44.5, -30, -13 and 7 degrees, so this 20 mm view (84 degrees wide) shows three whole, one "
+        "cut by the left edge and the fifth not at all.",
         "Camera at rest; " + SUN.split("; ")[1] + "; exposure -0.5 stops as Figs. 8-9.",
     ),
     (
@@ -63,15 +66,18 @@ FIGURES = [
         f"{W99} Fig. 8",
         "The Sun passing at 0.5c, Doppler effect only as the paper defines it: the shifted spectrum "
         "L(lambda D) with no further factor, so a blackbody at T is seen at the colour of D T with "
-        "Y(D T) / (D^5 Y(T)) of its rest brightness. Ahead it turns bluish but dimmer, behind orange and "
-        "brighter.",
+        "Y(D T) / (D^5 Y(T)) of its rest brightness. Ahead it turns bluish, behind orange, and the brightness "
+        "hardly changes: Y(D T) / (D^5 Y(T)) is largest, 1.02, near D = 0.9 and falls on both sides, to about "
+        "0.8 for the Sun behind (D = 0.67) and for the one ahead (D = 1.23). Aberration draws the Sun behind "
+        "larger and the one ahead smaller.",
         SUN + "; Doppler colour on, searchlight off, `doppler_only_brightness = 'SPECTRUM'`.",
     ),
     (
         "weiskopf_fig9_sun_doppler_searchlight",
         f"{W99} Fig. 9",
         "The same with Doppler and searchlight together (eq. 14): a blackbody seen at D T, brightness "
-        "Y(D T) / Y(T): ahead bright and bluish, behind dark red.",
+        "Y(D T) / Y(T): ahead 2.3 times as bright as at rest (bluish white, 7070 K; clipped to white in the PNG), "
+        "behind a ninth as bright and orange-brown (3860 K).",
         SUN + "; Doppler colour and searchlight on.",
     ),
     (

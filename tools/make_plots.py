@@ -50,10 +50,15 @@ def doppler_against_angle(plt, path):
     figure.savefig(path)
 
 
-def aberration_map(plt, path, speed=0.9):
-    """Lines of constant longitude and latitude of the scene-frame sky, as the moving observer
-    sees them (motion toward longitude 0, latitude 0), equirectangular."""
-    figure, axes = _figure(plt, 9.0, 4.8)
+def aberration_map_lines(speed=0.9, step_deg=15):
+    """The lines of constant scene-frame longitude and latitude, every ``step_deg`` degrees, as the
+    observer moving at ``speed`` toward longitude 0, latitude 0 sees them: a list of
+    (kind, longitude seen, latitude seen), kind "latitude" or "longitude", in degrees.
+
+    A line that leaves the map at one edge comes back at the other: the seen longitude wraps at
+    +-180 degrees, or the line passes a pole. NaN breaks it there, so that no segment is drawn
+    across the map. The meridian behind the observer lies on both edges, +-180 degrees: it is
+    drawn as both, longitude -180 and +180."""
     beta = np.array([speed, 0.0, 0.0])
 
     def seen(longitude, latitude):
@@ -61,19 +66,37 @@ def aberration_map(plt, path, speed=0.9):
             [np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude), np.sin(latitude)], axis=-1
         )
         view_observed = -lorentz.aberrate(-view, beta)  # photons travel against the view direction
+        # aberration along x keeps the sign of y: on the meridians 0 and +-180 (y ~ 1e-16 of either
+        # sign after rounding) take it from the scene longitude, so that -180 and +180 keep their edges
+        side = np.where(
+            np.abs(view_observed[..., 1]) < 1e-12, np.copysign(0.0, np.sin(longitude)), view_observed[..., 1]
+        )
         return (
-            np.degrees(np.arctan2(view_observed[..., 1], view_observed[..., 0])),
+            np.degrees(np.arctan2(side, view_observed[..., 0])),
             np.degrees(np.arcsin(np.clip(view_observed[..., 2], -1.0, 1.0))),
         )
 
+    def broken(kind, x, y):
+        jumps = np.nonzero(np.abs(np.diff(x)) > 90.0)[0] + 1
+        return kind, np.insert(x, jumps, np.nan), np.insert(y, jumps, np.nan)
+
+    lines = []
     fine = np.radians(np.linspace(-179.9, 179.9, 721))
-    for latitude in np.radians(np.arange(-75, 76, 15)):
-        x, y = seen(fine, np.full_like(fine, latitude))
-        axes.plot(x, y, color="tab:blue", lw=0.8)
+    for latitude in np.radians(np.arange(-90 + step_deg, 90, step_deg)):
+        lines.append(broken("latitude", *seen(fine, np.full_like(fine, latitude))))
     fine_latitude = np.radians(np.linspace(-89.9, 89.9, 361))
-    for longitude in np.radians(np.arange(-165, 181, 15)):
-        x, y = seen(np.full_like(fine_latitude, longitude), fine_latitude)
-        axes.plot(x, y, color="tab:orange", lw=0.8)
+    for longitude in np.radians(np.arange(-180, 181, step_deg)):
+        lines.append(broken("longitude", *seen(np.full_like(fine_latitude, longitude), fine_latitude)))
+    return lines
+
+
+def aberration_map(plt, path, speed=0.9):
+    """Lines of constant longitude and latitude of the scene-frame sky, as the moving observer
+    sees them (motion toward longitude 0, latitude 0), equirectangular."""
+    figure, axes = _figure(plt, 9.0, 4.8)
+    colours = {"latitude": "tab:blue", "longitude": "tab:orange"}
+    for kind, x, y in aberration_map_lines(speed):
+        axes.plot(x, y, color=colours[kind], lw=0.8)
     axes.set_xlim(-180, 180)
     axes.set_ylim(-90, 90)
     axes.set_xlabel("longitude seen (degrees; motion toward 0)")

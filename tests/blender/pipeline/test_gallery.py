@@ -13,6 +13,7 @@ geometry x_seen = x + beta r does.
 """
 
 import json
+import re
 import subprocess
 import sys
 
@@ -23,6 +24,38 @@ import pipeline_helpers as wh
 
 GALLERY_SCRIPT = wh.REPO_ROOT / "examples" / "gallery.py"
 TEMPERATURE = 5762.0
+# Blender prints log lines of its own to stdout (this one in a Debian root without /proc/mounts)
+NOISY_PYTHON = """
+import runpy, sys
+print("Could not get a list of mounted file-systems", flush=True)
+script = sys.argv[1]
+sys.argv = sys.argv[1:]
+runpy.run_path(script, run_name="__main__")
+"""
+
+
+def _figure_names(python, tmp_path):
+    """The gallery's figure names as a script reads them (``python``: the interpreter's command),
+    from the file ``--list-file`` writes, where Blender's own log lines cannot go."""
+    list_file = tmp_path / "figures.txt"
+    result = subprocess.run(
+        [*python, str(GALLERY_SCRIPT), f"--list-file={list_file}"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=wh._env(),
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    return list_file.read_text().split()
+
+
+def test_gallery_figure_names_ignore_blender_log_lines(tmp_path):
+    """The names are those of the figures in docs/gallery, whatever Blender prints besides."""
+    names = _figure_names([sys.executable, "-c", NOISY_PYTHON], tmp_path)
+    in_docs = [path.stem for path in (wh.REPO_ROOT / "docs" / "gallery").glob("*.png") if path.stem != "contact_sheet"]
+    assert len(in_docs) == 26
+    assert sorted(names) == sorted(in_docs)
+    assert all(re.fullmatch(r"(weiskopf|gray)_[a-z0-9_]+", name) for name in names), names
 
 
 def _y(temperature):
@@ -33,10 +66,51 @@ def _y(temperature):
     return colour.sd_to_XYZ(colour.sd_blackbody(temperature, shape), cmfs, method="Integration")[1]
 
 
+CONTACT_SHEET = """
+import json, sys
+from pathlib import Path
+import bpy
+import numpy as np
+out = Path(sys.argv[1])
+sys.argv = ["gallery.py"]
+sys.path.insert(0, "examples")
+import gallery
+names = list(gallery.FIGURES)
+for index, name in enumerate(names):  # flat tiles, each its own dark colour
+    image = bpy.data.images.new(name, 24, 18)
+    image.pixels.foreach_set(np.tile([(index + 1) / 64, 0.1, 0.3, 1.0], 24 * 18).astype(np.float32))
+    image.filepath_raw = str(out / f"{name}.png")
+    image.file_format = "PNG"
+    image.save()
+gallery.contact_sheet(out, names)
+(out / "names.json").write_text(json.dumps(names))
+"""
+
+
+def test_contact_sheet_labels_every_panel(factory_blender, tmp_path):
+    """Below each panel, light text as wide as the figure's name is long (the panels are flat dark
+    colours here, so only a label can put light pixels under them)."""
+    result = wh.run_python(CONTACT_SHEET, tmp_path)
+    assert result.returncode == 0, result.stderr[-2000:]
+    names = json.loads((tmp_path / "names.json").read_text())
+    sheet = wh.read_image(factory_blender, tmp_path / "contact_sheet.png")[..., :3]
+    ink = sheet.min(axis=-1) > 0.5
+    widths = []
+    for name in names:
+        colour = wh.read_image(factory_blender, tmp_path / f"{name}.png")[0, 0, :3]
+        panel = (np.abs(sheet - colour) < 0.5 / 255).all(axis=-1)
+        rows, columns = np.nonzero(panel)
+        assert rows.size > 1000, name  # the panel, scaled up
+        below = ink[rows.max() + 1 : rows.max() + 19, columns.min() : columns.max() + 1]
+        assert below.sum() > 30, f"no label under {name}"
+        inked = np.nonzero(below.any(axis=0))[0]
+        widths.append(inked.max() - inked.min())
+    lengths = [len(name) for name in names]
+    assert np.corrcoef(lengths, widths)[0, 1] > 0.95, list(zip(names, widths, strict=True))
+
+
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
-    names = subprocess.run(
-        [sys.executable, str(GALLERY_SCRIPT), "--list"], capture_output=True, text=True, timeout=120, env=wh._env()
-    ).stdout.split()
+    names = _figure_names([sys.executable], tmp_path)
     assert len(names) == 26
     result = subprocess.run(
         [sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48", "--samples=2"],
