@@ -122,11 +122,29 @@ def type_problem(camera_name, camera_data: Camera):
     if kind == "PANO":
         if camera_data.panorama_type in PANORAMA_PROJECTIONS:
             return None
+        projection = compat.enum_name(camera_data, "panorama_type")
         return (
-            f"camera {camera_name!r} is a {camera_data.panorama_type} panorama: the relativistic camera "
+            f"Camera {camera_name!r} is a {projection} panorama: the relativistic camera "
             "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras"
         )
-    return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
+    kind = compat.enum_name(camera_data, "type")
+    return f"Camera {camera_name!r} is {kind}: the relativistic camera replaces a perspective or panoramic camera only"
+
+
+def final_render_problem(scene: Scene, snap: Snapshot):
+    """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
+    line, lower-case: it follows a colon), or None when it is. Without a moving observer nothing
+    needs it (the boosted meshes are then scene-frame meshes)."""
+    if snap.method != "GEOMETRY" or snap.geometry_final_render != "EXACT":
+        return "Final Render is set to Boosted Meshes" if snap.method == "GEOMETRY" else "not Apparent Geometry"
+    if snap.speed == 0.0 and snap.velocity_source != "CAMERA_ANIMATION":
+        return "the observer is at rest"
+    if snap.engine != "CYCLES":
+        return f"the exact camera needs Cycles, not {compat.enum_name(scene.render, 'engine', snap.engine)}"
+    no_osl = osl.unavailable_reason()
+    if no_osl is not None:
+        return no_osl[0].lower() + no_osl[1:]
+    return type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
 def lens_warnings(camera_object: Object):
@@ -313,7 +331,7 @@ def compile_shader(camera_data: Camera) -> None:
     try:
         errors = osl.compile_custom_camera(camera_data)
     except osl.OSLUnavailableError as error:
-        raise RelativityError(f"OSL unavailable: {error}") from error
+        raise RelativityError(f"{error}: the relativistic camera needs it") from error
     if errors:
         raise RelativityError(f"relativistic camera shader failed to compile: {errors[0]}")
     missing = _missing_parameters(camera_data)
@@ -351,7 +369,7 @@ def apply(scene: Scene, snap: Snapshot, render_only=False):
         try:
             osl.ensure_oslquery_importable()
         except osl.OSLUnavailableError as error:
-            raise RelativityError(f"OSL unavailable: {error}") from error
+            raise RelativityError(f"{error}: the relativistic camera needs it") from error
         _save_state(camera_data, render_only)
         text = ensure_shader_text()
         camera_data.type = "CUSTOM"

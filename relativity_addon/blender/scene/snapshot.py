@@ -23,7 +23,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
-from ..common import names
+from ..common import names, osl
 from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
 
 if TYPE_CHECKING:
@@ -455,6 +455,8 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
     moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
+    if settings.method == "CAMERA" and osl.unavailable_reason() is not None:
+        raise RelativityError(f"{osl.unavailable_reason()}: Method Exact Camera needs it (use Apparent Geometry)")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
         lens.check_detector_image(scene, camera, matrix)
