@@ -333,11 +333,11 @@ def compile_shader(camera_data: Camera) -> None:
     except osl.OSLUnavailableError as error:
         raise RelativityError(f"{error}: the relativistic camera needs it") from error
     if errors:
-        raise RelativityError(f"relativistic camera shader failed to compile: {errors[0]}")
+        raise RelativityError(f"Relativistic camera shader failed to compile: {errors[0]}")
     missing = _missing_parameters(camera_data)
     if missing or not camera_data.custom_bytecode:
         raise RelativityError(
-            "relativistic camera shader compiled to an empty shader "
+            "Relativistic camera shader compiled to an empty shader "
             f"(missing parameters: {', '.join(missing) or 'bytecode'})"
         )
 
@@ -388,23 +388,23 @@ def write(scene: Scene, snap: Snapshot) -> None:
     camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
     if not is_applied(camera_data):
-        raise RelativityError(f"camera {camera_object.name!r} is not the relativistic camera")
+        raise RelativityError(f"Camera {camera_object.name!r} is not the relativistic camera")
     if camera_data.type != "CUSTOM":
-        raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
+        raise RelativityError(f"Camera {camera_object.name!r} is no longer a custom camera")
     if lens_type(camera_data) == "PANO" and snap.shutter_model in LENS_SHUTTERS:
         name = snap.shutter_model.replace("_", " ").lower()
         raise RelativityError(
-            f"the {name} shutter needs a perspective camera's lens: camera "
+            f"The {name} shutter needs a perspective camera's lens: camera "
             f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)"
         )
     if stereo_eyes(scene) and lens_type(camera_data) == "PANO":
         raise RelativityError(
-            f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
+            f"Camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
             "are not rendered by the relativistic camera; switch Stereoscopy off"
         )
     if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
         raise RelativityError(
-            f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
+            f"Camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
             "share one shutter plane; use off-axis or parallel convergence"
         )
     if _missing_parameters(camera_data) or not camera_data.custom_bytecode:

@@ -27,11 +27,11 @@ class OSLUnavailableError(RuntimeError):
 def unavailable_reason() -> str | None:
     """Why this Blender cannot render the add-on's OSL shaders (one line for the user), or None.
 
-    The one place the add-on decides whether OSL is available (tests patch it to the answer of a
-    build without OSL): Cycles must be built with OSL (``_cycles.with_osl``; Debian's 5.2 is
-    not) and its ``oslquery`` module must import, from the wheel's bundled folder if needed."""
+    The one place the add-on decides whether OSL is available: Cycles must be built with OSL
+    (``_cycles.with_osl``; Debian's 5.2 is not) and its ``oslquery`` module must import, from the
+    wheel's bundled folder if needed."""
     try:
-        import _cycles
+        import _cycles  # type: ignore[import-not-found]  # Cycles' C module, no stubs
     except ImportError:
         return NO_OSL
     if not getattr(_cycles, "with_osl", False):

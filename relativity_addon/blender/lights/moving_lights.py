@@ -111,7 +111,7 @@ def ensure_group(light_names):
         node.script = text  # compiles (oslquery must be importable) and creates the sockets
         node.location = (200.0, -200.0 * index)
         if "Emission" not in node.outputs or "light_position" not in node.inputs:
-            raise RelativityError("the moving-light OSL shader did not compile (no sockets on its script node)")
+            raise RelativityError("The moving-light OSL shader did not compile (no sockets on its script node)")
         group.links.new(inputs.outputs["Albedo"], node.inputs["Albedo"])
         if previous is None:
             previous = node.outputs["Emission"]
