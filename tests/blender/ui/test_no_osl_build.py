@@ -239,3 +239,30 @@ def test_long_warnings_are_wrapped_whole(relativity_addon, factory_blender, widt
     assert len(lines) > len(messages)
     for line in lines:
         assert blf.dimensions(0, line)[0] <= room, (width, line)
+
+
+def test_switching_method_that_removes_the_effect_says_so(relativity_addon, factory_blender, monkeypatch):
+    """With OSL: Apparent Geometry set up, then Method Exact Camera with an orthographic camera,
+    which the exact camera cannot replace: the effect is gone, and the panel and a popup say so
+    (an update callback has no operator report)."""
+    bpy = factory_blender
+    effect = _module(bpy, "pipeline.effect")
+    notice = _module(bpy, "pipeline.render_notice")
+    monkeypatch.setattr(notice, "_background", lambda: False)
+    scene, camera, _ = _geometry_scene(bpy)
+    camera.data.type = "ORTHO"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    _drain(notice)
+    scene.relativity.method = "CAMERA"
+    bpy.context.view_layer.update()
+    assert effect.applied_method(scene) is None
+    popups = [reason for _, reason in _drain(notice)]
+    assert popups and "removed" in popups[0] and "Orthographic" in popups[0], popups
+    _assert_user_facing(popups[0])
+    messages, _ = _errors(bpy, scene)
+    assert popups[0] in messages, messages
+    assert bpy.ops.relativity.setup_scene.poll()
+    scene.relativity.method = "GEOMETRY"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    messages, _ = _errors(bpy, scene)
+    assert not any("removed" in m for m in messages), messages
