@@ -124,7 +124,7 @@ def type_problem(camera_name, camera_data: Camera):
             return None
         projection = compat.enum_name(camera_data, "panorama_type")
         return (
-            f"Camera {camera_name!r} is a {projection} panorama: the relativistic camera "
+            f"Camera {camera_name!r} has panorama type {projection}: the relativistic camera "
             "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras"
         )
     kind = compat.enum_name(camera_data, "type")
