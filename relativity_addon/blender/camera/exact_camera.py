@@ -115,11 +115,29 @@ def type_problem(camera_name, camera_data: Camera):
     if kind == "PANO":
         if camera_data.panorama_type in PANORAMA_PROJECTIONS:
             return None
+        projection = compat.enum_name(camera_data, "panorama_type")
         return (
-            f"camera {camera_name!r} is a {camera_data.panorama_type} panorama: the relativistic camera "
+            f"Camera {camera_name!r} has panorama type {projection}: the relativistic camera "
             "renders perspective, equirectangular, fisheye equidistant/equisolid and mirror ball cameras"
         )
-    return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
+    kind = compat.enum_name(camera_data, "type")
+    return f"Camera {camera_name!r} is {kind}: the relativistic camera replaces a perspective or panoramic camera only"
+
+
+def final_render_problem(scene: Scene, snap: Snapshot):
+    """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
+    line, lower-case: it follows a colon), or None when it is. Without a moving observer nothing
+    needs it (the boosted meshes are then scene-frame meshes)."""
+    if snap.method != "GEOMETRY" or snap.geometry_final_render != "EXACT":
+        return "Final Render is set to Boosted Meshes" if snap.method == "GEOMETRY" else "not Apparent Geometry"
+    if snap.speed == 0.0 and snap.velocity_source != "CAMERA_ANIMATION":
+        return "the observer is at rest"
+    if snap.engine != "CYCLES":
+        return f"the exact camera needs Cycles, not {compat.enum_name(scene.render, 'engine', snap.engine)}"
+    no_osl = osl.unavailable_reason()
+    if no_osl is not None:
+        return no_osl[0].lower() + no_osl[1:]
+    return type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
 def lens_warnings(camera_object: Object):
@@ -270,13 +288,13 @@ def compile_shader(camera_data: Camera) -> None:
     try:
         errors = osl.compile_custom_camera(camera_data)
     except osl.OSLUnavailableError as error:
-        raise RelativityError(f"OSL unavailable: {error}") from error
+        raise RelativityError(f"{error}: the relativistic camera needs it") from error
     if errors:
-        raise RelativityError(f"relativistic camera shader failed to compile: {errors[0]}")
+        raise RelativityError(f"Relativistic camera shader failed to compile: {errors[0]}")
     missing = _missing_parameters(camera_data)
     if missing or not camera_data.custom_bytecode:
         raise RelativityError(
-            "relativistic camera shader compiled to an empty shader "
+            "Relativistic camera shader compiled to an empty shader "
             f"(missing parameters: {', '.join(missing) or 'bytecode'})"
         )
 
@@ -308,7 +326,7 @@ def apply(scene: Scene, snap: Snapshot, render_only=False):
         try:
             osl.ensure_oslquery_importable()
         except osl.OSLUnavailableError as error:
-            raise RelativityError(f"OSL unavailable: {error}") from error
+            raise RelativityError(f"{error}: the relativistic camera needs it") from error
         _save_state(camera_data, render_only)
         text = ensure_shader_text()
         camera_data.type = "CUSTOM"
@@ -327,23 +345,23 @@ def write(scene: Scene, snap: Snapshot) -> None:
     camera_object = scene.objects[snap.camera]
     camera_data = camera_object.data
     if not is_applied(camera_data):
-        raise RelativityError(f"camera {camera_object.name!r} is not the relativistic camera")
+        raise RelativityError(f"Camera {camera_object.name!r} is not the relativistic camera")
     if camera_data.type != "CUSTOM":
-        raise RelativityError(f"camera {camera_object.name!r} is no longer a custom camera")
+        raise RelativityError(f"Camera {camera_object.name!r} is no longer a custom camera")
     if lens_type(camera_data) == "PANO" and snap.shutter_model in LENS_SHUTTERS:
         name = snap.shutter_model.replace("_", " ").lower()
         raise RelativityError(
-            f"the {name} shutter needs a perspective camera's lens: camera "
+            f"The {name} shutter needs a perspective camera's lens: camera "
             f"{camera_object.name!r} is a panorama (use pinhole, aperture plane or arbitrary plane)"
         )
     if stereo_eyes(scene) and lens_type(camera_data) == "PANO":
         raise RelativityError(
-            f"camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
+            f"Camera {camera_object.name!r}: stereo panoramas (Blender's spherical stereo) "
             "are not rendered by the relativistic camera; switch Stereoscopy off"
         )
     if stereo_eyes(scene) and camera_data.stereo.convergence_mode == "TOE":
         raise RelativityError(
-            f"camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
+            f"Camera {camera_object.name!r}: toe-in stereo turns the eyes apart, so they cannot "
             "share one shutter plane; use off-axis or parallel convergence"
         )
     if _missing_parameters(camera_data) or not camera_data.custom_bytecode:

@@ -90,6 +90,17 @@ def eevee_engine():
     return "BLENDER_EEVEE" if "BLENDER_EEVEE" in engines else "BLENDER_EEVEE_NEXT"
 
 
+def enum_name(data, prop: str, value: str | None = None) -> str:
+    """The name the user sees for ``value`` (default: the current value) of ``data``'s enum
+    property ``prop``: "EEVEE" for the engine identifier 'BLENDER_EEVEE_NEXT' (4.5) or
+    'BLENDER_EEVEE' (5.x)."""
+    value = getattr(data, prop) if value is None else value
+    for item in data.bl_rna.properties[prop].enum_items:
+        if item.identifier == value:
+            return item.name
+    return value.replace("_", " ").title()
+
+
 def has_compositor_node_groups():
     """5.x: the scene's compositor is a node group (``scene.compositing_node_group``) ending in a
     Group Output; 4.5 has the scene-owned ``scene.node_tree`` with a Composite node instead."""

@@ -1,4 +1,4 @@
-"""OSL compilation support: make Cycles' ``oslquery`` importable and compile camera shaders.
+"""OSL compilation support: whether this Blender can compile OSL, and compiling camera shaders.
 
 Cycles compiles an OSL camera shader with its own Python add-on (``cycles.osl``), which imports
 the bundled ``oslquery`` module. A real Blender install has it on ``sys.path``; the ``bpy`` wheel
@@ -16,16 +16,37 @@ if TYPE_CHECKING:
     from bpy.types import Camera
 
 
+NO_OSL = "This Blender build has no OSL (Open Shading Language)"
+NO_OSL_COMPILER = "This Blender build cannot compile OSL shaders (Open Shading Language)"
+
+
 class OSLUnavailableError(RuntimeError):
-    """Cycles cannot compile OSL here (no ``oslquery``, or a build without OSL)."""
+    """Cycles cannot compile OSL here (a build without OSL, or without its shader compiler)."""
 
 
-def ensure_oslquery_importable() -> None:
-    """Make ``import oslquery`` work, adding the wheel's bundled site-packages if needed."""
+def unavailable_reason() -> str | None:
+    """Why this Blender cannot render the add-on's OSL shaders (one line for the user), or None.
+
+    The one place the add-on decides whether OSL is available: Cycles must be built with OSL
+    (``_cycles.with_osl``; Debian's 5.2 is not) and its ``oslquery`` module must import, from the
+    wheel's bundled folder if needed."""
+    try:
+        import _cycles  # type: ignore[import-not-found]  # Cycles' C module, no stubs
+    except ImportError:
+        return NO_OSL
+    if not getattr(_cycles, "with_osl", False):
+        return NO_OSL
+    if not _import_oslquery():
+        return NO_OSL_COMPILER
+    return None
+
+
+def _import_oslquery() -> bool:
+    """Whether ``import oslquery`` works, adding the wheel's bundled site-packages if needed."""
     try:
         import oslquery  # noqa: F401
 
-        return
+        return True
     except ImportError:
         pass
     import bpy
@@ -41,10 +62,17 @@ def ensure_oslquery_importable() -> None:
             break
     try:
         import oslquery  # noqa: F401
-    except ImportError as error:
-        raise OSLUnavailableError(
-            "Cycles' oslquery module is missing, so OSL camera shaders cannot be compiled"
-        ) from error
+    except ImportError:
+        return False
+    return True
+
+
+def ensure_oslquery_importable() -> None:
+    """Make ``import oslquery`` work; OSLUnavailableError (one line for the user) if OSL cannot
+    be compiled here."""
+    reason = unavailable_reason()
+    if reason is not None:
+        raise OSLUnavailableError(reason)
 
 
 def compile_custom_camera(camera_data: Camera):
@@ -57,9 +85,9 @@ def compile_custom_camera(camera_data: Camera):
     try:
         from cycles import engine, osl
     except ImportError as error:
-        raise OSLUnavailableError("the Cycles add-on is not available") from error
+        raise OSLUnavailableError("Cycles is not available in this Blender") from error
     if not engine.with_osl():
-        raise OSLUnavailableError("this Blender build has no OSL support")
+        raise OSLUnavailableError(NO_OSL)
 
     errors = []
 

@@ -72,12 +72,12 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         depsgraph = bpy.context.evaluated_depsgraph_get()
     rest = modifier.evaluated_rest_positions(obj, depsgraph)
     if rest is None:
-        raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
+        raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
     try:
         world, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
-        raise RelativityError(f"object {obj.name!r}: {error}") from None
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
     inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T

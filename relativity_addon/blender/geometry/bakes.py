@@ -40,7 +40,7 @@ def _bake_frames(scene, obj, frame_start, frame_end):
     per_frame = int(obj.relativity.samples_per_frame)
     frames = first + np.arange(int(round((last - first) * per_frame)) + 1) / per_frame
     if len(frames) < 2:
-        raise RelativityError(f"object {obj.name!r}: bake range needs at least two samples")
+        raise RelativityError(f"Object {obj.name!r}: bake range needs at least two samples")
     return frames, per_frame
 
 
@@ -80,7 +80,7 @@ def bake_deformation(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=
     def sample(depsgraph: bpy.types.Depsgraph) -> None:
         rest = modifier.evaluated_rest_positions(obj, depsgraph)
         if rest is None or (samples and len(rest) != len(samples[0])):
-            raise RelativityError(f"object {obj.name!r}: vertex count changes during the bake range")
+            raise RelativityError(f"Object {obj.name!r}: vertex count changes during the bake range")
         matrix = matrix_array(obj.evaluated_get(depsgraph).matrix_world)
         samples.append(to_world(matrix, rest))
         origins.append(matrix[:3, 3])

@@ -103,7 +103,7 @@ def check_parent_motion(obj: Object) -> None:
             if own.motion != settings.motion or (own.motion == "CONSTANT" and tuple(own.beta) != tuple(settings.beta)):
                 how = "Constant Velocity with the same velocity" if settings.motion == "CONSTANT" else "Animation"
                 raise RelativityError(
-                    f"object {obj.name!r} rides on its moving parent {parent.name!r}: set its Motion to {how}"
+                    f"Object {obj.name!r} rides on its moving parent {parent.name!r}: set its Motion to {how}"
                 )
             return
         parent = parent.parent
@@ -222,7 +222,7 @@ def proper_time_apparent_positions(
                 matrices, step, shaped, t_o, x_o, beta_o, c, world_matrix_now=now
             )
     except ValueError as error:
-        raise RelativityError(f"object {obj.name!r}: {error}") from None
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
     return result
 
 
@@ -250,7 +250,7 @@ def animated_apparent_positions(
     problem = animation.keyframe_motion_problem(obj, scene)
     if problem is not None:
         raise RelativityError(
-            f"object {obj.name!r} is moved by more than its keyframes ({problem}): "
+            f"Object {obj.name!r} is moved by more than its keyframes ({problem}): "
             "bake its motion (Bake Motion in the Relativity panel)"
         )
     if obj.relativity.use_proper_time and plays_own_animation(obj, scene):
@@ -271,7 +271,7 @@ def animated_apparent_positions(
             world_matrix_now=matrix_array(obj_eval.matrix_world),
         )
     except ValueError as error:
-        raise RelativityError(f"object {obj.name!r}: {error}") from None
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
 
 
 def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, beta_o, c):
@@ -283,7 +283,7 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
         now = matrix_array(obj_eval.matrix_world)
         if np.max(np.abs(matrices[round(index)] - now)) > 1e-5 * (1.0 + np.max(np.abs(now))):
             raise RelativityError(
-                f"object {obj.name!r} moves differently from its motion bake at frame {frame_now:g}: "
+                f"Object {obj.name!r} moves differently from its motion bake at frame {frame_now:g}: "
                 "bake its motion again"
             )
     start, step = first_frame / fps, 1.0 / (per_frame * fps)
@@ -292,7 +292,7 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
     t_e = t_o - result[1]
     if t_e.size and (t_e.min() < times[0] or t_e.max() > times[-1]):
         raise RelativityError(
-            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"Object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
             f"baked motion {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range"
         )
     return result
@@ -302,13 +302,13 @@ def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
     """Apparent positions of a deforming object from its baked samples (per-vertex retarded times)."""
     mesh = modifier.bake_mesh(obj)
     if mesh is None:
-        raise RelativityError(f"object {obj.name!r} is deforming but not baked: run bake_deformation first")
+        raise RelativityError(f"Object {obj.name!r} is deforming but not baked: press Bake Deformation first")
     info = modifier.cache_data(obj)[names.BAKE_KEY]
     if info["points"] != count:
-        raise RelativityError(f"object {obj.name!r}: the mesh changed since the deformation bake; bake again")
+        raise RelativityError(f"Object {obj.name!r}: the mesh changed since the deformation bake; bake again")
     if names.BAKE_ORIGINS_KEY not in info:
         raise RelativityError(
-            f"object {obj.name!r}: the deformation bake has no origin path (an earlier version made it); bake again"
+            f"Object {obj.name!r}: the deformation bake has no origin path (an earlier version made it); bake again"
         )
     positions = np.empty((info["samples"], count * 3), dtype=np.float32)
     for i in range(info["samples"]):
@@ -322,12 +322,12 @@ def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
         try:
             positions = proper_time.own_animation_at_proper_time(times, positions, origins, c)
         except ValueError as error:
-            raise RelativityError(f"object {obj.name!r}: {error}") from None
+            raise RelativityError(f"Object {obj.name!r}: {error}") from None
     result = rest_shape.apparent_positions_deforming_rest_shape(times, positions, origins, t_o, x_o, c, beta_o)
     t_e = t_o - result[1]
     if t_e.min() < times[0] or t_e.max() > times[-1]:
         raise RelativityError(
-            f"object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
+            f"Object {obj.name!r}: retarded times {t_e.min():.4g}..{t_e.max():.4g} s lie outside the "
             f"baked range {times[0]:.4g}..{times[-1]:.4g} s; bake a wider frame range"
         )
     return result

@@ -104,7 +104,7 @@ class ShapeKeyMotion:
         self.name = obj.name
         if not key.use_relative:
             raise RelativityError(
-                f"object {obj.name!r}: absolute shape keys (Evaluation Time) are not played "
+                f"Object {obj.name!r}: absolute shape keys (Evaluation Time) are not played "
                 "at proper time; use relative shape keys"
             )
         count = len(obj.data.vertices)
@@ -119,7 +119,7 @@ class ShapeKeyMotion:
             _VALUE_PATH.match(driver.data_path) and not driver.mute for driver in key.animation_data.drivers
         ):
             raise RelativityError(
-                f"object {obj.name!r}: drivers set its shape keys; driven shape keys are not "
+                f"Object {obj.name!r}: drivers set its shape keys; driven shape keys are not "
                 "played at proper time (turn Proper Time off, or bake the deformation)"
             )
         self.base = coordinates(key.reference_key)
@@ -129,7 +129,7 @@ class ShapeKeyMotion:
                 continue
             if block.vertex_group:
                 raise RelativityError(
-                    f"object {obj.name!r}: shape key {block.name!r} has a vertex group; "
+                    f"Object {obj.name!r}: shape key {block.name!r} has a vertex group; "
                     "shape keys with vertex groups are not played at proper time"
                 )
             self.offsets.append(coordinates(block) - coordinates(block.relative_key))
@@ -168,7 +168,7 @@ class ShapeKeyMotion:
         blend at ``frame``: the shape keys are then the only thing shaping the rest points."""
         if len(rest) != len(self.base):
             raise RelativityError(
-                f"object {self.name!r}: its animated shape keys are played at proper time only "
+                f"Object {self.name!r}: its animated shape keys are played at proper time only "
                 "on the mesh's own vertices; set Tessellation to 0 and move modifiers after "
                 "the relativity modifier, or bake the deformation (Animation, Deforming), "
                 "or turn Proper Time off"
@@ -177,7 +177,7 @@ class ShapeKeyMotion:
         scale = 1.0 + float(np.abs(blend).max(initial=0.0))
         if np.abs(blend - rest).max(initial=0.0) > 1e-5 * scale:
             raise RelativityError(
-                f"object {self.name!r}: something besides its shape keys (a modifier before the "
+                f"Object {self.name!r}: something besides its shape keys (a modifier before the "
                 "relativity modifier, a driver) shapes the mesh; its shape keys cannot be played at "
                 "proper time (turn Proper Time off, or bake the deformation)"
             )

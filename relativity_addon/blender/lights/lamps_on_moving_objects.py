@@ -111,7 +111,7 @@ def movers(scene: Scene, snap: Snapshot):
                 scene, obj, obj, centre, at_rest_observer, shape_keys_too=False
             )
         except ValueError as error:
-            raise RelativityError(f"object {obj.name!r}: {error}") from None
+            raise RelativityError(f"Object {obj.name!r}: {error}") from None
         beta = tuple(float(b) for b in np.asarray(beta)[0])
         if math.hypot(*beta) > 0.0:
             found.append(Mover(obj.name, tuple(float(x) for x in world[0]), beta))

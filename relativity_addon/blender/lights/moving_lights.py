@@ -30,6 +30,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import spectral_render
+from ..camera import exact_camera
 from ..colour import materials
 from ..common import names, osl
 from ..scene import emitting_meshes, sources
@@ -52,7 +53,10 @@ ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffus
 def supported(snap: Snapshot):
     """The snapshot's moving lights this stage renders: point and spot lights with constant
     velocity, and every kind, constant or keyframed (ANIMATION), where stand-in lamps draw them
-    (:func:`uses_lamps`; a keyframed sun moves with its keyframes' velocity at the frame)."""
+    (:func:`uses_lamps`; a keyframed sun moves with its keyframes' velocity at the frame). None
+    in a Blender build without OSL: both ways are OSL shaders."""
+    if osl.unavailable_reason() is not None:
+        return []
     if uses_lamps(snap):
         return [light for light in snap.moving_lights if light.kind in LAMP_KINDS]
     return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
@@ -107,7 +111,7 @@ def ensure_group(light_names):
         node.script = text  # compiles (oslquery must be importable) and creates the sockets
         node.location = (200.0, -200.0 * index)
         if "Emission" not in node.outputs or "light_position" not in node.inputs:
-            raise RelativityError("the moving-light OSL shader did not compile (no sockets on its script node)")
+            raise RelativityError("The moving-light OSL shader did not compile (no sockets on its script node)")
         group.links.new(inputs.outputs["Albedo"], node.inputs["Albedo"])
         if previous is None:
             previous = node.outputs["Emission"]
@@ -399,7 +403,7 @@ def write(scene: Scene, snap: Snapshot, attach_new_materials=False, depsgraph: D
     try:
         osl.ensure_oslquery_importable()
     except osl.OSLUnavailableError as error:
-        raise RelativityError(f"OSL unavailable for moving lights: {error}") from error
+        raise RelativityError(f"{error}: moving lights need it") from error
     light_names = [light.name for light in lights]
     for obj in scene.objects:
         saved = names.LIGHT_SAVED_KEY in obj or names.EMITTER_SAVED_KEY in obj
@@ -452,16 +456,20 @@ def remove(scene: Scene) -> None:
 def warnings(scene: Scene, snap: Snapshot):
     """What the moving-light stage does not render right, one line each."""
     drawn = {light.name for light in supported(snap)}
+    no_osl = osl.unavailable_reason()
+    why = (
+        f"{no_osl[0].lower()}{no_osl[1:]}" if no_osl else "moving {kind} lights with this motion need the exact camera"
+    )
     found = [
-        f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here (moving {light.kind.lower()} lights "
-        "with this motion need the exact camera)"
+        f"Light {light.name!r} ({light.kind.lower()}): rendered at rest here ({why.format(kind=light.kind.lower())})"
         for light in snap.moving_lights
         if light.name not in drawn
     ]
     if supported(snap) and snap.method == "GEOMETRY" and snap.speed > 0.0:
+        problem = exact_camera.final_render_problem(scene, snap)
         found.append(
-            "Moving lights with a moving observer: the viewport preview lights the surfaces where they "
-            "appear; the final render is exact"
+            "Moving lights with a moving observer: the viewport preview lights the surfaces where they appear; "
+            + ("the final render is exact" if problem is None else f"so does the final render ({problem})")
         )
     if supported(snap) and uses_lamps(snap):
         found.append(

@@ -72,7 +72,7 @@ def basis_defines():
     grid, basis = tables["basis_nm"][rows], tables["basis"][rows]
     step = float(grid[1] - grid[0])
     if not (grid[0] == low and grid[-1] == high and np.allclose(np.diff(grid), step)):
-        raise RelativityError("the shipped RGB basis table is not on an even grid over its band")
+        raise RelativityError("The shipped RGB basis table is not on an even grid over its band")
     values = ", ".join(f"{float(v):.9g}" for v in basis.ravel())
     return (
         f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
@@ -159,7 +159,7 @@ def lamp_path(scene: Scene, snap: Snapshot, light, values, reception_time, point
     path = _keyframe_path(obj, snap, reception_time, knots)
     speed = float(np.max(np.linalg.norm(np.diff(path, axis=0), axis=-1)) / (knots[1] - knots[0]))
     if speed >= 1.0:
-        raise RelativityError(f"light {light.name!r} moves at {speed:.3f}c on its keyframes (must be below c)")
+        raise RelativityError(f"Light {light.name!r} moves at {speed:.3f}c on its keyframes (must be below c)")
     if speed == 0.0:
         return np.zeros(1), here[None, :]
     knots = np.linspace(-reach * 2.0 / (1.0 - speed), 0.0, 513)
@@ -194,7 +194,7 @@ def _new_lamp(scene, name, text, kind="POINT"):
     node.script = text
     if "Emission" not in node.outputs or "lamp_time" not in node.inputs:
         bpy.data.lights.remove(light)
-        raise RelativityError("the moving-lamp OSL shader did not compile (no sockets on its script node)")
+        raise RelativityError("The moving-lamp OSL shader did not compile (no sockets on its script node)")
     output = tree.nodes.new("ShaderNodeOutputLight")
     output.location = (300.0, 0.0)
     tree.links.new(node.outputs["Emission"], output.inputs["Surface"])

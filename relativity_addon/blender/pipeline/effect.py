@@ -22,9 +22,10 @@ renders black, never a wrong image).
 from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
-from ..common import busy
+from ..common import busy, compat
 from ..geometry import apparent_meshes, modifier, shape_keys
 from ..scene import animation, snapshot, traveller
+from . import render_notice
 from .stages import STAGES, Sync
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
@@ -32,6 +33,7 @@ _scene_status = {}
 _object_warnings = {}
 _final_render_valid = {}  # scene name -> whether its last exact final render's camera was valid
 _traveller_times = {}  # scene name -> the observer's proper time at the last synced frame
+_setup_notices = {}  # scene name -> why switching the Method did not set the scene up again
 
 
 def applied_method(scene):
@@ -78,6 +80,7 @@ def apply(scene, frame_range=None, objects=None):
         _remove_stages(scene)
         undo()
         raise
+    _setup_notices.pop(scene.name, None)
     _record(scene, snap)
     return result
 
@@ -97,6 +100,7 @@ def remove(scene):
     _remove_stages(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
+    _setup_notices.pop(scene.name, None)
     return removed
 
 
@@ -105,15 +109,8 @@ def remove(scene):
 
 def final_render_problem(scene, snap):
     """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
-    line), or None when it is. Without a moving observer nothing needs it (the boosted meshes are
-    then scene-frame meshes)."""
-    if snap.method != "GEOMETRY" or snap.geometry_final_render != "EXACT":
-        return "the final render is set to Boosted Meshes" if snap.method == "GEOMETRY" else "not Apparent Geometry"
-    if snap.speed == 0.0 and snap.velocity_source != "CAMERA_ANIMATION":
-        return "the observer is at rest"
-    if snap.engine != "CYCLES":
-        return f"the exact camera needs Cycles, not {snap.engine}"
-    return exact_camera.type_problem(snap.camera, scene.objects[snap.camera].data)
+    line), or None when it is (``exact_camera.final_render_problem``)."""
+    return exact_camera.final_render_problem(scene, snap)
 
 
 def begin_final_render(scene):
@@ -126,8 +123,11 @@ def begin_final_render(scene):
         return snapshot.in_final_render(scene)
     problem = final_render_problem(scene, snapshot.read(scene))
     if problem is not None:
-        if problem.startswith(("camera", "the exact camera")):
+        if problem.startswith(("Camera", "the exact camera", "this Blender build")):
             print(f"Relativity: Apparent Geometry renders the boosted-mesh preview: {problem}")
+            render_notice.tell(
+                "Relativity: the final render is the boosted-mesh preview", problem[0].upper() + problem[1:]
+            )
         return False
     snapshot.begin_final_render(scene)
     try:
@@ -188,7 +188,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
         snap = snapshot.read(scene, depsgraph)
         if method is not None and method != snap.method:
             # applied with the other method (the setting changed where no callback ran)
-            raise RelativityError(f"Set up again: the scene is set up for {method.title()}")
+            raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             exact_camera.write(scene, snap)
         if method == "GEOMETRY" and update_geometry:
@@ -215,6 +215,7 @@ def setting_changed(scene):
             apply(scene)
         except RelativityError as error:
             _refused(scene, error)
+            _setup_refused(scene, error)
         return
     sync(scene)
 
@@ -237,6 +238,27 @@ def object_changed(scene, obj):
 
 
 # --- warnings, computed when the effect syncs -------------------------------------------------
+
+
+def _setup_refused(scene, error):
+    """Switching the Method could not set the scene up again: one line for the panel (until the
+    next Set Up or Remove) and, when Blender has a window, a popup (an update callback has no
+    operator to report with)."""
+    if applied_method(scene) is None:
+        notice = f"The relativistic effect was removed: {error}"
+    else:
+        notice = f"Still set up for {_method_name(scene, applied_method(scene))}: {error}"
+    _setup_notices[scene.name] = notice
+    render_notice.tell("Relativity: the Method was not switched", notice)
+
+
+def _method_name(scene, method):
+    return compat.enum_name(scene.relativity, "method", method)
+
+
+def setup_notice(scene):
+    """Why the last switch of the Method failed (one line), or None."""
+    return _setup_notices.get(scene.name)
 
 
 def _refused(scene, error):

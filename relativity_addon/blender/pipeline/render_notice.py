@@ -28,6 +28,13 @@ def render_refused(scene, reason, black):
         _pending.put((title, reason))
 
 
+def tell(title, reason):
+    """A popup with ``reason`` (one line) when Blender has a window; nothing in background mode
+    (the batch script and the panel say it there). Any thread."""
+    if not _background():
+        _pending.put((title, reason))
+
+
 def _background():
     return bpy.app.background
 

@@ -217,6 +217,6 @@ def check_supported(obj: Object, scene: Scene | None = None) -> None:
     problem = keyframe_motion_problem(obj, scene)
     if problem is not None:
         raise RelativityError(
-            f"velocity from animation reads keyframes only, and {problem}; "
+            f"Velocity from animation reads keyframes only, and {problem}; "
             "bake the camera motion to keyframes or set the velocity manually"
         )

@@ -23,7 +23,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
-from ..common import names
+from ..common import compat, names, osl
 from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
 
 if TYPE_CHECKING:
@@ -189,14 +189,14 @@ def check_velocity(beta, what):
 def check_speed_of_light(c):
     c = float(c)
     if not (math.isfinite(c) and c > 0.0):
-        raise RelativityError("speed of light must be a positive finite number")
+        raise RelativityError("Speed of light must be a positive finite number")
     return c
 
 
 def active_camera(scene: Scene):
     camera = scene.camera
     if camera is None or camera.type != "CAMERA":
-        raise RelativityError(f"scene {scene.name!r} has no active camera")
+        raise RelativityError(f"Scene {scene.name!r} has no active camera")
     return camera
 
 
@@ -252,7 +252,7 @@ def observer_speeds(scene: Scene, frames):
     speeds = np.linalg.norm(after - before, axis=1) * animation.frames_per_second(scene) / (2.0 * STEP_FRAMES * c)
     if np.any(speeds >= 1.0):
         raise RelativityError(
-            f"camera {camera.name!r} reaches the speed of light at frame {float(frames[np.argmax(speeds >= 1.0)]):g}"
+            f"Camera {camera.name!r} reaches the speed of light at frame {float(frames[np.argmax(speeds >= 1.0)]):g}"
         )
     return speeds
 
@@ -263,7 +263,7 @@ def _checked_camera_speed(camera, beta, frame):
         whole = math.floor(frame)
         where = f"frame {whole}" if frame == whole else f"frame {whole} (sub-frame {frame:g})"
         raise RelativityError(
-            f"camera {camera.name!r} moves at {speed:.4g} c at {where}: "
+            f"Camera {camera.name!r} moves at {speed:.4g} c at {where}: "
             "its animation must stay below the speed of light (slow it down or raise c)"
         )
     return speed
@@ -303,7 +303,7 @@ def _keyframe_beta(scene, obj, frame, step=0.01):
     """An animated object's velocity over c at ``frame`` from its keyframes (central difference)."""
     problem = animation.keyframe_motion_problem(obj, scene)
     if problem is not None:
-        raise RelativityError(f"light {obj.name!r} moves by its keyframes, but {problem}: set its motion to Constant")
+        raise RelativityError(f"Light {obj.name!r} moves by its keyframes, but {problem}: set its motion to Constant")
     positions = animation.world_matrices(obj, [frame - step, frame + step])[:, :3, 3]
     c = check_speed_of_light(scene.relativity.speed_of_light)
     per_frame = (positions[1] - positions[0]) / (2.0 * step)
@@ -434,14 +434,14 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
     frame = current_frame(scene)
     beta = observer_velocity(scene, camera, frame)
     if not math.isfinite(settings.shutter_time):
-        raise RelativityError("shutter time must be finite")
+        raise RelativityError("Shutter time must be finite")
     normal = tuple(settings.shutter_plane_normal)
     if settings.shutter_model == "ARBITRARY_PLANE" and (not _finite(normal) or sum(n * n for n in normal) == 0.0):
-        raise RelativityError("arbitrary shutter plane needs a non-zero normal")
+        raise RelativityError("Arbitrary shutter plane needs a non-zero normal")
     if not _finite(settings.shutter_plane_point):
-        raise RelativityError("the shutter plane point must be finite")
+        raise RelativityError("The shutter plane point must be finite")
     if not math.isfinite(settings.lorentz_window_time):
-        raise RelativityError("the Lorentz window time must be finite")
+        raise RelativityError("The Lorentz window time must be finite")
     matrix = camera_matrix(scene, camera, frame, depsgraph)
     lights = moving_lights(scene, frame, depsgraph)
     time_of_flight = bool(settings.use_time_of_flight)
@@ -449,7 +449,11 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         check_time_of_flight(settings, lights)
     moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
-        raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
+        raise RelativityError(
+            f"The relativistic camera needs the Cycles render engine, not {compat.enum_name(scene.render, 'engine')}"
+        )
+    if settings.method == "CAMERA" and osl.unavailable_reason() is not None:
+        raise RelativityError(f"{osl.unavailable_reason()}: Method Exact Camera needs it (use Apparent Geometry)")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
         lens.check_detector_image(scene, camera, matrix)

@@ -63,7 +63,7 @@ def frames_at_proper_times(scene: Scene, taus):
     """Scene frames (floats) at which the traveller's clock reads ``taus`` (seconds, >= 0)."""
     taus = np.asarray(taus, dtype=np.float64)
     if taus.min() < 0.0:
-        raise RelativityError("proper-time frames start at frame 0 (the traveller's clock reads 0 there)")
+        raise RelativityError("Proper-time frames start at frame 0 (the traveller's clock reads 0 there)")
     fps = animation.frames_per_second(scene)
     last = max(2.0, taus.max() * fps * 1.5 + 2.0)
     for _ in range(12):
@@ -71,4 +71,4 @@ def frames_at_proper_times(scene: Scene, taus):
         if grid_taus[-1] >= taus.max():
             return proper_time.scene_times(taus, frames, grid_taus)
         last *= 2.0
-    raise RelativityError(f"the traveller's clock does not reach {taus.max():.6g} s by frame {last:g}")
+    raise RelativityError(f"The traveller's clock does not reach {taus.max():.6g} s by frame {last:g}")

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from bpy.types import Context, Operator
 
 from ...errors import RelativityError
+from ..common import osl
 from ..pipeline import effect, spectral_render
 from ..scene import snapshot
 
@@ -52,6 +53,10 @@ class RELATIVITY_OT_setup_scene(Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         snap = effect.last_snapshot(scene)
+        no_osl = osl.unavailable_reason()
+        if no_osl is not None and snap.method == "GEOMETRY":
+            at_rest = ", moving lights at rest" if snap.moving_lights else ""
+            self.report({"WARNING"}, f"{no_osl}: the final render is the boosted-mesh preview{at_rest}")
         self.report({"INFO"}, f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}")
         return {"FINISHED"}
 

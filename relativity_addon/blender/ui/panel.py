@@ -5,16 +5,41 @@ Nothing here computes: the warnings come from the effect's last sync (``effect.s
 """
 
 import math
+import textwrap
 
 from bpy.types import Context, Panel
 
+from ..common import osl
 from ..pipeline import effect, render_notice
+
+CHARACTER_WIDTH = 7.0  # pixels per character of the sidebar's text at UI scale 1 (a mean)
+LABEL_MARGIN = 60.0  # pixels of a label row not given to its text (icon, padding, scroll bar)
 
 
 def _split(layout):
     layout.use_property_split = True
     layout.use_property_decorate = False
     return layout
+
+
+def _lines(context, text):
+    """``text`` split into lines that fit the region's width (a label cuts what does not fit);
+    one line where no region is drawn into."""
+    region = getattr(context, "region", None)
+    if region is None:
+        return [text]
+    width = region.width
+    preferences = getattr(context, "preferences", None)
+    scale = (preferences.system.ui_scale if preferences is not None else 0.0) or 1.0  # 0 in background
+    columns = max(16, int((width - LABEL_MARGIN) / (CHARACTER_WIDTH * scale)))
+    return textwrap.wrap(text, columns) or [""]
+
+
+def _message(layout, context, text, icon="ERROR"):
+    """A warning drawn whole: wrapped to the sidebar's width, the icon on its first line."""
+    column = layout.column(align=True)
+    for number, line in enumerate(_lines(context, text)):
+        column.label(text=line, icon=icon if number == 0 else "BLANK1")
 
 
 def _preset_row(layout, kind, label):
@@ -43,14 +68,20 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
         layout = _split(self.layout)
         layout.menu("RELATIVITY_MT_paper_setups_presets", text="Paper Setups")
         layout.prop(scene.relativity, "method")
+        no_osl = osl.unavailable_reason()
         if scene.relativity.method == "GEOMETRY":
             layout.prop(scene.relativity, "geometry_final_render")
             layout.label(text="The viewport shows the boosted-mesh preview", icon="INFO")
+            if no_osl is not None and scene.relativity.geometry_final_render == "EXACT":
+                _message(layout, context, f"{no_osl}: the final render is the boosted-mesh preview too")
+        notice = effect.setup_notice(scene)
+        if notice is not None:
+            _message(layout, context, notice)
         refused = render_notice.last_refusal(scene)
         if refused is not None:
-            layout.label(text=f"Last render refused: {refused}", icon="ERROR")
+            _message(layout, context, f"Last render refused: {refused}")
         for warning in effect.scene_warnings(scene):
-            layout.label(text=warning, icon="ERROR")
+            _message(layout, context, warning)
         column = layout.column(align=True)
         column.operator("relativity.setup_scene", icon="PLAY")
         column.operator("relativity.remove_all", icon="X")
@@ -205,7 +236,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
                 column.label(text=baked, icon="CHECKMARK")
             column.operator(operator, icon="REC")
         for warning in effect.object_warnings(context.scene, obj):
-            layout.label(text=warning, icon="ERROR")
+            _message(layout, context, warning)
 
 
 def _draw_light(layout, obj):

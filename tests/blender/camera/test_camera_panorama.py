@@ -304,6 +304,6 @@ def test_panorama_camera_restored_and_lens_models_refused(addon, factory_blender
     assert data.type == "PANO"
     scene.relativity.shutter_model = "PINHOLE"
     data.panorama_type = "EQUIANGULAR_CUBEMAP_FACE"
-    with pytest.raises(addon.RelativityError, match="EQUIANGULAR_CUBEMAP_FACE panorama"):
+    with pytest.raises(addon.RelativityError, match="panorama type Equiangular Cubemap Face"):
         addon.apply(scene)
     assert data.type == "PANO"
