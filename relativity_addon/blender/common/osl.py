@@ -47,7 +47,7 @@ def ensure_oslquery_importable() -> None:
         ) from error
 
 
-def compile_custom_camera(camera_data: Camera):
+def compile_custom_camera(camera_data: Camera) -> list[str]:
     """Compile the camera's OSL shader with Cycles; return the list of error messages.
 
     An empty list means Cycles reported success; the caller still checks that the shader's
