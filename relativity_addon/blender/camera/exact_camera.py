@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
@@ -32,7 +32,7 @@ from ..common import compat, names, osl
 from ..scene import lens, snapshot
 
 if TYPE_CHECKING:
-    from bpy.types import Camera, Object, Scene
+    from bpy.types import Camera, Object, Scene, Text
 
     from ..scene.snapshot import Snapshot
 
@@ -81,12 +81,12 @@ PANORAMA_PROJECTIONS = {"EQUIRECTANGULAR": 1, "FISHEYE_EQUIDISTANT": 2, "FISHEYE
 LENS_SHUTTERS = ("DETECTOR_PLANE", "FOCUS_SURFACE", "FIXED_POINT_SURFACE")
 
 
-def shader_source():
+def shader_source() -> str:
     with open(SHADER_PATH, encoding="utf-8") as handle:
         return handle.read()
 
 
-def ensure_shader_text():
+def ensure_shader_text() -> Text:
     """The text datablock holding the camera shader, created or refreshed from the package."""
     source = shader_source()
     text = bpy.data.texts.get(names.SHADER_TEXT)
@@ -98,23 +98,23 @@ def ensure_shader_text():
     return text
 
 
-def is_applied(camera_data: Camera):
+def is_applied(camera_data: Camera | None) -> bool:
     return camera_data is not None and names.CAMERA_SAVED_STATE_KEY in camera_data
 
 
-def is_render_only(camera_data: Camera):
+def is_render_only(camera_data: Camera) -> bool:
     """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
     return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
 
 
-def lens_type(camera_data: Camera):
+def lens_type(camera_data: Camera) -> str:
     """The camera's own type (PERSP, PANO, ...): the saved one while the OSL camera is applied."""
     if is_applied(camera_data):
         return camera_data[names.CAMERA_SAVED_STATE_KEY]["type"]
     return camera_data.type
 
 
-def type_problem(camera_name, camera_data: Camera):
+def type_problem(camera_name: str, camera_data: Camera) -> str | None:
     """Why the exact camera cannot replace this camera (one line), or None."""
     kind = lens_type(camera_data)
     if kind == "PERSP":
@@ -129,7 +129,7 @@ def type_problem(camera_name, camera_data: Camera):
     return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
 
 
-def lens_warnings(camera_object: Object):
+def lens_warnings(camera_object: Object) -> list[str]:
     """One-line notes on what the exact camera does not render for this camera (the shutter model
     read from the scene whose active camera it is)."""
     if camera_object is None or camera_object.type != "CAMERA" or not camera_object.data.dof.use_dof:
@@ -177,7 +177,7 @@ def _focus_surface_warning(scene, camera_object):
     )
 
 
-def stereo_eyes(scene: Scene):
+def stereo_eyes(scene: Scene) -> bool:
     """Whether the scene renders Blender's stereo pair (each eye offset from the camera)."""
     render = scene.render
     return bool(render.use_multiview and render.views_format == "STEREO_3D")
@@ -196,7 +196,7 @@ def _fitted_sensor(scene, camera_data):
     return size * x_ratio / y_ratio, size
 
 
-def projection_parameters(scene: Scene, camera_data: Camera):
+def projection_parameters(scene: Scene, camera_data: Camera) -> dict[str, Any]:
     kind = lens_type(camera_data)
     projection = PANORAMA_PROJECTIONS.get(camera_data.panorama_type, 0) if kind == "PANO" else 0
     sensor_width, sensor_height = _fitted_sensor(scene, camera_data)
@@ -217,7 +217,7 @@ def _local_to_shader(vector):
     return (vector[0], vector[1], -vector[2])
 
 
-def camera_frame_window(scene: Scene, camera_data: Camera):
+def camera_frame_window(scene: Scene, camera_data: Camera) -> tuple[float, float, float, float]:
     """Image window of lens-centre rays on the plane at unit distance: left, right, bottom, top.
 
     Taken from Blender's own view frame, so sensor fit, aspect and lens shift match the
@@ -241,7 +241,7 @@ def camera_frame_window(scene: Scene, camera_data: Camera):
     )
 
 
-def shader_parameters(scene: Scene, camera_data: Camera, snap: Snapshot):
+def shader_parameters(scene: Scene, camera_data: Camera, snap: Snapshot) -> dict[str, Any]:
     """Values for ``cycles_custom`` from the snapshot and the camera's lens and sensor."""
     left, right, bottom, top = camera_frame_window(scene, camera_data)
     unit_scale = scene.unit_settings.scale_length or 1.0
@@ -338,7 +338,7 @@ def _save_state(camera_data, render_only):
     }
 
 
-def apply(scene: Scene, snap: Snapshot, render_only=False):
+def apply(scene: Scene, snap: Snapshot, render_only: bool = False) -> Object:
     """Turn the snapshot's camera into the relativistic OSL camera and write its parameters
     (``render_only``: for the time of a final render). Returns the camera object;
     RelativityError (one line), with the camera restored, on failure."""
@@ -403,11 +403,11 @@ def invalidate(camera_object: Object) -> None:
         _write_parameters(camera_object.data, {"settings_valid": False})
 
 
-def applied_cameras():
+def applied_cameras() -> list[Object]:
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
-def remove(camera_object: Object):
+def remove(camera_object: Object) -> bool:
     """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False

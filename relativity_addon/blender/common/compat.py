@@ -21,7 +21,7 @@ if TYPE_CHECKING:
         FCurve,
         Light,
         Material,
-        NodesModifier,
+        Modifier,
         NodeTree,
         Scene,
         ShaderNodeTree,
@@ -36,7 +36,7 @@ def _modifier_inputs(modifier):
     return getattr(properties, "inputs", None)
 
 
-def modifier_input(modifier: NodesModifier, identifier: str) -> Any:
+def modifier_input(modifier: Modifier, identifier: str) -> Any:
     """Value of a geometry-nodes modifier input (``identifier`` as in ``interface.items_tree``)."""
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
@@ -44,7 +44,7 @@ def modifier_input(modifier: NodesModifier, identifier: str) -> Any:
     return modifier.get(identifier)  # 4.5: ID properties on the modifier
 
 
-def set_modifier_input(modifier: NodesModifier, identifier: str, value: Any) -> None:
+def set_modifier_input(modifier: Modifier, identifier: str, value: Any) -> None:
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
         getattr(inputs, identifier).value = value
