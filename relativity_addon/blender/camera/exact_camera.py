@@ -129,7 +129,7 @@ def type_problem(camera_name: str, camera_data: Camera) -> str | None:
     return f"camera {camera_name!r} is {kind}, the relativistic camera replaces a perspective or panoramic camera only"
 
 
-def lens_warnings(camera_object: Object) -> list[str]:
+def lens_warnings(camera_object: Object | None) -> list[str]:
     """One-line notes on what the exact camera does not render for this camera (the shutter model
     read from the scene whose active camera it is)."""
     if camera_object is None or camera_object.type != "CAMERA" or not camera_object.data.dof.use_dof:
@@ -395,7 +395,7 @@ def write(scene: Scene, snap: Snapshot) -> None:
     _write_parameters(camera_data, shader_parameters(scene, camera_data, snap))
 
 
-def invalidate(camera_object: Object) -> None:
+def invalidate(camera_object: Object | None) -> None:
     """Mark the camera's parameters invalid: the shader renders black, never a wrong image."""
     if camera_object is None or camera_object.type != "CAMERA" or not is_applied(camera_object.data):
         return
@@ -407,7 +407,7 @@ def applied_cameras() -> list[Object]:
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
-def remove(camera_object: Object) -> bool:
+def remove(camera_object: Object | None) -> bool:
     """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False

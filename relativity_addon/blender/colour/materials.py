@@ -379,7 +379,7 @@ def is_attached(material: Material | None) -> bool:
     return material is not None and ATTACHED_KEY in material
 
 
-def attach(material: Material, temperature: float | None = None) -> bool:
+def attach(material: Material | None, temperature: float | None = None) -> bool:
     """Insert the Doppler colour group in front of every colour input of ``material``.
 
     A colour fed by a Blackbody node is shifted as a blackbody at that node's temperature. With
@@ -515,7 +515,7 @@ def attach_scene(scene: Scene, camera_path: bool) -> None:
         attach_world(scene.world)
 
 
-def attach_world(world: World) -> bool:
+def attach_world(world: World | None) -> bool:
     """The world's Doppler AOV writer (muted where ``world_doppler`` gives the compositor the
     world's D) and a colour group in front of every Background colour (``world_colour`` links it
     where it changes the colour: blackbodies, spectral passes)."""
@@ -532,7 +532,7 @@ def attach_world(world: World) -> bool:
     return True
 
 
-def detach_world(world: World) -> bool:
+def detach_world(world: World | None) -> bool:
     if world is None or ATTACHED_KEY not in world:
         return False
     if not isinstance(world[ATTACHED_KEY], str):

@@ -54,7 +54,7 @@ def is_active(group: Node) -> bool:
     return materials.spectral_pass_wavelengths() is not None or group.inputs["Is Blackbody"].default_value > 0.0
 
 
-def write(world: World) -> None:
+def write(world: World | None) -> None:
     """Link each world colour group into its Background where :func:`is_active`, else give the
     Background its own colour; only links that differ are changed (this runs at every sync)."""
     tree = world.node_tree if world is not None else None

@@ -63,7 +63,7 @@ def compile_custom_camera(camera_data: Camera) -> list[str]:
 
     errors = []
 
-    def report(kind: str, message) -> None:
+    def report(kind: str, message: object) -> None:
         if {"ERROR", "WARNING"} & set(kind):
             errors.append(str(message))
 

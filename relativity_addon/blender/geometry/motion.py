@@ -37,7 +37,7 @@ from ..scene.snapshot import check_velocity
 from . import modifier, shape_keys
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable, Sequence
+    from collections.abc import Iterable
 
     import numpy.typing as npt
     from bpy.types import Object, Scene
@@ -182,8 +182,8 @@ def proper_time_apparent_positions(
     x_o: npt.ArrayLike,
     beta_o: npt.ArrayLike,
     c: float,
-    beta_u: Sequence[float] | None = None,
-    matrix_now: npt.ArrayLike | None = None,
+    beta_u: FloatArray | None = None,
+    matrix_now: FloatArray | None = None,
     shape_keys_too: bool = True,
 ) -> Positions:
     """An object with its own animation (:func:`plays_own_animation`: a spinning wheel, a clock's

@@ -275,7 +275,7 @@ def _albedo_source(socket):
     return socket.links[0].from_socket if socket is not None and socket.is_linked else None
 
 
-def attach(material: Material, group: NodeTree) -> bool:
+def attach(material: Material | None, group: NodeTree) -> bool:
     """Add the group's emission to the material's surface: ``surface + moving lights``."""
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
@@ -316,7 +316,7 @@ def attach(material: Material, group: NodeTree) -> bool:
     return True
 
 
-def detach(material: Material) -> bool:
+def detach(material: Material | None) -> bool:
     """Remove the inserted nodes and link the old surface shader to the output again."""
     if material is None or MATERIAL_KEY not in material:
         return False

@@ -102,7 +102,7 @@ def _normal_inputs(tree):
     ]
 
 
-def attach(material: Material, group: NodeTree) -> bool:
+def attach(material: Material | None, group: NodeTree) -> bool:
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
     tree = material.node_tree
@@ -119,7 +119,7 @@ def attach(material: Material, group: NodeTree) -> bool:
     return True
 
 
-def detach(material: Material) -> bool:
+def detach(material: Material | None) -> bool:
     if material is None or MATERIAL_KEY not in material:
         return False
     tree = material.node_tree

@@ -116,7 +116,9 @@ def view_directions(
     return world
 
 
-def visible_points(scene: Scene, snap: Snapshot, depsgraph: Depsgraph, origin: npt.ArrayLike) -> npt.NDArray[Any]:
+def visible_points(
+    scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None, origin: npt.ArrayLike
+) -> npt.NDArray[Any]:
     """Surface points the camera sees (the first hit of each ray of :func:`view_directions`)."""
     if depsgraph is None:
         try:

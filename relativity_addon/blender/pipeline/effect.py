@@ -345,7 +345,7 @@ def scene_warnings(scene: Scene) -> list[str]:
     return list(_status(scene)[1])
 
 
-def object_warnings(scene: Scene, obj: Object) -> list[str]:
+def object_warnings(scene: Scene, obj: Object | None) -> list[str]:
     """Warnings for the active object on the apparent-geometry path: its last update error, a bake
     it needs, a mesh too coarse to curve (as of the last sync), shape keys left at scene time."""
     if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
