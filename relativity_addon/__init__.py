@@ -6,13 +6,13 @@ Blender registers the extension, so the core stays importable (and testable) wit
 """
 
 
-def register():
+def register() -> None:
     from . import blender
 
     blender.register()
 
 
-def unregister():
+def unregister() -> None:
     from . import blender
 
     blender.unregister()

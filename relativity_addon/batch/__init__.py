@@ -5,14 +5,23 @@ and inside Blender (``blender -b file.blend --python examples/render.py -- [opti
 Every failure ends in ``BatchError`` with a one-line reason; ``main`` turns it into exit code 1.
 """
 
+from __future__ import annotations
+
 import argparse
 import math
 import os
 import sys
+from typing import TYPE_CHECKING
 
 from ..errors import BatchError, RelativityError
 from ..physics.shutter import ShutterModel
 from .frame_files import format_seconds, frame_output_path, output_problem, partial_path
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from types import ModuleType
+
+    from bpy.types import Scene
 
 ADDON_PACKAGE = "relativity_addon"
 
@@ -68,7 +77,7 @@ SHUTTER_CHOICES = tuple(model.name.lower() for model in ShutterModel)
 LENS_CHOICES = {"ideal": "IDEAL_LENS", "phase-hologram": "PHASE_HOLOGRAM"}
 
 
-def build_parser(with_blend_file):
+def build_parser(with_blend_file: bool) -> argparse.ArgumentParser:
     parser = _Parser(
         prog="render.py",
         description="Render a .blend with the relativistic camera (Cycles, CPU).",
@@ -195,7 +204,7 @@ def _split_argv(argv):
     return argv[1:], True
 
 
-def enable_addon():
+def enable_addon() -> None:
     """Register the add-on unless it already is (installed extension or this source tree)."""
     import bpy
 
@@ -216,7 +225,7 @@ def enable_addon():
     importlib.import_module(ADDON_PACKAGE).register()
 
 
-def addon_module(name):
+def addon_module(name: str) -> ModuleType:
     """The add-on's ``blender.<name>`` module as registered in this Blender: the installed extension
     (``bl_ext....relativity_addon``) when it is enabled, which may be another copy than this file's
     package. Its handlers keep per-render state (the spectral pass), so the modules this script
@@ -275,7 +284,7 @@ def _apply_options(scene, options):
         settings.use_time_of_flight = True
 
 
-def animation_fps(scene):
+def animation_fps(scene: Scene) -> float:
     return scene.render.fps / scene.render.fps_base
 
 
@@ -297,7 +306,7 @@ def _stereo_output(scene, mode):
     image_settings.stereo_3d_format.display_mode = "ANAGLYPH" if mode == "anaglyph" else "SIDEBYSIDE"
 
 
-def view_paths(path):
+def view_paths(path: str) -> list[str]:
     """The files Blender writes for the two views of ``path`` (``--stereo views``)."""
     stem, extension = os.path.splitext(path)
     return [f"{stem}_L{extension}", f"{stem}_R{extension}"]
@@ -390,14 +399,14 @@ def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, s
                 os.remove(written)
 
 
-def parse(argv):
+def parse(argv: Sequence[str]) -> tuple[argparse.Namespace, argparse.ArgumentParser]:
     """(options, parser) for the command line ``argv`` (either invocation form)."""
     arguments, with_blend_file = _split_argv(argv)
     parser = build_parser(with_blend_file)
     return parser.parse_args(arguments), parser
 
 
-def run(argv, log=print):
+def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     import time
 
     import bpy
@@ -489,7 +498,7 @@ def run(argv, log=print):
     return paths
 
 
-def command_line():
+def command_line() -> None:
     """The entry point of ``examples/render.py``. A distributed render's coordinator never imports
     bpy (its worker processes, which start by importing the main script, neither)."""
     try:
@@ -512,7 +521,7 @@ def command_line():
     compat.run_main(main)
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
     try:
         options, parser = parse(argv)

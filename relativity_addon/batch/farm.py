@@ -12,14 +12,21 @@ on by default here). The coordinator (this module) imports neither bpy nor, befo
 Dask: the single-process path stays free of both.
 """
 
+from __future__ import annotations
+
 import glob
 import importlib.util
 import os
 import sys
 import time
+from typing import TYPE_CHECKING
 
 from ..errors import BatchError
 from . import frame_files
+
+if TYPE_CHECKING:
+    import argparse
+    from collections.abc import Callable, Iterable, Sequence
 
 # Options of the coordinator, not passed on to the per-task batch script.
 COORDINATOR_OPTIONS = {
@@ -60,7 +67,7 @@ class LostProcessError(Exception):
     user): Dask runs the task again, elsewhere if it can."""
 
 
-def render_task(arguments, label):
+def render_task(arguments: Sequence[str], label: str) -> tuple[int, str | None, float, str]:
     """Run on a worker: render ``arguments`` (batch script options, ``--frames`` included) in a
     fresh Blender process. Returns (exit status, one-line reason or None, seconds, worker host:pid);
     raises LostProcessError when the process was killed, so Dask retries it."""
@@ -84,7 +91,7 @@ def render_task(arguments, label):
     return process.returncode, reason, seconds, f"{socket.gethostname()}:{os.getpid()}"
 
 
-def output_pattern(out_path, several):
+def output_pattern(out_path: str, several: bool) -> str:
     """The --out path with a run of '#' for the frame number: each task renders its frames to the
     names a single-process ``--frames`` render gives them (``shot_0001.png``)."""
     directory, name = os.path.split(out_path)
@@ -102,7 +109,7 @@ def _option_text(dest, value):
     return str(value)
 
 
-def task_options(parser, options):
+def task_options(parser: argparse.ArgumentParser, options: argparse.Namespace) -> list[str]:
     """The batch script options of ``options`` that every task repeats (scene, camera, samples...),
     as command-line text; the coordinator's own options are left out."""
     arguments = []
@@ -115,7 +122,7 @@ def task_options(parser, options):
     return arguments
 
 
-def chunks(frames, size):
+def chunks(frames: Iterable[int], size: int) -> list[list[int]]:
     """Runs of at most ``size`` consecutive frames."""
     runs, current = [], []
     for frame in frames:
@@ -130,7 +137,7 @@ def _label(frames):
     return f"frame {frames[0]}" if len(frames) == 1 else f"frames {frames[0]}-{frames[-1]}"
 
 
-def remove_partials(paths):
+def remove_partials(paths: Iterable[str]) -> None:
     """Partial files of these frames left by killed Blender processes."""
     for path in paths:
         directory, name = os.path.split(path)
@@ -250,7 +257,12 @@ class _Job:
         return 1 if self.failed else 0
 
 
-def render(options, parser, log=print, error_log=None):
+def render(
+    options: argparse.Namespace,
+    parser: argparse.ArgumentParser,
+    log: Callable[..., object] = print,
+    error_log: Callable[[str], object] | None = None,
+) -> int:
     """Run the distributed render; returns the exit status (1 if any frame failed)."""
     error_log = error_log or (lambda line: print(line, file=sys.stderr, flush=True))
     blend = os.path.abspath(options.blend_file)

@@ -27,7 +27,7 @@ EXR_MAGIC = 20000630
 EXR_LINES_PER_CHUNK = {0: 1, 1: 1, 2: 1, 3: 16, 4: 32, 5: 16, 6: 32, 7: 32, 8: 32, 9: 256}
 
 
-def frame_output_path(out_path, frame, several):
+def frame_output_path(out_path: str, frame: int, several: bool) -> str:
     """The file for ``frame``: a run of '#' becomes the zero-padded frame number; otherwise,
     when several frames are rendered, ``_NNNN`` is inserted before the extension."""
     directory, name = os.path.split(out_path)
@@ -43,7 +43,7 @@ def frame_output_path(out_path, frame, several):
     return os.path.join(directory, f"{stem}_{number}{extension}")
 
 
-def partial_path(path):
+def partial_path(path: str) -> str:
     """Where a frame is written before it is complete; renamed to ``path`` when it is. A hidden name
     in the same folder (the rename is atomic), unique per process."""
     directory, name = os.path.split(path)
@@ -51,7 +51,7 @@ def partial_path(path):
     return os.path.join(directory, f".{stem}.{os.getpid()}.partial{extension}")
 
 
-def output_problem(out_path):
+def output_problem(out_path: str) -> str | None:
     """Why no image can be written at ``out_path`` (one line), or None. Checked before anything is
     loaded or rendered: the nearest existing folder on its path must be a folder in which a file can
     be created (tried, not guessed from the permission bits: root may write anywhere but /proc)."""
@@ -72,7 +72,7 @@ def output_problem(out_path):
     return None
 
 
-def format_seconds(seconds):
+def format_seconds(seconds: float) -> str:
     if seconds < 60.0:
         return f"{seconds:.1f} s"
     minutes, seconds = divmod(int(round(seconds)), 60)
@@ -80,7 +80,7 @@ def format_seconds(seconds):
     return f"{hours}h{minutes:02d}m" if hours else f"{minutes}m{seconds:02d}s"
 
 
-def problem(path):
+def problem(path: str) -> str | None:
     """Why the file at ``path`` is not a complete PNG or EXR image (one line), or None."""
     try:
         with open(path, "rb") as stream:
@@ -97,7 +97,7 @@ def problem(path):
     return f"not a .png or .exr file: {os.path.basename(path)}"
 
 
-def is_complete(path):
+def is_complete(path: str) -> bool:
     return problem(path) is None
 
 

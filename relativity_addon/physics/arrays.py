@@ -1,6 +1,7 @@
 """Type aliases for the physics core's signatures (numpy arrays in, float64 arrays out)."""
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -8,7 +9,8 @@ import numpy.typing as npt
 ArrayLike = npt.ArrayLike
 FloatArray = npt.NDArray[np.float64]
 Float32Array = npt.NDArray[np.float32]
-IndexArray = npt.NDArray[np.integer]
+IndexArray = npt.NDArray[np.integer[Any]]
+BoolArray = npt.NDArray[np.bool_]
 
 # A function of wavelength (array) returning a spectral quantity of the same shape.
 Spectrum = Callable[[FloatArray], ArrayLike]

@@ -10,11 +10,11 @@ from .arrays import ArrayLike, FloatArray
 from .validation import finite_array, unit_vectors, velocity_array
 
 
-def _dot(a, b):
+def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.sum(a * b, axis=-1)
 
 
-def _gamma(beta):
+def _gamma(beta: FloatArray) -> FloatArray:
     return 1.0 / np.sqrt(1.0 - _dot(beta, beta))
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .arrays import FloatArray
+from .arrays import ArrayLike, Float32Array, FloatArray
 from .spectral_render import PLANCK_C1, PLANCK_C2, WHITE_TEMPERATURE_K, luminance, reflectance_matrix, tables
 
 TEMPERATURE_RANGE_K = (1000.0, 40000.0)
@@ -33,14 +33,14 @@ asks for reflectances far outside [0, 1]."""
 _NM = 1e-9
 
 
-def log_planck(wavelengths_nm, temperature_k: float) -> FloatArray:
+def log_planck(wavelengths_nm: ArrayLike, temperature_k: float) -> FloatArray:
     """``ln B(lambda, T)`` (Planck's law per metre, colour-science's constants), finite for any ``lambda``."""
     metres = np.asarray(wavelengths_nm, dtype=np.float64) * _NM
     x = PLANCK_C2 / (metres * float(temperature_k))
     return np.log(PLANCK_C1 / np.pi / metres**5) - x - np.log(-np.expm1(-x))
 
 
-def _scaled_columns(log_doppler: np.ndarray, temperature_k: float):
+def _scaled_columns(log_doppler: FloatArray, temperature_k: float) -> tuple[FloatArray, FloatArray]:
     """``(A_S(D) exp(-m), m)``: the unnormalised matrices scaled by ``exp(-m(D))`` per ``D``."""
     shipped = tables()
     emitted = shipped["cmfs_nm"][None, :] * np.exp(log_doppler)[:, None]  # lambda D, (J, W)
@@ -51,7 +51,7 @@ def _scaled_columns(log_doppler: np.ndarray, temperature_k: float):
     return shipped["xyz_to_rgb"] @ columns, peak
 
 
-def normalised_matrices(log_doppler, temperature_k: float | None) -> tuple[FloatArray, FloatArray]:
+def normalised_matrices(log_doppler: ArrayLike, temperature_k: float | None) -> tuple[FloatArray, FloatArray]:
     """``(N, a)`` with ``M_S(D) = exp(a) N``, shapes ``(J, 3, 3)`` and ``(J,)``, for the illuminant
     a blackbody at ``temperature_k`` (None: the 6504 K white of up-sampled colours)."""
     temperature = WHITE_TEMPERATURE_K if temperature_k is None else float(np.clip(temperature_k, *TEMPERATURE_RANGE_K))
@@ -65,14 +65,14 @@ def normalised_matrices(log_doppler, temperature_k: float | None) -> tuple[Float
     return product / white[:, None, None], peak - rest_peak[0] + np.log(white)
 
 
-def doppler_matrix(doppler, temperature_k: float | None) -> FloatArray:
+def doppler_matrix(doppler: ArrayLike, temperature_k: float | None) -> FloatArray:
     """``M_S(D)``, shape ``(..., 3, 3)``: pixel ``rgb`` (a reflectance under the illuminant) -> observed."""
     doppler = np.asarray(doppler, dtype=np.float64)
     normalised, log_scale = normalised_matrices(np.log(doppler).ravel(), temperature_k)
     return (normalised * np.exp(log_scale)[:, None, None]).reshape(*doppler.shape, 3, 3)
 
 
-def doppler_lut(log10_d_grid, temperature_k: float | None) -> np.ndarray:
+def doppler_lut(log10_d_grid: ArrayLike, temperature_k: float | None) -> Float32Array:
     """The packed table (float32, flat, ``12 N`` values), laid out as ``spectral_luts.doppler_matrix_lut``."""
     log10_d_grid = np.asarray(log10_d_grid, dtype=np.float64)
     normalised, log_scale = normalised_matrices(log10_d_grid * np.log(10.0), temperature_k)

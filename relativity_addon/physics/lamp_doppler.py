@@ -45,7 +45,7 @@ IRRADIANCE_POWER = 2.0
 """``E'/E = D^2``: object-frame irradiance over scene-frame irradiance at the same event."""
 
 
-def _gamma(beta):
+def _gamma(beta: FloatArray) -> FloatArray:
     return 1.0 / np.sqrt(1.0 - np.sum(beta * beta, axis=-1))
 
 
@@ -139,7 +139,7 @@ def lamp_rgb_factor(
     return np.clip(factor, 0.0, 1e30)
 
 
-def _blackbody_unit_rgb(temperature_k):
+def _blackbody_unit_rgb(temperature_k: float) -> FloatArray:
     """Linear Rec.709 colour of a blackbody at ``temperature_k``, gamut-mapped, luminance 1 (Blender's)."""
     rgb = spectral_render.xyz_to_linear_rec709(spectral_render.blackbody_xyz(temperature_k))
     mapped = spectral_render.gamut_map(rgb)
@@ -147,7 +147,7 @@ def _blackbody_unit_rgb(temperature_k):
     return mapped / y if y > 0.0 and np.isfinite(y) else np.zeros(3)  # no visible light left (a few K)
 
 
-def _same_luminance(rgb, reference):
+def _same_luminance(rgb: FloatArray, reference: FloatArray) -> FloatArray:
     y, y0 = spectral_render.luminance(rgb), spectral_render.luminance(reference)
     return rgb * (y0 / y) if y > 0.0 else rgb * 0.0
 
@@ -198,7 +198,9 @@ def one_factor_irradiance(
     return irradiance_factor(doppler) * cos_scene / r**2 * intensity
 
 
-def contracted_sphere(radius: float, centre: ArrayLike, beta_object: ArrayLike, count: int = 4000):
+def contracted_sphere(
+    radius: float, centre: ArrayLike, beta_object: ArrayLike, count: int = 4000
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Points, scene-frame normals and rest-frame normals of a sphere of rest radius ``radius``
     moving with ``beta_object``, Lorentz-contracted about ``centre`` at one scene time (a
     Fibonacci lattice of ``count`` points)."""

@@ -12,7 +12,7 @@ from .arrays import ArrayLike, FloatArray
 from .validation import finite_array, speed_of_light, unit_vectors, vector_array, velocity_array
 
 
-def _dot(a, b):
+def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.sum(a * b, axis=-1)
 
 
@@ -22,7 +22,7 @@ def lorentz_factor(beta: ArrayLike) -> FloatArray:
     return 1.0 / np.sqrt(1.0 - _dot(beta, beta))
 
 
-def _boost(t, x, beta, c):
+def _boost(t: FloatArray, x: FloatArray, beta: FloatArray, c: float) -> tuple[FloatArray, FloatArray]:
     gamma = 1.0 / np.sqrt(1.0 - _dot(beta, beta))
     beta_x = _dot(beta, x)
     ct = c * t
@@ -71,7 +71,7 @@ def aberrate(k: ArrayLike, beta: ArrayLike) -> FloatArray:
     return _aberrate(k, beta)
 
 
-def _aberrate(k, beta):
+def _aberrate(k: FloatArray, beta: FloatArray) -> FloatArray:
     gamma = 1.0 / np.sqrt(1.0 - _dot(beta, beta))
     beta_k = _dot(beta, k)
     numerator = k + ((gamma * gamma / (gamma + 1.0)) * beta_k - gamma)[..., None] * beta

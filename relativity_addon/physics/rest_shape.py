@@ -25,7 +25,7 @@ from .apparent import (
     apparent_positions,
     apparent_positions_sampled,
 )
-from .arrays import ArrayLike, FloatArray
+from .arrays import ArrayLike, BoolArray, FloatArray
 from .validation import finite_array, positive_array, speed_of_light, vector_array
 
 
@@ -41,7 +41,7 @@ def origin_velocities(origins: ArrayLike, step: float) -> FloatArray:
     return (padded[2:] - padded[:-2]) / (2.0 * step)
 
 
-def contraction_matrices(beta: ArrayLike) -> tuple[FloatArray, np.ndarray]:
+def contraction_matrices(beta: ArrayLike) -> tuple[FloatArray, BoolArray]:
     """``C(beta)`` of :func:`apparent.lorentz_contraction_matrix` for each row of ``beta``
     (``(K, 3)``, fractions of c), shape ``(K, 3, 3)``, and the mask of rows with ``|beta| >= 1``
     (not slower than light: their matrix is the identity, and they must not be used)."""
@@ -58,7 +58,7 @@ def contraction_matrices(beta: ArrayLike) -> tuple[FloatArray, np.ndarray]:
     return result, superluminal
 
 
-def contracted_rigid_samples(matrices: ArrayLike, step: float, c: float) -> tuple[FloatArray, np.ndarray]:
+def contracted_rigid_samples(matrices: ArrayLike, step: float, c: float) -> tuple[FloatArray, BoolArray]:
     """Object-to-world matrices ``(K, 4, 4)`` sampled every ``step`` seconds with the rest-shape
     contraction applied: the 3x3 part ``L`` becomes ``C(beta_k) L`` with ``beta_k`` the origin's
     knot velocity over ``c``; the translation (the origin) is kept. Returns the matrices and the
@@ -75,7 +75,7 @@ def contracted_rigid_samples(matrices: ArrayLike, step: float, c: float) -> tupl
 
 def contracted_point_samples(
     positions: ArrayLike, origins: ArrayLike, step: float, c: float
-) -> tuple[FloatArray, np.ndarray]:
+) -> tuple[FloatArray, BoolArray]:
     """World positions ``(K, N, 3)`` of a deforming mesh sampled every ``step`` seconds, with the
     object's origin at ``origins`` (``(K, 3)``), contracted about the origin along its knot
     velocity (the same convention as rigid motion: the baked shape is taken as the rest shape
@@ -90,7 +90,7 @@ def contracted_point_samples(
     return np.einsum("kij,knj->kni", contraction, relative) + origins[:, None, :], superluminal
 
 
-def check_samples_used(t_e: ArrayLike, start: float, step: float, superluminal: np.ndarray) -> None:
+def check_samples_used(t_e: ArrayLike, start: float, step: float, superluminal: BoolArray) -> None:
     """``ValueError`` if a retarded time ``t_e`` is interpolated from a sample whose origin is not
     slower than light (samples ``start + k step``; an interval uses its two ends and one sample on
     each side, the end intervals also the linear extrapolation beyond the grid)."""

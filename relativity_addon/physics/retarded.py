@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .arrays import ArrayLike, FloatArray, WorldLine
+from .arrays import ArrayLike, FloatArray, IndexArray, WorldLine
 from .validation import finite_array, speed_of_light, vector_array, velocity_array
 
 
@@ -88,7 +88,7 @@ def light_travel_time(
     x_o = np.broadcast_to(observer_position, (count, 3))
     t_o = np.broadcast_to(finite_array(observer_time, "observer_time"), (count,)).astype(np.float64)
 
-    def g(tau, index):
+    def g(tau: FloatArray, index: IndexArray) -> tuple[FloatArray, FloatArray]:
         """g and the size of its rounding error (a few ulps of the positions' magnitudes)."""
         positions = finite_array(world_line(t_o[index] - tau, index), "world_line positions")
         rounding = 8.0 * np.finfo(np.float64).eps * (np.abs(x_o[index]).sum(-1) + np.abs(positions).sum(-1))

@@ -45,7 +45,7 @@ class ShutterModel(enum.IntEnum):
 SHUTTER_MODEL_NAMES: tuple[str, ...] = tuple(model.name for model in ShutterModel)
 
 
-def _dot(a, b):
+def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
     return np.sum(a * b, axis=-1)
 
 

@@ -18,7 +18,10 @@ the ends) and are the reference the tests compare with the exact functions. Layo
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 
 from .arrays import ArrayLike, Float32Array, FloatArray
 from .spectral import (
@@ -98,7 +101,7 @@ def blackbody_rgb_lut(log10_t_grid: ArrayLike | None = None) -> Float32Array:
     return table.astype(np.float32).ravel()
 
 
-def sample_blackbody_rgb_lut(lut: ArrayLike, log10_t_grid: ArrayLike, temperature_K: ArrayLike) -> FloatArray:
+def sample_blackbody_rgb_lut(lut: ArrayLike, log10_t_grid: FloatArray, temperature_K: ArrayLike) -> FloatArray:
     """Absolute gamut-mapped RGB at ``temperature_K`` read from :func:`blackbody_rgb_lut`.
 
     Reference for the shader: linear interpolation in ``log10 T``, clamped at the ends (an image
@@ -158,7 +161,7 @@ def doppler_matrix_lut(log10_d_grid: ArrayLike | None = None) -> Float32Array:
     return np.ascontiguousarray(np.swapaxes(pixels, 0, 1)).astype(np.float32).ravel()
 
 
-def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: ArrayLike, doppler_factor: ArrayLike) -> FloatArray:
+def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: FloatArray, doppler_factor: ArrayLike) -> FloatArray:
     """``M(D)``, shape (..., 3, 3), read from :func:`doppler_matrix_lut` as the shader does it.
 
     Linear interpolation in ``log10 D`` of ``N`` and of ``a = ln Y(white)``, clamped at the ends.
@@ -175,7 +178,7 @@ def sample_doppler_matrix_lut(lut: ArrayLike, log10_d_grid: ArrayLike, doppler_f
     return sampled[..., :3] * np.exp(sampled[..., :1, 3:4])
 
 
-def spectral_mode_tables() -> dict:
+def spectral_mode_tables() -> dict[str, npt.NDArray[Any]]:
     """What the spectral mode (:mod:`.spectral_render`) needs at render time, where Blender has no
     colour-science: the CIE 1931 functions on the 1 nm grid, Mallett & Yuksel's basis table and its
     constrained band, the rest-frame inverse matrix of the up-sampled colours and the Rec.709 matrices."""

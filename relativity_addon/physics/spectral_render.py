@@ -33,6 +33,7 @@ import numpy as np
 
 from . import shipped_luts
 from .arrays import ArrayLike, FloatArray
+from .shipped_luts import Table
 
 __all__ = [
     "VISIBLE_BAND_NM",
@@ -61,16 +62,16 @@ WHITE_TEMPERATURE_K = 6504.0  # the white light of up-sampled colours (spectral.
 
 
 @functools.lru_cache(maxsize=1)
-def _tables():
+def _tables() -> dict[str, Table]:
     return shipped_luts.spectral_mode_tables()
 
 
-def tables():
+def tables() -> dict[str, Table]:
     """The shipped tables (colour matching functions on their 1 nm grid, XYZ -> RGB, ...)."""
     return _tables()
 
 
-def planck(wavelengths_nm: ArrayLike, temperature_k: float) -> FloatArray:
+def planck(wavelengths_nm: ArrayLike, temperature_k: float | FloatArray) -> FloatArray:
     """Planck's law per metre of wavelength (as colour-science's ``planck_law``), 0 deep in the Wien tail."""
     metres = np.asarray(wavelengths_nm, dtype=np.float64) * _NM
     with np.errstate(over="ignore"):
@@ -169,7 +170,7 @@ def blackbody_samples(wavelengths_nm: ArrayLike, temperature_k: float, luminance
     return luminance * np.exp(log_radiance - log_blackbody_luminance(float(temperature_k))) * _NM
 
 
-def _cmfs():
+def _cmfs() -> tuple[Table, Table]:
     return _tables()["cmfs_nm"], _tables()["cmfs"]
 
 

@@ -24,7 +24,7 @@ KEY = names.CLAMP_SAVED_KEY
 CLAMPS = ("sample_clamp_direct", "sample_clamp_indirect")
 
 
-def factor(snap: Snapshot):
+def factor(snap: Snapshot) -> float:
     if not (snap.exact_camera and snap.use_searchlight and snap.speed > 0.0):
         return 1.0
     return (snap.gamma * (1.0 + snap.speed)) ** 4
@@ -51,7 +51,7 @@ def write(scene: Scene, snap: Snapshot) -> None:
         saved[f"written {name}"] = getattr(cycles, name)
 
 
-def remove(scene: Scene):
+def remove(scene: Scene) -> bool:
     """Give the user's clamps back."""
     if KEY not in scene:
         return False

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
@@ -33,7 +33,7 @@ from ..scene import lens, snapshot
 from ..scene.lens import PANORAMA_PROJECTIONS, lens_type, projection_parameters, stereo_eyes
 
 if TYPE_CHECKING:
-    from bpy.types import Camera, Object, Scene
+    from bpy.types import Camera, Object, Scene, Text
 
     from ..scene.snapshot import Snapshot
 
@@ -81,12 +81,12 @@ REQUIRED_PARAMETERS = (
 LENS_SHUTTERS = ("DETECTOR_PLANE", "FOCUS_SURFACE", "FIXED_POINT_SURFACE")
 
 
-def shader_source():
+def shader_source() -> str:
     with open(SHADER_PATH, encoding="utf-8") as handle:
         return handle.read()
 
 
-def ensure_shader_text():
+def ensure_shader_text() -> Text:
     """The text datablock holding the camera shader, created or refreshed from the package."""
     source = shader_source()
     text = bpy.data.texts.get(names.SHADER_TEXT)
@@ -98,16 +98,16 @@ def ensure_shader_text():
     return text
 
 
-def is_applied(camera_data: Camera):
+def is_applied(camera_data: Camera | None) -> bool:
     return camera_data is not None and names.CAMERA_SAVED_STATE_KEY in camera_data
 
 
-def is_render_only(camera_data: Camera):
+def is_render_only(camera_data: Camera) -> bool:
     """Applied for the time of an Apparent Geometry final render (``effect.begin_final_render``)."""
     return is_applied(camera_data) and bool(camera_data[names.CAMERA_SAVED_STATE_KEY].get("render_only", False))
 
 
-def type_problem(camera_name, camera_data: Camera):
+def type_problem(camera_name: str, camera_data: Camera) -> str | None:
     """Why the exact camera cannot replace this camera (one line), or None."""
     kind = lens_type(camera_data)
     if kind == "PERSP":
@@ -124,7 +124,7 @@ def type_problem(camera_name, camera_data: Camera):
     return f"Camera {camera_name!r} is {kind}: the relativistic camera replaces a perspective or panoramic camera only"
 
 
-def final_render_problem(scene: Scene, snap: Snapshot):
+def final_render_problem(scene: Scene, snap: Snapshot) -> str | None:
     """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
     line, lower-case: it follows a colon), or None when it is. Without a moving observer nothing
     needs it (the boosted meshes are then scene-frame meshes)."""
@@ -140,7 +140,7 @@ def final_render_problem(scene: Scene, snap: Snapshot):
     return type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
-def lens_warnings(camera_object: Object):
+def lens_warnings(camera_object: Object | None) -> list[str]:
     """One-line notes on what the exact camera does not render for this camera (the shutter model
     read from the scene whose active camera it is)."""
     if camera_object is None or camera_object.type != "CAMERA" or not camera_object.data.dof.use_dof:
@@ -192,7 +192,7 @@ def _local_to_shader(vector):
     return (vector[0], vector[1], -vector[2])
 
 
-def camera_frame_window(scene: Scene, camera_data: Camera):
+def camera_frame_window(scene: Scene, camera_data: Camera) -> tuple[float, float, float, float]:
     """Image window of lens-centre rays on the plane at unit distance: left, right, bottom, top.
 
     Taken from Blender's own view frame, so sensor fit, aspect and lens shift match the
@@ -216,7 +216,7 @@ def camera_frame_window(scene: Scene, camera_data: Camera):
     )
 
 
-def shader_parameters(scene: Scene, camera_data: Camera, snap: Snapshot):
+def shader_parameters(scene: Scene, camera_data: Camera, snap: Snapshot) -> dict[str, Any]:
     """Values for ``cycles_custom`` from the snapshot and the camera's lens and sensor."""
     left, right, bottom, top = camera_frame_window(scene, camera_data)
     unit_scale = scene.unit_settings.scale_length or 1.0
@@ -313,7 +313,7 @@ def _save_state(camera_data, render_only):
     }
 
 
-def apply(scene: Scene, snap: Snapshot, render_only=False):
+def apply(scene: Scene, snap: Snapshot, render_only: bool = False) -> Object:
     """Turn the snapshot's camera into the relativistic OSL camera and write its parameters
     (``render_only``: for the time of a final render). Returns the camera object;
     RelativityError (one line), with the camera restored, on failure."""
@@ -370,7 +370,7 @@ def write(scene: Scene, snap: Snapshot) -> None:
     _write_parameters(camera_data, shader_parameters(scene, camera_data, snap))
 
 
-def invalidate(camera_object: Object) -> None:
+def invalidate(camera_object: Object | None) -> None:
     """Mark the camera's parameters invalid: the shader renders black, never a wrong image."""
     if camera_object is None or camera_object.type != "CAMERA" or not is_applied(camera_object.data):
         return
@@ -378,11 +378,11 @@ def invalidate(camera_object: Object) -> None:
         _write_parameters(camera_object.data, {"settings_valid": False})
 
 
-def applied_cameras():
+def applied_cameras() -> list[Object]:
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
-def remove(camera_object: Object):
+def remove(camera_object: Object | None) -> bool:
     """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False

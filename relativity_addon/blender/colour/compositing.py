@@ -32,7 +32,7 @@ created if the scene has none); :func:`remove_colour_stage` restores the composi
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
@@ -41,7 +41,7 @@ from ..common.nodes import Group, Menu, Node, ensure_group, fmath, group_node, v
 from . import light_groups, lut_images, materials
 
 if TYPE_CHECKING:
-    from bpy.types import Scene
+    from bpy.types import Image, NodeTree, Scene
 
     from ..scene.snapshot import Snapshot
 
@@ -95,7 +95,7 @@ def _matrix_nodes(key, image_name, colour):
     return nodes
 
 
-def compositor_group():
+def compositor_group() -> Group:
     scale, offset = lut_images.texture_u_scale_offset(lut_images.DOPPLER_LOG10_RANGE)
     nodes = {
         # ln D per pixel from the materials' AOV (materials.doppler_aov_group), over the share
@@ -172,7 +172,7 @@ def compositor_group():
     )
 
 
-def ensure_world_image(size=(1, 1)):
+def ensure_world_image(size: tuple[int, int] = (1, 1)) -> Image:
     """The float image of the pixels' world ``ln D`` (``world_doppler`` writes it), of ``size``."""
     image = bpy.data.images.get(names.WORLD_DOPPLER_IMAGE)
     if image is not None and (tuple(image.size) != tuple(size) or not image.is_float):
@@ -185,7 +185,7 @@ def ensure_world_image(size=(1, 1)):
     return image
 
 
-def ensure_compositor_group():
+def ensure_compositor_group() -> NodeTree:
     lut_images.ensure_doppler_matrix_lut()
     for name in lut_images.ILLUMINANT_LUT_NAMES:
         if bpy.data.images.get(name) is None:
@@ -196,7 +196,7 @@ def ensure_compositor_group():
     return ensure_group(compositor_group(), *version)
 
 
-def colour_stage_values(snap: Snapshot):
+def colour_stage_values(snap: Snapshot) -> dict[str, Any]:
     """Values of the compositor group's flag inputs, from the snapshot."""
     values = materials.settings_values(snap)
     values = {name: values[name] for name in VALUE_NAMES if name in values}
@@ -209,7 +209,7 @@ def colour_stage_values(snap: Snapshot):
 _stage_mode = {"mode": "COLOUR"}
 
 
-def set_stage_mode(mode) -> None:
+def set_stage_mode(mode: str) -> None:
     """Switch the stage's output for the next renders (written at the next sync)."""
     if mode not in ("COLOUR", "PASS_THROUGH"):
         raise ValueError(mode)
@@ -224,7 +224,7 @@ def _inserted_nodes(scene):
     return tree, [tree.nodes[name] for name in names if name in tree.nodes]
 
 
-def write_colour_stage(scene: Scene, snap: Snapshot):
+def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
     """Write the effect flags into the inserted group nodes (only where they changed).
 
     ``D`` itself comes from the AOV, computed by Cycles for every frame. The flags are written
@@ -302,7 +302,7 @@ def _link_light_group_pass(tree, layers, denoiser, slot):
             tree.links.new(outputs[output_name], denoiser.inputs[input_name])
 
 
-def write_world_directions(scene: Scene, value):
+def write_world_directions(scene: Scene, value: float) -> bool:
     """1: the samples without ln D AOV take the world image's ln D; 0: the world writes the AOV.
     False if an inserted group has no such input (a file set up before it: set up again)."""
     _tree, nodes = _inserted_nodes(scene)
@@ -315,7 +315,7 @@ def write_world_directions(scene: Scene, value):
     return True
 
 
-def is_applied(scene: Scene):
+def is_applied(scene: Scene) -> bool:
     return SAVED_KEY in scene
 
 
@@ -376,7 +376,7 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
     write_colour_stage(scene, snap)
 
 
-def remove_colour_stage(scene: Scene):
+def remove_colour_stage(scene: Scene) -> bool:
     """Restore the compositor (tree, links, AOVs, the compositing switch) exactly."""
     if not is_applied(scene):
         return False

@@ -41,7 +41,7 @@ def apply(scene: Scene, snap: Snapshot) -> None:
         ) from error
 
 
-def write(scene: Scene, snap: Snapshot, attach_new_materials=False) -> None:
+def write(scene: Scene, snap: Snapshot, attach_new_materials: bool = False) -> None:
     """Write the snapshot's colour factors; before a render also attach materials added since."""
     if attach_new_materials:
         _attach(scene, snap)
@@ -79,7 +79,7 @@ def remove(scene: Scene) -> None:
         remove_unused_data()
 
 
-def remove_unused_data():
+def remove_unused_data() -> bool:
     """Delete the add-on's node groups and LUT images once nothing uses the effect any more."""
     if any(materials.is_attached(material) for material in bpy.data.materials):
         return False

@@ -21,20 +21,23 @@ from ..common import names
 from ..scene import illuminants
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from bpy.types import Scene
 
+    from ..scene.illuminants import LitGroup
     from ..scene.snapshot import Snapshot
 
 KEY = names.LIGHT_GROUPS_KEY
 SLOTS = names.LIT_GROUPS
 
 
-def user_groups(scene: Scene):
+def user_groups(scene: Scene) -> list[str]:
     """Names of the light groups of ``scene``'s view layers that are not the add-on's."""
     return sorted({group.name for layer in scene.view_layers for group in layer.lightgroups} - set(SLOTS))
 
 
-def warnings(scene: Scene, snap: Snapshot):
+def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """One line when blackbody lamps are read in white because the scene has its own light groups."""
     if snap.lit_groups and user_groups(scene):
         return [
@@ -44,7 +47,7 @@ def warnings(scene: Scene, snap: Snapshot):
     return []
 
 
-def hold(scene: Scene):
+def hold(scene: Scene) -> bool:
     """Add the slots' light groups to every view layer (before the compositor stage links their passes)."""
     if KEY in scene or user_groups(scene):
         return False
@@ -60,7 +63,7 @@ def _datablock(kind, name):
     return (bpy.data.objects if kind == "objects" else bpy.data.worlds).get(name)
 
 
-def assign(scene: Scene, groups):
+def assign(scene: Scene, groups: Sequence[LitGroup]) -> tuple[float, ...]:
     """Put the lamps of ``groups`` (``illuminants.LitGroup``, one per slot) into the slots' light
     groups and take every other lamp the add-on put there out again. Returns the temperature of
     each slot (0: empty)."""
@@ -93,7 +96,7 @@ def assign(scene: Scene, groups):
     return tuple(temperatures[: len(SLOTS)])
 
 
-def release(scene: Scene):
+def release(scene: Scene) -> bool:
     """Give back every light group set and remove the slots' light groups."""
     if KEY not in scene:
         return False

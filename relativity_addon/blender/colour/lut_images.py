@@ -10,11 +10,16 @@ from the file alone: neither colour-science nor the add-on is needed to render.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import bpy
 import numpy as np
 
 from ...physics import illuminants, shipped_luts
 from ..common import names
+
+if TYPE_CHECKING:
+    from bpy.types import Image
 
 DOPPLER_LUT_NAME = names.DOPPLER_LUT_IMAGE
 BLACKBODY_LUT_NAME = names.BLACKBODY_LUT_IMAGE
@@ -66,19 +71,19 @@ def _ensure_lut(name, table, log10_range, height):
     return _packed_float_image(name, LUT_SIZE, height, _shipped_table(table, log10_range))
 
 
-def ensure_doppler_matrix_lut():
+def ensure_doppler_matrix_lut() -> Image:
     """The packed ``N x 3`` Doppler matrix table (``spectral_luts.doppler_matrix_lut``)."""
 
     return _ensure_lut(DOPPLER_LUT_NAME, shipped_luts.doppler_matrix_lut, DOPPLER_LOG10_RANGE, 3)
 
 
-def ensure_blackbody_lut():
+def ensure_blackbody_lut() -> Image:
     """The packed ``N x 1`` blackbody table (``spectral_luts.blackbody_rgb_lut``)."""
 
     return _ensure_lut(BLACKBODY_LUT_NAME, shipped_luts.blackbody_rgb_lut, BLACKBODY_LOG10_RANGE, 1)
 
 
-def ensure_illuminant_lut(name: str, temperature_k):
+def ensure_illuminant_lut(name: str, temperature_k: float) -> Image:
     """The packed ``N x 3`` table ``name`` for light reflected under a blackbody at
     ``temperature_k`` (0: white), laid out as the Doppler matrix table (``physics/illuminants.py``);
     rebuilt in place (0.1-0.5 s) only when the illuminant changes, packed so that the file renders alone."""
@@ -97,7 +102,7 @@ def ensure_illuminant_lut(name: str, temperature_k):
     return image
 
 
-def texture_u_scale_offset(log10_range, size=LUT_SIZE):
+def texture_u_scale_offset(log10_range: tuple[float, float], size: int = LUT_SIZE) -> tuple[float, float]:
     """``(scale, offset)`` with ``u = scale * log10(x) + offset`` at pixel centres of the grid."""
     low, high = log10_range
     scale = (size - 1) / size / (high - low)

@@ -24,7 +24,7 @@ materials never need to be touched again after :func:`attach`.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
@@ -34,8 +34,11 @@ from ..scene import grouped_colours, sources
 from . import lut_images, spectral_nodes
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Scene, World
+    from collections.abc import Iterable, Mapping
 
+    from bpy.types import Material, NodeSocket, NodeTree, Scene, World
+
+    from ..common.nodes import TreeType
     from ..scene.snapshot import Snapshot
 
 BETA_ATTRIBUTE = names.BETA_ATTRIBUTE
@@ -63,7 +66,7 @@ E = math.e
 LUMINANCE_WEIGHTS = (0.2126729, 0.7151522, 0.0721750)
 
 
-def settings_group():
+def settings_group() -> Group:
     """Constants written by :func:`write_settings` (one place for every material)."""
     values = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power", "Camera Path")
     nodes = {name: Node("ShaderNodeValue") for name in values}
@@ -75,7 +78,7 @@ def settings_group():
     return Group(SETTINGS, "ShaderNodeTree", (), outputs + spectral_outputs, nodes)
 
 
-def doppler_factor_group():
+def doppler_factor_group() -> Group:
     """``ln D`` for the photon reaching the camera from this shading point."""
     nodes = {
         "geometry": Node("ShaderNodeNewGeometry"),
@@ -113,7 +116,7 @@ def doppler_factor_group():
     )
 
 
-def gamut_map_group(name: str | None = None, tree_type="ShaderNodeTree"):
+def gamut_map_group(name: str | None = None, tree_type: TreeType = "ShaderNodeTree") -> Group:
     """``rgb' = max(Y + (rgb - Y) clamp(Y / (Y - min rgb)), 0)`` (spectral.gamut_map_linear_rec709)."""
     nodes = {
         "luminance": vmath("DOT_PRODUCT", "group.Color", LUMINANCE_WEIGHTS),
@@ -148,7 +151,7 @@ def _lut_texture(image_name, u_reference, v):
     }
 
 
-def doppler_matrix_group():
+def doppler_matrix_group() -> Group:
     """``gamut_map(N(D) rgb)`` and ``a(D)``: ``M(D) rgb`` mapped is ``exp(a)`` times the colour."""
     scale, offset = lut_images.texture_u_scale_offset(lut_images.DOPPLER_LOG10_RANGE)
     nodes = {"u": fmath("MULTIPLY_ADD", "group.Log Doppler", scale / LN10, offset)}
@@ -169,7 +172,7 @@ def doppler_matrix_group():
     )
 
 
-def blackbody_shift_group():
+def blackbody_shift_group() -> Group:
     """Unit-luminance colour of the blackbody at ``D T`` and ``ln(Y(D T) / Y(T))``."""
     scale, offset = lut_images.texture_u_scale_offset(lut_images.BLACKBODY_LOG10_RANGE)
     nodes = {
@@ -194,7 +197,7 @@ def blackbody_shift_group():
     )
 
 
-def doppler_colour_group():
+def doppler_colour_group() -> Group:
     """Observed colour of a surface colour ``Color`` (or a blackbody at ``Temperature``).
 
     ``out = base exp(E)``, with ``base`` the Doppler-shifted colour (unshifted when Doppler is
@@ -277,7 +280,7 @@ def doppler_colour_group():
     )
 
 
-def doppler_aov_group():
+def doppler_aov_group() -> Group:
     """Writes ``ln D`` of the first camera hit to the ``relativity_log_doppler`` AOV, and 1 to the
     ``relativity_coverage`` AOV: samples that write neither (a camera ray scattered in a volume)
     would otherwise dilute the pixel's mean ``ln D``; the compositor divides by the coverage.
@@ -307,7 +310,7 @@ GROUP_BUILDERS = (
 )
 
 
-def ensure_node_groups():
+def ensure_node_groups() -> NodeTree:
     """Pack the LUTs and build any missing or outdated group, dependencies first.
 
     Existing up-to-date groups are left alone: rebuilding a group's interface would drop the
@@ -327,18 +330,18 @@ def ensure_node_groups():
 _spectral_pass = {"wavelengths": None}
 
 
-def set_spectral_pass(wavelengths_nm) -> None:
+def set_spectral_pass(wavelengths_nm: Iterable[float] | None) -> None:
     """Render the next passes at these three rest-frame wavelengths (None: the fast mode again);
     takes effect at the next :func:`write_settings`."""
     _spectral_pass["wavelengths"] = None if wavelengths_nm is None else tuple(float(w) for w in wavelengths_nm)
 
 
-def spectral_pass_wavelengths():
+def spectral_pass_wavelengths() -> tuple[float, ...] | None:
     """The three wavelengths (nm) of the spectral pass being rendered, or None."""
     return _spectral_pass["wavelengths"]
 
 
-def settings_values(snap: Snapshot):
+def settings_values(snap: Snapshot) -> dict[str, Any]:
     """Constants for ``Relativity Settings`` from a ``snapshot.Snapshot`` (and the spectral pass)."""
     colour = snap.colour
     return {
@@ -353,7 +356,7 @@ def settings_values(snap: Snapshot):
     }
 
 
-def write_settings(snap: Snapshot):
+def write_settings(snap: Snapshot) -> bool:
     """Write the settings (Cycles reads shader values written in render_pre for every frame)."""
     tree = bpy.data.node_groups.get(SETTINGS)
     if tree is None:
@@ -372,11 +375,11 @@ def write_settings(snap: Snapshot):
 # --- attaching to materials -----------------------------------------------------------------
 
 
-def is_attached(material: Material):
+def is_attached(material: Material | None) -> bool:
     return material is not None and ATTACHED_KEY in material
 
 
-def attach(material: Material, temperature=None):
+def attach(material: Material | None, temperature: float | None = None) -> bool:
     """Insert the Doppler colour group in front of every colour input of ``material``.
 
     A colour fed by a Blackbody node is shifted as a blackbody at that node's temperature. With
@@ -408,7 +411,14 @@ def attach(material: Material, temperature=None):
     return True
 
 
-def insert_colour_group(tree, group_tree, prefix, target_node, socket, is_emission):
+def insert_colour_group(
+    tree: NodeTree,
+    group_tree: NodeTree,
+    prefix: str,
+    target_node: bpy.types.Node,
+    socket: NodeSocket,
+    is_emission: bool,
+) -> tuple[bpy.types.Node, dict[str, Any]]:
     """Put colour group ``group_tree`` (inputs ``spectral_nodes.COLOUR_INPUTS``) in front of
     ``socket`` of ``target_node``, a colour fed by a Blackbody (through reroutes, mixes, groups)
     marked as one; returns the group node and the record :func:`detach` undoes it by."""
@@ -444,14 +454,16 @@ def _insert_aov_writer(tree):
     return {"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
 
 
-def detach(material: Material | World):
+def detach(material: Material | World) -> bool:
     """Remove the inserted groups and restore the original links exactly."""
     if not is_attached(material):
         return False
     return _detach_records(material, material.node_tree)
 
 
-def resolve_record(tree, record):
+def resolve_record(
+    tree: NodeTree, record: Mapping[str, Any]
+) -> tuple[bpy.types.Node | None, NodeSocket | None, NodeSocket | None]:
     """``(group node, target input socket, source output socket)`` of an insertion record
     (:func:`insert_colour_group`) in ``tree``, each None where it is gone (or was never there)."""
     node = tree.nodes.get(record["group_node"])
@@ -474,7 +486,7 @@ def _detach_records(owner, tree):
     return True
 
 
-def scene_materials(scene: Scene):
+def scene_materials(scene: Scene) -> list[tuple[Material, float | None]]:
     """``(material, blackbody temperature or None)`` for every material used in ``scene``."""
     found = {}
     for obj in scene.objects:
@@ -485,13 +497,13 @@ def scene_materials(scene: Scene):
     return list(found.items())
 
 
-def attached_temperature(material: Material):
+def attached_temperature(material: Material) -> float:
     """The object blackbody temperature ``material`` was attached with (0: none)."""
     records = material[ATTACHED_KEY]
     return float(records[0].get("object_temperature", 0.0)) if len(records) else 0.0
 
 
-def attach_scene(scene: Scene, camera_path) -> None:
+def attach_scene(scene: Scene, camera_path: bool) -> None:
     """Attach the Doppler colour group to every material of ``scene`` (no-op for attached ones);
     on the exact camera's path the world writes the Doppler AOV too."""
     ensure_node_groups()
@@ -503,7 +515,7 @@ def attach_scene(scene: Scene, camera_path) -> None:
         attach_world(scene.world)
 
 
-def attach_world(world: World):
+def attach_world(world: World | None) -> bool:
     """The world's Doppler AOV writer (muted where ``world_doppler`` gives the compositor the
     world's D) and a colour group in front of every Background colour (``world_colour`` links it
     where it changes the colour: blackbodies, spectral passes)."""
@@ -520,7 +532,7 @@ def attach_world(world: World):
     return True
 
 
-def detach_world(world: World):
+def detach_world(world: World | None) -> bool:
     if world is None or ATTACHED_KEY not in world:
         return False
     if not isinstance(world[ATTACHED_KEY], str):

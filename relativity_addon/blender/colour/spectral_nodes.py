@@ -17,12 +17,16 @@ settings group before each pass:
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...physics import spectral_render
 from ..common import names
 from ..common.nodes import Group, Node, fmath, group_node, vmath
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 from . import lut_images
 
 SPECTRAL_COLOUR = names.SPECTRAL_COLOUR_GROUP
@@ -46,7 +50,7 @@ COLOUR_INPUTS = (
 COLOUR_LINKS = {name: f"group.{name}" for name, _kind, _default in COLOUR_INPUTS}
 
 
-def settings_nodes():
+def settings_nodes() -> tuple[dict[str, Node], tuple[tuple[str, str, str], ...]]:
     """Nodes of the settings group for the spectral pass (outputs named like the nodes)."""
     nodes = {"Spectral Pass": Node("ShaderNodeValue")}
     nodes.update({name: Node("ShaderNodeCombineXYZ", {0: 0.0, 1: 0.0, 2: 0.0}) for name in VECTORS})
@@ -55,7 +59,7 @@ def settings_nodes():
     return nodes, outputs
 
 
-def pass_values(wavelengths_nm):
+def pass_values(wavelengths_nm: Sequence[float] | None) -> dict[str, Any]:
     """Settings values for a spectral pass at three rest-frame wavelengths (nm), or the fast mode's
     (``wavelengths_nm`` None)."""
     if wavelengths_nm is None:
@@ -74,7 +78,7 @@ def pass_values(wavelengths_nm):
     }
 
 
-def spectral_colour_group():
+def spectral_colour_group() -> Group:
     """Spectral values of ``Color`` at the pass's wavelengths (see the module docstring)."""
     scale, offset = lut_images.texture_u_scale_offset(lut_images.BLACKBODY_LOG10_RANGE)
     nodes = {
@@ -136,7 +140,7 @@ def spectral_colour_group():
     )
 
 
-def volume_colour_group():
+def volume_colour_group() -> Group:
     """A volume shader's colour (``volumes.attach_colours``): unchanged outside the spectral passes
     (volumes write no AOVs: the compositor shifts their pixels), its spectral values in them."""
     nodes = {

@@ -81,7 +81,7 @@ VOLUME_KINDS = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLU
 SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the Principled Volume
 
 
-def volume_blackbody_group():
+def volume_blackbody_group() -> Group:
     """``Color``: the emission to add to the volume (``X - E`` for camera rays on the exact camera's
     path, 0 otherwise; in a spectral pass ``E``'s spectral values); ``Done``: 1 where the boundary
     marks the pixel as shifted; ``Intensity``: the Principled Volume's Blackbody Intensity (0 in a
@@ -185,7 +185,7 @@ def _correctable(material):
     return output, source, blackbody, intensity
 
 
-def attach(material: Material):
+def attach(material: Material) -> bool:
     """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
     (after ``materials.attach``, whose records restore it on detach). Returns whether it did."""
     if not materials.is_attached(material):
@@ -266,7 +266,7 @@ def _reads_grids(obj):
     )
 
 
-def grid_materials(scene: Scene):
+def grid_materials(scene: Scene) -> dict[Material, str]:
     """``{material: object name}`` of the materials on objects with temperature grids: their
     emission is ``Temperature x grid``, which the correction does not follow (a grid fades to 0 K
     at its edges, where Y(D T) / Y(T) of Cycles' sigma T^4 glow explodes: docs/spectral-model.md),
@@ -280,7 +280,7 @@ def grid_materials(scene: Scene):
     return found
 
 
-def attach_colours(material: Material):
+def attach_colours(material: Material) -> bool:
     """Put the volume colour group (``spectral_nodes.volume_colour_group``: unchanged outside the
     spectral passes) in front of every volume colour input of an attached ``material``
     (:data:`VOLUME_COLOURS`), recorded like ``materials.attach``'s groups. Returns whether it did."""
@@ -327,7 +327,7 @@ def _emits_blackbody(node):
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
 
 
-def spectral_problem(scene: Scene):
+def spectral_problem(scene: Scene) -> str | None:
     """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
     that may read a temperature grid (its emission varies with the grid, which has no spectrum in
     the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
@@ -373,7 +373,7 @@ def spectral_problem(scene: Scene):
     return None
 
 
-def warnings(scene: Scene):
+def warnings(scene: Scene) -> list[str]:
     """One line per Principled Volume blackbody on an object with temperature grids."""
     lines = []
     for material, name in grid_materials(scene).items():

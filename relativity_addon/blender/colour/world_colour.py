@@ -24,7 +24,7 @@ from ..common import names
 from . import materials
 
 if TYPE_CHECKING:
-    from bpy.types import World
+    from bpy.types import Node, World
 
 
 def _colour_records(world):
@@ -49,12 +49,12 @@ def _colour_records(world):
     return found
 
 
-def is_active(group):
+def is_active(group: Node) -> bool:
     """Whether the group must colour the Background now: a spectral pass, or a blackbody."""
     return materials.spectral_pass_wavelengths() is not None or group.inputs["Is Blackbody"].default_value > 0.0
 
 
-def write(world: World) -> None:
+def write(world: World | None) -> None:
     """Link each world colour group into its Background where :func:`is_active`, else give the
     Background its own colour; only links that differ are changed (this runs at every sync)."""
     tree = world.node_tree if world is not None else None
@@ -73,7 +73,7 @@ def write(world: World) -> None:
             tree.links.remove(socket.links[0])
 
 
-def linked_groups(world: World):
+def linked_groups(world: World) -> list[Node]:
     """The world's colour groups that feed their Background now (for tests and the docs)."""
     return [
         group

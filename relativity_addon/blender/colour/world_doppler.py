@@ -26,7 +26,7 @@ the effect.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,8 +35,12 @@ from ..common import names
 from . import compositing
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
     from bpy.types import Scene
 
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 IMAGE = names.WORLD_DOPPLER_IMAGE
@@ -44,7 +48,7 @@ AOV_NODE = f"{names.MATERIAL_NODE_PREFIX} AOV"  # materials._insert_aov_writer's
 _written = {}  # image session_uid -> the inputs its pixels were computed from
 
 
-def render_size(scene: Scene):
+def render_size(scene: Scene) -> tuple[int, int]:
     render = scene.render
     return (
         max(1, int(render.resolution_x * render.resolution_percentage / 100)),
@@ -52,7 +56,7 @@ def render_size(scene: Scene):
     )
 
 
-def problem(scene: Scene, snap: Snapshot):
+def problem(scene: Scene, snap: Snapshot) -> str | None:
     """Why the world must write its own ``ln D`` AOV in this render (one line), or None."""
     render = scene.render
     if snap.use_time_of_flight:
@@ -76,7 +80,9 @@ def _inputs(scene, snap):
     return snap.projection, render_size(scene), tuple(float(b) for b in snap.beta_camera), aberration
 
 
-def pixel_log_doppler(projection, size, beta_camera, aberration):
+def pixel_log_doppler(
+    projection: Sequence[Any], size: tuple[int, int], beta_camera: npt.ArrayLike, aberration: bool
+) -> FloatArray:
     """``ln D`` at every pixel centre (rows bottom first) for :func:`_inputs`' values; 0 outside a
     fisheye's or mirror ball's image circle (the camera renders black there)."""
     kind = projection[0]
@@ -101,7 +107,7 @@ def _mute_world_writer(world, mute):
         node.mute = mute
 
 
-def write(scene: Scene, snap: Snapshot, pixels=True):
+def write(scene: Scene, snap: Snapshot, pixels: bool = True) -> bool:
     """Bring the world's AOV writer, the compositor's switch and (with ``pixels``: before a render)
     the image up to date for ``snap`` (exact camera, compositor stage applied). Only what changed
     is written: the image costs a few tenths of a second at full HD, too much for every edit."""

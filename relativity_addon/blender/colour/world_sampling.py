@@ -36,7 +36,7 @@ def _constant(world):
     return background.bl_idname == "ShaderNodeBackground" and not any(socket.is_linked for socket in background.inputs)
 
 
-def hold(world: World) -> None:
+def hold(world: World | None) -> None:
     """Before the Doppler groups go into ``world``: a uniform map if the world is constant."""
     if world is None or SAVED in world or not _constant(world):
         return
@@ -49,7 +49,7 @@ def hold(world: World) -> None:
     settings.sample_map_resolution = MAP_RESOLUTION
 
 
-def release(world: World) -> None:
+def release(world: World | None) -> None:
     """Give the world back its sampling settings."""
     if world is None or SAVED not in world:
         return

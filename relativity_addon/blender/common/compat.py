@@ -8,12 +8,26 @@ lines in ``tests/blender/test_compat.py`` (real ``bpy``).
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Scene, World
+    from collections.abc import Callable, Iterable
+
+    from bpy.types import (
+        ActionChannelbag,
+        AnimData,
+        FCurve,
+        Light,
+        Material,
+        Modifier,
+        NodeTree,
+        Scene,
+        ShaderNodeTree,
+        World,
+        bpy_struct,
+    )
 
 
 def _modifier_inputs(modifier):
@@ -22,7 +36,7 @@ def _modifier_inputs(modifier):
     return getattr(properties, "inputs", None)
 
 
-def modifier_input(modifier, identifier: str):
+def modifier_input(modifier: Modifier, identifier: str) -> Any:
     """Value of a geometry-nodes modifier input (``identifier`` as in ``interface.items_tree``)."""
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
@@ -30,7 +44,7 @@ def modifier_input(modifier, identifier: str):
     return modifier.get(identifier)  # 4.5: ID properties on the modifier
 
 
-def set_modifier_input(modifier, identifier: str, value) -> None:
+def set_modifier_input(modifier: Modifier, identifier: str, value: Any) -> None:
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
         getattr(inputs, identifier).value = value
@@ -38,7 +52,7 @@ def set_modifier_input(modifier, identifier: str, value) -> None:
         modifier[identifier] = value
 
 
-def action_channelbag(animation_data):
+def action_channelbag(animation_data: AnimData | None) -> ActionChannelbag | None:
     """The channelbag (F-curves, groups) of the action slot assigned to ``animation_data``, or None.
 
     4.5 lacks ``anim_utils.animdata_get_channelbag_for_assigned_slot``; the per-slot lookup
@@ -50,7 +64,7 @@ def action_channelbag(animation_data):
     return anim_utils.action_get_channelbag_for_slot(animation_data.action, animation_data.action_slot)
 
 
-def action_fcurves(animation_data):
+def action_fcurves(animation_data: AnimData | None) -> Iterable[FCurve]:
     """The F-curves of the action slot assigned to ``animation_data`` (empty if none)."""
     channelbag = action_channelbag(animation_data)
     return () if channelbag is None else channelbag.fcurves
@@ -64,17 +78,17 @@ def _node_tree(owner):
     return owner.node_tree
 
 
-def world_node_tree(world: World):
+def world_node_tree(world: World) -> ShaderNodeTree:
     """The world's shader node tree, creating Blender's default one (Background) where needed."""
     return _node_tree(world)
 
 
-def material_node_tree(material: Material):
+def material_node_tree(material: Material) -> ShaderNodeTree:
     """The material's shader node tree, creating Blender's default one (Principled) where needed."""
     return _node_tree(material)
 
 
-def light_node_tree(light):
+def light_node_tree(light: Light) -> ShaderNodeTree | None:
     """The node tree a light renders with, or None. 5.x: lights always have one and always use
     it (``use_nodes`` is deprecated and stays on); 4.5: only while ``use_nodes`` is on."""
     if light.node_tree is None:
@@ -84,13 +98,13 @@ def light_node_tree(light):
         return light.node_tree if getattr(light, "use_nodes", True) else None
 
 
-def eevee_engine():
+def eevee_engine() -> str:
     """Identifier of the EEVEE render engine ('BLENDER_EEVEE_NEXT' in 4.5, 'BLENDER_EEVEE' in 5.x)."""
     engines = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
     return "BLENDER_EEVEE" if "BLENDER_EEVEE" in engines else "BLENDER_EEVEE_NEXT"
 
 
-def enum_name(data, prop: str, value: str | None = None) -> str:
+def enum_name(data: Any, prop: str, value: str | None = None) -> str:
     """The name the user sees for ``value`` (default: the current value) of ``data``'s enum
     property ``prop``: "EEVEE" for the engine identifier 'BLENDER_EEVEE_NEXT' (4.5) or
     'BLENDER_EEVEE' (5.x)."""
@@ -101,20 +115,20 @@ def enum_name(data, prop: str, value: str | None = None) -> str:
     return value.replace("_", " ").title()
 
 
-def has_compositor_node_groups():
+def has_compositor_node_groups() -> bool:
     """5.x: the scene's compositor is a node group (``scene.compositing_node_group``) ending in a
     Group Output; 4.5 has the scene-owned ``scene.node_tree`` with a Composite node instead."""
     return "compositing_node_group" in bpy.types.Scene.bl_rna.properties
 
 
-def compositor_tree(scene: Scene):
+def compositor_tree(scene: Scene) -> NodeTree | None:
     """The scene's compositor node tree or None (4.5: only while ``scene.use_nodes`` is on)."""
     if has_compositor_node_groups():
         return scene.compositing_node_group
     return scene.node_tree if scene.use_nodes else None
 
 
-def new_compositor_tree(scene: Scene, name: str):
+def new_compositor_tree(scene: Scene, name: str) -> NodeTree:
     """Give a scene with no compositor tree one that passes Render Layers to the output; return it.
 
     5.x: a new node group ``name`` ending in a Group Output, assigned to the scene. 4.5: switches
@@ -142,7 +156,7 @@ def restore_compositor_tree(scene: Scene, name: str) -> None:
     scene.compositing_node_group = bpy.data.node_groups.get(name) if name else None
 
 
-def map_uv_nearest():
+def map_uv_nearest() -> tuple[dict[str, str], dict[str, str]]:
     """``(inputs, props)`` for a compositor Map UV node that reads the nearest texel.
 
     5.x: the Interpolation menu socket; 4.5: the ``filter_type`` property (which offers only
@@ -152,7 +166,7 @@ def map_uv_nearest():
     return {"Interpolation": "Nearest"}, {}
 
 
-def run_main(main) -> None:
+def run_main(main: Callable[[], int | str | None]) -> None:
     """Run a script's ``main()`` and end the process with its exit status.
 
     Blender 4.5's ``bpy`` wheel can deadlock in ``exit()``: a static destructor waits on its
@@ -176,7 +190,7 @@ def run_main(main) -> None:
     os._exit(status)
 
 
-def custom_property_keys(owner):
+def custom_property_keys(owner: bpy_struct) -> list[str]:
     """Names of the user's custom (ID) properties on ``owner``.
 
     4.5 also lists there the storage of registered properties (``relativity``, ``cycles``, ...);
@@ -185,7 +199,7 @@ def custom_property_keys(owner):
     return [key for key in owner.keys() if key not in rna_properties]
 
 
-def custom_camera_aperture_scale(focal_length):
+def custom_camera_aperture_scale(focal_length: float) -> float:
     """Factor from Cycles' custom-camera ``cam:aperture_position`` to scene units.
 
     5.x samples the aperture for a unit focal length (radius ``1 / (2 f-stop)``), 4.5 in scene

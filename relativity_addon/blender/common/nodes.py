@@ -9,9 +9,16 @@ interface drops the links of every node that uses the group).
 
 from __future__ import annotations
 
+import typing
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import bpy
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from bpy.types import NodeTree
 
 
 class Literal(str):
@@ -19,6 +26,7 @@ class Literal(str):
 
 
 Menu = Literal
+TreeType = typing.Literal["GeometryNodeTree", "CompositorNodeTree", "ShaderNodeTree"]
 
 
 @dataclass
@@ -41,24 +49,24 @@ class Group:
     ``outputs``: (name, socket type, reference or None)."""
 
     name: str
-    tree_type: str
+    tree_type: TreeType
     inputs: tuple
     outputs: tuple
     nodes: dict
 
 
-def fmath(operation, a, b=0.0, c=0.0, clamp=False):
+def fmath(operation: str, a: object, b: object = 0.0, c: object = 0.0, clamp: bool = False) -> Node:
     return Node("ShaderNodeMath", {0: a, 1: b, 2: c}, {"operation": operation, "use_clamp": clamp})
 
 
-def vmath(operation, a, b=(0.0, 0.0, 0.0), scale=None):
+def vmath(operation: str, a: object, b: object = (0.0, 0.0, 0.0), scale: object = None) -> Node:
     inputs = {0: a, 1: b}
     if scale is not None:
         inputs["Scale"] = scale
     return Node("ShaderNodeVectorMath", inputs, {"operation": operation})
 
 
-def group_node(group_name, inputs=None, kind: str = "ShaderNodeGroup"):
+def group_node(group_name: str, inputs: dict | None = None, kind: str = "ShaderNodeGroup") -> Node:
     return Node(kind, inputs or {}, {"node_tree": group_name})
 
 
@@ -81,7 +89,7 @@ def _new_interface_socket(tree, name, in_out, socket_type, default):
             setattr(socket, attribute, value)
 
 
-def build_group(spec):
+def build_group(spec: Group) -> NodeTree:
     """Create or rebuild the node group described by ``spec`` (a :class:`Group`)."""
     tree = bpy.data.node_groups.get(spec.name)
     if tree is None or tree.bl_idname != spec.tree_type:
@@ -126,7 +134,7 @@ def build_group(spec):
     return tree
 
 
-def ensure_group(spec, version_key, version):
+def ensure_group(spec: Group, version_key: str, version: int) -> NodeTree:
     """The group of ``spec``, built if missing or stamped with another version."""
     tree = bpy.data.node_groups.get(spec.name)
     if tree is None or tree.get(version_key) != version:
@@ -135,7 +143,7 @@ def ensure_group(spec, version_key, version):
     return tree
 
 
-def interface_identifier(group, name: str, in_out="INPUT"):
+def interface_identifier(group: NodeTree, name: str, in_out: str = "INPUT") -> str:
     """The identifier (``Socket_N``) of the group's interface socket ``name``."""
     for item in group.interface.items_tree:
         if item.item_type == "SOCKET" and item.in_out == in_out and item.name == name:
@@ -143,7 +151,7 @@ def interface_identifier(group, name: str, in_out="INPUT"):
     raise KeyError(name)
 
 
-def remove_unused_groups(names) -> None:
+def remove_unused_groups(names: Iterable[str]) -> None:
     """Delete the named node groups that nothing uses any more."""
     for name in names:
         tree = bpy.data.node_groups.get(name)

@@ -75,7 +75,7 @@ def ensure_oslquery_importable() -> None:
         raise OSLUnavailableError(reason)
 
 
-def compile_custom_camera(camera_data: Camera):
+def compile_custom_camera(camera_data: Camera) -> list[str]:
     """Compile the camera's OSL shader with Cycles; return the list of error messages.
 
     An empty list means Cycles reported success; the caller still checks that the shader's
@@ -91,7 +91,7 @@ def compile_custom_camera(camera_data: Camera):
 
     errors = []
 
-    def report(kind: str, message) -> None:
+    def report(kind: str, message: object) -> None:
         if {"ERROR", "WARNING"} & set(kind):
             errors.append(str(message))
 

@@ -6,10 +6,12 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
     from bpy.types import Object
 
 
-def hide(obj: Object, key, attributes) -> None:
+def hide(obj: Object, key: str, attributes: Iterable[str]) -> None:
     """Switch ``attributes`` (``visible_camera``, ``visible_diffuse``, ...) off, the user's values
     saved under ``key`` the first time."""
     if key not in obj:
@@ -19,13 +21,13 @@ def hide(obj: Object, key, attributes) -> None:
             setattr(obj, name, False)
 
 
-def saved(obj: Object, key, name: str):
+def saved(obj: Object, key: str, name: str) -> bool:
     """The user's value of ``name`` (saved under ``key`` while hidden, else the object's own)."""
     values = obj.get(key)
     return bool(getattr(obj, name) if values is None else values[name])
 
 
-def restore(obj: Object, key):
+def restore(obj: Object, key: str) -> bool:
     """Give back the values saved under ``key``; whether there were any."""
     values = obj.get(key)
     if values is None:

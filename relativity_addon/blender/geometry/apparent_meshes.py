@@ -30,6 +30,9 @@ from . import modifier, motion
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    import numpy.typing as npt
     from bpy.types import Depsgraph, Object, Scene
 
     from ..scene.snapshot import Snapshot
@@ -39,7 +42,7 @@ if TYPE_CHECKING:
 COARSE_EDGE_FRACTION = 0.25
 
 
-def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None):
+def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
@@ -65,7 +68,7 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
     return repr(parts)
 
 
-def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None):
+def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None) -> int:
     """Recompute the cache of one object for the snapshot's frame. Raises RelativityError."""
     _, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
@@ -89,7 +92,7 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     return len(local)
 
 
-def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed=False):
+def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed: bool = False) -> int:
     """Recompute every object carrying the modifier (only those whose inputs changed, with
     ``only_changed``). A failure is recorded on the object's cache and printed, never raised:
     the viewport keeps the last valid state. Returns the number of objects updated."""
@@ -126,7 +129,7 @@ def update_after_bake(scene: Scene, obj: Object) -> None:
 _skipped_empty = {}
 
 
-def scene_errors(scene: Scene):
+def scene_errors(scene: Scene) -> list[str]:
     """One-line errors of the last update of each object (empty when every cache is current), and
     the meshes left out for having nothing to draw."""
     errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
@@ -137,7 +140,7 @@ def scene_errors(scene: Scene):
     return errors
 
 
-def instanced_by_moving(depsgraph, objects):
+def instanced_by_moving(depsgraph: Depsgraph, objects: Iterable[Object]) -> Object | None:
     """The first of ``objects`` with its own velocity whose evaluated geometry draws instances or
     other components (geometry nodes, particles, instancing) that the modifier does not move, or None."""
     moving = {obj.name: obj for obj in objects if moving_objects.has_own_velocity(obj)}
@@ -150,7 +153,7 @@ def instanced_by_moving(depsgraph, objects):
     return None
 
 
-def apply(scene: Scene, snap: Snapshot, objects=None):
+def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None) -> list[Object]:
     """Add the modifier to ``objects`` (default: every mesh of the scene whose
     ``relativity.enabled`` is on) and compute the snapshot's frame. Returns the objects.
     Meshes whose evaluated mesh has no vertices are left out (a warning: nothing to draw).
@@ -188,7 +191,7 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
     return list(objects)
 
 
-def remove(scene: Scene, objects=None):
+def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object]:
     """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
     if objects is None:
         _skipped_empty.pop(scene.name, None)
@@ -198,7 +201,7 @@ def remove(scene: Scene, objects=None):
     return restored
 
 
-def longest_edge_fraction(obj: Object, camera_position):
+def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:
     """Longest mesh edge divided by its midpoint's distance to the camera (world units)."""
     mesh = obj.data
     if len(mesh.edges) == 0 or len(mesh.edges) > 200_000:
@@ -214,7 +217,7 @@ def longest_edge_fraction(obj: Object, camera_position):
     return float(np.max(lengths / np.maximum(distances, 1e-9)))
 
 
-def coarse_mesh_warning(obj: Object, camera_position):
+def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | None:
     """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None."""
     # the modifier halves every edge once per tessellation level before moving the vertices
     fraction = longest_edge_fraction(obj, camera_position) / 2**obj.relativity.tessellation

@@ -9,6 +9,7 @@ removed with the effect.
 """
 
 import math
+from typing import TYPE_CHECKING
 
 import bpy
 import numpy as np
@@ -18,6 +19,9 @@ from ..common import busy, names
 from ..scene import animation, snapshot
 from . import apparent_meshes, modifier
 from .motion import matrix_array, to_world
+
+if TYPE_CHECKING:
+    from bpy.stub_internal.rna_enums import OperatorReturnItems
 
 
 def _bake_frames(scene, obj, frame_start, frame_end):
@@ -63,7 +67,9 @@ def _sample_frames(scene, frames, sample):
             window_manager.progress_end()
 
 
-def bake_deformation(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=None, frame_end=None):
+def bake_deformation(
+    scene: bpy.types.Scene, obj: bpy.types.Object, frame_start: float | None = None, frame_end: float | None = None
+) -> int:
     """Sample the evaluated (tessellated, deformed) world positions of ``obj`` and its origin from
     ``frame_start`` to ``frame_end`` (default: the scene's range, starting earlier by twice the
     current light-travel time to the farthest vertex) at ``relativity.samples_per_frame``
@@ -109,7 +115,9 @@ def bake_deformation(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=
     return len(samples)
 
 
-def bake_motion(scene: bpy.types.Scene, obj: bpy.types.Object, frame_start=None, frame_end=None):
+def bake_motion(
+    scene: bpy.types.Scene, obj: bpy.types.Object, frame_start: float | None = None, frame_end: float | None = None
+) -> int:
     """Sample the world matrix of ``obj`` as Blender evaluates it (depsgraph: constraints, drivers,
     NLA, parents of any type, simulations) from ``frame_start`` to ``frame_end`` (default as
     :func:`bake_deformation`) at ``relativity.samples_per_frame`` sub-frames, for the rigid
@@ -153,7 +161,7 @@ class _BakeOperator:
     use_deformation = False
     baked = "samples"
 
-    def execute(self, context: bpy.types.Context):
+    def execute(self, context: bpy.types.Context) -> "set[OperatorReturnItems]":
         scene, obj = context.scene, context.active_object
         if self.use_deformation:
             obj.relativity.use_deformation = True
@@ -177,7 +185,7 @@ class RELATIVITY_OT_bake_deformation(_BakeOperator, bpy.types.Operator):
     bake = staticmethod(bake_deformation)
 
     @classmethod
-    def poll(cls, context: bpy.types.Context):
+    def poll(cls, context: bpy.types.Context) -> bool:
         return _poll_mesh(cls, context)
 
 
@@ -192,7 +200,7 @@ class RELATIVITY_OT_bake_motion(_BakeOperator, bpy.types.Operator):
     bake = staticmethod(bake_motion)
 
     @classmethod
-    def poll(cls, context: bpy.types.Context):
+    def poll(cls, context: bpy.types.Context) -> bool:
         if not _poll_mesh(cls, context):
             return False
         if context.active_object.relativity.use_deformation:

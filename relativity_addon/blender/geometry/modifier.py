@@ -22,10 +22,12 @@ from ..common import compat, names
 from ..common.nodes import Group, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
 
 if TYPE_CHECKING:
-    from bpy.types import Depsgraph, Object, Scene
+    from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
+
+    from ...physics.arrays import FloatArray
 
 
-def node_group_spec():
+def node_group_spec() -> Group:
     store = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
     mesh_size = {"component": "MESH"}
     nodes = {
@@ -102,11 +104,11 @@ def node_group_spec():
     )
 
 
-def ensure_node_group():
+def ensure_node_group() -> NodeTree:
     return ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
 
 
-def find_modifier(obj: Object):
+def find_modifier(obj: Object) -> Modifier | None:
     for modifier in obj.modifiers:
         if (
             modifier.type == "NODES"
@@ -117,24 +119,24 @@ def find_modifier(obj: Object):
     return None
 
 
-def applied_objects(scene: Scene):
+def applied_objects(scene: Scene) -> list[Object]:
     return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None]
 
 
-def cache_object(obj: Object):
+def cache_object(obj: Object) -> Object | None:
     modifier = find_modifier(obj)
     if modifier is None:
         return None
     return compat.modifier_input(modifier, interface_identifier(modifier.node_group, "Cache"))
 
 
-def cache_data(obj: Object):
+def cache_data(obj: Object) -> ID | None:
     """The cache mesh of ``obj`` (where its update state and bakes live), or None."""
     cache = cache_object(obj)
     return cache.data if cache is not None else None
 
 
-def ensure_modifier(obj: Object):
+def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     """The object's modifier and cache object, created if missing. Returns (modifier, cache)."""
     group = ensure_node_group()
     modifier = find_modifier(obj)
@@ -166,7 +168,7 @@ def _shared_with_another_object(obj, cache):
     return owner is not None and owner != obj and cache_object(owner) == cache
 
 
-def bake_mesh(obj: Object):
+def bake_mesh(obj: Object) -> Mesh | None:
     """The mesh holding the object's deformation bake, or None."""
     data = cache_data(obj)
     if data is None or names.BAKE_KEY not in data:
@@ -174,7 +176,7 @@ def bake_mesh(obj: Object):
     return bpy.data.meshes.get(data[names.BAKE_KEY]["mesh"])
 
 
-def motion_bake(obj: Object):
+def motion_bake(obj: Object) -> tuple[float, int, FloatArray] | None:
     """``(first frame, samples per frame, matrices (K, 4, 4) float64)`` of the object's motion
     bake, or None."""
     data = cache_data(obj)
@@ -185,7 +187,7 @@ def motion_bake(obj: Object):
     return float(info["first_frame"]), int(info["samples_per_frame"]), matrices
 
 
-def motion_bake_range(obj: Object):
+def motion_bake_range(obj: Object) -> tuple[float, float] | None:
     """(first, last) frame of the object's motion bake, or None (reads no matrices)."""
     data = cache_data(obj)
     if data is None or names.MOTION_BAKE_KEY not in data:
@@ -195,13 +197,13 @@ def motion_bake_range(obj: Object):
     return first, first + (len(info["matrices"]) // 16 - 1) / per_frame
 
 
-def object_error(obj: Object):
+def object_error(obj: Object) -> str | None:
     """The one-line error of the object's last handler update, or None."""
     data = cache_data(obj) if find_modifier(obj) is not None else None
     return data.get(names.ERROR_KEY) or None if data is not None else None
 
 
-def remove_object_effect(obj: Object):
+def remove_object_effect(obj: Object) -> bool:
     """Remove the object's modifier, cache and bakes; the mesh data was never written."""
     modifier = find_modifier(obj)
     if modifier is None:
@@ -225,7 +227,7 @@ def remove_unused_group() -> None:
     remove_unused_groups((names.GEOMETRY_GROUP,))
 
 
-def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph):
+def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph) -> FloatArray | None:
     """The tessellated rest positions (object space, float64 ``(N, 3)``) the modifier stored on
     the evaluated mesh, or None without the attribute."""
     obj_eval = obj.evaluated_get(depsgraph)
@@ -241,7 +243,7 @@ def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph):
     return rest.reshape(-1, 3).astype(np.float64)
 
 
-def write_cache(mesh, positions, beta) -> None:
+def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray) -> None:
     """Object-space positions ``(N, 3)`` and observer-frame velocities ``beta`` (``(N, 3)``, or
     ``(1, 3)`` shared by every point) into the cache mesh."""
     count = len(positions)

@@ -37,9 +37,16 @@ from ..scene.snapshot import check_velocity
 from . import modifier, shape_keys
 
 if TYPE_CHECKING:
-    from bpy.types import Object, Scene
+    from collections.abc import Iterable
 
+    import numpy.typing as npt
+    from bpy.types import Object, Scene
+    from mathutils import Matrix
+
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
+
+    Positions = tuple[FloatArray, FloatArray, FloatArray]
 
 # Most samples of a keyframed object's clock table (its path from scene time 0 to the retarded times).
 CLOCK_SAMPLES = 200_000
@@ -48,15 +55,17 @@ SHAPE_PASSES = 2
 _clock_tables = {}  # object name -> the clock table of its last update (see _path_clock)
 
 
-def matrix_array(matrix):
+def matrix_array(matrix: Matrix | Iterable[Iterable[float]]) -> FloatArray:
     return np.array([list(row) for row in matrix], dtype=np.float64)
 
 
-def to_world(matrix, points):
+def to_world(matrix: FloatArray, points: FloatArray) -> FloatArray:
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
-def apparent_world_positions(scene: Scene, obj: Object, obj_eval: Object, rest, snap: Snapshot, shape_keys_too=True):
+def apparent_world_positions(
+    scene: Scene, obj: Object, obj_eval: Object, rest: FloatArray, snap: Snapshot, shape_keys_too: bool = True
+) -> tuple[FloatArray, FloatArray]:
     """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
     points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all).
     ``shape_keys_too=False``: ``rest`` are not the mesh's points (its centre, say): rigid motion only."""
@@ -109,7 +118,7 @@ def check_parent_motion(obj: Object) -> None:
         parent = parent.parent
 
 
-def plays_own_animation(obj: Object, scene: Scene):
+def plays_own_animation(obj: Object, scene: Scene) -> bool:
     """Whether the object has its own animation to play on a clock of its own: keyframes that turn
     or scale it (or an object parent), or keyframed shape-key values. Objects whose keyframes are
     not their motion (:func:`animation.keyframe_motion_problem`) are left as Blender shows them."""
@@ -166,8 +175,17 @@ def _path_clock(obj, fps, step, c):
 
 
 def proper_time_apparent_positions(
-    obj: Object, scene: Scene, rest_local, t_o, x_o, beta_o, c, beta_u=None, matrix_now=None, shape_keys_too=True
-):
+    obj: Object,
+    scene: Scene,
+    rest_local: FloatArray,
+    t_o: float,
+    x_o: npt.ArrayLike,
+    beta_o: npt.ArrayLike,
+    c: float,
+    beta_u: FloatArray | None = None,
+    matrix_now: FloatArray | None = None,
+    shape_keys_too: bool = True,
+) -> Positions:
     """An object with its own animation (:func:`plays_own_animation`: a spinning wheel, a clock's
     hands, shape keys) plays it at its proper time ``tau`` (its clock reads 0 at scene time 0),
     evaluated at each vertex's retarded time by the sampled solver.
@@ -229,15 +247,15 @@ def proper_time_apparent_positions(
 def animated_apparent_positions(
     obj: Object,
     scene: Scene,
-    rest_local,
-    t_o,
-    x_o,
-    beta_o,
-    c,
-    max_tries=4,
+    rest_local: FloatArray,
+    t_o: float,
+    x_o: npt.ArrayLike,
+    beta_o: npt.ArrayLike,
+    c: float,
+    max_tries: int = 4,
     obj_eval: Object | None = None,
-    shape_keys_too=True,
-):
+    shape_keys_too: bool = True,
+) -> Positions:
     """Apparent world positions and beta of an ANIMATION object (rigid motion): from its baked
     world matrices when it has a motion bake, else from its keyframes under its parent chain
     (:func:`animation.world_matrices`). An object whose keyframes are not its motion
@@ -298,7 +316,9 @@ def _baked_apparent_positions(obj, bake, obj_eval, rest_local, fps, t_o, x_o, be
     return result
 
 
-def deformed_apparent_positions(obj: Object, count, t_o, x_o, beta_o, c):
+def deformed_apparent_positions(
+    obj: Object, count: int, t_o: float, x_o: npt.ArrayLike, beta_o: npt.ArrayLike, c: float
+) -> Positions:
     """Apparent positions of a deforming object from its baked samples (per-vertex retarded times)."""
     mesh = modifier.bake_mesh(obj)
     if mesh is None:

@@ -23,7 +23,10 @@ from ..common import compat
 from . import modifier
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Object
+
+    from ...physics.arrays import FloatArray
 
 _VALUE_PATH = re.compile(r'^key_blocks\["(.+)"\]\.value$')
 FRAME_SAMPLES_PER_FRAME = 16  # the values' table between the frames asked for (linear in between)
@@ -42,13 +45,13 @@ def _value_fcurves(key):
     return curves
 
 
-def has_animated_shape_keys(obj: Object):
+def has_animated_shape_keys(obj: Object) -> bool:
     """Whether keyframes change the values of the mesh's shape keys (its own animation)."""
     key = getattr(obj.data, "shape_keys", None)
     return key is not None and bool(_value_fcurves(key))
 
 
-def scene_time_reason(obj: Object):
+def scene_time_reason(obj: Object) -> str | None:
     """Why ``obj``'s animated shape keys cannot be blended here at other times (one line), or None.
     The blend works on the mesh's own vertices with Blender's relative blending; otherwise the keys
     play at the scene's time (the shape Blender evaluated), which the object's warnings say."""
@@ -76,7 +79,7 @@ def scene_time_reason(obj: Object):
     return None
 
 
-def scene_time_warning(obj: Object):
+def scene_time_warning(obj: Object) -> str | None:
     """The object's warning when its animated shape keys play at the scene's time although its own
     animation runs on its proper time, or None."""
     settings = obj.relativity
@@ -137,7 +140,7 @@ class ShapeKeyMotion:
             self.limits.append((block.slider_min, block.slider_max))
             self.values.append(block.value)
 
-    def values_at(self, frames):
+    def values_at(self, frames: npt.ArrayLike) -> FloatArray:
         """Each key's value at ``frames`` (``(K,)``), shape ``(keys, K)``."""
         frames = np.atleast_1d(np.asarray(frames, dtype=np.float64))
         low, high = float(frames.min()), float(frames.max())
@@ -154,7 +157,7 @@ class ShapeKeyMotion:
             rows.append(np.clip(row, lowest, highest))
         return np.array(rows).reshape(len(self.curves), len(frames))
 
-    def positions(self, frames):
+    def positions(self, frames: npt.ArrayLike) -> FloatArray:
         """Blended positions ``(N, 3)``: vertex ``j`` at ``frames[j]`` (or all at one frame)."""
         frames = np.broadcast_to(np.asarray(frames, dtype=np.float64), (len(self.base),))
         values = self.values_at(frames)
@@ -163,7 +166,7 @@ class ShapeKeyMotion:
             result += row[:, None] * offset
         return result
 
-    def check(self, rest, frame) -> None:
+    def check(self, rest: FloatArray, frame: float) -> None:
         """RelativityError unless ``rest`` (the rest points Blender evaluated at ``frame``) is this
         blend at ``frame``: the shape keys are then the only thing shaping the rest points."""
         if len(rest) != len(self.base):

@@ -42,6 +42,7 @@ from . import rest_normals
 if TYPE_CHECKING:
     from bpy.types import Object, Scene
 
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 KEY = names.LAMP_DOPPLER_KEY
@@ -62,7 +63,7 @@ class Mover:
     beta: tuple  # scene-frame velocity there, fraction of c
 
 
-def is_copy(obj: Object):
+def is_copy(obj: Object) -> bool:
     return COPY_KEY in obj
 
 
@@ -70,7 +71,7 @@ def _skipped_lamp(obj):
     return obj.light_linking.receiver_collection is not None and KEY not in obj
 
 
-def lamps(scene: Scene):
+def lamps(scene: Scene) -> list[Object]:
     """Lamps at rest that render and that the stage can split (no light linking of their own)."""
     return [
         obj
@@ -94,7 +95,7 @@ def _local_centre(obj):
     return (co.min(axis=0) + co.max(axis=0)) / 2.0
 
 
-def movers(scene: Scene, snap: Snapshot):
+def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
     """The moving objects of the Apparent Geometry path: centre and scene-frame velocity, with
     light-travel time from the camera event and no boost (the scene frame)."""
     # the scene frame: the exact camera's meshes are there already (seen from the aperture at the
@@ -118,12 +119,12 @@ def movers(scene: Scene, snap: Snapshot):
     return found
 
 
-def lamp_matrix(scene: Scene, lamp, snap: Snapshot):
+def lamp_matrix(scene: Scene, lamp: Object, snap: Snapshot) -> FloatArray:
     """The lamp's world matrix at the snapshot's frame (its keyframes evaluated there)."""
     return np.asarray(snapshot.camera_matrix(scene, lamp, snap.frame), dtype=np.float64)
 
 
-def incidence(matrix, kind: str, mover):
+def incidence(matrix: FloatArray, kind: str, mover: Mover) -> FloatArray:
     """The photon direction ``k`` (scene frame) from a lamp with world ``matrix`` to ``mover``'s centre."""
     if kind == "SUN":
         return -matrix[:3, 2]
@@ -133,7 +134,7 @@ def incidence(matrix, kind: str, mover):
     return direction
 
 
-def placement(matrix, kind: str, mover):
+def placement(matrix: FloatArray, kind: str, mover: Mover) -> tuple[float, FloatArray]:
     """``(D, copy's world matrix)``: eq. 18's factor for the lamp's light on ``mover`` and the lamp
     turned about the centre to the direction the object sees it from in its own frame."""
     k = incidence(matrix, kind, mover)
@@ -141,7 +142,7 @@ def placement(matrix, kind: str, mover):
     return doppler_factor, lamp_doppler.aberrated_lamp_matrix(matrix, mover.centre, k, mover.beta)
 
 
-def copy_colour(lamp, doppler_factor, snap: Snapshot):
+def copy_colour(lamp: Object, doppler_factor: float, snap: Snapshot) -> tuple[float, ...]:
     """The copy's colour: the lamp's colour with eq. 18's factor (its temperature folded in)."""
     light = lamp.data
     temperature = sources.light_blackbody(light)
@@ -224,7 +225,7 @@ def _follow(copy_data, light):
         _set(copy_data, key, tuple(value) if getattr(prop, "is_array", False) else value)
 
 
-def write(scene: Scene, snap: Snapshot):
+def write(scene: Scene, snap: Snapshot) -> int:
     """Bring the copies up to date with the snapshot (rebuilt when the lamps or moving objects
     changed, else only their colours and settings written). Nothing without moving objects or
     off the Apparent Geometry path."""
@@ -263,11 +264,11 @@ def _copy_pairs(record):
     return found
 
 
-def apply(scene: Scene, snap: Snapshot):
+def apply(scene: Scene, snap: Snapshot) -> int:
     return write(scene, snap)
 
 
-def remove(scene: Scene):
+def remove(scene: Scene) -> int:
     """Delete the copies, their light data and the collections; give the lamps back their own
     (empty) light linking. Returns the number of copies removed."""
     rest_normals.remove(scene)
@@ -302,7 +303,7 @@ def remove(scene: Scene):
     return len(copies)
 
 
-def warnings(scene: Scene, snap: Snapshot):
+def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """What this stage does not render right, one line each."""
     if snap.method != "GEOMETRY" or not modifier.applied_objects(scene):
         return []

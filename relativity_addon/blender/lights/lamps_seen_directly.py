@@ -266,7 +266,7 @@ def _delete(face_name):
             bpy.data.materials.remove(material)
 
 
-def drawable(obj: Object, snap: Snapshot):
+def drawable(obj: Object, snap: Snapshot) -> tuple[tuple[float, ...], float | None, float] | None:
     """``(rgb, temperature, radiance)`` of the face that draws light object ``obj``, or None."""
     if obj.data.type not in KINDS or not _facing_camera(obj, snap):
         return None
@@ -328,7 +328,7 @@ def _has_extent(light):
     return light.type == "AREA" or light.shadow_soft_size > 0.0
 
 
-def warnings(scene: Scene, snap: Snapshot):
+def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """Lamps seen directly whose colour the exact camera shifts as the pixel behind them."""
     if not snap.exact_camera:
         return []

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 import numpy as np
@@ -37,9 +37,12 @@ from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
 if TYPE_CHECKING:
-    from bpy.types import Depsgraph, Material, Scene
+    from collections.abc import Sequence
 
-    from ..scene.snapshot import Snapshot
+    import numpy.typing as npt
+    from bpy.types import Depsgraph, Material, NodeTree, Scene
+
+    from ..scene.snapshot import MovingLight, Snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LIGHT_SHADER_TEXT)
 GROUP = names.MOVING_LIGHTS_GROUP
@@ -50,7 +53,7 @@ LAMP_KINDS = {"POINT", "SPOT", "SUN", "AREA"}  # by stand-in lamps (moving_lamps
 ALBEDO_INPUTS = {"ShaderNodeBsdfPrincipled": "Base Color", "ShaderNodeBsdfDiffuse": "Color"}
 
 
-def supported(snap: Snapshot):
+def supported(snap: Snapshot) -> list[MovingLight]:
     """The snapshot's moving lights this stage renders: point and spot lights with constant
     velocity, and every kind, constant or keyframed (ANIMATION), where stand-in lamps draw them
     (:func:`uses_lamps`; a keyframed sun moves with its keyframes' velocity at the frame). None
@@ -62,7 +65,7 @@ def supported(snap: Snapshot):
     return [light for light in snap.moving_lights if light.kind in SUPPORTED_KINDS and light.motion == "CONSTANT"]
 
 
-def is_applied(scene: Scene):
+def is_applied(scene: Scene) -> bool:
     return names.SHADING_SYSTEM_SAVED_KEY in scene
 
 
@@ -93,7 +96,7 @@ def _new_group():
     return group
 
 
-def ensure_group(light_names):
+def ensure_group(light_names: Sequence[str]) -> NodeTree:
     """The group with one compiled script node per light (rebuilt inside when the lights change;
     its interface never changes, so the materials' links survive)."""
     group = bpy.data.node_groups.get(GROUP) or _new_group()
@@ -127,7 +130,7 @@ def ensure_group(light_names):
     return group
 
 
-def reception_event(snap: Snapshot):
+def reception_event(snap: Snapshot) -> tuple[float, tuple[float, ...]]:
     """``(c (t - t_o), x)``, the event where the camera receives the light, in the scene frame
     (``Snapshot.mesh_observer``: the exact camera's aperture centre at its shutter time; the
     boosted-mesh preview's ``(t_o, x_cam)``)."""
@@ -135,7 +138,7 @@ def reception_event(snap: Snapshot):
     return snap.speed_of_light * (t - snap.time), tuple(float(v) for v in x)
 
 
-def spot_cone(spot_size, spot_blend):
+def spot_cone(spot_size: float, spot_blend: float) -> tuple[float, float]:
     """Cycles' spot cone: ``(cos of the half angle, 1 / width of the blend in cos)``; the mask is
     ``smoothstep(0, 1, (cos - cos_half) * smooth)`` (no blend: smooth 0, a hard edge)."""
     cos_half = math.cos(min(spot_size, math.pi) * 0.5)
@@ -143,7 +146,7 @@ def spot_cone(spot_size, spot_blend):
     return cos_half, smooth
 
 
-def shader_parameters(light, snap: Snapshot):
+def shader_parameters(light: MovingLight, snap: Snapshot) -> dict[str, Any]:
     """The script node's inputs for one light (world axes; intensity in W/sr per channel): the
     light's position at the reception event's time and that event's position."""
     cos_half, smooth = spot_cone(light.spot_size, light.spot_blend)
@@ -166,7 +169,7 @@ def shader_parameters(light, snap: Snapshot):
     }
 
 
-def blackbody_parameters(temperature, luminance):
+def blackbody_parameters(temperature: float, luminance: float) -> dict[str, Any]:
     """The stand-in lamp shader's blackbody inputs (eq. 18's spectrum, docs/moving-lights.md): the
     light's temperature and luminance, and in a spectral pass its wavelengths and the scale of
     ``planck_shape``: ``luminance B(mu, T') / Y_B(T)`` per nm with ``B = C1 / pi (500 nm)^-5
@@ -188,7 +191,7 @@ def blackbody_parameters(temperature, luminance):
     }
 
 
-def rgb_spectral_parameters(temperature, intensity):
+def rgb_spectral_parameters(temperature: float, intensity: npt.ArrayLike) -> dict[str, Any]:
     """An RGB light's stand-in lamp inputs (eq. 18, docs/moving-lights.md): the basis weights of
     its intensity, ``A(1)^-1 I``, whose up-sampled spectrum the shader shifts by each receiving
     point's ``D`` (the passes give lamps at rest ``emission_matrix(mu) @ I``), and ``spectral`` in
@@ -276,7 +279,7 @@ def _albedo_source(socket):
     return socket.links[0].from_socket if socket is not None and socket.is_linked else None
 
 
-def attach(material: Material, group):
+def attach(material: Material | None, group: NodeTree) -> bool:
     """Add the group's emission to the material's surface: ``surface + moving lights``."""
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
@@ -317,7 +320,7 @@ def attach(material: Material, group):
     return True
 
 
-def detach(material: Material):
+def detach(material: Material | None) -> bool:
     """Remove the inserted nodes and link the old surface shader to the output again."""
     if material is None or MATERIAL_KEY not in material:
         return False
@@ -383,13 +386,15 @@ def _enable_osl(scene):
         scene.cycles.shading_system = True
 
 
-def uses_lamps(snap: Snapshot):
+def uses_lamps(snap: Snapshot) -> bool:
     """Whether the moving lights are drawn by stand-in lamps (``moving_lamps.py``, with shadows
     behind Cycles' OSL camera) rather than by the material shader (with traced shadows)."""
     return snap.exact_camera
 
 
-def write(scene: Scene, snap: Snapshot, attach_new_materials=False, depsgraph: Depsgraph | None = None):
+def write(
+    scene: Scene, snap: Snapshot, attach_new_materials: bool = False, depsgraph: Depsgraph | None = None
+) -> NodeTree | None:
     """Bring the moving lights up to date with the snapshot: hide the moving lights (and show
     again those no longer moving), rebuild the group when the lights changed, write every light's
     parameters and attach materials (all on the first write, then new ones on request). With no
@@ -427,7 +432,7 @@ def write(scene: Scene, snap: Snapshot, attach_new_materials=False, depsgraph: D
     return group
 
 
-def apply(scene: Scene, snap: Snapshot):
+def apply(scene: Scene, snap: Snapshot) -> NodeTree | None:
     return write(scene, snap, attach_new_materials=True)
 
 
@@ -453,7 +458,7 @@ def remove(scene: Scene) -> None:
             bpy.data.texts.remove(text)
 
 
-def warnings(scene: Scene, snap: Snapshot):
+def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """What the moving-light stage does not render right, one line each."""
     drawn = {light.name for light in supported(snap)}
     no_osl = osl.unavailable_reason()

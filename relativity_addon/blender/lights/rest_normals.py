@@ -27,7 +27,9 @@ import numpy as np
 from ..common import names, nodes
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Scene
+    from collections.abc import Sequence
+
+    from bpy.types import Material, NodeTree, Object, Scene
 
 KEY = names.REST_NORMAL_KEY
 ATTRIBUTE = names.REST_NORMAL_ATTRIBUTE
@@ -100,7 +102,7 @@ def _normal_inputs(tree):
     ]
 
 
-def attach(material: Material, group):
+def attach(material: Material | None, group: NodeTree) -> bool:
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
     tree = material.node_tree
@@ -117,7 +119,7 @@ def attach(material: Material, group):
     return True
 
 
-def detach(material: Material):
+def detach(material: Material | None) -> bool:
     if material is None or MATERIAL_KEY not in material:
         return False
     tree = material.node_tree
@@ -128,7 +130,7 @@ def detach(material: Material):
     return True
 
 
-def write(scene: Scene, objects) -> None:
+def write(scene: Scene, objects: Sequence[Object]) -> None:
     """Rest normals for ``objects`` (the moving meshes lit by lamp copies); everything removed
     when there are none."""
     if not objects:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 import numpy as np
@@ -36,9 +36,13 @@ from ..common import names
 from ..scene import animation, lens, sources
 
 if TYPE_CHECKING:
-    from bpy.types import Depsgraph, Scene
+    from collections.abc import Callable, Mapping, Sequence
 
-    from ..scene.snapshot import Snapshot
+    import numpy.typing as npt
+    from bpy.types import Depsgraph, Light, Scene
+
+    from ...physics.arrays import FloatArray
+    from ..scene.snapshot import MovingLight, Snapshot
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
@@ -62,7 +66,7 @@ def _cmf_defines():
     return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
 
 
-def basis_defines():
+def basis_defines() -> str:
     """Mallett & Yuksel's basis on its 5 nm grid over its constrained band (outside it the basis
     is held at the band's edge values, ``physics.spectral_render.reflectance_matrix``) and the white's
     temperature, as OSL macros: the table the shader interpolates linearly."""
@@ -92,7 +96,9 @@ def _shader_text():
     return text
 
 
-def view_directions(scene: Scene, snap: Snapshot, columns=32, rows=24, margin=0.05):
+def view_directions(
+    scene: Scene, snap: Snapshot, columns: int = 32, rows: int = 24, margin: float = 0.05
+) -> FloatArray:
     """Scene-frame directions of a grid over the camera's view, widened by ``margin`` (the exact
     camera's rays: the pinhole direction in the camera frame, aberrated into the scene frame unless
     a Lorentz window keeps it, Gray eq. 6)."""
@@ -110,7 +116,9 @@ def view_directions(scene: Scene, snap: Snapshot, columns=32, rows=24, margin=0.
     return world
 
 
-def visible_points(scene: Scene, snap: Snapshot, depsgraph: Depsgraph, origin):
+def visible_points(
+    scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None, origin: npt.ArrayLike
+) -> npt.NDArray[Any]:
     """Surface points the camera sees (the first hit of each ray of :func:`view_directions`)."""
     if depsgraph is None:
         try:
@@ -138,7 +146,14 @@ def _keyframe_path(obj, snap, reception_time, times):
     return animation.world_matrices(obj, frames)[:, :3, 3]
 
 
-def lamp_path(scene: Scene, snap: Snapshot, light, values, reception_time, points):
+def lamp_path(
+    scene: Scene,
+    snap: Snapshot,
+    light: MovingLight,
+    values: Mapping[str, Any],
+    reception_time: float,
+    points: FloatArray,
+) -> tuple[FloatArray, FloatArray]:
     """Where the stand-in lamps go: their times ``c (t - t_reception)`` on the light's path (ascending)
     and positions, for these surface points (the lit ones' retarded times; at least one lamp)."""
     camera_position = values["camera_position"]
@@ -266,7 +281,14 @@ def _positions(scene, snap, light, values, reception_time, times):
     return np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
 
 
-def write(scene: Scene, snap: Snapshot, lights, parameters, reception_time, depsgraph: Depsgraph | None = None) -> None:
+def write(
+    scene: Scene,
+    snap: Snapshot,
+    lights: Sequence[MovingLight],
+    parameters: Callable[[MovingLight], Mapping[str, Any]],
+    reception_time: float,
+    depsgraph: Depsgraph | None = None,
+) -> None:
     """Place and set the stand-in lamps of ``lights`` (``parameters(light)``: the material
     shader's inputs, ``moving_lights.shader_parameters``; ``reception_time`` ``c (t_reception -
     t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
@@ -326,7 +348,7 @@ def write(scene: Scene, snap: Snapshot, lights, parameters, reception_time, deps
                 _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
 
 
-def sun_in_scene_frame(axis, beta):
+def sun_in_scene_frame(axis: npt.ArrayLike, beta: npt.ArrayLike) -> tuple[FloatArray, float]:
     """A sun (plane wave) moving with ``beta``: the photon direction in the scene frame (its own
     frame's ``axis`` aberrated) and ``D = 1 / (gamma (1 - beta . k))``; the irradiance on a surface
     facing it scales by ``D^2`` (radiance ``D^4`` times the disc's solid angle ``1 / D^2``) and its
@@ -337,7 +359,7 @@ def sun_in_scene_frame(axis, beta):
     return k, 1.0 / (gamma * (1.0 - float(beta @ k)))
 
 
-def fast_sun(user, doppler):
+def fast_sun(user: Light, doppler: float) -> tuple[tuple[float, ...], float | None, float]:
     """``(colour, temperature or None, strength factor)`` of the stand-in for sun ``user`` seen at
     ``D`` in the fast mode (eq. 18 for a plane wave: irradiance ``D^3 S(lambda D)``): a blackbody
     sun is the blackbody at ``D T`` with ``D^-2 Y(D T)/Y(T)`` its strength (the spectral passes'

@@ -19,6 +19,10 @@ kept as the scene's warnings (shown in the panel), and the exact camera is marke
 renders black, never a wrong image).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
@@ -28,6 +32,13 @@ from ..scene import animation, snapshot, traveller
 from . import render_notice
 from .stages import STAGES, Sync
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from bpy.types import Depsgraph, Object, Scene
+
+    from ..scene.snapshot import Snapshot
+
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
 _scene_status = {}
 _object_warnings = {}
@@ -36,7 +47,7 @@ _traveller_times = {}  # scene name -> the observer's proper time at the last sy
 _setup_notices = {}  # scene name -> why switching the Method did not set the scene up again
 
 
-def applied_method(scene):
+def applied_method(scene: Scene) -> str | None:
     """``'CAMERA'`` or ``'GEOMETRY'``: the render path applied to ``scene``, or None (the exact
     camera of an Apparent Geometry final render does not count: it is there for the render)."""
     camera_object = scene.camera
@@ -52,11 +63,13 @@ def applied_method(scene):
     return None
 
 
-def is_applied(scene):
+def is_applied(scene: Scene) -> bool:
     return applied_method(scene) is not None or bool(exact_camera.applied_cameras())
 
 
-def apply(scene, frame_range=None, objects=None):
+def apply(
+    scene: Scene, frame_range: tuple[int, int] | None = None, objects: Iterable[Object] | None = None
+) -> Object | list[Object]:
     """Apply the scene's method: check the observer (and the camera's speed over ``frame_range``,
     first and last frame, default the scene's range, when the velocity comes from its animation),
     then the render path and the colour stage. Returns the camera object (exact camera) or the
@@ -91,7 +104,7 @@ def _remove_stages(scene):
         stage.remove(scene)
 
 
-def remove(scene):
+def remove(scene: Scene) -> int:
     """Remove everything the add-on added (every relativistic camera, the apparent geometry, the
     colour stage); the settings stay, they are the user's. Returns the number of things removed."""
     removed = len(apparent_meshes.remove(scene))
@@ -107,13 +120,13 @@ def remove(scene):
 # --- the Apparent Geometry final render -------------------------------------------------------
 
 
-def final_render_problem(scene, snap):
+def final_render_problem(scene: Scene, snap: Snapshot) -> str | None:
     """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
     line), or None when it is (``exact_camera.final_render_problem``)."""
     return exact_camera.final_render_problem(scene, snap)
 
 
-def begin_final_render(scene):
+def begin_final_render(scene: Scene) -> bool:
     """Before a final render (``render_init``) of an Apparent Geometry scene with a moving observer:
     the exact camera photographs the scene, whose moving objects hold their retarded positions in
     the scene frame, so lamps, shadows and the world light them where they are
@@ -141,7 +154,7 @@ def begin_final_render(scene):
     return True
 
 
-def end_final_render(scene):
+def end_final_render(scene: Scene) -> None:
     """After the render (``render_complete``, ``render_cancel``): back to the boosted-mesh preview;
     the meshes follow at the next depsgraph update or frame change (a handler of the render thread
     must not evaluate the depsgraph)."""
@@ -158,7 +171,7 @@ def end_final_render(scene):
             obj.update_tag()
 
 
-def final_render_was_valid(scene):
+def final_render_was_valid(scene: Scene) -> bool:
     """False if the exact camera of the scene's last Apparent Geometry final render was invalid
     (it rendered black: the scene's warnings say why)."""
     return _final_render_valid.pop(scene.name, True)
@@ -170,7 +183,14 @@ def _remove_render_only_camera(scene):
         exact_camera.remove(camera_object)
 
 
-def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=False, before_render=False):
+def sync(
+    scene: Scene,
+    depsgraph: Depsgraph | None = None,
+    *,
+    update_geometry: bool = True,
+    attach_new_materials: bool = False,
+    before_render: bool = False,
+) -> Snapshot | None:
     """Bring the applied render path up to date with the scene at its current frame.
 
     ``update_geometry=False`` skips the apparent geometry (it needs the frame's evaluated meshes,
@@ -206,7 +226,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
     return snap
 
 
-def setting_changed(scene):
+def setting_changed(scene: Scene) -> None:
     """Update callback of every scene setting: switch the render path if the method changed
     (re-applying it), else sync. Never raises."""
     method = applied_method(scene)
@@ -220,7 +240,7 @@ def setting_changed(scene):
     sync(scene)
 
 
-def object_changed(scene, obj):
+def object_changed(scene: Scene, obj: Object) -> None:
     """Update callback of every object setting: a mesh switched on after Set Up gets the apparent
     geometry, a changed blackbody temperature re-attaches its materials, then sync. Never raises."""
     if (
@@ -256,7 +276,7 @@ def _method_name(scene, method):
     return compat.enum_name(scene.relativity, "method", method)
 
 
-def setup_notice(scene):
+def setup_notice(scene: Scene) -> str | None:
     """Why the last switch of the Method failed (one line), or None."""
     return _setup_notices.get(scene.name)
 
@@ -330,24 +350,24 @@ def _status(scene):
     return _scene_status[scene.name]
 
 
-def last_snapshot(scene):
+def last_snapshot(scene: Scene) -> Snapshot | None:
     """The snapshot of the scene's last sync, or None if that sync was refused."""
     return _status(scene)[0]
 
 
-def traveller_time(scene):
+def traveller_time(scene: Scene) -> float | None:
     """The observer's proper time (seconds, 0 at frame 0) at the scene's last synced frame, or None."""
     _status(scene)
     return _traveller_times.get(scene.name)
 
 
-def scene_warnings(scene):
+def scene_warnings(scene: Scene) -> list[str]:
     """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
     sync)."""
     return list(_status(scene)[1])
 
 
-def object_warnings(scene, obj):
+def object_warnings(scene: Scene, obj: Object | None) -> list[str]:
     """Warnings for the active object on the apparent-geometry path: its last update error, a bake
     it needs, a mesh too coarse to curve (as of the last sync), shape keys left at scene time."""
     if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
@@ -362,7 +382,7 @@ def object_warnings(scene, obj):
     return warnings + _shape_key_warnings(obj)
 
 
-def bake_status(scene, obj):
+def bake_status(scene: Scene, obj: Object) -> tuple[str, str | None, str | None] | None:
     """For an ANIMATION mesh: (bake operator, what is baked or None, why a bake is needed or None);
     None for other objects."""
     settings = obj.relativity

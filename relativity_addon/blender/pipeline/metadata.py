@@ -23,7 +23,7 @@ SAVED_KEY = names.STAMP_SAVED_KEY
 PREFIX = "relativity:"
 
 
-def note(snap: Snapshot):
+def note(snap: Snapshot) -> str:
     beta = ",".join(f"{b:.9g}" for b in snap.beta)
     return (
         f"{PREFIX} exposure={snap.exposure:.9g} ({snap.exposure_mode.lower()}) beta={beta} "
@@ -44,7 +44,7 @@ def write(scene: Scene, snap: Snapshot) -> None:
         render.stamp_note_text = text
 
 
-def remove(scene: Scene):
+def remove(scene: Scene) -> bool:
     """Give the user's note back."""
     if SAVED_KEY not in scene:
         return False

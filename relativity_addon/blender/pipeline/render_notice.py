@@ -9,9 +9,15 @@ it (the pattern of ``bpy.app.timers``' documentation). In background mode nothin
 batch script checks the camera itself and exits 1 with the reason.
 """
 
+from __future__ import annotations
+
 import queue
+from typing import TYPE_CHECKING
 
 import bpy
+
+if TYPE_CHECKING:
+    from bpy.types import Scene
 
 POLL_SECONDS = 0.5
 
@@ -19,7 +25,7 @@ _last = {}  # scene name -> why its last render was refused
 _pending = queue.Queue()  # (title, reason) for the main thread
 
 
-def render_refused(scene, reason, black):
+def render_refused(scene: Scene, reason: str, black: bool) -> None:
     """Record that the render of ``scene`` starting now is refused for ``reason`` (one line);
     ``black``: the exact camera renders black (else the last valid state is rendered). Any thread."""
     _last[scene.name] = reason
@@ -28,7 +34,7 @@ def render_refused(scene, reason, black):
         _pending.put((title, reason))
 
 
-def tell(title, reason):
+def tell(title: str, reason: str) -> None:
     """A popup with ``reason`` (one line) when Blender has a window; nothing in background mode
     (the batch script and the panel say it there). Any thread."""
     if not _background():
@@ -39,11 +45,11 @@ def _background():
     return bpy.app.background
 
 
-def render_accepted(scene):
+def render_accepted(scene: Scene) -> None:
     _last.pop(scene.name, None)
 
 
-def last_refusal(scene):
+def last_refusal(scene: Scene) -> str | None:
     """Why the last render of ``scene`` was refused, or None."""
     return _last.get(scene.name)
 
@@ -64,7 +70,7 @@ def _popup(title, reason):
         window_manager.popup_menu(draw, title=title, icon="ERROR")
 
 
-def show_pending():
+def show_pending() -> float:
     """The main-thread timer: show every queued notice (the last one per reason). Never raises."""
     shown = set()
     while True:
@@ -82,12 +88,12 @@ def show_pending():
     return POLL_SECONDS
 
 
-def register():
+def register() -> None:
     if not _background() and not bpy.app.timers.is_registered(show_pending):
         bpy.app.timers.register(show_pending, first_interval=POLL_SECONDS, persistent=True)
 
 
-def unregister():
+def unregister() -> None:
     if bpy.app.timers.is_registered(show_pending):
         bpy.app.timers.unregister(show_pending)
     _last.clear()

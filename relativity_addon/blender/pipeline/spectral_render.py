@@ -24,7 +24,7 @@ from __future__ import annotations
 import os
 import tempfile
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 import numpy as np
@@ -38,8 +38,12 @@ from ..scene import snapshot
 from . import effect
 
 if TYPE_CHECKING:
-    from bpy.types import Scene
+    from collections.abc import Callable
 
+    import numpy.typing as npt
+    from bpy.types import Image, Scene
+
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 IMAGE_NAME = names.SPECTRAL_IMAGE
@@ -114,7 +118,7 @@ class _Saved:
                 light.color, light.use_temperature = colour, use_temperature
 
 
-def pixel_log_doppler(scene: Scene, snap: Snapshot):
+def pixel_log_doppler(scene: Scene, snap: Snapshot) -> FloatArray:
     """``ln D`` at every pixel centre (rows bottom first, as Blender stores images), for the
     snapshot's projection: a perspective view window or one of the exact camera's panoramas."""
     aberration = bool(snap.use_geometry and not snap.use_lorentz_window)
@@ -161,7 +165,9 @@ def _render_exr(scene, path):
     return pixels.reshape(height, width, 4)  # bottom row first, as Blender stores images
 
 
-def render(scene: Scene, passes, progress=None):
+def render(
+    scene: Scene, passes: int, progress: Callable[[int, int], object] | None = None
+) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
     """Render the scene's current frame in spectral mode: ``(pixels, info)``, pixels RGBA float32
     (bottom row first, scene linear), info the Doppler range, wavelengths and time taken.
     ``progress(done, total)`` is called after each pass. RelativityError (one line) on failure."""
@@ -218,7 +224,7 @@ def render(scene: Scene, passes, progress=None):
     return pixels, info
 
 
-def store_image(pixels, name: str = IMAGE_NAME):
+def store_image(pixels: npt.ArrayLike, name: str = IMAGE_NAME) -> Image:
     """Put the pixels into the float image ``name`` (made or resized as needed) and return it."""
     height, width = pixels.shape[:2]
     image = bpy.data.images.get(name)

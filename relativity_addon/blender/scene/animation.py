@@ -24,10 +24,11 @@ from ...physics import transforms
 from ..common import compat
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Object, Scene
 
 
-def frames_per_second(scene: Scene):
+def frames_per_second(scene: Scene) -> float:
     return scene.render.fps / scene.render.fps_base
 
 
@@ -80,7 +81,9 @@ def _channels(obj, curves, path, size, frames):
     return np.stack(columns, axis=1)
 
 
-def basis_matrices(obj: Object, frames, own_frames=None):
+def basis_matrices(
+    obj: Object, frames: npt.ArrayLike, own_frames: npt.ArrayLike | None = None
+) -> npt.NDArray[np.float64]:
     """The object's ``matrix_basis`` at each of ``frames`` (float, sub-frames allowed) from its
     keyframes, deltas included, as float64 ``(K, 4, 4)`` (mathutils is float32). With
     ``own_frames`` (same shape), the rotation and scale channels (the object's own animation) are
@@ -114,7 +117,9 @@ def basis_matrices(obj: Object, frames, own_frames=None):
     )
 
 
-def world_matrices(obj: Object, frames, own_frames=None):
+def world_matrices(
+    obj: Object, frames: npt.ArrayLike, own_frames: npt.ArrayLike | None = None
+) -> npt.NDArray[np.float64]:
     """``matrix_world`` at each of ``frames`` from keyframes alone, float64 ``(K, 4, 4)``: the
     object's basis under its object-parent chain evaluated at the same frames,
     ``parent_world @ matrix_parent_inverse @ basis`` (rotation and scale channels of every link at
@@ -134,7 +139,7 @@ def world_matrices(obj: Object, frames, own_frames=None):
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
-def keyframes_signature(obj: Object):
+def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
     cache key; None when an F-curve has modifiers (their settings are not in the key)."""
     parts = []
@@ -168,7 +173,7 @@ def keyframes_signature(obj: Object):
     return tuple(parts)
 
 
-def has_own_animation(obj: Object, scene: Scene | None = None):
+def has_own_animation(obj: Object, scene: Scene | None = None) -> bool:
     """Whether keyframes turn or scale the object (or an object parent): its own animation, which a
     CONSTANT object plays at its proper time (``world_lines``). Objects whose keyframes are not
     their motion (:func:`keyframe_motion_problem`) are left as Blender shows them."""
@@ -181,12 +186,12 @@ def has_own_animation(obj: Object, scene: Scene | None = None):
     return False
 
 
-def world_matrix_at(obj: Object, frame):
+def world_matrix_at(obj: Object, frame: float) -> Matrix:
     """``matrix_world`` at ``frame`` from keyframes alone (object parents; no constraints)."""
     return Matrix(world_matrices(obj, [frame])[0].tolist())
 
 
-def keyframe_motion_problem(obj: Object, scene: Scene | None = None):
+def keyframe_motion_problem(obj: Object, scene: Scene | None = None) -> str | None:
     """Why keyframes alone do not give the object's world matrix at other frames of ``scene`` (one
     line, naming the object or ancestor at fault), or None when :func:`world_matrices` is exact."""
     if scene is not None and scene.render.frame_map_old != scene.render.frame_map_new:

@@ -25,12 +25,14 @@ from ..common import names, visibility
 from . import sources
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Object
+    from mathutils import Matrix
 
 RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 
 
-def emission_radiance(obj: Object):
+def emission_radiance(obj: Object) -> tuple[float, ...] | None:
     """``(r, g, b)`` radiance of the emitter's first constant emission, or None."""
     for slot in obj.material_slots:
         material = slot.material
@@ -59,7 +61,7 @@ def _rest_colour(socket):
     return None if socket is None or socket.is_linked else socket
 
 
-def surface_area(obj: Object, matrix):
+def surface_area(obj: Object, matrix: Matrix | npt.ArrayLike) -> float:
     """The mesh's surface area in world units (its rest shape under the world matrix ``matrix``)."""
     mesh = obj.data
     mesh.calc_loop_triangles()
@@ -75,7 +77,7 @@ def surface_area(obj: Object, matrix):
     return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1).sum())
 
 
-def intensity(obj: Object, matrix):
+def intensity(obj: Object, matrix: Matrix | npt.ArrayLike) -> tuple[float, ...] | None:
     """Mean radiant intensity ``L A / 4`` (W/sr per channel) of the emitter, or None."""
     radiance = emission_radiance(obj)
     if radiance is None:
@@ -84,7 +86,7 @@ def intensity(obj: Object, matrix):
     return tuple(v * area / 4.0 for v in radiance) if area > 0.0 else None
 
 
-def is_emitter_light(obj: Object):
+def is_emitter_light(obj: Object) -> bool:
     return obj.type == "MESH" and obj.relativity.motion == "CONSTANT" and obj.relativity.lights_scene
 
 
@@ -93,5 +95,5 @@ def hide_from_light_rays(obj: Object) -> None:
     visibility.hide(obj, names.EMITTER_SAVED_KEY, RAYS)
 
 
-def restore(obj: Object):
+def restore(obj: Object) -> bool:
     return visibility.restore(obj, names.EMITTER_SAVED_KEY)

@@ -22,16 +22,23 @@ materials' own nodes and their pass-throughs, not colours computed inside a shar
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import bpy
 
 from ..common import names
 from . import sources
 
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterator
+
+    from bpy.types import Node, NodeSocket, NodeTree
+
 KEY = names.MATERIAL_ATTACHED_KEY
 OWN_PREFIX = "Relativity"  # the add-on's node groups and inserted nodes
 
 
-def user_groups(tree):
+def user_groups(tree: NodeTree) -> list[Node]:
     """The group nodes of ``tree`` that hold a user's node group (not the add-on's)."""
     return [
         node
@@ -57,7 +64,7 @@ def _group_input(socket):
     return None
 
 
-def targets(tree, seen=()):
+def targets(tree: NodeTree, seen: tuple[str, ...] = ()) -> Iterator[tuple[Node, NodeSocket, bool]]:
     """``(node, socket, is_emission)`` for every colour input of ``tree`` that a colour group goes
     in front of: the colour nodes' own, and the inputs of group nodes that their group passes
     straight to a colour (:func:`pass_throughs`)."""
@@ -75,7 +82,7 @@ def targets(tree, seen=()):
                 yield node, socket, is_emission
 
 
-def pass_throughs(group_tree, seen=()):
+def pass_throughs(group_tree: NodeTree, seen: tuple[str, ...] = ()) -> dict[str, bool]:
     """``{Group Input identifier: is_emission}``: the colour inputs of ``group_tree`` that feed a
     colour input of its own (or of a group inside it) straight, all of one kind."""
     if group_tree.name in seen:
@@ -88,7 +95,9 @@ def pass_throughs(group_tree, seen=()):
     return {identifier: next(iter(found)) for identifier, found in kinds.items() if len(found) == 1}
 
 
-def attach_groups(tree, insert, seen=()) -> None:
+def attach_groups(
+    tree: NodeTree, insert: Callable[[NodeTree, Node, NodeSocket, bool], object], seen: tuple[str, ...] = ()
+) -> None:
     """Colour groups into every user group used in ``tree`` (at any depth) not yet attached:
     ``insert(tree, node, socket, is_emission)`` puts one in and returns its record."""
     for node in user_groups(tree):
@@ -106,7 +115,7 @@ def attach_groups(tree, insert, seen=()) -> None:
         attach_groups(group_tree, insert, (*seen, group_tree.name))
 
 
-def detach_all(detach_records) -> None:
+def detach_all(detach_records: Callable[..., object]) -> None:
     """Remove the colour groups from every node group: ``detach_records(owner, tree)``."""
     for group_tree in bpy.data.node_groups:
         if KEY in group_tree:

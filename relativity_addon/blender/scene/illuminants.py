@@ -89,7 +89,7 @@ def _candidates(scene):
     return [obj for obj in scene.objects if not obj.hide_render and not obj.name.startswith(OWN_PREFIX)]
 
 
-def lit_groups(scene: Scene):
+def lit_groups(scene: Scene) -> tuple[LitGroup, ...]:
     """The light groups of the fast mode's blackbody lamps, by *Lit By* (tuple of :class:`LitGroup`)."""
     settings = scene.relativity
     if settings.fast_illuminant == "WHITE":

@@ -14,7 +14,9 @@ from ...physics.shutter import image_distance
 from ..common import names
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Camera, Object, Scene
+    from mathutils import Matrix
 
 # The panoramas the exact camera renders, as its shader numbers them.
 PANORAMA_PROJECTIONS = {"EQUIRECTANGULAR": 1, "FISHEYE_EQUIDISTANT": 2, "FISHEYE_EQUISOLID": 3, "MIRRORBALL": 4}
@@ -87,12 +89,12 @@ def projection(scene: Scene, camera: Object) -> tuple:
     return (kind,)
 
 
-def focal_length(scene, camera):
+def focal_length(scene: Scene, camera: Object) -> float:
     """The camera's focal length in scene units."""
     return camera.data.lens * 1e-3 / (scene.unit_settings.scale_length or 1.0)
 
 
-def focus_distance(camera, matrix=None):
+def focus_distance(camera: Object, matrix: Matrix | npt.ArrayLike | None = None) -> float | None:
     """The focus distance (scene units) of a camera with depth of field on, as Cycles takes it (a
     focus object's distance along the view axis); None with depth of field off."""
     dof = camera.data.dof
@@ -105,11 +107,11 @@ def focus_distance(camera, matrix=None):
     return float(axis @ (np.array(dof.focus_object.matrix_world.translation, dtype=np.float64) - matrix[:3, 3]))
 
 
-def check_detector_image(scene, camera, matrix=None):
+def check_detector_image(scene: Scene, camera: Object, matrix: Matrix | npt.ArrayLike | None = None) -> None:
     """RelativityError (one line) when the detector-plane shutter has no detector: depth of field on
     with the focus inside the focal length (the thin lens forms no real image). Depth of field off,
     the detector is Blender's sensor at the focal length (``shutter.image_distance``)."""
-    if lens_type(camera.data) != "PERSP":
+    if lens_type(cast("Camera", camera.data)) != "PERSP":
         return
     focus = focus_distance(camera, matrix)
     f = focal_length(scene, camera)

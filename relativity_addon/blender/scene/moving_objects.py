@@ -9,7 +9,7 @@ from ...errors import RelativityError
 from . import emitting_meshes
 
 if TYPE_CHECKING:
-    pass
+    from bpy.types import Object, Scene
 
 
 TYPE_LABELS = {
@@ -34,7 +34,7 @@ TYPE_LABELS = {
 DRAWS_NOTHING = ("EMPTY", "CAMERA", "SPEAKER", "LIGHT_PROBE", "LIGHTPROBE", "ARMATURE", "LATTICE")
 
 
-def has_own_velocity(obj):
+def has_own_velocity(obj: Object) -> bool:
     """Whether the object's settings give it its own motion: ``relativity.enabled`` with Constant
     Velocity of nonzero ``beta``, or with Animation (its keyframes or motion bake are its world
     line). What the Apparent Geometry path moves (for meshes) and the exact camera cannot."""
@@ -44,14 +44,14 @@ def has_own_velocity(obj):
     return settings.motion == "ANIMATION" or any(float(b) != 0.0 for b in settings.beta)
 
 
-def object_label(obj):
+def object_label(obj: Object) -> str:
     """``Text 'Name'``: the object's kind (a collection instance named so) and name."""
     if obj.type == "EMPTY" and obj.instance_type == "COLLECTION" and obj.instance_collection is not None:
         return f"Collection instance {obj.name!r}"
     return f"{TYPE_LABELS.get(obj.type, obj.type.title())} {obj.name!r}"
 
 
-def draws_nothing(obj):
+def draws_nothing(obj: Object) -> bool:
     """Whether the object draws nothing in a render itself (an empty instancing a collection does)."""
     return obj.type in DRAWS_NOTHING and not (
         obj.type == "EMPTY" and obj.instance_type == "COLLECTION" and obj.instance_collection is not None
@@ -63,7 +63,7 @@ def _named(labels, limit=4):
     return shown + (f" and {len(labels) - limit} more" if len(labels) > limit else "")
 
 
-def mesh_instancer(obj):
+def mesh_instancer(obj: Object) -> str | None:
     """How a mesh draws other objects that the apparent-geometry modifier does not move (one
     phrase), or None: rendered particle systems (hair, object or collection instances) and
     vertex or face instancing. Geometry-nodes instances are found on the evaluated scene
@@ -80,7 +80,7 @@ def mesh_instancer(obj):
     return None
 
 
-def check_object_velocities(scene, method):
+def check_object_velocities(scene: Scene, method: str) -> None:
     """RelativityError (one line) naming the objects whose own velocity ``method`` cannot render:
     with the exact camera every object but lights (the moving-light stage takes those); with
     Apparent Geometry every moving object that is not a mesh, and meshes drawing particles or

@@ -27,7 +27,10 @@ from ..common import compat, names, osl
 from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
 
 if TYPE_CHECKING:
-    from bpy.types import Depsgraph, Object, Scene
+    from collections.abc import Iterable, Sequence
+
+    import numpy.typing as npt
+    from bpy.types import Depsgraph, Object, PropertyGroup, Scene
 
 Vector3 = tuple[float, float, float]
 
@@ -171,11 +174,11 @@ def _finite(values):
     return all(math.isfinite(value) for value in values)
 
 
-def current_frame(scene: Scene):
+def current_frame(scene: Scene) -> float:
     return scene.frame_current + scene.frame_subframe
 
 
-def check_velocity(beta, what):
+def check_velocity(beta: Iterable[float], what: str) -> tuple[float, ...]:
     """``beta`` as a float tuple; RelativityError unless finite and below the speed of light."""
     beta = tuple(float(b) for b in beta)
     if not _finite(beta):
@@ -186,21 +189,23 @@ def check_velocity(beta, what):
     return beta
 
 
-def check_speed_of_light(c):
+def check_speed_of_light(c: float) -> float:
     c = float(c)
     if not (math.isfinite(c) and c > 0.0):
         raise RelativityError("Speed of light must be a positive finite number")
     return c
 
 
-def active_camera(scene: Scene):
+def active_camera(scene: Scene) -> Object:
     camera = scene.camera
     if camera is None or camera.type != "CAMERA":
         raise RelativityError(f"Scene {scene.name!r} has no active camera")
     return camera
 
 
-def camera_matrix(scene: Scene, camera, frame, depsgraph: Depsgraph | None = None):
+def camera_matrix(
+    scene: Scene, camera: Object, frame: float, depsgraph: Depsgraph | None = None
+) -> npt.NDArray[np.float64]:
     """The camera's world matrix at ``frame`` as float64 ``(4, 4)``.
 
     Blender's animation render does not re-evaluate the original camera object, so its
@@ -222,7 +227,7 @@ STEP_FRAMES = 1.0 / 64.0
 CHECK_SAMPLES_PER_FRAME = 4
 
 
-def camera_beta_at(scene: Scene, frame, camera=None):
+def camera_beta_at(scene: Scene, frame: float, camera: Object | None = None) -> tuple[float, ...]:
     """The camera's velocity (world axes, fraction of c) at ``frame`` (float allowed), from its
     keyframes: the time derivative of its world position in scene time ``t = frame / fps``, over c
     (docs/physics.md, units), by a central difference of half-width STEP_FRAMES. A camera that its
@@ -235,7 +240,7 @@ def camera_beta_at(scene: Scene, frame, camera=None):
     return tuple(float(x) for x in (after - before) / dt / c)
 
 
-def observer_speeds(scene: Scene, frames):
+def observer_speeds(scene: Scene, frames: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """The observer's speed ``|beta|`` at each of ``frames`` (array, sub-frames allowed): the
     setting, or the camera's keyframes (central differences, as :func:`camera_beta_at`, for all
     frames at once). RelativityError at or above the speed of light."""
@@ -269,7 +274,7 @@ def _checked_camera_speed(camera, beta, frame):
     return speed
 
 
-def check_animation_speed(scene: Scene, frame_start=None, frame_end=None):
+def check_animation_speed(scene: Scene, frame_start: int | None = None, frame_end: int | None = None) -> float:
     """Raise RelativityError naming the first frame where the camera moves at or above c.
 
     Samples every frame of [frame_start, frame_end] (default: the scene's frame range) and
@@ -283,7 +288,7 @@ def check_animation_speed(scene: Scene, frame_start=None, frame_end=None):
     return max((_checked_camera_speed(camera, camera_beta_at(scene, f, camera), f) for f in frames), default=0.0)
 
 
-def observer_velocity(scene: Scene, camera, frame):
+def observer_velocity(scene: Scene, camera: Object | None, frame: float) -> tuple[float, ...]:
     """The observer velocity at ``frame``: the setting, or the camera's keyframed motion."""
     if scene.relativity.velocity_source == "CAMERA_ANIMATION":
         beta = camera_beta_at(scene, frame, camera)
@@ -292,7 +297,7 @@ def observer_velocity(scene: Scene, camera, frame):
     return check_velocity(scene.relativity.beta, "observer velocity beta")
 
 
-def light_render_hidden(obj: Object):
+def light_render_hidden(obj: Object) -> bool:
     """Whether the user hid the light from renders (the moving-light stage hides it too, keeping
     the user's value under ``names.LIGHT_SAVED_KEY``)."""
     saved = obj.get(names.LIGHT_SAVED_KEY)
@@ -310,7 +315,7 @@ def _keyframe_beta(scene, obj, frame, step=0.01):
     return tuple(float(v) for v in per_frame * animation.frames_per_second(scene) / c)
 
 
-def moving_lights(scene: Scene, frame, depsgraph: Depsgraph | None = None):
+def moving_lights(scene: Scene, frame: float, depsgraph: Depsgraph | None = None) -> tuple[MovingLight, ...]:
     """Every light of ``scene`` with constant velocity or keyframed motion that renders, at ``frame``; RelativityError
     for a light at or above the speed of light."""
     found = []
@@ -388,18 +393,20 @@ def end_final_render(scene: Scene) -> None:
     _final_renders.discard(scene.name)
 
 
-def in_final_render(scene: Scene):
+def in_final_render(scene: Scene) -> bool:
     return scene.name in _final_renders
 
 
-def world_to_camera(camera_matrix):
+def world_to_camera(camera_matrix: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Rotation ``(3, 3)`` taking world vectors to the axes of a camera with world matrix
     ``camera_matrix`` (4x4): the nearest rotation (polar decomposition), scale and shear removed."""
     u, _, vt = np.linalg.svd(np.asarray(camera_matrix, dtype=np.float64)[:3, :3])
     return (u @ vt).T
 
 
-def frame_exposure(scene: Scene, camera, settings, beta, camera_matrix):
+def frame_exposure(
+    scene: Scene, camera: Object, settings: PropertyGroup, beta: Sequence[float], camera_matrix: npt.ArrayLike
+) -> float:
     """The exposure factor of the frame (``physics.exposure.compensation``; 1 when FIXED)."""
     if settings.exposure_mode != "COMPENSATED" or not any(beta):
         return 1.0
@@ -409,7 +416,7 @@ def frame_exposure(scene: Scene, camera, settings, beta, camera_matrix):
     return exposure.compensation(beta_camera, lens.view_window(scene, camera), aberration, power)
 
 
-def check_time_of_flight(settings, lights) -> None:
+def check_time_of_flight(settings: PropertyGroup, lights: Sequence[MovingLight]) -> None:
     """RelativityError (one line) for what time-of-flight mode (Gray Fig. 1c) cannot render: it is
     the exact camera's, for a scene at rest, and has no Lorentz transformation to window or to
     take spatial fixed points from."""

@@ -39,7 +39,9 @@ from typing import TYPE_CHECKING, NamedTuple
 from ..common import compat, names
 
 if TYPE_CHECKING:
-    from bpy.types import Scene
+    from collections.abc import Container, Iterable
+
+    from bpy.types import Light, Node, NodeLink, NodeSocket, NodeTree, Scene
 
 MIX_NODES = ("ShaderNodeMix", "ShaderNodeMixRGB")
 BLACKBODY_INTENSITY_CUTOFF = 1e-3  # below this Blender's Principled Volume emits no blackbody
@@ -50,14 +52,14 @@ class Blackbody(NamedTuple):
     node's Temperature; ``scale`` the non-negative factor it is multiplied by (None: varies per
     shading point, e.g. a clamped Mix factor fed by a texture)."""
 
-    temperature: object
+    temperature: float | NodeSocket
     scale: float | None
 
 
 # --- following links ------------------------------------------------------------------------
 
 
-def live_link(socket):
+def live_link(socket: NodeSocket) -> NodeLink | None:
     """The link feeding input ``socket`` as Cycles sees it (muted and invalid links do not count)."""
     for link in socket.links:
         if link.is_valid and not link.is_muted:
@@ -76,7 +78,7 @@ def _group_output_input(group_node, identifier):
     return next((socket for socket in output.inputs if socket.identifier == identifier), None)
 
 
-def by_identifier(sockets, identifier: str):
+def by_identifier(sockets: Iterable[NodeSocket], identifier: str) -> NodeSocket | None:
     return next((socket for socket in sockets if socket.identifier == identifier), None)
 
 
@@ -143,7 +145,7 @@ def _float_feed(input_socket, groups):
     return socket, groups
 
 
-def constant_value(input_socket):
+def constant_value(input_socket: NodeSocket) -> float | None:
     """The constant value an input holds (unlinked, or a Value node, also through groups), or None."""
     return _constant(input_socket, ())
 
@@ -173,7 +175,7 @@ def _grey_constant(input_socket, groups):
 # --- the rules ------------------------------------------------------------------------------
 
 
-def blackbody_source(socket):
+def blackbody_source(socket: NodeSocket | None) -> Blackbody | None:
     """What feeds input ``socket``, as a :class:`Blackbody`, or None (not recognised as one)."""
     return _trace(socket, ())
 
@@ -267,7 +269,7 @@ def _grey(colour):
     return r == g == b
 
 
-def light_emission_node(tree):
+def light_emission_node(tree: NodeTree | None) -> Node | None:
     """The Emission node that a light's active Light Output shows, or None."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputLight"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
@@ -285,7 +287,7 @@ def _light_emission_colour(tree):
     return None if node is None else node.inputs["Color"]
 
 
-def light_blackbody(light):
+def light_blackbody(light: Light) -> float | None:
     """Temperature (K) of a light (``bpy.types.Light``) whose emitted spectrum is a blackbody's
     times a constant, or None.
 
@@ -311,7 +313,7 @@ def light_blackbody(light):
     return source.temperature
 
 
-def scene_blackbody_lights(scene: Scene):
+def scene_blackbody_lights(scene: Scene) -> dict[str, float]:
     """``{light object name: temperature}`` for every light of ``scene`` that is a blackbody."""
     found = {}
     for obj in scene.objects:
@@ -325,7 +327,7 @@ def scene_blackbody_lights(scene: Scene):
 # --- Principled Volume ----------------------------------------------------------------------
 
 
-def volume_blackbody(node):
+def volume_blackbody(node: Node) -> Blackbody | None:
     """The Principled Volume's own blackbody emission, or None.
 
     Blender (Cycles and EEVEE alike) adds ``tint sigma mix(1, T^4, intensity) blackbody(T)``
@@ -352,7 +354,7 @@ COLOUR_INPUTS = (
 )
 
 
-def grouped_node(tree, kinds, seen=()):
+def grouped_node(tree: NodeTree | None, kinds: Container[str], seen: tuple[str, ...] = ()) -> tuple[Node, Node] | None:
     """``(group node, inner node)``: the first node whose type is in ``kinds`` inside a node
     group of ``tree`` (at any depth; the add-on's own groups aside), or None."""
     if tree is None or tree.name in seen:
@@ -373,7 +375,7 @@ def grouped_node(tree, kinds, seen=()):
     return None
 
 
-def mark_blackbody(tree, node, blackbody) -> None:
+def mark_blackbody(tree: NodeTree, node: Node, blackbody: Blackbody) -> None:
     """Colour group ``node`` shifts its colour as a blackbody (``sources.Blackbody``)."""
     node.inputs["Is Blackbody"].default_value = 1.0
     if isinstance(blackbody.temperature, float):
@@ -382,7 +384,7 @@ def mark_blackbody(tree, node, blackbody) -> None:
         tree.links.new(blackbody.temperature, node.inputs["Temperature"])
 
 
-def rest_colour_input(socket):
+def rest_colour_input(socket: NodeSocket) -> NodeSocket | None:
     """The input socket holding the user's rest-frame colour of a colour input: the socket itself,
     or, where the Doppler colour stage's group (``materials.py``) feeds it, that group's Color
     input; None for a group without one."""

@@ -18,6 +18,7 @@ from ...physics import proper_time
 from . import animation, snapshot
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Scene
 
 SAMPLES_PER_FRAME = 4
@@ -33,7 +34,7 @@ def _grid(scene, first_frame, last_frame):
     return frames, proper_time.proper_times(frames / fps, snapshot.observer_speeds(scene, frames))
 
 
-def proper_time_at(scene: Scene, frame):
+def proper_time_at(scene: Scene, frame: float) -> float:
     """The traveller's time (seconds) at ``frame`` (negative before frame 0), interpolated in a
     table of the scene's frame range sampled SAMPLES_PER_FRAME times a frame, which is computed
     again only when the motion changes (the panel shows it at every sync). RelativityError for an
@@ -59,7 +60,7 @@ def proper_time_at(scene: Scene, frame):
     return float(np.interp(frame, _cache["frames"], _cache["taus"]))
 
 
-def frames_at_proper_times(scene: Scene, taus):
+def frames_at_proper_times(scene: Scene, taus: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Scene frames (floats) at which the traveller's clock reads ``taus`` (seconds, >= 0)."""
     taus = np.asarray(taus, dtype=np.float64)
     if taus.min() < 0.0:

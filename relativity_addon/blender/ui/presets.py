@@ -22,7 +22,7 @@ _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(_
 _registered_path = None
 
 
-def preset_search_path():
+def preset_search_path() -> str | None:
     """The folder containing ``presets/relativity``: the package (built extension) or, when the
     add-on runs from a source checkout, the repository root."""
     for candidate in (_PACKAGE_DIR, os.path.dirname(_PACKAGE_DIR)):
@@ -31,11 +31,11 @@ def preset_search_path():
     return None
 
 
-def preset_subdir(kind: str):
+def preset_subdir(kind: str) -> str:
     return f"{PRESET_ROOT}/{kind}"
 
 
-def preset_files(kind: str):
+def preset_files(kind: str) -> list[str]:
     """Absolute paths of all presets of ``kind`` Blender can see, sorted by file name."""
     files = []
     for directory in bpy.utils.preset_paths(preset_subdir(kind)):

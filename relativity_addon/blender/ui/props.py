@@ -4,6 +4,9 @@ Everything lives in the scene (saved with the .blend, animatable, undoable). Cha
 calls ``effect.setting_changed``, which brings whichever render path is applied up to date.
 """
 
+from collections.abc import Callable
+from typing import Any
+
 import bpy
 from bpy.props import (
     BoolProperty,
@@ -13,6 +16,7 @@ from bpy.props import (
     IntProperty,
     PointerProperty,
 )
+from bpy.types import Context
 
 from ...physics.shutter import ShutterModel
 from ..pipeline import effect
@@ -100,7 +104,7 @@ VELOCITY_SOURCE_ITEMS = (
 )
 
 
-def velocity_property(what, update):
+def velocity_property(what: str, update: Callable[[Any, Context], None]) -> Any:
     """A velocity as a fraction of c in world axes (``|beta| < 1`` is checked where it is used)."""
     return FloatVectorProperty(
         name="Velocity (c)",
