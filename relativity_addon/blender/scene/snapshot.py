@@ -24,7 +24,7 @@ from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
 from ..common import names
-from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
+from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Object, Scene
@@ -447,6 +447,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         raise RelativityError("the shutter plane point must be finite")
     if not math.isfinite(settings.lorentz_window_time):
         raise RelativityError("the Lorentz window time must be finite")
+    temperatures.check_temperatures(scene)
     matrix = camera_matrix(scene, camera, frame, depsgraph)
     lights = moving_lights(scene, frame, depsgraph)
     time_of_flight = bool(settings.use_time_of_flight)
