@@ -90,6 +90,13 @@ def eevee_engine():
     return "BLENDER_EEVEE" if "BLENDER_EEVEE" in engines else "BLENDER_EEVEE_NEXT"
 
 
+def engine_label(identifier):
+    """The render engine's name as the Render Engine menu shows it ('EEVEE', not its identifier)."""
+    items = bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items  # EEVEE's only, in the wheel
+    labels = {"CYCLES": "Cycles", "BLENDER_WORKBENCH": "Workbench"} | {item.identifier: item.name for item in items}
+    return labels.get(identifier, identifier)
+
+
 def has_compositor_node_groups():
     """5.x: the scene's compositor is a node group (``scene.compositing_node_group``) ending in a
     Group Output; 4.5 has the scene-owned ``scene.node_tree`` with a Composite node instead."""

@@ -22,7 +22,7 @@ renders black, never a wrong image).
 from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
-from ..common import busy
+from ..common import busy, compat
 from ..geometry import apparent_meshes, modifier, shape_keys
 from ..scene import animation, snapshot, traveller
 from .stages import STAGES, Sync
@@ -112,7 +112,7 @@ def final_render_problem(scene, snap):
     if snap.speed == 0.0 and snap.velocity_source != "CAMERA_ANIMATION":
         return "the observer is at rest"
     if snap.engine != "CYCLES":
-        return f"the exact camera needs Cycles, not {snap.engine}"
+        return f"the exact camera needs Cycles, not {compat.engine_label(snap.engine)}"
     return exact_camera.type_problem(snap.camera, scene.objects[snap.camera].data)
 
 

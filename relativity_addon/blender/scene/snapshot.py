@@ -23,7 +23,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
-from ..common import names
+from ..common import compat, names
 from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
 
 if TYPE_CHECKING:
@@ -455,7 +455,8 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         check_time_of_flight(settings, lights)
     moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
-        raise RelativityError(f"the relativistic camera needs the Cycles render engine, not {scene.render.engine}")
+        engine = compat.engine_label(scene.render.engine)
+        raise RelativityError(f"Render Engine is {engine}: the exact camera renders with Cycles only")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
         lens.check_detector_image(scene, camera, matrix)
