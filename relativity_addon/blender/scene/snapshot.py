@@ -492,7 +492,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
-        lit_groups=illuminants.lit_groups(scene)
+        lit_groups=temperatures.checked_lit_groups(illuminants.lit_groups(scene))
         if exact_camera and settings.use_doppler and not time_of_flight
         else (),
     )

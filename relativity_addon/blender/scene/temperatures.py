@@ -1,5 +1,6 @@
 """The check of every blackbody temperature a setting gives (``snapshot.read``): an object's
-Blackbody Temperature, a light's own Temperature and *Lit By: Blackbody*'s Temperature.
+Blackbody Temperature, a light's own Temperature, *Lit By: Blackbody*'s Temperature and the
+Blackbody nodes that make a lamp's light group (``illuminants.lit_groups``).
 
 Blender's float settings take NaN from a script or a driver (their minimum and maximum clamp
 only numbers), and a NaN temperature reaches the colour tables and the shaders as a NaN or a
@@ -34,3 +35,13 @@ def check_temperatures(scene: Scene) -> None:
     settings = scene.relativity
     if settings.fast_illuminant == "BLACKBODY" and not math.isfinite(float(settings.fast_illuminant_temperature)):
         _refuse("Lit By: Blackbody", "Temperature", float(settings.fast_illuminant_temperature))
+
+
+def checked_lit_groups(groups):
+    """``groups`` (``illuminants.LitGroup``); RelativityError (one line) naming a lamp whose
+    Blackbody node's Temperature is not a number (its light group's table has no light)."""
+    for group in groups:
+        if not math.isfinite(group.temperature):
+            lamp = next((f"Object {name!r}" for name in group.members if name), "World")
+            _refuse(lamp, "a Blackbody node's Temperature", group.temperature)
+    return groups

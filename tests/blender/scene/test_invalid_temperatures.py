@@ -99,3 +99,24 @@ def test_numbers_render_finite_pixels(relativity_addon, factory_blender, tmp_pat
     pixels = _f12(bpy, scene, tmp_path / "f.exr")
     assert _notice(bpy).last_refusal(scene) is None
     assert 0.0 < pixels.max() < 1e3, pixels.max()
+
+
+def test_nan_blackbody_node_refused_naming_the_object(relativity_addon, factory_blender, tmp_path):
+    """A material's Blackbody node at NaN makes its lamp's light group on the exact camera: the
+    refusal names the object and the setting, not the colour table."""
+    bpy = factory_blender
+    scene, sphere = _scene(bpy, "CAMERA")
+    sphere.relativity.temperature = 0.0
+    tree = sphere.active_material.node_tree
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    blackbody.inputs["Temperature"].default_value = 3000.0
+    tree.links.new(blackbody.outputs[0], tree.nodes["Emission"].inputs["Color"])
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    blackbody.inputs["Temperature"].default_value = NAN
+    pixels = _f12(bpy, scene, tmp_path / "nan.exr")
+    refusal = _notice(bpy).last_refusal(scene)
+    assert refusal is not None and "Object 'Marker': a Blackbody node's Temperature is nan K" in refusal, refusal
+    assert pixels.max() <= 1e-6  # black
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    with pytest.raises(RuntimeError, match=r"Object 'Marker': a Blackbody node's Temperature is nan K"):
+        bpy.ops.relativity.setup_scene()
