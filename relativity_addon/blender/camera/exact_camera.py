@@ -140,6 +140,15 @@ def final_render_problem(scene: Scene, snap: Snapshot) -> str | None:
     return type_problem(snap.camera, scene.objects[snap.camera].data)
 
 
+def type_changed(camera_object: Object) -> str:
+    """The one line for a camera whose Type the user changed after Set Up (the OSL camera is Custom)."""
+    kind = compat.enum_name(camera_object.data, "type")
+    return (
+        f"Camera {camera_object.name!r}: Type was changed to {kind} after Set Up: "
+        "set it back to Custom, or press Remove and Set Up again"
+    )
+
+
 def lens_warnings(camera_object: Object | None) -> list[str]:
     """One-line notes on what the exact camera does not render for this camera (the shutter model
     read from the scene whose active camera it is)."""
@@ -332,6 +341,8 @@ def apply(scene: Scene, snap: Snapshot, render_only: bool = False) -> Object:
         camera_data.type = "CUSTOM"
         camera_data.custom_mode = "INTERNAL"
         camera_data.custom_shader = text
+    elif camera_data.type != "CUSTOM":
+        raise RelativityError(type_changed(camera_object))  # the user's change stays until Remove
     try:
         write(scene, snap)
     except RelativityError:
@@ -347,7 +358,7 @@ def write(scene: Scene, snap: Snapshot) -> None:
     if not is_applied(camera_data):
         raise RelativityError(f"Camera {camera_object.name!r} is not the relativistic camera")
     if camera_data.type != "CUSTOM":
-        raise RelativityError(f"Camera {camera_object.name!r} is no longer a custom camera")
+        raise RelativityError(type_changed(camera_object))
     if lens_type(camera_data) == "PANO" and snap.shutter_model in LENS_SHUTTERS:
         name = snap.shutter_model.replace("_", " ").lower()
         raise RelativityError(
@@ -383,7 +394,8 @@ def applied_cameras() -> list[Object]:
 
 
 def remove(camera_object: Object | None) -> bool:
-    """Restore the camera exactly as it was before :func:`apply`."""
+    """Restore the camera exactly as it was before :func:`apply`; a Type the user chose after Set
+    Up (no longer the OSL camera's Custom) stays."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False
     camera_data = camera_object.data
@@ -400,7 +412,8 @@ def remove(camera_object: Object | None) -> bool:
     camera_data.custom_filepath = saved["custom_filepath"]
     camera_data.custom_bytecode = saved["custom_bytecode"]
     camera_data.custom_bytecode_hash = saved["custom_bytecode_hash"]
-    camera_data.type = saved["type"]
+    if camera_data.type == "CUSTOM":
+        camera_data.type = saved["type"]
     del camera_data[names.CAMERA_SAVED_STATE_KEY]
     text = bpy.data.texts.get(names.SHADER_TEXT)
     if text is not None and not any(cam.custom_shader == text for cam in bpy.data.cameras):

@@ -112,7 +112,16 @@ def enum_name(data: Any, prop: str, value: str | None = None) -> str:
     for item in data.bl_rna.properties[prop].enum_items:
         if item.identifier == value:
             return item.name
-    return value.replace("_", " ").title()
+    # the bpy module lists only EEVEE among the engines: the others as the Render Engine menu shows them
+    return _ENGINE_NAMES.get(value, value.replace("_", " ").title())
+
+
+_ENGINE_NAMES = {"CYCLES": "Cycles", "BLENDER_WORKBENCH": "Workbench"}
+
+
+def engine_label(identifier: str) -> str:
+    """The render engine's name as the Render Engine menu shows it ('EEVEE', not its identifier)."""
+    return enum_name(bpy.types.RenderSettings, "engine", identifier)
 
 
 def has_compositor_node_groups() -> bool:

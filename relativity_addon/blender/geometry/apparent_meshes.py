@@ -18,6 +18,7 @@ the object's cache (:func:`scene_errors`) and the viewport keeps the last valid 
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import bpy
@@ -25,7 +26,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ..common import busy, names
-from ..scene import moving_objects, snapshot
+from ..scene import lens, moving_objects, snapshot
 from . import modifier, motion
 from .modifier import applied_objects, object_error
 
@@ -85,6 +86,7 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
     modifier.write_cache(cache.data, local, beta_seen)
+    cache.data[names.DEPTH_KEY] = farthest_seen_depth(scene, snap, world)
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
@@ -224,3 +226,50 @@ def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | No
     if fraction > COARSE_EDGE_FRACTION:
         return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
     return None
+
+
+def farthest_seen_depth(scene: Scene, snap: Snapshot, world: npt.ArrayLike) -> float:
+    """The largest depth along the view axis (scene units) of the apparent vertices ``world``
+    (N, 3) in the boosted preview's camera view (a tenth of the view wider on each side), 0 when
+    none: how far Clip End must reach. Fast observers see what lies ahead much farther away (a
+    point at distance d ahead at gamma (1 + beta) d, docs/physics.md)."""
+    camera = scene.objects.get(snap.camera)
+    if snap.exact_camera or camera is None or len(world) == 0:
+        return 0.0
+    world = np.asarray(world, dtype=np.float64)
+    local = (snap.world_to_camera @ (world - snap.camera_position).T).T
+    depth = -local[:, 2]
+    seen = depth > 0.0
+    if camera.data.type != "ORTHO":
+        left, right, bottom, top = lens.view_window(scene, camera)
+        x, y = local[:, 0] / np.maximum(depth, 1e-30), local[:, 1] / np.maximum(depth, 1e-30)
+        margin_x, margin_y = 0.1 * (right - left), 0.1 * (top - bottom)
+        seen &= (x >= left - margin_x) & (x <= right + margin_x) & (y >= bottom - margin_y) & (y <= top + margin_y)
+    return float(depth[seen].max()) if np.any(seen) else 0.0
+
+
+def _round_up(value):
+    """``value`` rounded up to two significant digits."""
+    step = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return math.ceil(value / step - 1e-9) * step
+
+
+def clip_end_warnings(scene: Scene, snap: Snapshot) -> list[str]:
+    """One line when the boosted meshes reach beyond the camera's Clip End (they are cut off in the
+    viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs."""
+    camera = scene.objects.get(snap.camera)
+    if snap.exact_camera or camera is None or camera.type != "CAMERA":
+        return []
+    depths = []
+    for obj in applied_objects(scene):
+        data = modifier.cache_data(obj)
+        if data is not None:
+            depths.append((float(data.get(names.DEPTH_KEY, 0.0)), obj.name))
+    depth, name = max(depths, default=(0.0, ""))
+    if depth <= camera.data.clip_end:
+        return []
+    scale = scene.unit_settings.scale_length or 1.0
+    return [
+        f"Camera {camera.name!r}: Clip End {camera.data.clip_end * scale:.5g} m cuts off mesh {name!r}, "
+        f"seen {depth * scale:.5g} m away at this speed: set Clip End to {_round_up(depth * scale * 1.01):.5g} m"
+    ]

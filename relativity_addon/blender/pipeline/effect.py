@@ -305,6 +305,8 @@ def _record(scene, snap):
             if snap.exposure_mode == "COMPENSATED":
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
+    if snap.method == "GEOMETRY":
+        warnings += apparent_meshes.clip_end_warnings(scene, snap)
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)

@@ -12,7 +12,8 @@ for the render, ``render_complete``/``render_cancel`` take it back to the booste
 (``effect.begin_final_render``). A handler never raises: a problem
 becomes the scene's warning and, for the exact camera, a black (never a wrong) image; a render of a
 set-up scene whose sync is refused is recorded in ``render_notice`` (the panel shows it, and a popup
-after the render when Blender has a window).
+after the render when Blender has a window), also when the exact camera's Type or the Render Engine
+was changed after Set Up, which renders without the relativistic camera.
 """
 
 from __future__ import annotations
@@ -69,12 +70,16 @@ def _tell_if_refused(scene):
     if not exact and effect.applied_method(scene) is None:
         render_notice.render_accepted(scene)  # never set up: an ordinary render
         return
-    black = exact and not camera_object.data.cycles_custom.get("settings_valid", False)
+    # the OSL camera renders (black when invalid) only as a Custom camera in Cycles; a Type or
+    # Render Engine changed after Set Up renders without it
+    osl_renders = exact and camera_object.data.type == "CUSTOM" and scene.render.engine == "CYCLES"
+    black = osl_renders and not camera_object.data.cycles_custom.get("settings_valid", False)
     if not black and effect.last_snapshot(scene) is not None:
         render_notice.render_accepted(scene)
         return
     warnings = effect.scene_warnings(scene)
-    render_notice.render_refused(scene, warnings[0] if warnings else "the relativistic camera is invalid", black)
+    reason = warnings[0] if warnings else "the relativistic camera is invalid"
+    render_notice.render_refused(scene, reason, black, relativistic=osl_renders or not exact)
 
 
 @persistent

@@ -25,12 +25,18 @@ _last = {}  # scene name -> why its last render was refused
 _pending = queue.Queue()  # (title, reason) for the main thread
 
 
-def render_refused(scene: Scene, reason: str, black: bool) -> None:
+def render_refused(scene: Scene, reason: str, black: bool, relativistic: bool = True) -> None:
     """Record that the render of ``scene`` starting now is refused for ``reason`` (one line);
-    ``black``: the exact camera renders black (else the last valid state is rendered). Any thread."""
+    ``black``: the exact camera renders black (else the last valid state is rendered, or, not
+    ``relativistic``, an ordinary picture: the exact camera's Type or the engine changed). Any thread."""
     _last[scene.name] = reason
     if not _background():
-        title = "Relativity: this render is black" if black else "Relativity: this render is not up to date"
+        if black:
+            title = "Relativity: this render is black"
+        elif not relativistic:
+            title = "Relativity: this render is not relativistic"
+        else:
+            title = "Relativity: this render is not up to date"
         _pending.put((title, reason))
 
 

@@ -24,7 +24,7 @@ from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
 from ..common import compat, names, osl
-from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources
+from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Sequence
@@ -449,6 +449,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         raise RelativityError("The shutter plane point must be finite")
     if not math.isfinite(settings.lorentz_window_time):
         raise RelativityError("The Lorentz window time must be finite")
+    temperatures.check_temperatures(scene)
     matrix = camera_matrix(scene, camera, frame, depsgraph)
     lights = moving_lights(scene, frame, depsgraph)
     time_of_flight = bool(settings.use_time_of_flight)
@@ -456,9 +457,8 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         check_time_of_flight(settings, lights)
     moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
-        raise RelativityError(
-            f"The relativistic camera needs the Cycles render engine, not {compat.enum_name(scene.render, 'engine')}"
-        )
+        engine = compat.engine_label(scene.render.engine)
+        raise RelativityError(f"Render Engine is {engine}: the exact camera renders with Cycles only")
     if settings.method == "CAMERA" and osl.unavailable_reason() is not None:
         raise RelativityError(f"{osl.unavailable_reason()}: Method Exact Camera needs it (use Apparent Geometry)")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
@@ -496,7 +496,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
-        lit_groups=illuminants.lit_groups(scene)
+        lit_groups=temperatures.checked_lit_groups(illuminants.lit_groups(scene))
         if exact_camera and settings.use_doppler and not time_of_flight
         else (),
         projection=lens.projection(scene, camera),

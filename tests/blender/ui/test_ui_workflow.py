@@ -177,7 +177,7 @@ def test_operator_reports_errors_and_changes_nothing(relativity_addon, factory_b
     bpy.context.view_layer.update()  # what the UI does after any change: the handlers sync
     assert not bpy.ops.relativity.setup_scene.poll()
     log = draw_panel(bpy, "RELATIVITY_PT_main", scene)
-    assert any(e[0] == "label" and "needs the Cycles render engine" in e[1] for e in log)
+    assert any(e[0] == "label" and e[1].startswith("Render Engine is Workbench: ") and "Cycles" in e[1] for e in log)
 
 
 def test_geometry_method_through_the_operators_and_object_panel(relativity_addon, factory_blender):
