@@ -22,6 +22,8 @@ Left out, with the reason:
 - ID properties behind registered groups (``mesh["cycles"]``, ``scene["relativity"]``): Blender
   stores a value there once anything writes or reads the group, even the default; the groups are
   compared through RNA instead (a default written back is the default).
+- A camera's ``["cycles"]`` ID property: Blender 4.5 writes this legacy group (the panorama
+  settings) on every camera of a file it opens, with or without the add-on.
 - Images of type Render Result and Viewer Node: Blender makes them for any render and compositor
   output; they hold no user data.
 - 4.5's scene-owned compositor tree while Use Nodes is off and it is Blender's default tree (Render
@@ -224,7 +226,8 @@ def camera_dump(bpy, camera):
     return {
         "rna": rna(bpy, camera, depth=1),
         "cycles_custom": idprops(custom) if custom is not None else None,
-        "idprops": idprops(camera),
+        # 4.5's Cycles versioning writes a legacy "cycles" group on every camera of a file it loads
+        "idprops": {k: v for k, v in idprops(camera).items() if k != "cycles"},
     }
 
 

@@ -83,3 +83,135 @@ def test_set_up_then_remove_gives_the_file_back(relativity_addon, factory_blende
     assert scene_dump.differences(before, scene_dump.dump(bpy)), "Set Up changed nothing the dump sees"
     _remove(bpy)
     _assert_same(before, scene_dump.dump(bpy))
+
+
+def _moved(bpy, method):
+    """What the operation acts on: the moving cube (Apparent Geometry) or the moving camera."""
+    return bpy.data.objects["Cube" if method == "GEOMETRY" else "Camera"]
+
+
+def _rename(bpy, method):
+    bpy.data.objects["Cube"].name = "Box"
+    bpy.data.meshes["CubeMesh"].name = "BoxMesh"
+    bpy.data.materials["Paint"].name = "Varnish"
+    bpy.context.view_layer.update()
+
+
+def _rename_back(bpy):
+    bpy.data.objects["Box"].name = "Cube"
+    bpy.data.meshes["BoxMesh"].name = "CubeMesh"
+    bpy.data.materials["Varnish"].name = "Paint"
+
+
+def _duplicate(bpy, method):
+    cube = bpy.data.objects["Cube"]
+    copy = cube.copy()  # Shift+D: the object with its modifiers, and a copy of its mesh
+    copy.data = cube.data.copy()
+    copy.name, copy.data.name = "Cube Copy", "CubeMesh Copy"
+    bpy.context.scene.collection.objects.link(copy)
+    bpy.context.view_layer.update()
+
+
+def _delete_duplicate(bpy):
+    copy = bpy.data.objects["Cube Copy"]
+    assert not [m.name for m in copy.modifiers], "Remove left the modifier on the duplicate"
+    mesh = copy.data
+    bpy.data.objects.remove(copy)
+    bpy.data.meshes.remove(mesh)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_rename_while_set_up(relativity_addon, factory_blender, method):
+    """Object, mesh data and material renamed while set up (found: Remove left
+    ``relativity_rest_normal`` on the renamed mesh). Renamed back after Remove, the file is the
+    file before Set Up."""
+    bpy = factory_blender
+    _build(bpy, method)
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    _rename(bpy, method)
+    _remove(bpy)
+    _rename_back(bpy)
+    _assert_same(before, scene_dump.dump(bpy))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_duplicate_while_set_up(relativity_addon, factory_blender, method):
+    bpy = factory_blender
+    _build(bpy, method)
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    _duplicate(bpy, method)
+    _remove(bpy)
+    _delete_duplicate(bpy)
+    _assert_same(before, scene_dump.dump(bpy))
+
+
+def _without(state, collection, name):
+    state = dict(state)
+    state[collection] = {k: v for k, v in state[collection].items() if k != name}
+    return state
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_delete_moved_object_while_set_up(relativity_addon, factory_blender, method):
+    """The moving cube (Apparent Geometry) or the moving camera (Exact Camera) deleted while set up
+    (found: with the camera deleted, Remove was disabled and 16 datablocks, the Doppler nodes in
+    every material and the orphan camera data's relativistic settings stayed). Its data (mesh or
+    camera) stays in the file as Blender leaves it, and must be the user's own again."""
+    bpy = factory_blender
+    scene = _build(bpy, method)
+    name = _moved(bpy, method).name
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    bpy.data.objects.remove(_moved(bpy, method))
+    bpy.context.view_layer.update()
+    _remove(bpy)
+    expected = _without(before, "objects", name)
+    expected["scenes"]["Scene"]["objects"] = [o for o in expected["scenes"]["Scene"]["objects"] if o != name]
+    expected["collections"] = before["collections"]
+    after = scene_dump.dump(bpy)
+    if method == "CAMERA":  # the scene lost its camera with the object
+        expected["scenes"]["Scene"]["rna"]["camera"] = after["scenes"]["Scene"]["rna"]["camera"]
+        assert scene.camera is None
+    _assert_same(expected, after)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_undo_after_set_up_and_after_remove(relativity_addon, factory_blender, method):
+    """Undo of Set Up gives the file back; Set Up, Remove, undo (set up again), Remove again too."""
+    bpy = factory_blender
+    _build(bpy, method)
+    bpy.ops.ed.undo_push(message="built")
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    bpy.ops.ed.undo_push(message="set up")
+    bpy.ops.ed.undo()
+    _assert_same(before, scene_dump.dump(bpy))
+    _set_up(bpy)
+    bpy.ops.ed.undo_push(message="set up")
+    _remove(bpy)
+    bpy.ops.ed.undo_push(message="removed")
+    bpy.ops.ed.undo()  # set up again
+    assert scene_dump.differences(before, scene_dump.dump(bpy)), "undo of Remove did not bring Set Up back"
+    _remove(bpy)
+    _assert_same(before, scene_dump.dump(bpy))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_save_and_reopen_with_the_add_on(relativity_addon, factory_blender, method, tmp_path, capfd):
+    """Saved set up, opened again, Remove (found on Exact Camera: Cycles tracebacks on stderr,
+    ``No module named 'oslquery'`` and ``StructRNA of type CyclesRender has been removed``)."""
+    bpy = factory_blender
+    _build(bpy, method)
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    path = tmp_path / "set_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), check_existing=False)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    capfd.readouterr()
+    _remove(bpy)
+    bpy.context.view_layer.update()
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Error" not in err, err
+    _assert_same(before, scene_dump.dump(bpy))
