@@ -407,11 +407,21 @@ def applied_cameras():
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
+def applied_camera_data():
+    """Every camera datablock holding the OSL camera, also one whose object was deleted (an
+    orphan keeps the relativistic settings until it is restored)."""
+    return [data for data in bpy.data.cameras if data.library is None and is_applied(data)]
+
+
 def remove(camera_object: Object):
     """Restore the camera exactly as it was before :func:`apply`."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False
-    camera_data = camera_object.data
+    return remove_data(camera_object.data)
+
+
+def remove_data(camera_data: Camera):
+    """Restore camera data exactly as it was before :func:`apply` (its object may be gone)."""
     if not is_applied(camera_data):
         return False
     saved = camera_data[names.CAMERA_SAVED_STATE_KEY].to_dict()

@@ -189,13 +189,27 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
 
 
 def remove(scene: Scene, objects=None):
-    """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
+    """Remove the modifier, the caches and (if unused) the node group. Returns objects restored.
+    Without ``objects``, also the caches of objects deleted while set up."""
+    orphans = []
     if objects is None:
         _skipped_empty.pop(scene.name, None)
+        orphans = orphan_caches()
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
+    for cache in orphans:
+        modifier.remove_cache(cache)
     modifier.remove_unused_group()
     return restored
+
+
+def orphan_caches():
+    """Cache objects no modifier uses any more (their object was deleted while set up)."""
+    return [
+        obj
+        for obj in bpy.data.objects
+        if obj.library is None and obj.users == 0 and obj.data is not None and names.OWNER_KEY in obj.data
+    ]
 
 
 def longest_edge_fraction(obj: Object, camera_position):

@@ -214,11 +214,20 @@ def remove_object_effect(obj: Object):
     if baked is not None:
         bpy.data.meshes.remove(baked)
     if cache is not None:
-        mesh = cache.data
-        bpy.data.objects.remove(cache)
-        if mesh is not None and mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
+        remove_cache(cache, with_bake=False)
     return True
+
+
+def remove_cache(cache: Object, with_bake=True) -> None:
+    """Delete a cache object, its mesh and (``with_bake``) the deformation bake it records."""
+    mesh = cache.data
+    bake_name = mesh.get(names.BAKE_KEY, {}).get("mesh") if with_bake and mesh is not None else None
+    bpy.data.objects.remove(cache)
+    if mesh is not None and mesh.users == 0:
+        bpy.data.meshes.remove(mesh)
+    baked = bpy.data.meshes.get(bake_name) if bake_name else None
+    if baked is not None and baked.users == 0:
+        bpy.data.meshes.remove(baked)
 
 
 def remove_unused_group() -> None:

@@ -15,9 +15,9 @@ Undo works in the bpy module (``bpy.ops.ed.undo_push`` / ``ed.undo``, global mem
 import importlib
 
 import pytest
-
 import scene_dump
-from blender_support import ADDON_MODULE, disable_addon, enable_addon
+
+from blender_support import ADDON_MODULE
 from pipeline_helpers import ch
 
 
