@@ -159,7 +159,9 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
     instances the modifier cannot move; nothing is changed in that case.
     """
     if objects is None:
-        objects = [obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled]
+        objects = [
+            obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled and not modifier.is_cache(obj)
+        ]
     for obj in objects:
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
@@ -203,13 +205,25 @@ def remove(scene: Scene, objects=None):
     return restored
 
 
+_object_count = [-1]  # bpy.data.objects' length at the last look for linked caches
+
+
+def unlink_caches() -> None:
+    """Cache objects belong to no collection (the modifier is their only user). Append instantiates
+    the loose objects it brings into the active collection, where a cache shows as a second,
+    visible mesh: take them out again. Looks only when the number of objects changed."""
+    if len(bpy.data.objects) == _object_count[0]:
+        return
+    _object_count[0] = len(bpy.data.objects)
+    for obj in bpy.data.objects:
+        if obj.name.startswith(names.CACHE_PREFIX) and obj.library is None and modifier.is_cache(obj):
+            for collection in obj.users_collection:
+                collection.objects.unlink(obj)
+
+
 def orphan_caches():
     """Cache objects no modifier uses any more (their object was deleted while set up)."""
-    return [
-        obj
-        for obj in bpy.data.objects
-        if obj.library is None and obj.users == 0 and obj.data is not None and names.OWNER_KEY in obj.data
-    ]
+    return [obj for obj in bpy.data.objects if obj.library is None and obj.users == 0 and modifier.is_cache(obj)]
 
 
 def longest_edge_fraction(obj: Object, camera_position):

@@ -117,8 +117,13 @@ def find_modifier(obj: Object):
     return None
 
 
+def is_cache(obj: Object):
+    """A cache object (its mesh records the object it serves), never an object of the user's."""
+    return obj.type == "MESH" and obj.data is not None and names.OWNER_KEY in obj.data
+
+
 def applied_objects(scene: Scene):
-    return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None]
+    return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None and not is_cache(obj)]
 
 
 def cache_object(obj: Object):

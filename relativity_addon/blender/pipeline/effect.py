@@ -211,6 +211,7 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
     Never raises."""
     if busy.is_computing():
         return None
+    apparent_meshes.unlink_caches()  # brought into a collection by Append
     method = applied_method(scene)
     if not snapshot.in_final_render(scene):
         _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)

@@ -215,3 +215,46 @@ def test_save_and_reopen_with_the_add_on(relativity_addon, factory_blender, meth
     err = capfd.readouterr().err
     assert "Traceback" not in err and "Error" not in err, err
     _assert_same(before, scene_dump.dump(bpy))
+
+
+def _set_up_source_and_target(bpy, tmp_path):
+    """``target.blend``: a Cycles scene with a camera and a lamp, set to Apparent Geometry;
+    ``source.blend``: the moving cube's scene, set up. Returns (source path, target path, the
+    source's dump before Set Up)."""
+    scene, _camera = ch.new_scene(bpy, resolution=(32, 24), samples=2, location=(0.0, -8.0, 0.0))
+    _camera.rotation_euler = (1.5707963, 0.0, 0.0)
+    scene.relativity.speed_of_light = 10.0
+    scene.relativity.method = "GEOMETRY"
+    target = tmp_path / "target.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(target), check_existing=False)
+    _build(bpy, "GEOMETRY")
+    source_before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    source = tmp_path / "source.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source), check_existing=False)
+    bpy.ops.wm.open_mainfile(filepath=str(target))
+    return source, target, source_before
+
+
+def test_append_from_a_set_up_file(relativity_addon, factory_blender, tmp_path, capfd):
+    """The moving cube appended from a file where it was set up (found: its cache object came
+    along as a visible mesh; Set Up then Remove raised ``ReferenceError`` and left 17 datablocks
+    and the material's nodes). After Set Up and Remove the file is the target file plus the
+    user's cube, mesh and material as they were before the source was set up."""
+    bpy = factory_blender
+    source, _target, source_before = _set_up_source_and_target(bpy, tmp_path)
+    target_before = scene_dump.dump(bpy)
+    capfd.readouterr()
+    bpy.ops.wm.append(directory=f"{source}/Object/", filename="Cube")
+    bpy.context.view_layer.update()
+    assert sorted(o.name for o in bpy.context.scene.objects) == ["Camera", "Cube"], "the cache came along"
+    _set_up(bpy)
+    _remove(bpy)
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Error" not in err, err
+    expected = dict(target_before)
+    for collection, name in (("objects", "Cube"), ("meshes", "CubeMesh"), ("materials", "Paint")):
+        expected[collection] = {**target_before[collection], name: source_before[collection][name]}
+    expected["scenes"]["Scene"]["objects"] = ["Camera", "Cube"]
+    expected["libraries"] = [str(source)]  # Append keeps the library entry (Blender's, add-on or not)
+    _assert_same(expected, scene_dump.dump(bpy))
