@@ -162,6 +162,12 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
         objects = [
             obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled and not modifier.is_cache(obj)
         ]
+    linked = next((obj for obj in objects if obj.library is not None), None)
+    if linked is not None:
+        raise RelativityError(
+            f"Mesh {linked.name!r} is linked from {bpy.path.basename(linked.library.filepath)!r}: its apparent "
+            "geometry cannot be written in this file; make it local (Object > Relations > Make Local)"
+        )
     for obj in objects:
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")

@@ -123,7 +123,13 @@ def is_cache(obj: Object):
 
 
 def applied_objects(scene: Scene):
-    return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None and not is_cache(obj)]
+    """The scene's meshes carrying the modifier; linked objects are the library's (set up there or
+    not), never this file's."""
+    return [
+        obj
+        for obj in scene.objects
+        if obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
+    ]
 
 
 def cache_object(obj: Object):

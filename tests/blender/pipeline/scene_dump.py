@@ -84,6 +84,12 @@ def _id_ref(bpy, value):
     return ("ID", type(value).__name__, value.name, value.library.filepath if value.library else "")
 
 
+def key(block):
+    """A datablock's key in the dump: its name, and for linked data the library's file name too
+    (a linked and a local datablock may share a name)."""
+    return block.name if block.library is None else f"{block.name} [{block.library.filepath}]"
+
+
 def idprops(owner):
     """ID properties (custom properties, the add-on's stored records) as plain values."""
     try:
@@ -272,11 +278,8 @@ def _text_hash(text):
 
 
 def _image(bpy, image):
-    pixels = ""
-    if image.has_data or image.source == "GENERATED":
-        pixels = (
-            hashlib.sha1(repr(tuple(image.pixels[:])).encode()).hexdigest() if len(image.pixels) < 4_000_000 else ""
-        )
+    count = len(image.pixels)  # reading loads a packed or generated image's buffer: the same each time
+    pixels = hashlib.sha1(repr(tuple(image.pixels[:])).encode()).hexdigest() if count < 4_000_000 else count
     return {"size": tuple(image.size), "source": image.source, "pixels": pixels, "idprops": idprops(image)}
 
 
@@ -284,20 +287,20 @@ def dump(bpy):
     """The file's state: {collection: {datablock name: what it holds}}."""
     data = bpy.data
     return {
-        "objects": {o.name: object_dump(bpy, o) for o in data.objects},
-        "meshes": {m.name: mesh_dump(bpy, m) for m in data.meshes},
+        "objects": {key(o): object_dump(bpy, o) for o in data.objects},
+        "meshes": {key(m): mesh_dump(bpy, m) for m in data.meshes},
         "materials": {
-            m.name: {
+            key(m): {
                 "rna": rna(bpy, m, depth=1),
                 "tree": node_tree_dump(bpy, m.node_tree),
                 "idprops": idprops(m),
             }
             for m in data.materials
         },
-        "node_groups": {g.name: node_tree_dump(bpy, g) for g in data.node_groups},
-        "cameras": {c.name: camera_dump(bpy, c) for c in data.cameras},
+        "node_groups": {key(g): node_tree_dump(bpy, g) for g in data.node_groups},
+        "cameras": {key(c): camera_dump(bpy, c) for c in data.cameras},
         "lights": {
-            light.name: {
+            key(light): {
                 "rna": rna(bpy, light, depth=1),
                 "tree": node_tree_dump(bpy, light.node_tree),
                 "idprops": idprops(light),
@@ -305,16 +308,16 @@ def dump(bpy):
             for light in data.lights
         },
         "worlds": {
-            w.name: {"rna": rna(bpy, w, depth=1), "tree": node_tree_dump(bpy, w.node_tree), "idprops": idprops(w)}
+            key(w): {"rna": rna(bpy, w, depth=1), "tree": node_tree_dump(bpy, w.node_tree), "idprops": idprops(w)}
             for w in data.worlds
         },
-        "scenes": {s.name: scene_dump(bpy, s) for s in data.scenes},
+        "scenes": {key(s): scene_dump(bpy, s) for s in data.scenes},
         "collections": {
-            c.name: (sorted(o.name for o in c.objects), sorted(k.name for k in c.children), idprops(c))
+            key(c): (sorted(o.name for o in c.objects), sorted(k.name for k in c.children), idprops(c))
             for c in data.collections
         },
-        "texts": {t.name: _text_hash(t) for t in data.texts},
-        "images": {i.name: _image(bpy, i) for i in data.images if i.type not in ("RENDER_RESULT", "COMPOSITING")},
+        "texts": {key(t): _text_hash(t) for t in data.texts},
+        "images": {key(i): _image(bpy, i) for i in data.images if i.type not in ("RENDER_RESULT", "COMPOSITING")},
         "actions": sorted(a.name for a in data.actions),
         "libraries": sorted(lib.filepath for lib in data.libraries),
     }

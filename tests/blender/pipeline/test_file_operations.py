@@ -258,3 +258,28 @@ def test_append_from_a_set_up_file(relativity_addon, factory_blender, tmp_path, 
     expected["scenes"]["Scene"]["objects"] = ["Camera", "Cube"]
     expected["libraries"] = [str(source)]  # Append keeps the library entry (Blender's, add-on or not)
     _assert_same(expected, scene_dump.dump(bpy))
+
+
+def test_link_from_a_set_up_file(relativity_addon, factory_blender, tmp_path, capfd):
+    """The moving cube linked from a file where it was set up: linked data is the library's. This
+    file does not count as set up (its syncs wrote Doppler nodes, the metadata note and the
+    apparent geometry into the linked data, in memory), Set Up refuses the linked mesh in one
+    line, Remove is not offered, and the file is as the link left it."""
+    bpy = factory_blender
+    source, _target, _source_before = _set_up_source_and_target(bpy, tmp_path)
+    target_before = scene_dump.dump(bpy)
+    capfd.readouterr()
+    bpy.ops.wm.link(directory=f"{source}/Object/", filename="Cube")
+    bpy.context.view_layer.update()
+    linked = scene_dump.dump(bpy)
+    # the link adds linked datablocks ("name [library]"), the library and the object in the scene, nothing else
+    local = [line for line in scene_dump.differences(target_before, linked) if "[" not in line.split(": ")[0]]
+    assert all(line.startswith(("/scenes/Scene/objects:", "/libraries:")) for line in local), local
+    assert not bpy.ops.relativity.remove_all.poll()
+    with pytest.raises(RuntimeError, match="Mesh 'Cube' is linked from 'source.blend'"):
+        bpy.ops.relativity.setup_scene()
+    bpy.context.view_layer.update()
+    err = capfd.readouterr().err
+    assert "Traceback" not in err, err
+    assert not bpy.ops.relativity.remove_all.poll()
+    _assert_same(linked, scene_dump.dump(bpy))
