@@ -424,6 +424,10 @@ def remove_data(camera_data: Camera):
     """Restore camera data exactly as it was before :func:`apply` (its object may be gone)."""
     if not is_applied(camera_data):
         return False
+    try:  # restoring the shader runs Cycles' update, which compiles it (in a freshly opened file too)
+        osl.ensure_oslquery_importable()
+    except osl.OSLUnavailableError:
+        pass  # Cycles cannot compile then either: it reports that itself
     saved = camera_data[names.CAMERA_SAVED_STATE_KEY].to_dict()
     custom = camera_data.cycles_custom
     for key in list(custom.keys()):
@@ -431,7 +435,15 @@ def remove_data(camera_data: Camera):
     for key, value in saved.get("cycles_custom", {}).items():
         custom[key] = value
     camera_data.custom_mode = saved["custom_mode"]
-    camera_data.custom_shader = bpy.data.texts.get(saved["custom_shader"]) if saved["custom_shader"] else None
+    shader = bpy.data.texts.get(saved["custom_shader"]) if saved["custom_shader"] else None
+    ours = bpy.data.texts.get(names.SHADER_TEXT)
+    last = ours is not None and not any(cam.custom_shader == ours for cam in bpy.data.cameras if cam != camera_data)
+    if last and shader is None and camera_data.custom_shader == ours:
+        # Deleting the text clears the pointer: Blender 4.5 counts this pointer of a file it opened
+        # one user short, and clearing it by hand prints "ID user decrement error".
+        bpy.data.texts.remove(ours)
+    elif camera_data.custom_shader != shader:
+        camera_data.custom_shader = shader
     camera_data.custom_filepath = saved["custom_filepath"]
     camera_data.custom_bytecode = saved["custom_bytecode"]
     camera_data.custom_bytecode_hash = saved["custom_bytecode_hash"]

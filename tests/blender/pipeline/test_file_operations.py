@@ -18,7 +18,7 @@ import pytest
 import scene_dump
 
 from blender_support import ADDON_MODULE
-from pipeline_helpers import ch
+from pipeline_helpers import ch, run_python
 
 
 def _effect():
@@ -283,3 +283,36 @@ def test_link_from_a_set_up_file(relativity_addon, factory_blender, tmp_path, ca
     assert "Traceback" not in err, err
     assert not bpy.ops.relativity.remove_all.poll()
     _assert_same(linked, scene_dump.dump(bpy))
+
+
+REOPEN_AND_REMOVE = """
+import sys
+import bpy
+sys.path.insert(0, ".")
+from relativity_addon import batch
+batch.enable_addon()  # as in a Blender that starts with the add-on enabled
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+assert bpy.ops.relativity.remove_all.poll()
+print("removed", bpy.ops.relativity.remove_all())
+bpy.context.view_layer.update()
+bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2])
+"""
+
+
+def test_reopen_an_exact_camera_file_in_a_fresh_blender_then_remove(relativity_addon, factory_blender, tmp_path):
+    """A saved Exact Camera file opened in a fresh Blender, then Remove (found: Cycles tracebacks on
+    stderr, ``No module named 'oslquery'`` and ``StructRNA of type CyclesRender has been removed``;
+    on 4.5 also an ID user decrement error on the OSL text). The saved result is the file before
+    Set Up."""
+    bpy = factory_blender
+    _build(bpy, "CAMERA")
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    set_up, removed = tmp_path / "set_up.blend", tmp_path / "removed.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(set_up), check_existing=False)
+    result = run_python(REOPEN_AND_REMOVE, set_up, removed)
+    assert result.returncode == 0 and "removed {'FINISHED'}" in result.stdout, result.stderr[-3000:]
+    output = result.stderr + result.stdout
+    assert "Traceback" not in output and "Error" not in output and "decrement" not in output, output[-3000:]
+    bpy.ops.wm.open_mainfile(filepath=str(removed))
+    _assert_same(before, scene_dump.dump(bpy))
