@@ -13,11 +13,13 @@ Undo works in the bpy module (``bpy.ops.ed.undo_push`` / ``ed.undo``, global mem
 """
 
 import importlib
+import re
 
+import numpy as np
 import pytest
 import scene_dump
 
-from blender_support import ADDON_MODULE
+from blender_support import ADDON_MODULE, disable_addon, enable_addon
 from pipeline_helpers import ch, run_python
 
 
@@ -27,7 +29,8 @@ def _effect():
 
 def _build(bpy, method):
     """A tiny Cycles scene: camera at -Y looking at a cube with a diffuse material, a point lamp.
-    Apparent Geometry: the cube moves at 0.5c along +X; Exact Camera: the observer does."""
+    Apparent Geometry: the cube moves at 0.5c along +X, placed so that it is seen near the image
+    centre (light-travel time); Exact Camera: the observer moves at 0.5c along the view."""
     scene, camera = ch.new_scene(bpy, resolution=(32, 24), samples=2, location=(0.0, -8.0, 0.0))
     camera.rotation_euler = (1.5707963, 0.0, 0.0)
     camera.data.name = "CameraData"
@@ -50,8 +53,10 @@ def _build(bpy, method):
         cube.relativity.enabled = True
         cube.relativity.motion = "CONSTANT"
         cube.relativity.beta = (0.5, 0.0, 0.0)
+        cube.location = (4.0, 0.0, 0.0)
+        lamp.location = (4.0, -6.0, 4.0)
     else:
-        scene.relativity.beta = (0.5, 0.0, 0.0)
+        scene.relativity.beta = (0.0, 0.5, 0.0)
     bpy.context.view_layer.update()
     return scene
 
@@ -316,3 +321,67 @@ def test_reopen_an_exact_camera_file_in_a_fresh_blender_then_remove(relativity_a
     assert "Traceback" not in output and "Error" not in output and "decrement" not in output, output[-3000:]
     bpy.ops.wm.open_mainfile(filepath=str(removed))
     _assert_same(before, scene_dump.dump(bpy))
+
+
+def _render(bpy, path):
+    """F12 into an EXR: (linear RGB, the metadata note); the scene's output settings given back."""
+    render = bpy.context.scene.render
+    settings = (render.filepath, render.use_file_extension)
+    output = (render.image_settings.file_format, render.image_settings.color_depth)
+    image = ch.render_exr(bpy, bpy.context.scene, path)
+    render.filepath, render.use_file_extension = settings
+    render.image_settings.file_format, render.image_settings.color_depth = output
+    match = re.search(rb"relativity: [^\x00]*", path.read_bytes()[:20000])
+    return image[..., :3], match.group(0).decode() if match else ""
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_save_then_reopen_without_the_add_on(relativity_addon, factory_blender, method, tmp_path):
+    """A set-up file opened while the add-on is disabled, rendered, then the add-on enabled again and
+    Remove pressed: the file before Set Up comes back."""
+    bpy = factory_blender
+    _build(bpy, method)
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    path = tmp_path / "set_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), check_existing=False)
+    disable_addon()
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    image, _note = _render(bpy, tmp_path / "without.exr")
+    assert np.isfinite(image).all() and image.max() > 0.0
+    enable_addon()
+    _remove(bpy)
+    _assert_same(before, scene_dump.dump(bpy))
+
+
+def test_apparent_geometry_file_without_the_add_on_says_it_renders_the_preview(
+    relativity_addon, factory_blender, tmp_path
+):
+    """An Apparent Geometry file with a moving observer and Final Render on Exact Camera (found: opened
+    without the add-on it silently rendered the boosted-mesh preview). Measured: without the add-on
+    the render is, pixel for pixel, the add-on's boosted-mesh preview (Final Render on Preview), not
+    the exact camera's final render; and the output's metadata note says which one it is."""
+    bpy = factory_blender
+    scene = _build(bpy, "GEOMETRY")
+    scene.relativity.beta = (0.0, 0.3, 0.0)  # the observer moves along the view
+    scene.cycles.seed = 3
+    _set_up(bpy)
+    exact, exact_note = _render(bpy, tmp_path / "exact.exr")
+    assert "render=exact-camera" in exact_note, exact_note
+    scene.relativity.geometry_final_render = "PREVIEW"
+    preview, preview_note = _render(bpy, tmp_path / "preview.exr")
+    assert "render=boosted-mesh-preview" in preview_note, preview_note
+    scene.relativity.geometry_final_render = "EXACT"
+    path = tmp_path / "set_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), check_existing=False)
+    disable_addon()
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    without, without_note = _render(bpy, tmp_path / "without.exr")
+    print(
+        f"mean radiance: exact {exact.mean():.5g}, preview {preview.mean():.5g}, without the add-on "
+        f"{without.mean():.5g}; largest |without - preview| {np.abs(without - preview).max():.3g}, "
+        f"|without - exact| {np.abs(without - exact).max():.3g}"
+    )
+    assert np.abs(exact - preview).max() > 0.05, "the exact final render and the preview differ here"
+    np.testing.assert_allclose(without, preview, atol=1e-4)  # the preview, not the promised final render
+    assert "render=boosted-mesh-preview" in without_note, without_note  # and the file says so
