@@ -159,27 +159,38 @@ def _without(state, collection, name):
 
 
 @pytest.mark.parametrize("method", METHODS)
-def test_delete_moved_object_while_set_up(relativity_addon, factory_blender, method):
-    """The moving cube (Apparent Geometry) or the moving camera (Exact Camera) deleted while set up
-    (found: with the camera deleted, Remove was disabled and 16 datablocks, the Doppler nodes in
-    every material and the orphan camera data's relativistic settings stayed). Its data (mesh or
-    camera) stays in the file as Blender leaves it, and must be the user's own again."""
+@pytest.mark.parametrize("deleted", ("Camera", "Cube"))
+def test_delete_object_while_set_up(relativity_addon, factory_blender, method, deleted, tmp_path):
+    """The camera or the cube deleted while set up (found: with the camera deleted, Remove was
+    disabled and 16 datablocks, the Doppler nodes in every material and the orphan camera data's
+    relativistic settings stayed; the deleted moving cube's cache object stayed). Its data (mesh
+    or camera) stays in the file as Blender leaves it, and must be the user's own again: the
+    orphan camera data, given an object again, renders what it rendered before Set Up."""
     bpy = factory_blender
     scene = _build(bpy, method)
-    name = _moved(bpy, method).name
     before = scene_dump.dump(bpy)
+    rendered = deleted == "Camera" and method == "CAMERA"  # the orphan data held the OSL camera
+    plain = _render(bpy, tmp_path / "before.exr")[0] if rendered else None
     _set_up(bpy)
-    bpy.data.objects.remove(_moved(bpy, method))
+    camera_matrix = scene.camera.matrix_world.copy()
+    bpy.data.objects.remove(bpy.data.objects[deleted])
     bpy.context.view_layer.update()
     _remove(bpy)
-    expected = _without(before, "objects", name)
-    expected["scenes"]["Scene"]["objects"] = [o for o in expected["scenes"]["Scene"]["objects"] if o != name]
-    expected["collections"] = before["collections"]
+    expected = _without(before, "objects", deleted)
+    expected["scenes"]["Scene"]["objects"] = [o for o in expected["scenes"]["Scene"]["objects"] if o != deleted]
     after = scene_dump.dump(bpy)
-    if method == "CAMERA":  # the scene lost its camera with the object
+    if deleted == "Camera":  # the scene lost its camera with the object
         expected["scenes"]["Scene"]["rna"]["camera"] = after["scenes"]["Scene"]["rna"]["camera"]
         assert scene.camera is None
     _assert_same(expected, after)
+    if rendered:
+        camera = bpy.data.objects.new("Camera", bpy.data.cameras["CameraData"])
+        camera.matrix_world = camera_matrix
+        scene.collection.objects.link(camera)
+        scene.camera = camera
+        again = _render(bpy, tmp_path / "again.exr")[0]
+        assert plain.max() > 0.05
+        np.testing.assert_allclose(again, plain, atol=1e-5)
 
 
 @pytest.mark.parametrize("method", METHODS)
