@@ -231,7 +231,7 @@ def remove_object_effect(obj: Object):
 
 def remove_cache(cache: Object, with_bake=True) -> None:
     """Delete a cache object, its mesh and (``with_bake``) the deformation bake it records."""
-    mesh = cache.data
+    mesh = cache.data if isinstance(cache.data, bpy.types.Mesh) else None
     bake_name = mesh.get(names.BAKE_KEY, {}).get("mesh") if with_bake and mesh is not None else None
     bpy.data.objects.remove(cache)
     if mesh is not None and mesh.users == 0:
