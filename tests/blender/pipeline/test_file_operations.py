@@ -108,21 +108,29 @@ def _rename_back(bpy):
     bpy.data.materials["Varnish"].name = "Paint"
 
 
-def _duplicate(bpy, method):
-    cube = bpy.data.objects["Cube"]
-    copy = cube.copy()  # Shift+D: the object with its modifiers, and a copy of its mesh
-    copy.data = cube.data.copy()
-    copy.name, copy.data.name = "Cube Copy", "CubeMesh Copy"
+def _duplicate(bpy, name, linked):
+    """Shift+D (the object with its modifiers and a copy of its data) or Alt+D (the data shared)."""
+    original = bpy.data.objects[name]
+    copy = original.copy()
+    copy.name = f"{name} Copy"
+    if not linked:
+        copy.data = original.data.copy()
+        copy.data.name = f"{original.data.name} Copy"
     bpy.context.scene.collection.objects.link(copy)
     bpy.context.view_layer.update()
 
 
-def _delete_duplicate(bpy):
-    copy = bpy.data.objects["Cube Copy"]
+def _delete_duplicate(bpy, name):
+    copy = bpy.data.objects[f"{name} Copy"]
     assert not [m.name for m in copy.modifiers], "Remove left the modifier on the duplicate"
-    mesh = copy.data
+    data = copy.data if copy.data.users == 1 else None
     bpy.data.objects.remove(copy)
-    bpy.data.meshes.remove(mesh)
+    if data is not None:
+        getattr(bpy.data, "meshes" if copy_type(data) == "MESH" else "cameras").remove(data)
+
+
+def copy_type(data):
+    return "MESH" if type(data).__name__ == "Mesh" else "CAMERA"
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -141,14 +149,17 @@ def test_rename_while_set_up(relativity_addon, factory_blender, method):
 
 
 @pytest.mark.parametrize("method", METHODS)
-def test_duplicate_while_set_up(relativity_addon, factory_blender, method):
+@pytest.mark.parametrize("name, linked", [("Cube", False), ("Cube", True), ("Camera", False)])
+def test_duplicate_while_set_up(relativity_addon, factory_blender, method, name, linked):
+    """The cube (its mesh copied, or shared) or the camera duplicated while set up; after Remove
+    the duplicate carries nothing of the add-on and, deleted, leaves the file before Set Up."""
     bpy = factory_blender
     _build(bpy, method)
     before = scene_dump.dump(bpy)
     _set_up(bpy)
-    _duplicate(bpy, method)
+    _duplicate(bpy, name, linked)
     _remove(bpy)
-    _delete_duplicate(bpy)
+    _delete_duplicate(bpy, name)
     _assert_same(before, scene_dump.dump(bpy))
 
 
