@@ -56,10 +56,15 @@ def is_applied(scene):
     """Whether anything of the add-on is in the file (Remove is available): an applied render path,
     a camera datablock holding the OSL camera (its object may be deleted), a cache object, or any
     datablock or scene record a stage left (its ``relativity_`` ID properties, its node groups,
-    texts and images), also when the camera or a moving object was deleted after Set Up."""
-    if applied_method(scene) is not None or exact_camera.applied_camera_data() or apparent_meshes.orphan_caches():
+    texts and images), also when the camera or a moving object was deleted after Set Up. Pieces
+    outside the scene while another scene is set up are that scene's."""
+    if applied_method(scene) is not None or _stored_by_add_on(scene):
         return True
-    return any(_stored_by_add_on(block) for block in (scene, *_local_blocks())) or _named_by_add_on()
+    if any(applied_method(other) is not None for other in bpy.data.scenes if other != scene):
+        return False  # the pieces are another set-up scene's: its own Remove takes them
+    if exact_camera.applied_camera_data() or apparent_meshes.orphan_caches():
+        return True
+    return any(_stored_by_add_on(block) for block in _local_blocks()) or _named_by_add_on()
 
 
 def _local_blocks():

@@ -407,3 +407,19 @@ def test_apparent_geometry_file_without_the_add_on_says_it_renders_the_preview(
     assert np.abs(exact - preview).max() > 0.05, "the exact final render and the preview differ here"
     np.testing.assert_allclose(without, preview, atol=1e-4)  # the preview, not the promised final render
     assert "render=boosted-mesh-preview" in without_note, without_note  # and the file says so
+
+
+def test_another_scene_does_not_offer_remove_of_a_set_up_scene(relativity_addon, factory_blender):
+    """Remove is offered wherever the add-on's pieces are, except in another scene while a scene is
+    set up: that scene's Remove takes them (Remove in the other scene would strip the set-up scene's
+    materials and camera)."""
+    bpy = factory_blender
+    scene = _build(bpy, "CAMERA")
+    other = bpy.data.scenes.new("Other")
+    _set_up(bpy)
+    with bpy.context.temp_override(scene=other):
+        assert not bpy.ops.relativity.remove_all.poll()
+    assert bpy.ops.relativity.remove_all.poll()
+    bpy.data.objects.remove(scene.camera)  # no scene is set up now, but its pieces are in the file
+    with bpy.context.temp_override(scene=other):
+        assert bpy.ops.relativity.remove_all.poll()
