@@ -99,6 +99,8 @@ def _rename(bpy, method):
     bpy.data.objects["Cube"].name = "Box"
     bpy.data.meshes["CubeMesh"].name = "BoxMesh"
     bpy.data.materials["Paint"].name = "Varnish"
+    bpy.data.objects["Camera"].name = "Eye"
+    bpy.data.cameras["CameraData"].name = "EyeData"
     bpy.context.view_layer.update()
 
 
@@ -106,6 +108,8 @@ def _rename_back(bpy):
     bpy.data.objects["Box"].name = "Cube"
     bpy.data.meshes["BoxMesh"].name = "CubeMesh"
     bpy.data.materials["Varnish"].name = "Paint"
+    bpy.data.objects["Eye"].name = "Camera"
+    bpy.data.cameras["EyeData"].name = "CameraData"
 
 
 def _duplicate(bpy, name, linked):
@@ -135,7 +139,7 @@ def copy_type(data):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_rename_while_set_up(relativity_addon, factory_blender, method):
-    """Object, mesh data and material renamed while set up (found: Remove left
+    """Object, mesh data, material, camera and camera data renamed while set up (found: Remove left
     ``relativity_rest_normal`` on the renamed mesh). Renamed back after Remove, the file is the
     file before Set Up."""
     bpy = factory_blender
