@@ -393,14 +393,28 @@ def applied_cameras() -> list[Object]:
     return [obj for obj in bpy.data.objects if obj.type == "CAMERA" and is_applied(obj.data)]
 
 
+def applied_camera_data() -> list[Camera]:
+    """Every camera datablock holding the OSL camera, also one whose object was deleted (an
+    orphan keeps the relativistic settings until it is restored)."""
+    return [data for data in bpy.data.cameras if data.library is None and is_applied(data)]
+
+
 def remove(camera_object: Object | None) -> bool:
     """Restore the camera exactly as it was before :func:`apply`; a Type the user chose after Set
     Up (no longer the OSL camera's Custom) stays."""
     if camera_object is None or camera_object.type != "CAMERA":
         return False
-    camera_data = camera_object.data
+    return remove_data(camera_object.data)
+
+
+def remove_data(camera_data: Camera) -> bool:
+    """Restore camera data exactly as it was before :func:`apply` (its object may be gone)."""
     if not is_applied(camera_data):
         return False
+    try:  # restoring the shader runs Cycles' update, which compiles it (in a freshly opened file too)
+        osl.ensure_oslquery_importable()
+    except osl.OSLUnavailableError:
+        pass  # Cycles cannot compile then either: it reports that itself
     saved = camera_data[names.CAMERA_SAVED_STATE_KEY].to_dict()
     custom = camera_data.cycles_custom
     for key in list(custom.keys()):
@@ -408,7 +422,15 @@ def remove(camera_object: Object | None) -> bool:
     for key, value in saved.get("cycles_custom", {}).items():
         custom[key] = value
     camera_data.custom_mode = saved["custom_mode"]
-    camera_data.custom_shader = bpy.data.texts.get(saved["custom_shader"]) if saved["custom_shader"] else None
+    shader = bpy.data.texts.get(saved["custom_shader"]) if saved["custom_shader"] else None
+    ours = bpy.data.texts.get(names.SHADER_TEXT)
+    last = ours is not None and not any(cam.custom_shader == ours for cam in bpy.data.cameras if cam != camera_data)
+    if last and shader is None and camera_data.custom_shader == ours:
+        # Deleting the text clears the pointer: Blender 4.5 counts this pointer of a file it opened
+        # one user short, and clearing it by hand prints "ID user decrement error".
+        bpy.data.texts.remove(ours)
+    elif camera_data.custom_shader != shader:
+        camera_data.custom_shader = shader
     camera_data.custom_filepath = saved["custom_filepath"]
     camera_data.custom_bytecode = saved["custom_bytecode"]
     camera_data.custom_bytecode_hash = saved["custom_bytecode_hash"]

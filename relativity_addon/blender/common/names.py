@@ -90,6 +90,9 @@ LAMP_DOPPLER_KEY = "relativity_lamp_doppler"  # on the scene: what the stage add
 LAMP_DOPPLER_COPY_KEY = "relativity_lamp_copy"  # on a lamp copy: (lamp name, object name)
 REST_NORMAL_ATTRIBUTE = "relativity_rest_normal"  # corner normals of the rest shape (object space)
 REST_NORMAL_KEY = "relativity_rest_normals"  # on the scene: the meshes given that attribute
+REST_NORMAL_MESH_KEY = (
+    "relativity_rest_normal_added"  # on such a mesh: the attribute is the add-on's (follows a rename)
+)
 REST_NORMAL_MATERIAL_KEY = "relativity_rest_normal_node"  # on materials: the inserted group node's name
 REST_NORMAL_GROUP = "Relativity Rest Normal"  # shader group: rest-frame normal in world axes
 REST_NORMAL_GROUP_VERSION = 1

@@ -164,7 +164,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
     instances the modifier cannot move; nothing is changed in that case.
     """
     if objects is None:
-        objects = [obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled]
+        objects = [
+            obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled and not modifier.is_cache(obj)
+        ]
+    linked = next((obj for obj in objects if obj.library is not None), None)
+    if linked is not None:
+        raise RelativityError(
+            f"Mesh {linked.name!r} is linked from {bpy.path.basename(linked.library.filepath)!r}: its apparent "
+            "geometry cannot be written in this file; make it local (Object > Relations > Make Local)"
+        )
     for obj in objects:
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
@@ -194,13 +202,39 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
 
 
 def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object]:
-    """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
+    """Remove the modifier, the caches and (if unused) the node group. Returns objects restored.
+    Without ``objects``, also the caches of objects deleted while set up."""
+    orphans = []
     if objects is None:
         _skipped_empty.pop(scene.name, None)
+        orphans = orphan_caches()
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
+    for cache in orphans:
+        modifier.remove_cache(cache)
     modifier.remove_unused_group()
     return restored
+
+
+_object_count = [-1]  # bpy.data.objects' length at the last look for linked caches
+
+
+def unlink_caches() -> None:
+    """Cache objects belong to no collection (the modifier is their only user). Append instantiates
+    the loose objects it brings into the active collection, where a cache shows as a second,
+    visible mesh: take them out again. Looks only when the number of objects changed."""
+    if len(bpy.data.objects) == _object_count[0]:
+        return
+    _object_count[0] = len(bpy.data.objects)
+    for obj in bpy.data.objects:
+        if obj.name.startswith(names.CACHE_PREFIX) and obj.library is None and modifier.is_cache(obj):
+            for collection in obj.users_collection:
+                collection.objects.unlink(obj)
+
+
+def orphan_caches() -> list[Object]:
+    """Cache objects no modifier uses any more (their object was deleted while set up)."""
+    return [obj for obj in bpy.data.objects if obj.library is None and obj.users == 0 and modifier.is_cache(obj)]
 
 
 def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:

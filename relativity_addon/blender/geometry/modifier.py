@@ -119,8 +119,19 @@ def find_modifier(obj: Object) -> Modifier | None:
     return None
 
 
+def is_cache(obj: Object) -> bool:
+    """A cache object (its mesh records the object it serves), never an object of the user's."""
+    return obj.type == "MESH" and obj.data is not None and names.OWNER_KEY in obj.data
+
+
 def applied_objects(scene: Scene) -> list[Object]:
-    return [obj for obj in scene.objects if obj.type == "MESH" and find_modifier(obj) is not None]
+    """The scene's meshes carrying the modifier; linked objects are the library's (set up there or
+    not), never this file's."""
+    return [
+        obj
+        for obj in scene.objects
+        if obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
+    ]
 
 
 def cache_object(obj: Object) -> Object | None:
@@ -216,11 +227,20 @@ def remove_object_effect(obj: Object) -> bool:
     if baked is not None:
         bpy.data.meshes.remove(baked)
     if cache is not None:
-        mesh = cache.data
-        bpy.data.objects.remove(cache)
-        if mesh is not None and mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
+        remove_cache(cache, with_bake=False)
     return True
+
+
+def remove_cache(cache: Object, with_bake: bool = True) -> None:
+    """Delete a cache object, its mesh and (``with_bake``) the deformation bake it records."""
+    mesh = cache.data if isinstance(cache.data, bpy.types.Mesh) else None
+    bake_name = mesh.get(names.BAKE_KEY, {}).get("mesh") if with_bake and mesh is not None else None
+    bpy.data.objects.remove(cache)
+    if mesh is not None and mesh.users == 0:
+        bpy.data.meshes.remove(mesh)
+    baked = bpy.data.meshes.get(bake_name) if bake_name else None
+    if baked is not None and baked.users == 0:
+        bpy.data.meshes.remove(baked)
 
 
 def remove_unused_group() -> None:

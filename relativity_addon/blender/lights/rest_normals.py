@@ -13,13 +13,13 @@ arrive from the object-frame direction; this stage gives the BSDFs the rest-fram
   normal, or the geometry's own normal where the attribute is absent, e.g. a static object
   sharing the material) linked into the Normal input of each BSDF whose Normal is not linked.
 
-Everything is recorded (the mesh names on the scene, the inserted node on each material) and
-:func:`remove` deletes exactly that.
+Everything is recorded (the mesh names on the scene and a mark on each mesh, which follows a
+rename; the inserted node on each material) and :func:`remove` deletes exactly that.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import bpy
 import numpy as np
@@ -29,11 +29,12 @@ from ..common import names, nodes
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from bpy.types import Material, NodeTree, Object, Scene
+    from bpy.types import Material, Mesh, NodeTree, Object, Scene
 
 KEY = names.REST_NORMAL_KEY
 ATTRIBUTE = names.REST_NORMAL_ATTRIBUTE
 MATERIAL_KEY = names.REST_NORMAL_MATERIAL_KEY
+MESH_KEY = names.REST_NORMAL_MESH_KEY
 NODE_NAME = names.REST_NORMAL_GROUP
 
 
@@ -139,10 +140,11 @@ def write(scene: Scene, objects: Sequence[Object]) -> None:
     record = scene[KEY].to_dict() if KEY in scene else {"meshes": []}
     group = _group()
     for obj in objects:
-        mesh = obj.data
+        mesh = cast("Mesh", obj.data)
         if mesh.name not in record["meshes"]:
-            if ATTRIBUTE in mesh.attributes:
+            if ATTRIBUTE in mesh.attributes and MESH_KEY not in mesh:
                 continue  # the user's own attribute of that name: left alone
+            mesh[MESH_KEY] = True
             record["meshes"].append(mesh.name)
             scene[KEY] = record
         _write_attribute(mesh)
@@ -154,11 +156,14 @@ def remove(scene: Scene) -> None:
     """Detach the group from every material, delete the attributes the stage added and the group."""
     for material in bpy.data.materials:
         detach(material)
-    if KEY in scene:
-        for name in scene[KEY].to_dict()["meshes"]:
-            mesh = bpy.data.meshes.get(name)
-            attribute = mesh.attributes.get(ATTRIBUTE) if mesh is not None else None
-            if attribute is not None:
-                mesh.attributes.remove(attribute)
+    added: list[Mesh | None] = [mesh for mesh in bpy.data.meshes if MESH_KEY in mesh and mesh.library is None]
+    if KEY in scene:  # also a file set up before meshes were marked
+        added += [bpy.data.meshes.get(name) for name in scene[KEY].to_dict()["meshes"]]
         del scene[KEY]
+    for mesh in added:
+        attribute = mesh.attributes.get(ATTRIBUTE) if mesh is not None else None
+        if attribute is not None:
+            mesh.attributes.remove(attribute)
+        if mesh is not None and MESH_KEY in mesh:
+            del mesh[MESH_KEY]
     nodes.remove_unused_groups([names.REST_NORMAL_GROUP])

@@ -23,10 +23,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import bpy
+
 from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
-from ..common import busy, compat
+from ..common import busy, compat, names
 from ..geometry import apparent_meshes, modifier, shape_keys
 from ..scene import animation, snapshot, traveller
 from . import render_notice
@@ -64,7 +66,40 @@ def applied_method(scene: Scene) -> str | None:
 
 
 def is_applied(scene: Scene) -> bool:
-    return applied_method(scene) is not None or bool(exact_camera.applied_cameras())
+    """Whether anything of the add-on is in the file (Remove is available): an applied render path,
+    a camera datablock holding the OSL camera (its object may be deleted), a cache object, or any
+    datablock or scene record a stage left (its ``relativity_`` ID properties, its node groups,
+    texts and images), also when the camera or a moving object was deleted after Set Up. Pieces
+    outside the scene while another scene is set up are that scene's."""
+    if applied_method(scene) is not None or _stored_by_add_on(scene):
+        return True
+    if any(applied_method(other) is not None for other in bpy.data.scenes if other != scene):
+        return False  # the pieces are another set-up scene's: its own Remove takes them
+    if exact_camera.applied_camera_data() or apparent_meshes.orphan_caches():
+        return True
+    return any(_stored_by_add_on(block) for block in _local_blocks()) or _named_by_add_on()
+
+
+def _local_blocks():
+    data = bpy.data
+    for collection in (data.cameras, data.materials, data.worlds, data.lights, data.objects, data.meshes):
+        yield from (block for block in collection if block.library is None)
+
+
+def _stored_by_add_on(block):
+    """An ID property of the add-on's (``relativity_...``; ``relativity`` itself holds the settings)."""
+    return any(key.startswith("relativity_") for key in block.keys())
+
+
+def _named_by_add_on():
+    data = bpy.data
+    return any(
+        block.library is None
+        and block.name.startswith(("Relativity ", "relativistic_"))
+        and block.name != names.SPECTRAL_IMAGE  # the spectral render's picture is the user's
+        for collection in (data.node_groups, data.texts, data.images)
+        for block in collection
+    )
 
 
 def apply(
@@ -108,8 +143,8 @@ def remove(scene: Scene) -> int:
     """Remove everything the add-on added (every relativistic camera, the apparent geometry, the
     colour stage); the settings stay, they are the user's. Returns the number of things removed."""
     removed = len(apparent_meshes.remove(scene))
-    for camera_object in exact_camera.applied_cameras():
-        removed += bool(exact_camera.remove(camera_object))
+    for camera_data in exact_camera.applied_camera_data():
+        removed += bool(exact_camera.remove_data(camera_data))
     _remove_stages(scene)
     snapshot.end_final_render(scene)
     _scene_status.pop(scene.name, None)
@@ -201,6 +236,7 @@ def sync(
     Never raises."""
     if busy.is_computing():
         return None
+    apparent_meshes.unlink_caches()  # brought into a collection by Append
     method = applied_method(scene)
     if not snapshot.in_final_render(scene):
         _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)

@@ -4,8 +4,10 @@ A compensated exposure multiplies the frame by one factor (``physics/exposure.py
 with the velocity and the speed of light, goes into Blender's *Note* metadata field
 (``render.stamp_note_text``, written into PNG, EXR and the other formats that keep metadata, not
 burnt into the image unless the user asks for it), so that the physical brightness is
-recoverable from any output file: divide by ``exposure``. The user's own note comes back when the
-effect is removed.
+recoverable from any output file: divide by ``exposure``. ``render=`` says what made the image: the
+exact camera, or Apparent Geometry's boosted-mesh preview. A set-up file keeps the preview's note,
+so a render of it without the add-on (no handler swaps the exact camera in for the final render)
+says that it is the preview. The user's own note comes back when the effect is removed.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ def note(snap: Snapshot) -> str:
     return (
         f"{PREFIX} exposure={snap.exposure:.9g} ({snap.exposure_mode.lower()}) beta={beta} "
         f"speed={snap.speed:.9g} c={snap.speed_of_light:.9g} frame={snap.frame:g} method={snap.method.lower()}"
+        f" render={'exact-camera' if snap.exact_camera else 'boosted-mesh-preview'}"
         + (" kinematics=galilean (time of flight only, not relativity)" if snap.use_time_of_flight else "")
     )
 
