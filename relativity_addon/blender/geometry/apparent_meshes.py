@@ -89,6 +89,15 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     return len(local)
 
 
+def _point_count_changed(obj: Object, cache_mesh, depsgraph: Depsgraph | None):
+    """Whether the evaluated mesh has another point count than the cache: a modifier or the mesh
+    was edited (an Array's count, say), which the signature does not see; the modifier would then
+    leave the mesh at rest. Known only with the update's depsgraph."""
+    if depsgraph is None or names.ERROR_KEY in cache_mesh:
+        return False
+    return len(obj.evaluated_get(depsgraph).data.vertices) != len(cache_mesh.vertices)
+
+
 def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed=False):
     """Recompute every object carrying the modifier (only those whose inputs changed, with
     ``only_changed``). A failure is recorded on the object's cache and printed, never raised:
@@ -101,6 +110,7 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
                 only_changed
                 and data is not None
                 and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph)
+                and not _point_count_changed(obj, data, depsgraph)
             ):
                 continue
             try:
