@@ -147,17 +147,59 @@ def scene_errors(scene: Scene):
     return errors
 
 
-def instanced_by_moving(depsgraph, objects):
-    """The first of ``objects`` with its own velocity whose evaluated geometry draws instances or
-    other components (geometry nodes, particles, instancing) that the modifier does not move, or None."""
+def _may_instance(obj: Object):
+    """Whether ``obj`` can draw instances: a collection, vertex or face instancer, a particle
+    system, or geometry nodes of the user's (cheap: tells which scenes need the instance scan)."""
+    if obj.instance_type != "NONE" or len(getattr(obj, "particle_systems", ())):
+        return True
+    ours = modifier.find_modifier(obj)
+    return any(each.type == "NODES" and each != ours for each in obj.modifiers)
+
+
+def instancing_problem(depsgraph: Depsgraph | None, objects, scene_objects):
+    """Why the evaluated scene (``depsgraph``, evaluated if None and needed) cannot be drawn right
+    (one line), or None: one of the moving ``objects`` (those with their own velocity) draws
+    instances or other components the modifier does not move (geometry nodes, particles, vertex or
+    face instancing), or an instancer among ``scene_objects`` (a collection instance, a particle
+    system, geometry nodes) draws one of them elsewhere: the instance shows the apparent geometry
+    computed where the object itself is."""
     moving = {obj.name: obj for obj in objects if moving_objects.has_own_velocity(obj)}
-    if not moving:
+    if not moving or not any(_may_instance(obj) for obj in scene_objects):
         return None
+    if depsgraph is None:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
     for instance in depsgraph.object_instances:
         parent = instance.parent
-        if instance.is_instance and parent is not None and parent.original.name in moving:
-            return moving[parent.original.name]
+        if not instance.is_instance or parent is None:
+            continue
+        if parent.original.name in moving:
+            return (
+                f"Mesh {parent.original.name!r} draws instances or other geometry (geometry nodes, particles or "
+                "instancing) that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
+            )
+        source = instance.object.original.name
+        if source in moving:
+            return (
+                f"{moving_objects.object_label(parent.original)} draws moving mesh {source!r} elsewhere, where its "
+                f"apparent geometry is not computed: make the instances real (Make Instances Real) or set the "
+                f"Motion of {source!r} to Static"
+            )
     return None
+
+
+# Scene name -> the instancing problem found at its last sync that evaluated the scene.
+_instancing_problems = {}
+
+
+def check_instancing(scene: Scene, depsgraph: Depsgraph | None = None, evaluate=True) -> None:
+    """RelativityError (one line) when an instancer draws a moving mesh or a moving mesh draws
+    instances (:func:`instancing_problem`), as found at Set Up or after an edit. ``evaluate=False``
+    (a sync without the frame's evaluated meshes) repeats what the last evaluating check found."""
+    if evaluate:
+        _instancing_problems[scene.name] = instancing_problem(depsgraph, applied_objects(scene), scene.objects)
+    problem = _instancing_problems.get(scene.name)
+    if problem is not None:
+        raise RelativityError(problem)
 
 
 def apply(scene: Scene, snap: Snapshot, objects=None):
@@ -174,12 +216,10 @@ def apply(scene: Scene, snap: Snapshot, objects=None):
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    instancer = instanced_by_moving(depsgraph, objects)
-    if instancer is not None:
-        raise RelativityError(
-            f"Mesh {instancer.name!r} draws instances or other geometry (geometry nodes, particles or instancing) "
-            "that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
-        )
+    problem = instancing_problem(depsgraph, [*objects, *applied_objects(scene)], scene.objects)
+    if problem is not None:
+        raise RelativityError(problem)
+    _instancing_problems.pop(scene.name, None)
     empty = [obj for obj in objects if len(obj.evaluated_get(depsgraph).data.vertices) == 0]
     objects = [obj for obj in objects if obj not in empty]
     _skipped_empty[scene.name] = sorted({*_skipped_empty.get(scene.name, ()), *(obj.name for obj in empty)})
@@ -202,6 +242,7 @@ def remove(scene: Scene, objects=None):
     """Remove the modifier, the caches and (if unused) the node group. Returns objects restored."""
     if objects is None:
         _skipped_empty.pop(scene.name, None)
+        _instancing_problems.pop(scene.name, None)
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
     modifier.remove_unused_group()

@@ -191,6 +191,8 @@ def sync(scene, depsgraph=None, *, update_geometry=True, attach_new_materials=Fa
             raise RelativityError(f"Set up again: the scene is set up for {method.title()}")
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             exact_camera.write(scene, snap)
+        if method == "GEOMETRY":
+            apparent_meshes.check_instancing(scene, depsgraph, evaluate=update_geometry)
         if method == "GEOMETRY" and update_geometry:
             apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:

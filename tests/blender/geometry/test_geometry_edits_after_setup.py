@@ -6,7 +6,8 @@ tau = ((D.u) + sqrt((D.u)^2 + (c^2 - u.u) D.D)) / (c^2 - u.u), D = x_o - p) or n
 in Set Up's refusal, or at sync (the panel's warnings, the last render's refusal)."""
 
 import numpy as np
-from test_object_type_sweep import _cube_mesh, _link
+import pytest
+from test_object_type_sweep import _cube_mesh, _instance_group, _link
 
 import geometry_helpers as gh
 
@@ -94,3 +95,106 @@ def test_array_count_edited_after_setup_is_followed_and_rendered_where_seen(
         assert total > 0.0 and np.linalg.norm(measured - pixel) < 0.6
         assert np.linalg.norm(rest_pixel - pixel) > 10.0  # the check tells the two apart
     assert not any("'Row'" in warning for warning in _warnings(scene)), _warnings(scene)
+
+
+# --- 4-6. instancers of moving meshes, before and after Set Up -------------------------------
+
+
+def _refused_at_sync(bpy, scene, *named):
+    """After an edit: the depsgraph handler's sync is refused in one line naming ``named``, shown in
+    the panel's warnings, and an F12 render is recorded as refused with the same line."""
+    bpy.context.view_layer.update()  # the depsgraph handler syncs
+    effect = gh.addon_module("pipeline.effect")
+    warnings = effect.scene_warnings(scene)
+    assert effect.last_snapshot(scene) is None, warnings
+    assert warnings and all(repr(name) in warnings[0] for name in named), warnings
+    assert "\n" not in warnings[0]
+    assert bpy.ops.render.render() == {"FINISHED"}
+    refusal = gh.addon_module("pipeline.render_notice").last_refusal(scene)
+    assert refusal == warnings[0], refusal
+    print(warnings[0])
+    return warnings[0]
+
+
+def _add_instancing(bpy, scene, obj, kind):
+    """Make the mesh ``obj`` draw instances of ``kind`` (the sweep's instancers)."""
+    if kind == "NODE_INSTANCES":
+        obj.modifiers.new("Instancer", "NODES").node_group = _instance_group(bpy)
+    elif kind == "PARTICLES":
+        obj.modifiers.new("Particles", "PARTICLE_SYSTEM")
+        settings = obj.particle_systems[0].settings
+        settings.count, settings.frame_start, settings.render_type = 4, -10, "OBJECT"
+        settings.instance_object = bpy.data.objects.new("Grain", _cube_mesh(bpy, "Grain", 0.05))
+    else:
+        child = _link(bpy, scene, "Dupli child", _cube_mesh(bpy, "Dupli child", 0.05))
+        child.parent, child.relativity.enabled = obj, False
+        obj.instance_type = "VERTS"
+
+
+@pytest.mark.parametrize("kind", ("NODE_INSTANCES", "PARTICLES", "VERTEX_INSTANCES"))
+def test_instancing_added_to_a_moving_mesh_after_setup_is_refused_at_sync(relativity_addon, factory_blender, kind):
+    """Set Up refuses a moving mesh that draws instances (test_object_type_sweep.py); the same
+    instancing added after Set Up is refused at the next sync (geometry nodes were rendered with
+    the instances left behind, silently). Remove then gives the scene back."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    mover = _mover(bpy, scene)
+    scene.relativity.method = "GEOMETRY"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    _add_instancing(bpy, scene, mover, kind)
+    _refused_at_sync(bpy, scene, "Mover")
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+
+
+def _instance_of(bpy, scene, source, kind):
+    """An instancer at rest drawing the mesh ``source`` 2 units lower: a collection instance of a
+    collection holding it, or a particle system of a static emitter instancing it."""
+    if kind == "COLLECTION":
+        collection = bpy.data.collections.new("Movers")
+        scene.collection.children.link(collection)
+        for owner in source.users_collection:
+            owner.objects.unlink(source)
+        collection.objects.link(source)
+        copy = _link(bpy, scene, "Copy", None)
+        copy.instance_type, copy.instance_collection = "COLLECTION", collection
+        copy.location = (0.0, -2.0, 0.0)
+        return copy
+    emitter = _link(bpy, scene, "Emitter", _cube_mesh(bpy, "Emitter", 0.3))
+    emitter.location = (0.0, -1.0, -6.0)
+    emitter.modifiers.new("Particles", "PARTICLE_SYSTEM")
+    settings = emitter.particle_systems[0].settings
+    settings.count, settings.frame_start, settings.render_type = 4, -10, "OBJECT"
+    settings.instance_object = source
+    return emitter
+
+
+@pytest.mark.parametrize("kind", ("COLLECTION", "PARTICLES"))
+@pytest.mark.parametrize("when", ("before", "after"))
+def test_instances_of_a_moving_mesh_are_refused(relativity_addon, factory_blender, kind, when):
+    """A moving mesh drawn again by an instancer at rest: each instance would show the mesh's
+    apparent geometry computed where the mesh itself is (the whole offset of its light delay there,
+    wherever the instance stands), so it is refused in one line naming the instancer and the mesh:
+    by Set Up (leaving the file as it was) or, added afterwards, at the next sync."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    mover = _mover(bpy, scene)
+    scene.relativity.method = "GEOMETRY"
+    if when == "after":
+        assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    instancer = _instance_of(bpy, scene, mover, kind)
+    if when == "after":
+        _refused_at_sync(bpy, scene, instancer.name, "Mover")
+        assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+        return
+    bpy.context.view_layer.update()
+    before = gh.file_fingerprint(bpy)
+    with pytest.raises(RuntimeError) as raised:
+        bpy.ops.relativity.setup_scene()
+    message = str(raised.value).strip().removeprefix("Error: ").strip()
+    print(message)
+    assert repr(instancer.name) in message and "'Mover'" in message and "\n" not in message
+    assert gh.file_fingerprint(bpy) == before
+    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+    mover.relativity.motion = "STATIC"  # the way out the message gives
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
