@@ -24,7 +24,7 @@ from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy
 from ..geometry import apparent_meshes, modifier, shape_keys
-from ..scene import animation, snapshot, traveller
+from ..scene import animation, moving_objects, snapshot, traveller
 from .stages import STAGES, Sync
 
 # Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
@@ -265,6 +265,8 @@ def _record(scene, snap):
             if snap.exposure_mode == "COMPENSATED":
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
+    if snap.method == "GEOMETRY":
+        warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)

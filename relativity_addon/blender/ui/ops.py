@@ -52,7 +52,13 @@ class RELATIVITY_OT_setup_scene(Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         snap = effect.last_snapshot(scene)
-        self.report({"INFO"}, f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}")
+        done = f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}"
+        warnings = effect.scene_warnings(scene)
+        if warnings:  # set up, but not everything renders right: say so now, not only in the panel
+            more = f" (and {len(warnings) - 1} more in the panel)" if len(warnings) > 1 else ""
+            self.report({"WARNING"}, f"{done}; {warnings[0]}{more}")
+        else:
+            self.report({"INFO"}, done)
         return {"FINISHED"}
 
 

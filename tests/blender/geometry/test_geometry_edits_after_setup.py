@@ -97,6 +97,51 @@ def test_array_count_edited_after_setup_is_followed_and_rendered_where_seen(
     assert not any("'Row'" in warning for warning in _warnings(scene)), _warnings(scene)
 
 
+# --- 2. a mesh carried by a keyframed parent, its Motion left at Static ---------------------
+
+
+def _keyframed_empty(bpy, scene, name="Carrier", speed=2.0):
+    """An empty keyframed along +x at ``speed`` units/s (linear keys at frames -96 and 96)."""
+    empty = _link(bpy, scene, name, None)
+    empty.location = (0.0, 0.0, -6.0)
+    for frame in (-96, 96):
+        empty.location.x = speed * frame / FPS
+        empty.keyframe_insert("location", index=0, frame=frame)
+    for fcurve in gh.compat.action_fcurves(empty.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    scene.frame_set(scene.frame_current)
+    return empty
+
+
+def test_mesh_on_a_keyframed_parent_with_motion_static_gets_a_hint(relativity_addon, factory_blender):
+    """A mesh riding on a keyframed empty at 0.5 c with Motion left at Static is rendered where it
+    is, unshifted: Set Up and every sync say so in one line naming the mesh and the Motion
+    setting; with Motion on Animation the hint goes, and the mesh is seen at its retarded
+    position (the parent's keys are its world line: x_e = p - u tau, uniform motion)."""
+    bpy = factory_blender
+    scene, camera = _scene(bpy)
+    carrier = _keyframed_empty(bpy, scene)
+    rider = _link(bpy, scene, "Rider", _cube_mesh(bpy, "Rider", 0.1))
+    rider.parent, rider.location = carrier, (0.0, 0.5, 0.0)
+    rider.relativity.tessellation = 0
+    scene.relativity.method = "GEOMETRY"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    hints = [warning for warning in _warnings(scene) if "'Rider'" in warning]
+    print(hints)
+    assert len(hints) == 1 and "Motion" in hints[0] and "Static" in hints[0], _warnings(scene)
+    assert "'Carrier'" in hints[0] and "\n" not in hints[0]
+    rider.relativity.motion = "ANIMATION"
+    bpy.context.view_layer.update()
+    assert not any("'Rider'" in warning for warning in _warnings(scene)), _warnings(scene)
+    x_a, _ = gh.evaluated_points(bpy, rider)
+    x_o = np.array(camera.matrix_world.translation)
+    p = np.array(rider.matrix_world.translation)
+    expected = _uniform_retarded(p, np.array([2.0, 0.0, 0.0]), x_o)
+    print(f"centre {x_a.mean(axis=0).round(4)}, retarded {expected.round(4)}, now {p.round(4)}")
+    assert np.linalg.norm(x_a.mean(axis=0) - expected) < 2e-3
+
+
 # --- 4-6. instancers of moving meshes, before and after Set Up -------------------------------
 
 
