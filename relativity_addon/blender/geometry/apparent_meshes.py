@@ -75,9 +75,10 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         raise RelativityError(f"object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
     try:
-        world, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap)
+        world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"object {obj.name!r}: {error}") from None
+    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))
     inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
@@ -85,6 +86,10 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
+    if warning is not None:
+        cache.data[names.WARNING_KEY] = warning
+    elif names.WARNING_KEY in cache.data:
+        del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
 
@@ -140,6 +145,10 @@ def scene_errors(scene: Scene):
     """One-line errors of the last update of each object (empty when every cache is current), and
     the meshes left out for having nothing to draw."""
     errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
+    for obj in applied_objects(scene):
+        data = modifier.cache_data(obj)
+        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
+            errors.append(data[names.WARNING_KEY])
     for name in _skipped_empty.get(scene.name, ()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:

@@ -5,6 +5,8 @@ the origin: a point of a body moving with velocity u is seen at x_e = p - u tau,
 tau = ((D.u) + sqrt((D.u)^2 + (c^2 - u.u) D.D)) / (c^2 - u.u), D = x_o - p) or named in one line:
 in Set Up's refusal, or at sync (the panel's warnings, the last render's refusal)."""
 
+import re
+
 import numpy as np
 import pytest
 from test_object_type_sweep import _cube_mesh, _instance_group, _link
@@ -140,6 +142,49 @@ def test_mesh_on_a_keyframed_parent_with_motion_static_gets_a_hint(relativity_ad
     expected = _uniform_retarded(p, np.array([2.0, 0.0, 0.0]), x_o)
     print(f"centre {x_a.mean(axis=0).round(4)}, retarded {expected.round(4)}, now {p.round(4)}")
     assert np.linalg.norm(x_a.mean(axis=0) - expected) < 2e-3
+
+
+# --- 3. retarded times before the first key ---------------------------------------------------
+
+
+def test_retarded_times_before_the_first_key_are_warned_with_the_frames_needed(relativity_addon, factory_blender):
+    """A mesh keyed from frame 10 on (0.5 c along x), seen at frame 20 from 6 units away with
+    c = 4 units/s: light left it about 36 frames earlier, before frame 10, where Blender's constant
+    extrapolation holds it still. A warning names it and the frame its keys must start from: the
+    earliest retarded frame of its points, t_e = t_o - |x_o - x_e| / c (docs/physics.md) with the
+    mesh at rest at its first key's place. Keys from that frame on clear it."""
+    bpy = factory_blender
+    scene, camera = _scene(bpy)
+    obj = _link(bpy, scene, "Late", _cube_mesh(bpy, "Late", 0.1))
+    obj.relativity.motion, obj.relativity.tessellation = "ANIMATION", 0
+
+    def key(first, last):
+        obj.animation_data_clear()
+        for frame in (first, last):
+            obj.location = (2.0 * (frame - 10) / FPS, 0.0, -6.0)
+            obj.keyframe_insert("location", index=0, frame=frame)
+        for fcurve in gh.compat.action_fcurves(obj.animation_data):
+            for point in fcurve.keyframe_points:
+                point.interpolation = "LINEAR"
+
+    key(10, 58)
+    scene.frame_set(20)
+    scene.relativity.method = "GEOMETRY"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    warnings = [warning for warning in _warnings(scene) if "'Late'" in warning]
+    print(warnings)
+    assert len(warnings) == 1 and "\n" not in warnings[0], _warnings(scene)
+    # the physics: every corner at rest at its first-key place (x = 0), seen across |x_o - x_e|
+    rest = np.array([v.co for v in obj.data.vertices]) + np.array([0.0, 0.0, -6.0])
+    x_o = np.array(camera.matrix_world.translation)
+    retarded_frames = 20 - np.linalg.norm(rest - x_o, axis=1) / C * FPS
+    stated = [float(f) for f in re.findall(r"frame (-?[0-9.]+)", warnings[0])]
+    print(f"retarded frames {retarded_frames.min():.2f}..{retarded_frames.max():.2f}, stated {stated}")
+    assert abs(stated[0] - retarded_frames.min()) < 0.06  # seen as it was at frame ...
+    assert 10.0 in stated and np.floor(retarded_frames.min()) in stated  # keys from 10; needed from ...
+    key(-30, 58)  # keys reaching back far enough
+    bpy.context.view_layer.update()
+    assert not any("'Late'" in warning for warning in _warnings(scene)), _warnings(scene)
 
 
 # --- 4-6. instancers of moving meshes, before and after Set Up -------------------------------
