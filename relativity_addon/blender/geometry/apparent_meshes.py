@@ -176,7 +176,8 @@ def instancing_problem(depsgraph: Depsgraph | None, objects, scene_objects):
     if not moving or not any(_may_instance(obj) for obj in scene_objects):
         return None
     if depsgraph is None:
-        depsgraph = bpy.context.evaluated_depsgraph_get()
+        with busy.computing():  # the update handlers this evaluation runs must not sync again
+            depsgraph = bpy.context.evaluated_depsgraph_get()
     for instance in depsgraph.object_instances:
         parent = instance.parent
         if not instance.is_instance or parent is None:

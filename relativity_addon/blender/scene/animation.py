@@ -168,6 +168,11 @@ def keyframes_signature(obj: Object):
     return tuple(parts)
 
 
+def has_transform_keys(obj: Object):
+    """Whether live keyframes of the object's own action move, turn or scale it."""
+    return bool(_transform_fcurves(obj))
+
+
 def held_before_frame(obj: Object):
     """The frame before which the keyframes of the object and its object parents hold it still
     (the earliest first key of the transform curves that move, all extrapolated as constant), or

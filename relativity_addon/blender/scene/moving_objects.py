@@ -142,7 +142,7 @@ def static_but_keyframed(obj, scene):
     while link is not None:
         chain.append(link)
         link = link.parent
-    keyed = [link for link in chain if link.animation_data is not None and link.animation_data.action is not None]
+    keyed = [link for link in chain if animation.has_transform_keys(link)]
     if not keyed or animation.keyframe_motion_problem(obj, scene) is not None:
         return None
     start, end = scene.frame_start, max(scene.frame_end, scene.frame_start + 1)
