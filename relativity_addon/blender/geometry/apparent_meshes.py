@@ -18,6 +18,7 @@ the object's cache (:func:`scene_errors`) and the viewport keeps the last valid 
 
 from __future__ import annotations
 
+import zlib
 from typing import TYPE_CHECKING
 
 import bpy
@@ -39,8 +40,21 @@ if TYPE_CHECKING:
 COARSE_EDGE_FRACTION = 0.25
 
 
+def rest_fingerprint(obj_eval: Object):
+    """``(point count, CRC-32)`` of the tessellated rest positions on the evaluated mesh, or None:
+    an edit of the mesh or of a modifier (an Array's count or offset) changes it, which nothing
+    else in the signature sees. One read of the attribute, no mesh copy."""
+    attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
+    if attribute is None:
+        return None
+    values = np.empty(len(attribute.data) * 3, dtype=np.float32)
+    attribute.data.foreach_get("vector", values)
+    return len(attribute.data), zlib.crc32(values)
+
+
 def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None):
-    """Everything the object's apparent positions depend on, as a string stored with its cache."""
+    """Everything the object's apparent positions depend on, as a string stored with its cache
+    (the evaluated rest shape too, given the update's ``depsgraph``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     parts = [
@@ -61,6 +75,7 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
         relativity.use_deformation,
         relativity.use_proper_time,
         len(obj.data.vertices),
+        rest_fingerprint(evaluated) if depsgraph is not None else None,
     ]
     return repr(parts)
 
@@ -94,28 +109,20 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     return len(local)
 
 
-def _point_count_changed(obj: Object, cache_mesh, depsgraph: Depsgraph | None):
-    """Whether the evaluated mesh has another point count than the cache: a modifier or the mesh
-    was edited (an Array's count, say), which the signature does not see; the modifier would then
-    leave the mesh at rest. Known only with the update's depsgraph."""
-    if depsgraph is None or names.ERROR_KEY in cache_mesh:
-        return False
-    return len(obj.evaluated_get(depsgraph).data.vertices) != len(cache_mesh.vertices)
-
-
 def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed=False):
     """Recompute every object carrying the modifier (only those whose inputs changed, with
     ``only_changed``). A failure is recorded on the object's cache and printed, never raised:
     the viewport keeps the last valid state. Returns the number of objects updated."""
     updated = 0
     with busy.computing():
+        if depsgraph is None:  # the signatures hold the evaluated rest shapes (update_object evaluates anyway)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
         for obj in applied_objects(scene):
             data = modifier.cache_data(obj)
             if (
                 only_changed
                 and data is not None
                 and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph)
-                and not _point_count_changed(obj, data, depsgraph)
             ):
                 continue
             try:

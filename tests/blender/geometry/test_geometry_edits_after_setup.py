@@ -99,6 +99,37 @@ def test_array_count_edited_after_setup_is_followed_and_rendered_where_seen(
     assert not any("'Row'" in warning for warning in _warnings(scene)), _warnings(scene)
 
 
+def test_edits_keeping_the_point_count_are_followed(relativity_addon, factory_blender):
+    """An Array's offset changed and a vertex of the mesh moved after Set Up (the point count stays):
+    the cache follows each at the next sync (it kept the old shape until the frame changed). The
+    evaluated cube centres and the moved corner are at their retarded positions (docs/physics.md)."""
+    bpy = factory_blender
+    scene, camera = _scene(bpy)
+    obj = _mover(bpy, scene, "Row", size=0.08, location=(1.2, -0.8, -6.0))
+    array = obj.modifiers.new("Array", "ARRAY")
+    array.count, array.use_relative_offset, array.use_constant_offset = 2, False, True
+    array.constant_offset_displace = (0.0, 0.8, 0.0)
+    scene.relativity.method = "GEOMETRY"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    x_o, u = np.array(camera.matrix_world.translation), BETA * C
+    array.constant_offset_displace = (0.0, 1.2, 0.0)
+    bpy.context.view_layer.update()  # the depsgraph handler syncs
+    x_a, _ = gh.evaluated_points(bpy, obj)
+    expected = _uniform_retarded(np.array([1.2, 0.4, -6.0]), u, x_o)
+    print(f"second cube: centre {x_a[8:].mean(axis=0).round(4)}, retarded {expected.round(4)}")
+    assert np.linalg.norm(x_a[8:].mean(axis=0) - expected) < 2e-3
+    corner = np.array(obj.data.vertices[0].co) + np.array([0.0, 0.0, 0.3])
+    obj.data.vertices[0].co = corner
+    obj.data.update()
+    bpy.context.view_layer.update()
+    x_a, _ = gh.evaluated_points(bpy, obj)
+    # the corner's offset from the origin is contracted along beta (rest shape, docs/architecture.md)
+    p = np.array([1.2, -0.8, -6.0]) + gh.contract(corner[None], BETA)[0]
+    expected = _uniform_retarded(p, u, x_o)
+    print(f"moved corner: {x_a[0].round(4)}, retarded {expected.round(4)}")
+    assert np.linalg.norm(x_a[0] - expected) < 1e-4
+
+
 # --- 2. a mesh carried by a keyframed parent, its Motion left at Static ---------------------
 
 
