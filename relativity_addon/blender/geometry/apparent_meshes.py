@@ -49,7 +49,7 @@ def rest_fingerprint(obj_eval: Object):
         return None
     values = np.empty(len(attribute.data) * 3, dtype=np.float32)
     attribute.data.foreach_get("vector", values)
-    return len(attribute.data), zlib.crc32(values)
+    return len(attribute.data), zlib.crc32(values.data)
 
 
 def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None):
