@@ -115,14 +115,14 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
     the viewport keeps the last valid state. Returns the number of objects updated."""
     updated = 0
     with busy.computing():
-        if depsgraph is None:  # the signatures hold the evaluated rest shapes (update_object evaluates anyway)
-            depsgraph = bpy.context.evaluated_depsgraph_get()
         for obj in applied_objects(scene):
             data = modifier.cache_data(obj)
+            # The signatures hold the evaluated rest shapes: without the handler's depsgraph, the
+            # scene's, evaluated now (update_object evaluates it again after its own edits).
             if (
                 only_changed
                 and data is not None
-                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph)
+                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, _evaluated(depsgraph))
             ):
                 continue
             try:
@@ -133,8 +133,12 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
                 data = modifier.cache_data(obj)
                 if data is not None:
                     data[names.ERROR_KEY] = str(error)
-                    data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+                    data[names.SIGNATURE_KEY] = object_signature(snap, obj, _evaluated(depsgraph))
     return updated
+
+
+def _evaluated(depsgraph: Depsgraph | None) -> Depsgraph:
+    return depsgraph if depsgraph is not None else bpy.context.evaluated_depsgraph_get()
 
 
 def update_after_bake(scene: Scene, obj: Object) -> None:
@@ -172,13 +176,39 @@ def _may_instance(obj: Object):
     return any(each.type == "NODES" and each != ours for each in obj.modifiers)
 
 
+def _instanced_by_settings(obj: Object):
+    """The objects ``obj`` draws again by its settings: a collection instance's objects, its
+    particle systems' instance object or collection (whether or not they are in the scene)."""
+    if obj.instance_type == "COLLECTION" and obj.instance_collection is not None:
+        yield from obj.instance_collection.all_objects
+    for system in getattr(obj, "particle_systems", ()):
+        settings = system.settings
+        if settings.render_type == "OBJECT" and settings.instance_object is not None:
+            yield settings.instance_object
+        elif settings.render_type == "COLLECTION" and settings.instance_collection is not None:
+            yield from settings.instance_collection.all_objects
+
+
+def _drawn_elsewhere(instancer: Object, source: Object):
+    return (
+        f"{moving_objects.object_label(instancer)} draws {moving_objects.object_label(source)} (which has its own "
+        "velocity) away from where its apparent geometry is computed: make the instances real (Make Instances "
+        f"Real) or set the Motion of {source.name!r} to Static"
+    )
+
+
 def instancing_problem(depsgraph: Depsgraph | None, objects, scene_objects):
     """Why the evaluated scene (``depsgraph``, evaluated if None and needed) cannot be drawn right
     (one line), or None: one of the moving ``objects`` (those with their own velocity) draws
     instances or other components the modifier does not move (geometry nodes, particles, vertex or
     face instancing), or an instancer among ``scene_objects`` (a collection instance, a particle
     system, geometry nodes) draws one of them elsewhere: the instance shows the apparent geometry
-    computed where the object itself is."""
+    computed where the object itself is (or, for an object only instanced, none). Objects drawn by
+    a collection instance or a particle system are checked by their settings, in the scene or not."""
+    for instancer in scene_objects:
+        for source in _instanced_by_settings(instancer):
+            if moving_objects.has_own_velocity(source):
+                return _drawn_elsewhere(instancer, source)
     moving = {obj.name: obj for obj in objects if moving_objects.has_own_velocity(obj)}
     if not moving or not any(_may_instance(obj) for obj in scene_objects):
         return None
@@ -194,13 +224,8 @@ def instancing_problem(depsgraph: Depsgraph | None, objects, scene_objects):
                 f"Mesh {parent.original.name!r} draws instances or other geometry (geometry nodes, particles or "
                 "instancing) that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
             )
-        source = instance.object.original.name
-        if source in moving:
-            return (
-                f"{moving_objects.object_label(parent.original)} draws moving mesh {source!r} elsewhere, where its "
-                f"apparent geometry is not computed: make the instances real (Make Instances Real) or set the "
-                f"Motion of {source!r} to Static"
-            )
+        if instance.object.original.name in moving:
+            return _drawn_elsewhere(parent.original, moving[instance.object.original.name])
     return None
 
 

@@ -270,10 +270,12 @@ def test_instancing_added_to_a_moving_mesh_after_setup_is_refused_at_sync(relati
 
 def _instance_of(bpy, scene, source, kind):
     """An instancer at rest drawing the mesh ``source`` 2 units lower: a collection instance of a
-    collection holding it, or a particle system of a static emitter instancing it."""
-    if kind == "COLLECTION":
+    collection holding it (linked in the scene too, or only instanced), or a particle system of a
+    static emitter instancing it."""
+    if kind in ("COLLECTION", "COLLECTION_ONLY"):
         collection = bpy.data.collections.new("Movers")
-        scene.collection.children.link(collection)
+        if kind == "COLLECTION":
+            scene.collection.children.link(collection)
         for owner in source.users_collection:
             owner.objects.unlink(source)
         collection.objects.link(source)
@@ -290,16 +292,18 @@ def _instance_of(bpy, scene, source, kind):
     return emitter
 
 
-@pytest.mark.parametrize("kind", ("COLLECTION", "PARTICLES"))
+@pytest.mark.parametrize("kind", ("COLLECTION", "COLLECTION_ONLY", "PARTICLES"))
 @pytest.mark.parametrize("when", ("before", "after"))
 def test_instances_of_a_moving_mesh_are_refused(relativity_addon, factory_blender, kind, when):
     """A moving mesh drawn again by an instancer at rest: each instance would show the mesh's
     apparent geometry computed where the mesh itself is (the whole offset of its light delay there,
-    wherever the instance stands), so it is refused in one line naming the instancer and the mesh:
-    by Set Up (leaving the file as it was) or, added afterwards, at the next sync."""
+    wherever the instance stands; a mesh only instanced, not in the scene, was drawn at rest), so it
+    is refused in one line naming the instancer and the mesh: by Set Up (leaving the file as it
+    was) or, added afterwards, at the next sync."""
     bpy = factory_blender
     scene, _ = _scene(bpy)
     mover = _mover(bpy, scene)
+    _link(bpy, scene, "Ground", _cube_mesh(bpy, "Ground"))  # at rest: set up still when 'Mover' leaves the scene
     scene.relativity.method = "GEOMETRY"
     if when == "after":
         assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
