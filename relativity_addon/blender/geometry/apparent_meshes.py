@@ -6,7 +6,8 @@ so its output never feeds back), computes the apparent positions for the snapsho
 event with numpy (``world_lines.py``, ``physics/apparent.py``) and writes them, with each point's
 velocity relative to the observer, into the cache mesh. ``effect.sync`` calls :func:`update` at
 every frame change and whenever an input changed (observer velocity, c, camera or object
-transform, object settings): the result depends only on the scene state at the frame.
+transform, object settings, the evaluated rest shape): the result depends only on the scene state
+at the frame. Instancers of moving meshes are refused (:func:`check_instancing`).
 
 Frames: the scene frame is the observer's frame only when the observer velocity is zero. The mesh
 path renders in the camera's frame (axes parallel to world): an object at rest in the scene
