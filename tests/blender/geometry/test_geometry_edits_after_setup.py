@@ -158,12 +158,18 @@ def test_mesh_on_a_keyframed_parent_with_motion_static_gets_a_hint(relativity_ad
     rider = _link(bpy, scene, "Rider", _cube_mesh(bpy, "Rider", 0.1))
     rider.parent, rider.location = carrier, (0.0, 0.5, 0.0)
     rider.relativity.tessellation = 0
+    keyed = _link(bpy, scene, "Keyed", _cube_mesh(bpy, "Keyed", 0.1))  # its own keys, Motion Static too
+    keyed.keyframe_insert("location", index=1, frame=0)
+    keyed.location.y = 2.0
+    keyed.keyframe_insert("location", index=1, frame=48)
+    scene.frame_set(scene.frame_current)
     scene.relativity.method = "GEOMETRY"
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     hints = [warning for warning in _warnings(scene) if "'Rider'" in warning]
     print(hints)
     assert len(hints) == 1 and "Motion" in hints[0] and "Static" in hints[0], _warnings(scene)
     assert "'Carrier'" in hints[0] and "\n" not in hints[0]
+    assert any("'Keyed'" in warning and "its keyframes" in warning for warning in _warnings(scene))
     rider.relativity.motion = "ANIMATION"
     bpy.context.view_layer.update()
     assert not any("'Rider'" in warning for warning in _warnings(scene)), _warnings(scene)
