@@ -157,15 +157,22 @@ def scene_errors(scene: Scene):
     """One-line errors of the last update of each object (empty when every cache is current), and
     the meshes left out for having nothing to draw."""
     errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
-    for obj in applied_objects(scene):
-        data = modifier.cache_data(obj)
-        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
-            errors.append(data[names.WARNING_KEY])
     for name in _skipped_empty.get(scene.name, ()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:
             errors.append(f"Mesh {name!r} has no vertices: nothing to draw, left out of the apparent geometry")
     return errors
+
+
+def update_warnings(scene: Scene):
+    """One-line warnings of the last update of each object that did not fail (what it drew that is
+    not the motion the user likely means: keys starting too late); they stop no render."""
+    warnings = []
+    for obj in applied_objects(scene):
+        data = modifier.cache_data(obj)
+        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
+            warnings.append(data[names.WARNING_KEY])
+    return warnings
 
 
 def _may_instance(obj: Object):

@@ -266,6 +266,7 @@ def _record(scene, snap):
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
     if snap.method == "GEOMETRY":
+        warnings += apparent_meshes.update_warnings(scene)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)
