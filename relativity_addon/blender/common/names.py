@@ -24,6 +24,7 @@ CACHE_PREFIX = "RelativityCache"  # cache mesh objects (not linked into any scen
 SIGNATURE_KEY = "relativity_signature"  # on the cache mesh: inputs of the last update
 ERROR_KEY = "relativity_error"  # on the cache mesh: why the last handler update failed
 DEPTH_KEY = "relativity_depth"  # on the cache mesh: farthest depth in the camera's view (scene units)
+WARNING_KEY = "relativity_warning"  # on the cache mesh: what the last update drew that is not the motion
 OWNER_KEY = "relativity_owner"  # on the cache mesh: the name of the object it serves
 BAKE_PREFIX = "RelativityBake"  # deformation bake meshes
 BAKE_KEY = "relativity_bake"  # on the cache mesh: name of the bake mesh and its time grid

@@ -6,7 +6,8 @@ so its output never feeds back), computes the apparent positions for the snapsho
 event with numpy (``world_lines.py``, ``physics/apparent.py``) and writes them, with each point's
 velocity relative to the observer, into the cache mesh. ``effect.sync`` calls :func:`update` at
 every frame change and whenever an input changed (observer velocity, c, camera or object
-transform, object settings): the result depends only on the scene state at the frame.
+transform, object settings, the evaluated rest shape): the result depends only on the scene state
+at the frame. Instancers of moving meshes are refused (:func:`check_instancing`).
 
 Frames: the scene frame is the observer's frame only when the observer velocity is zero. The mesh
 path renders in the camera's frame (axes parallel to world): an object at rest in the scene
@@ -19,6 +20,7 @@ the object's cache (:func:`scene_errors`) and the viewport keeps the last valid 
 from __future__ import annotations
 
 import math
+import zlib
 from typing import TYPE_CHECKING
 
 import bpy
@@ -31,7 +33,7 @@ from . import modifier, motion
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Iterable, Iterator
 
     import numpy.typing as npt
     from bpy.types import Depsgraph, Object, Scene
@@ -43,8 +45,21 @@ if TYPE_CHECKING:
 COARSE_EDGE_FRACTION = 0.25
 
 
+def rest_fingerprint(obj_eval: Object) -> tuple[int, int] | None:
+    """``(point count, CRC-32)`` of the tessellated rest positions on the evaluated mesh, or None:
+    an edit of the mesh or of a modifier (an Array's count or offset) changes it, which nothing
+    else in the signature sees. One read of the attribute, no mesh copy."""
+    attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
+    if attribute is None:
+        return None
+    values = np.empty(len(attribute.data) * 3, dtype=np.float32)
+    attribute.data.foreach_get("vector", values)
+    return len(attribute.data), zlib.crc32(values.data)
+
+
 def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None) -> str:
-    """Everything the object's apparent positions depend on, as a string stored with its cache."""
+    """Everything the object's apparent positions depend on, as a string stored with its cache
+    (the evaluated rest shape too, given the update's ``depsgraph``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     parts = [
@@ -65,6 +80,7 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
         relativity.use_deformation,
         relativity.use_proper_time,
         len(obj.data.vertices),
+        rest_fingerprint(evaluated) if depsgraph is not None else None,
     ]
     return repr(parts)
 
@@ -79,9 +95,10 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
     try:
-        world, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap)
+        world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))
     inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
@@ -90,6 +107,10 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
+    if warning is not None:
+        cache.data[names.WARNING_KEY] = warning
+    elif names.WARNING_KEY in cache.data:
+        del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
 
@@ -102,10 +123,12 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
     with busy.computing():
         for obj in applied_objects(scene):
             data = modifier.cache_data(obj)
+            # The signatures hold the evaluated rest shapes: without the handler's depsgraph, the
+            # scene's, evaluated now (update_object evaluates it again after its own edits).
             if (
                 only_changed
                 and data is not None
-                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, depsgraph)
+                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, _evaluated(depsgraph))
             ):
                 continue
             try:
@@ -116,8 +139,12 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
                 data = modifier.cache_data(obj)
                 if data is not None:
                     data[names.ERROR_KEY] = str(error)
-                    data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+                    data[names.SIGNATURE_KEY] = object_signature(snap, obj, _evaluated(depsgraph))
     return updated
+
+
+def _evaluated(depsgraph: Depsgraph | None) -> Depsgraph:
+    return depsgraph if depsgraph is not None else bpy.context.evaluated_depsgraph_get()
 
 
 def update_after_bake(scene: Scene, obj: Object) -> None:
@@ -142,17 +169,94 @@ def scene_errors(scene: Scene) -> list[str]:
     return errors
 
 
-def instanced_by_moving(depsgraph: Depsgraph, objects: Iterable[Object]) -> Object | None:
-    """The first of ``objects`` with its own velocity whose evaluated geometry draws instances or
-    other components (geometry nodes, particles, instancing) that the modifier does not move, or None."""
+def update_warnings(scene: Scene) -> list[str]:
+    """One-line warnings of the last update of each object that did not fail (what it drew that is
+    not the motion the user likely means: keys starting too late); they stop no render."""
+    warnings = []
+    for obj in applied_objects(scene):
+        data = modifier.cache_data(obj)
+        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
+            warnings.append(data[names.WARNING_KEY])
+    return warnings
+
+
+def _may_instance(obj: Object) -> bool:
+    """Whether ``obj`` can draw instances: a collection, vertex or face instancer, a particle
+    system, or geometry nodes of the user's (cheap: tells which scenes need the instance scan)."""
+    if obj.instance_type != "NONE" or len(getattr(obj, "particle_systems", ())):
+        return True
+    ours = modifier.find_modifier(obj)
+    return any(each.type == "NODES" and each != ours for each in obj.modifiers)
+
+
+def _instanced_by_settings(obj: Object) -> Iterator[Object]:
+    """The objects ``obj`` draws again by its settings: a collection instance's objects, its
+    particle systems' instance object or collection (whether or not they are in the scene)."""
+    if obj.instance_type == "COLLECTION" and obj.instance_collection is not None:
+        yield from obj.instance_collection.all_objects
+    for system in getattr(obj, "particle_systems", ()):
+        settings = system.settings
+        if settings.render_type == "OBJECT" and settings.instance_object is not None:
+            yield settings.instance_object
+        elif settings.render_type == "COLLECTION" and settings.instance_collection is not None:
+            yield from settings.instance_collection.all_objects
+
+
+def _drawn_elsewhere(instancer: Object, source: Object) -> str:
+    return (
+        f"{moving_objects.object_label(instancer)} draws {moving_objects.object_label(source)} (which has its own "
+        "velocity) away from where its apparent geometry is computed: make the instances real (Make Instances "
+        f"Real) or set the Motion of {source.name!r} to Static"
+    )
+
+
+def instancing_problem(
+    depsgraph: Depsgraph | None, objects: Iterable[Object], scene_objects: Iterable[Object]
+) -> str | None:
+    """Why the evaluated scene (``depsgraph``, evaluated if None and needed) cannot be drawn right
+    (one line), or None: one of the moving ``objects`` (those with their own velocity) draws
+    instances or other components the modifier does not move (geometry nodes, particles, vertex or
+    face instancing), or an instancer among ``scene_objects`` (a collection instance, a particle
+    system, geometry nodes) draws one of them elsewhere: the instance shows the apparent geometry
+    computed where the object itself is (or, for an object only instanced, none). Objects drawn by
+    a collection instance or a particle system are checked by their settings, in the scene or not."""
+    for instancer in scene_objects:
+        for source in _instanced_by_settings(instancer):
+            if moving_objects.has_own_velocity(source):
+                return _drawn_elsewhere(instancer, source)
     moving = {obj.name: obj for obj in objects if moving_objects.has_own_velocity(obj)}
-    if not moving:
+    if not moving or not any(_may_instance(obj) for obj in scene_objects):
         return None
+    if depsgraph is None:
+        with busy.computing():  # the update handlers this evaluation runs must not sync again
+            depsgraph = bpy.context.evaluated_depsgraph_get()
     for instance in depsgraph.object_instances:
         parent = instance.parent
-        if instance.is_instance and parent is not None and parent.original.name in moving:
-            return moving[parent.original.name]
+        if not instance.is_instance or parent is None:
+            continue
+        if parent.original.name in moving:
+            return (
+                f"Mesh {parent.original.name!r} draws instances or other geometry (geometry nodes, particles or "
+                "instancing) that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
+            )
+        if instance.object.original.name in moving:
+            return _drawn_elsewhere(parent.original, moving[instance.object.original.name])
     return None
+
+
+# Scene name -> the instancing problem found at its last sync that evaluated the scene.
+_instancing_problems = {}
+
+
+def check_instancing(scene: Scene, depsgraph: Depsgraph | None = None, evaluate: bool = True) -> None:
+    """RelativityError (one line) when an instancer draws a moving mesh or a moving mesh draws
+    instances (:func:`instancing_problem`), as found at Set Up or after an edit. ``evaluate=False``
+    (a sync without the frame's evaluated meshes) repeats what the last evaluating check found."""
+    if evaluate:
+        _instancing_problems[scene.name] = instancing_problem(depsgraph, applied_objects(scene), scene.objects)
+    problem = _instancing_problems.get(scene.name)
+    if problem is not None:
+        raise RelativityError(problem)
 
 
 def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None) -> list[Object]:
@@ -177,12 +281,10 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
         if obj.relativity.motion == "CONSTANT":
             snapshot.check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity")
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    instancer = instanced_by_moving(depsgraph, objects)
-    if instancer is not None:
-        raise RelativityError(
-            f"Mesh {instancer.name!r} draws instances or other geometry (geometry nodes, particles or instancing) "
-            "that cannot move on the Apparent Geometry path yet: make them real (Realize Instances)"
-        )
+    problem = instancing_problem(depsgraph, [*objects, *applied_objects(scene)], scene.objects)
+    if problem is not None:
+        raise RelativityError(problem)
+    _instancing_problems.pop(scene.name, None)
     empty = [obj for obj in objects if len(obj.evaluated_get(depsgraph).data.vertices) == 0]
     objects = [obj for obj in objects if obj not in empty]
     _skipped_empty[scene.name] = sorted({*_skipped_empty.get(scene.name, ()), *(obj.name for obj in empty)})
@@ -208,6 +310,7 @@ def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object
     if objects is None:
         _skipped_empty.pop(scene.name, None)
         orphans = orphan_caches()
+        _instancing_problems.pop(scene.name, None)
     objects = applied_objects(scene) if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
     for cache in orphans:

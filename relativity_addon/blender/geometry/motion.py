@@ -64,10 +64,17 @@ def to_world(matrix: FloatArray, points: FloatArray) -> FloatArray:
 
 
 def apparent_world_positions(
-    scene: Scene, obj: Object, obj_eval: Object, rest: FloatArray, snap: Snapshot, shape_keys_too: bool = True
-) -> tuple[FloatArray, FloatArray]:
+    scene: Scene,
+    obj: Object,
+    obj_eval: Object,
+    rest: FloatArray,
+    snap: Snapshot,
+    shape_keys_too: bool = True,
+    with_delay: bool = False,
+) -> tuple[FloatArray, ...]:
     """Apparent world positions ``(N, 3)`` of the rest points (object space) of ``obj`` and the
-    points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all).
+    points' velocities relative to the observer (``(N, 3)``, or ``(1, 3)`` shared by all); with
+    ``with_delay`` between them each point's light delay ``t_o - t_e`` (scene frame, seconds).
     ``shape_keys_too=False``: ``rest`` are not the mesh's points (its centre, say): rigid motion only."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
@@ -75,14 +82,14 @@ def apparent_world_positions(
     check_parent_motion(obj)
     motion = obj.relativity.motion
     if motion == "ANIMATION" and obj.relativity.use_deformation:
-        world, _, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
+        world, delay, beta_seen = deformed_apparent_positions(obj, len(rest), t_o, x_o, beta_o, c)
     elif motion == "ANIMATION":
-        world, _, beta_seen = animated_apparent_positions(
+        world, delay, beta_seen = animated_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too
         )
     elif motion == "CONSTANT" and plays_own_animation(obj, scene):
         beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
-        world, _, beta_seen = proper_time_apparent_positions(
+        world, delay, beta_seen = proper_time_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too
         )
     else:
@@ -94,9 +101,27 @@ def apparent_world_positions(
         contracted = apparent.lorentz_contraction_matrix(beta_u) @ matrix_now[:3, :3]
         # Built as coordinate rows (3, N), the layout the closed form works on: no copy there.
         world_now = (contracted @ rest.T + matrix_now[:3, 3:]).T
-        world, _, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
+        world, delay, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
         beta_seen = beta_seen[:1]  # one velocity for every vertex
-    return world, beta_seen
+    return (world, delay, beta_seen) if with_delay else (world, beta_seen)
+
+
+def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:
+    """A one-line warning when some point of a keyframed object (Motion Animation, no bake) is seen
+    as it was before its keyframes start moving it (``earliest_time``: its earliest retarded time,
+    seconds): Blender holds it still there, a motion the user rarely means. None otherwise."""
+    settings = obj.relativity
+    if settings.motion != "ANIMATION" or settings.use_deformation or modifier.motion_bake(obj) is not None:
+        return None
+    held_before = animation.held_before_frame(obj)
+    earliest = earliest_time * animation.frames_per_second(scene)
+    if held_before is None or earliest >= held_before - 1e-6:
+        return None
+    return (
+        f"Mesh {obj.name!r} is seen as it was at frame {earliest:.1f}, before its keyframes move it "
+        f"(from frame {held_before:g}): it is held still there; for this frame its keys must start by frame "
+        f"{np.floor(earliest):g}"
+    )
 
 
 def check_parent_motion(obj: Object) -> None:

@@ -30,7 +30,7 @@ from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
 from ..geometry import apparent_meshes, modifier, shape_keys
-from ..scene import animation, snapshot, traveller
+from ..scene import animation, moving_objects, snapshot, traveller
 from . import render_notice
 from .stages import STAGES, Sync
 
@@ -247,6 +247,8 @@ def sync(
             raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             exact_camera.write(scene, snap)
+        if method == "GEOMETRY":
+            apparent_meshes.check_instancing(scene, depsgraph, evaluate=update_geometry)
         if method == "GEOMETRY" and update_geometry:
             apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
@@ -343,6 +345,8 @@ def _record(scene, snap):
     warnings += apparent_meshes.scene_errors(scene)
     if snap.method == "GEOMETRY":
         warnings += apparent_meshes.clip_end_warnings(scene, snap)
+        warnings += apparent_meshes.update_warnings(scene)
+        warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)
     _scene_status[scene.name] = (snap, warnings)

@@ -173,6 +173,29 @@ def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
     return tuple(parts)
 
 
+def has_transform_keys(obj: Object) -> bool:
+    """Whether live keyframes of the object's own action move, turn or scale it."""
+    return bool(_transform_fcurves(obj))
+
+
+def held_before_frame(obj: Object) -> float | None:
+    """The frame before which the keyframes of the object and its object parents hold it still
+    (the earliest first key of the transform curves that move, all extrapolated as constant), or
+    None when a curve moves it before its first key (linear extrapolation, F-curve modifiers) or
+    nothing moves it."""
+    first = None
+    while obj is not None:
+        for fcurve in _transform_fcurves(obj).values():
+            if len(fcurve.modifiers) or fcurve.extrapolation != "CONSTANT":
+                return None
+            values = {round(point.co[1], 12) for point in fcurve.keyframe_points}
+            if len(values) > 1:
+                start = min(point.co[0] for point in fcurve.keyframe_points)
+                first = start if first is None else min(first, start)
+        obj = obj.parent
+    return first
+
+
 def has_own_animation(obj: Object, scene: Scene | None = None) -> bool:
     """Whether keyframes turn or scale the object (or an object parent): its own animation, which a
     CONSTANT object plays at its proper time (``world_lines``). Objects whose keyframes are not

@@ -5,8 +5,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ...errors import RelativityError
-from . import emitting_meshes
+from . import animation, emitting_meshes
 
 if TYPE_CHECKING:
     from bpy.types import Object, Scene
@@ -122,3 +124,37 @@ def check_object_velocities(scene: Scene, method: str) -> None:
             )
     if problems:
         raise RelativityError("; ".join(problems))
+
+
+# Frames of the scene's range (fractions of it) at which a Static mesh's keyframed place is compared.
+_RANGE_SAMPLES = (0.0, 0.25, 0.5, 0.75, 1.0)
+
+
+def static_but_keyframed(obj: Object, scene: Scene) -> str | None:
+    """A hint (one line) when a mesh on the Apparent Geometry path with Motion left at Static is
+    moved by keyframes, its own or an object parent's, over the scene's frame range: it is drawn at
+    rest where it is at each frame, with no light delay. None otherwise (also when constraints or
+    drivers move it: keyframes alone do not tell then)."""
+    if obj.type != "MESH" or not obj.relativity.enabled or obj.relativity.motion != "STATIC":
+        return None
+    chain = []
+    link: Object | None = obj
+    while link is not None:
+        chain.append(link)
+        link = link.parent
+    keyed = [link for link in chain if animation.has_transform_keys(link)]
+    if not keyed or animation.keyframe_motion_problem(obj, scene) is not None:
+        return None
+    start, end = scene.frame_start, max(scene.frame_end, scene.frame_start + 1)
+    frames = [start + fraction * (end - start) for fraction in _RANGE_SAMPLES] + [scene.frame_current]
+    try:
+        origins = animation.world_matrices(obj, frames)[:, :3, 3]
+    except RelativityError:
+        return None
+    if np.ptp(origins, axis=0).max() <= 1e-6 * (1.0 + np.abs(origins).max()):
+        return None
+    mover = "its keyframes" if keyed[0] is obj else f"the keyframes of its parent {keyed[0].name!r}"
+    return (
+        f"Mesh {obj.name!r} is moved by {mover} but its Motion is Static: it is drawn where it is, "
+        "without light delay; set its Motion to Animation"
+    )

@@ -57,7 +57,13 @@ class RELATIVITY_OT_setup_scene(Operator):
         if no_osl is not None and snap.method == "GEOMETRY":
             at_rest = ", moving lights at rest" if snap.moving_lights else ""
             self.report({"WARNING"}, f"{no_osl}: the final render is the boosted-mesh preview{at_rest}")
-        self.report({"INFO"}, f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}")
+        done = f"Relativistic render set up: {snap.speed:.4g} c, gamma {snap.gamma:.4g}"
+        warnings = effect.scene_warnings(scene)
+        if warnings:  # set up, but not everything renders right: say so now, not only in the panel
+            more = f" (and {len(warnings) - 1} more in the panel)" if len(warnings) > 1 else ""
+            self.report({"WARNING"}, f"{done}; {warnings[0]}{more}")
+        else:
+            self.report({"INFO"}, done)
         return {"FINISHED"}
 
 

@@ -244,7 +244,7 @@ def test_frame_above_c_fails_alone_with_its_reason(factory_blender, tmp_path, ru
     assert f"Dask scheduler {running_cluster}" in result.stdout
     errors = wh.error_lines(result)
     assert len(errors) == 1, result.stderr[-3000:]
-    assert errors[0].startswith("render.py: error: frame 3: camera 'Camera' moves at 1.2 c at frame 3"), errors
+    assert errors[0].startswith("render.py: error: frame 3: Camera 'Camera' moves at 1.2 c at frame 3"), errors
     assert "given up" not in errors[0]  # its own failure: not retried as a lost worker
     assert "Traceback" not in result.stderr + result.stdout
     assert "3 frames: 2 rendered, 0 skipped (already complete), 1 failed" in result.stdout
