@@ -201,23 +201,34 @@ def test_spectral_render_of_a_coloured_world(relativity_addon):
     assert d.max() / d.min() > 1.3
 
 
-def test_spectral_render_of_a_world_through_a_panorama(relativity_addon):
-    """An equirectangular camera's spectral passes weigh each pixel with its own direction's ``D``
-    (the panorama's, not a perspective view window's): ``D^5 S(lambda D)`` per pixel."""
+@pytest.mark.parametrize("panorama", ["EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT"])
+def test_spectral_render_of_a_world_through_a_panorama(relativity_addon, panorama):
+    """A panoramic camera's spectral passes weigh each pixel with its own direction's ``D`` (the
+    panorama's, not a perspective view window's): ``D^5 S(lambda D)`` per pixel, equirectangular and
+    fisheye (outside the fisheye's image circle: black)."""
     bpy = __import__("bpy")
-    width, height = 64, 32
+    width, height = (64, 32) if panorama == "EQUIRECTANGULAR" else (32, 32)
     scene, camera, _background = _world_scene(bpy, resolution=(width, height))
     camera.data.type = "PANO"
-    camera.data.panorama_type = "EQUIRECTANGULAR"
+    camera.data.panorama_type = panorama
+    camera.data.fisheye_fov = math.radians(240.0)
     beta = (0.3, 0.0, -0.6)
     _set_up(bpy, scene, beta)
     pixels, _info = dh.addon_module(relativity_addon, "pipeline.spectral_render").render(scene, 3)
     image = pixels[::-1, :, :3].astype(float)  # top row first
-    d = _doppler(_equirectangular_directions(width, height), beta)
     spectrum = dh.emitted_spectrum(COLOUR)
-    # ahead (the view axis is the image centre), to the side, behind (the left edge), up and down
-    patches = [(slice(14, 18), slice(30, 34)), (slice(14, 18), slice(46, 50)), (slice(14, 18), slice(1, 4))]
-    patches += [(slice(5, 8), slice(20, 24)), (slice(24, 27), slice(40, 44))]
+    if panorama == "EQUIRECTANGULAR":
+        d = _doppler(_equirectangular_directions(width, height), beta)
+        # ahead (the view axis is the image centre), to the side, behind (the left edge), up and down
+        patches = [(slice(14, 18), slice(30, 34)), (slice(14, 18), slice(46, 50)), (slice(14, 18), slice(1, 4))]
+        patches += [(slice(5, 8), slice(20, 24)), (slice(24, 27), slice(40, 44))]
+    else:
+        view, radius = _equidistant_directions(width, height, math.radians(240.0))
+        d = _doppler(view, beta)
+        assert np.abs(image[radius > 1.0 + 3.0 / width]).max() < 1e-6  # outside the image circle
+        # the centre (ahead), halfway out right and left, and near the rim (behind the side) above and below
+        patches = [(slice(14, 18), slice(14, 18)), (slice(14, 18), slice(22, 25)), (slice(14, 18), slice(7, 10))]
+        patches += [(slice(3, 5), slice(14, 18)), (slice(27, 29), slice(14, 18))]
     for rows, cols in patches:
         expected = np.mean([dh.observed_xyz(spectrum, value) for value in d[rows, cols].ravel()], axis=0)
         measured = dh.linear_rec709_to_xyz(image[rows, cols].reshape(-1, 3).mean(0))
