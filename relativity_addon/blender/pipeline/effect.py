@@ -122,6 +122,8 @@ def apply(
         result = apparent_meshes.apply(scene, snap, objects)
         undo = lambda: apparent_meshes.remove(scene, result)  # noqa: E731
     try:
+        if snap.method == "GEOMETRY":
+            apparent_meshes.check_instancing(scene, preview=_preview(scene, snap))
         for stage in STAGES:
             stage.apply(scene, snap)
     except RelativityError:
@@ -159,6 +161,14 @@ def final_render_problem(scene: Scene, snap: Snapshot) -> str | None:
     """Why an Apparent Geometry final render of ``snap`` is not made with the exact camera (one
     line), or None when it is (``exact_camera.final_render_problem``)."""
     return exact_camera.final_render_problem(scene, snap)
+
+
+def _preview(scene, snap):
+    """Where the boosted-mesh preview of a moving observer is seen: None (the meshes are not boosted),
+    "RENDER" (the final render is the preview too) or "VIEWPORT"."""
+    if not apparent_meshes.boosted(snap):
+        return None
+    return "RENDER" if final_render_problem(scene, snap) is not None else "VIEWPORT"
 
 
 def begin_final_render(scene: Scene) -> bool:
@@ -248,7 +258,7 @@ def sync(
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             exact_camera.write(scene, snap)
         if method == "GEOMETRY":
-            apparent_meshes.check_instancing(scene, depsgraph, evaluate=update_geometry)
+            apparent_meshes.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
         if method == "GEOMETRY" and update_geometry:
             apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
@@ -346,6 +356,7 @@ def _record(scene, snap):
     if snap.method == "GEOMETRY":
         warnings += apparent_meshes.clip_end_warnings(scene, snap)
         warnings += apparent_meshes.update_warnings(scene)
+        warnings += apparent_meshes.instancing_warnings(scene, snap)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)

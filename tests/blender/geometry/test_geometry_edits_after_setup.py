@@ -329,3 +329,70 @@ def test_instances_of_a_moving_mesh_are_refused(relativity_addon, factory_blende
     assert not gh.addon_module("pipeline.effect").is_applied(scene)
     mover.relativity.motion = "STATIC"  # the way out the message gives
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+
+
+# --- 7. instances of meshes at rest, seen by a moving observer ---------------------------------
+
+
+def _boxes_and_copy(bpy, scene):
+    """A box at rest in a collection, and below it to the right a collection instance of it."""
+    collection = bpy.data.collections.new("Boxes")
+    scene.collection.children.link(collection)
+    box = bpy.data.objects.new("Box", _cube_mesh(bpy, "Box", 0.5))
+    box.data.materials.append(gh.ch.emission_material(bpy))
+    collection.objects.link(box)
+    box.location = (0.0, 1.0, -6.0)
+    copy = _link(bpy, scene, "Copy", None)
+    copy.instance_type, copy.instance_collection = "COLLECTION", collection
+    copy.location = (1.5, -2.0, 0.0)
+    scene.relativity.method = "GEOMETRY"
+    scene.relativity.beta = (0.1, 0.0, -0.5)  # mostly ahead: the boxes stay in the picture
+    return copy
+
+
+def test_instances_of_meshes_at_rest_on_the_boosted_preview_are_refused_or_warned(
+    relativity_addon, factory_blender, tmp_path
+):
+    """A moving observer's boosted-mesh preview draws every mesh as seen from the moving camera, so
+    an instance elsewhere of a mesh at rest showed that mesh as seen where the mesh is (measured
+    before: 0.43 units off along the line of sight, silently). Final Render: Boosted Meshes refuses
+    it in one line naming the instancer and the mesh (at Set Up, and at sync when chosen after Set
+    Up); with the exact camera's final render the viewport's warning says so, and F12 renders the
+    instance where a real box at its place renders (measured on the two renders)."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy)
+    copy = _boxes_and_copy(bpy, scene)
+    scene.relativity.geometry_final_render = "PREVIEW"
+    bpy.context.view_layer.update()
+    before = gh.file_fingerprint(bpy)
+    with pytest.raises(RuntimeError) as raised:
+        bpy.ops.relativity.setup_scene()
+    message = str(raised.value).strip().removeprefix("Error: ").strip()
+    print(message)
+    assert repr(copy.name) in message and "'Box'" in message and "\n" not in message
+    assert "Final Render" in message
+    assert gh.file_fingerprint(bpy) == before
+    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+
+    scene.relativity.geometry_final_render = "EXACT"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    bpy.context.view_layer.update()
+    warnings = _warnings(scene)
+    assert any("'Copy'" in line and "'Box'" in line and "viewport" in line for line in warnings), warnings
+    instanced = gh.ch.render_exr(bpy, scene, tmp_path / "instanced.exr")
+
+    scene.relativity.geometry_final_render = "PREVIEW"  # chosen after Set Up: refused at the next sync
+    _refused_at_sync(bpy, scene, "Copy", "Box")
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+
+    bpy.data.objects.remove(copy)  # a real box where the instance drew one
+    real_box = _link(bpy, scene, "Real", _cube_mesh(bpy, "Real", 0.5))
+    real_box.data.materials.append(bpy.data.materials["Emitter"])
+    real_box.location = (1.5, -1.0, -6.0)
+    scene.relativity.geometry_final_render = "EXACT"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    real = gh.ch.render_exr(bpy, scene, tmp_path / "real.exr")
+    difference = np.abs(instanced - real)[..., :3]
+    print(f"instance against a real box: mean |difference| {difference.mean():.4f}, max {difference.max():.3f}")
+    assert real[..., :3].std() > 0.01  # the boxes are in the picture
+    assert difference.mean() < 0.01
