@@ -387,14 +387,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
 
 def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object]:
     """Remove the modifier, the caches and (if unused) the node group. Returns objects restored.
-    Without ``objects``, also the caches of objects deleted while set up."""
+    Without ``objects``, also the caches of objects deleted while set up and the effect of meshes
+    unlinked from every scene while set up."""
     orphans = []
     if objects is None:
         _skipped_empty.pop(scene.name, None)
         orphans = orphan_caches()
         _instancing_problems.pop(scene.name, None)
         _preview_problems.pop(scene.name, None)
-    objects = applied_objects(scene) if objects is None else objects
+    objects = [*applied_objects(scene), *unlinked_objects()] if objects is None else objects
     restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
     for cache in orphans:
         modifier.remove_cache(cache)
@@ -416,6 +417,20 @@ def unlink_caches() -> None:
         if obj.name.startswith(names.CACHE_PREFIX) and obj.library is None and modifier.is_cache(obj):
             for collection in obj.users_collection:
                 collection.objects.unlink(obj)
+
+
+def unlinked_objects() -> list[Object]:
+    """Meshes of this file carrying the modifier but in no scene (unlinked while set up): linked
+    back, they would draw a stale apparent geometry and set the scene up again."""
+    return [
+        obj
+        for obj in bpy.data.objects
+        if obj.type == "MESH"
+        and obj.library is None
+        and not obj.users_scene
+        and not modifier.is_cache(obj)
+        and modifier.find_modifier(obj) is not None
+    ]
 
 
 def orphan_caches() -> list[Object]:

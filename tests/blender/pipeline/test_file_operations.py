@@ -209,6 +209,26 @@ def test_delete_object_while_set_up(relativity_addon, factory_blender, method, d
 
 
 @pytest.mark.parametrize("method", METHODS)
+def test_object_unlinked_from_the_scene_while_set_up(relativity_addon, factory_blender, method):
+    """The moving cube (or a cube at rest) unlinked from the scene while set up, not deleted: it stays
+    in the file (Blender's Outliner > Unlink, or a collection taken out). Found: Remove looked at the
+    scene's objects only and left the modifier and its cache on the unlinked mesh, so linked back
+    it drew a stale apparent geometry. After Remove and linking it back, the file equals the file
+    before Set Up."""
+    bpy = factory_blender
+    scene = _build(bpy, method)
+    before = scene_dump.dump(bpy)
+    _set_up(bpy)
+    cube = bpy.data.objects["Cube"]
+    scene.collection.objects.unlink(cube)
+    bpy.context.view_layer.update()
+    _remove(bpy)
+    scene.collection.objects.link(cube)
+    bpy.context.view_layer.update()
+    _assert_same(before, scene_dump.dump(bpy))
+
+
+@pytest.mark.parametrize("method", METHODS)
 def test_undo_after_set_up_and_after_remove(relativity_addon, factory_blender, method):
     """Undo of Set Up gives the file back; Set Up, Remove, undo (set up again), Remove again too."""
     bpy = factory_blender
