@@ -330,9 +330,11 @@ def setup_notice(scene: Scene) -> str | None:
 
 
 def _refused(scene, error):
-    if applied_method(scene) is not None or snapshot.in_final_render(scene):  # a scene never set up: the panel only
-        print(f"Relativity: {error}")
-    _scene_status[scene.name] = (None, [str(error)])
+    status = (None, [str(error)])
+    repeated = _scene_status.get(scene.name) == status  # said at the last sync: once on the console
+    if (applied_method(scene) is not None or snapshot.in_final_render(scene)) and not repeated:
+        print(f"Relativity: {error}")  # a scene never set up: the panel only
+    _scene_status[scene.name] = status
 
 
 def _record(scene, snap):

@@ -179,7 +179,9 @@ def current_frame(scene: Scene) -> float:
 
 
 def check_velocity(beta: Iterable[float], what: str) -> tuple[float, ...]:
-    """``beta`` as a float tuple; RelativityError unless finite and below the speed of light."""
+    """``beta`` as a float tuple; RelativityError unless finite and below the speed of light (the
+    line starts with ``what``, capitalised: it is shown as it is)."""
+    what = what[:1].upper() + what[1:]
     beta = tuple(float(b) for b in beta)
     if not _finite(beta):
         raise RelativityError(f"{what} is not a finite vector")

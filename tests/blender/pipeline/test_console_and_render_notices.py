@@ -60,6 +60,24 @@ def test_a_set_up_scene_still_says_why_on_the_console(relativity_addon, factory_
     assert any("must be below 1" in line for line in _relativity_lines(capfd))
 
 
+def test_a_refusal_repeated_by_later_syncs_is_printed_once(relativity_addon, factory_blender, capfd):
+    """Every edit syncs again; the same refusal at each of them was printed each time (seven lines
+    for one instancing problem). Once per change of what is refused; a new reason is printed."""
+    bpy = factory_blender
+    scene, _, _ = wh.new_scene(bpy, samples=1)
+    scene.relativity.beta = (0.0, 0.0, -0.5)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    capfd.readouterr()
+    scene.relativity.beta = (0.0, 0.0, -1.2)
+    for frame in (2, 3, 4):  # later edits and frame changes, still faster than light
+        scene.frame_set(frame)
+        bpy.context.view_layer.update()
+    lines = _relativity_lines(capfd)
+    assert len([line for line in lines if "must be below 1" in line]) == 1, lines
+    scene.relativity.beta = (0.0, 0.0, -2.0)  # another value: said again
+    assert any("must be below 1" in line for line in _relativity_lines(capfd))
+
+
 def _set_up_then_faster_than_light(bpy):
     scene, _, _ = wh.new_scene(bpy, samples=1)
     scene.relativity.beta = (0.0, 0.0, -0.5)
