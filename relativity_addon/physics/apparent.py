@@ -186,7 +186,7 @@ def lorentz_contraction_matrix(beta: ArrayLike) -> FloatArray:
     return np.eye(3) - (1.0 - 1.0 / gamma) * np.outer(bhat, bhat)
 
 
-def _uniform_grid(times):
+def _uniform_grid(times: FloatArray) -> tuple[float, float, int]:
     """``(start, step, intervals)`` of increasing, uniformly spaced sample ``times``."""
     steps = np.diff(times)
     if np.any(steps <= 0.0) or np.ptp(steps) > 1e-9 * max(abs(times[-1]), abs(steps[0]), 1.0):
@@ -291,7 +291,7 @@ class SampledRigidMotion:
                 curvature += y2
                 curvature[:, beyond != 0.0] = 0.0
         velocities /= self.step
-        if with_acceleration:
+        if accelerations is not None:
             accelerations /= self.step * self.step
             return positions, velocities, accelerations
         return positions, velocities

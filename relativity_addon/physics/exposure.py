@@ -21,7 +21,7 @@ without it (and behind the Lorentz window) the ray is taken as the scene-frame d
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .arrays import FloatArray
+from .arrays import BoolArray, FloatArray
 from .validation import velocity_array
 
 
@@ -29,7 +29,7 @@ def pixel_directions(window: ArrayLike, size: tuple[int, int]) -> FloatArray:
     """Unit camera-frame directions ``(height, width, 3)`` through the pixel centres, rows bottom
     first (as Blender stores images); ``window`` is the image's ``(left, right, bottom, top)`` on
     the plane at unit distance in front of the camera."""
-    left, right, bottom, top = (float(v) for v in window)
+    left, right, bottom, top = (float(v) for v in np.asarray(window, dtype=np.float64).ravel())
     width, height = size
     x = left + (np.arange(width) + 0.5) / width * (right - left)
     y = bottom + (np.arange(height) + 0.5) / height * (top - bottom)
@@ -67,12 +67,12 @@ PANORAMAS = ("EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT", "FISHEYE_EQUISOLID", "MIR
 def panorama_directions(
     kind: str,
     size: tuple[int, int],
-    longitude=(-np.pi, np.pi),
-    latitude=(-np.pi / 2, np.pi / 2),
+    longitude: tuple[float, float] = (-np.pi, np.pi),
+    latitude: tuple[float, float] = (-np.pi / 2, np.pi / 2),
     fov: float = np.pi,
     lens: float = 10.5,
-    sensor=(36.0, 24.0),
-) -> tuple[FloatArray, np.ndarray]:
+    sensor: tuple[float, float] = (36.0, 24.0),
+) -> tuple[FloatArray, BoolArray]:
     """Unit camera-frame directions ``(height, width, 3)`` through the pixel centres of one of
     Blender's panoramas (rows bottom first, camera looking down -Z), as Cycles maps them and the
     exact camera's shader writes them out; and the mask of pixels inside the image (a fisheye's or

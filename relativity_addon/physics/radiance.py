@@ -10,7 +10,7 @@ from .arrays import ArrayLike, FloatArray, Spectrum
 from .validation import finite_array, positive_array
 
 
-def _doppler(doppler):
+def _doppler(doppler: ArrayLike) -> FloatArray:
     return positive_array(doppler, "doppler")
 
 
@@ -49,7 +49,8 @@ def transform_spectral_radiance(
     wavelength = positive_array(wavelength, "wavelength")
     doppler = _doppler(doppler)
     emitted = finite_array(emitted_spectral_radiance(wavelength * doppler), "emitted spectral radiance")
-    return doppler**5 * emitted
+    result: FloatArray = doppler**5 * emitted
+    return result
 
 
 def point_light_irradiance(
@@ -62,10 +63,11 @@ def point_light_irradiance(
     incidence cosine and distance measured in the surface's frame at the retarded time. Light
     arriving from behind the surface (cos < 0) gives zero.
     """
-    intensity = finite_array(intensity, "intensity")
-    cos_incidence = finite_array(cos_incidence, "cos_incidence")
-    distance = positive_array(distance, "distance")
-    return _doppler(doppler) ** 4 * np.maximum(cos_incidence, 0.0) / distance**2 * intensity
+    i = finite_array(intensity, "intensity")
+    cosine = finite_array(cos_incidence, "cos_incidence")
+    r = positive_array(distance, "distance")
+    result: FloatArray = _doppler(doppler) ** 4 * np.maximum(cosine, 0.0) / r**2 * i
+    return result
 
 
 def spectral_point_light_irradiance(
@@ -79,6 +81,7 @@ def spectral_point_light_irradiance(
     wavelength = positive_array(wavelength, "wavelength")
     doppler = _doppler(doppler)
     emitted = finite_array(emitted_spectral_intensity(wavelength * doppler), "emitted spectral intensity")
-    cos_incidence = finite_array(cos_incidence, "cos_incidence")
-    distance = positive_array(distance, "distance")
-    return doppler**5 * emitted * np.maximum(cos_incidence, 0.0) / distance**2
+    cosine = finite_array(cos_incidence, "cos_incidence")
+    r = positive_array(distance, "distance")
+    result: FloatArray = doppler**5 * emitted * np.maximum(cosine, 0.0) / r**2
+    return result

@@ -82,7 +82,7 @@ _WAVELENGTH_STEP_NM = 1.0
 _REC709 = colour.RGB_COLOURSPACES["ITU-R BT.709"]
 
 
-def _validated_positive(values, name: str) -> np.ndarray:
+def _validated_positive(values: ArrayLike, name: str) -> FloatArray:
     """``values`` as a float64 array; ``ValueError`` unless every entry is finite and > 0."""
 
     array = np.asarray(values, dtype=np.float64)
@@ -93,7 +93,7 @@ def _validated_positive(values, name: str) -> np.ndarray:
     return array
 
 
-def _validated_finite(values, name: str) -> np.ndarray:
+def _validated_finite(values: ArrayLike, name: str) -> FloatArray:
     array = np.asarray(values, dtype=np.float64)
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be finite (got NaN or inf): {values!r}")
@@ -101,7 +101,7 @@ def _validated_finite(values, name: str) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=None)
-def _cmfs_visible() -> np.ndarray:
+def _cmfs_visible() -> FloatArray:
     """CIE 1931 2 degree CMFs on :data:`WAVELENGTHS_VISIBLE_NM`, shape (W, 3), read-only."""
 
     cmfs = colour.MSDS_CMFS[CMFS_NAME]
@@ -145,7 +145,7 @@ def linear_rec709_to_XYZ(RGB: ArrayLike) -> FloatArray:
 
 
 @functools.lru_cache(maxsize=None)
-def _rec709_luminance_weights() -> np.ndarray:
+def _rec709_luminance_weights() -> FloatArray:
     """Row Y of the Rec.709 RGB -> XYZ matrix (about 0.2126, 0.7152, 0.0722)."""
 
     weights = np.array(_REC709.matrix_RGB_to_XYZ[1], dtype=np.float64)
@@ -191,7 +191,7 @@ def gamut_map_linear_rec709(RGB: ArrayLike) -> FloatArray:
 # --- Blackbody ----------------------------------------------------------------------------------
 
 
-def _planck_outer(wavelength_nm, temperature_K) -> np.ndarray:
+def _planck_outer(wavelength_nm: ArrayLike, temperature_K: ArrayLike) -> FloatArray:
     """:func:`colour.colorimetry.planck_law` as an outer product, shape (W, N), W/(sr m^2 m).
 
     planck_law evaluates every wavelength at every temperature (flattening both); this keeps that
@@ -236,9 +236,9 @@ def doppler_shifted_spectral_radiance(
     wavelength in nm, in the emitter's rest frame; ``wavelength_nm`` and ``doppler_factor`` broadcast.
     """
 
-    doppler_factor = _validated_positive(doppler_factor, "doppler_factor")
-    wavelength_nm = _validated_positive(wavelength_nm, "wavelength_nm")
-    return doppler_factor**5 * emitted_spectral_radiance(wavelength_nm * doppler_factor)
+    doppler = _validated_positive(doppler_factor, "doppler_factor")
+    wavelength = _validated_positive(wavelength_nm, "wavelength_nm")
+    return doppler**5 * np.asarray(emitted_spectral_radiance(wavelength * doppler), dtype=np.float64)
 
 
 def blackbody_XYZ(temperature_K: ArrayLike) -> FloatArray:
@@ -302,7 +302,7 @@ def blackbody_luminance_ratio(temperature_K: ArrayLike, doppler_factor: ArrayLik
         return np.exp(_log_blackbody_luminance(observed) - log_emitted)
 
 
-def _log_blackbody_luminance(temperature_K) -> np.ndarray:
+def _log_blackbody_luminance(temperature_K: ArrayLike) -> FloatArray:
     """``ln Y(T)`` computed in log space (finite even where ``Y`` underflows, e.g. T of a few K)."""
 
     temperature_K = np.asarray(temperature_K, dtype=np.float64)
@@ -323,7 +323,7 @@ def _log_blackbody_luminance(temperature_K) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=None)
-def _basis_table():
+def _basis_table() -> tuple[FloatArray, FloatArray]:
     basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
     return np.array(basis.wavelengths, dtype=np.float64), np.array(basis.values, dtype=np.float64)
 
@@ -383,7 +383,7 @@ def illuminant_white(wavelength_nm: ArrayLike) -> FloatArray:
     return radiance / _planck_outer(560.0, WHITE_TEMPERATURE_K)[0, 0]
 
 
-def _unnormalised_doppler_rgb_matrix(doppler_factor: np.ndarray) -> np.ndarray:
+def _unnormalised_doppler_rgb_matrix(doppler_factor: FloatArray) -> FloatArray:
     """``A(D)``: column ``i`` is the linear Rec.709 RGB seen at ``D`` of basis ``i`` in white light.
 
     ``A(D)_{:, i} = RGB(integral xyzbar(lambda) D^5 E(lambda D) basis_i(lambda D) dlambda)``
@@ -398,7 +398,7 @@ def _unnormalised_doppler_rgb_matrix(doppler_factor: np.ndarray) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=None)
-def _inverse_rest_frame_matrix() -> np.ndarray:
+def _inverse_rest_frame_matrix() -> FloatArray:
     inverse = np.linalg.inv(_unnormalised_doppler_rgb_matrix(np.array(1.0)))
     inverse.setflags(write=False)
     return inverse
