@@ -111,3 +111,10 @@ VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-r
 VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material
 VOLUME_COLOUR_GROUP = "Relativity Spectral Volume Colour"  # shader group: a volume colour, spectral in the passes
 VOLUME_COLOUR_NODE_PREFIX = "Relativity Spectral Volume"  # its nodes in front of volume colour inputs
+
+# --- Bake for Render Anywhere (pipeline/bake.py) -------------------------------------------------
+BAKE_RECORD_KEY = "relativity_render_anywhere"  # on the scene: the baked frames, F-curves, actions, sequences
+BAKE_ACTION_PREFIX = "Relativity Bake"  # actions the bake made for datablocks that had none
+BAKE_IMAGE_SUFFIX = " (baked)"  # the image sequence standing for a per-frame image
+BAKE_SCRATCH_IMAGE = "Relativity Bake Scratch"  # writes the sequence's files, removed at once
+BAKE_FOLDER_SUFFIX = "_relativity_bake"  # the folder beside the .blend holding the sequences

@@ -31,7 +31,7 @@ from ..colour import doppler_colour
 from ..common import busy, compat, names
 from ..geometry import apparent_meshes, modifier, shape_keys
 from ..scene import animation, moving_objects, snapshot, traveller
-from . import render_notice
+from . import bake, render_notice
 from .stages import STAGES, Sync
 
 if TYPE_CHECKING:
@@ -143,8 +143,9 @@ def _remove_stages(scene):
 
 def remove(scene: Scene) -> int:
     """Remove everything the add-on added (every relativistic camera, the apparent geometry, the
-    colour stage); the settings stay, they are the user's. Returns the number of things removed."""
-    removed = len(apparent_meshes.remove(scene))
+    colour stage, a bake for rendering anywhere); the settings stay, they are the user's. Returns
+    the number of things removed."""
+    removed = bool(bake.unbake(scene)) + len(apparent_meshes.remove(scene))
     for camera_data in exact_camera.applied_camera_data():
         removed += bool(exact_camera.remove_data(camera_data))
     _remove_stages(scene)
@@ -152,6 +153,24 @@ def remove(scene: Scene) -> int:
     _scene_status.pop(scene.name, None)
     _setup_notices.pop(scene.name, None)
     return removed
+
+
+def bake_for_render_anywhere(scene: Scene, first: int, last: int) -> dict[str, int]:
+    """Bake frames ``first`` .. ``last`` of the set-up scene into keyframes and image sequences
+    that render without the add-on (``bake.py``). RelativityError (one line) where that cannot
+    be done: nothing set up, Apparent Geometry, no OSL in this Blender, a frame refused."""
+    method = applied_method(scene)
+    if method is None:
+        raise RelativityError("Nothing to bake: press Set Up Relativistic Render first")
+    problem = bake.refusal(scene, method)
+    if problem is not None:
+        raise RelativityError(problem)
+    snap = snapshot.read(scene)
+    if snap.velocity_source == "CAMERA_ANIMATION":
+        snapshot.check_animation_speed(scene, first, last)
+    counts = bake.bake(scene, first, last, lambda: sync(scene, before_render=True))
+    _record(scene, snapshot.read(scene))
+    return counts
 
 
 # --- the Apparent Geometry final render -------------------------------------------------------

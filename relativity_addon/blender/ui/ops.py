@@ -6,6 +6,7 @@ and report a ``RelativityError`` in one line instead of leaving a half-applied s
 
 from typing import TYPE_CHECKING
 
+from bpy.props import IntProperty
 from bpy.types import Context, Operator
 
 from ...errors import RelativityError
@@ -166,9 +167,48 @@ class RELATIVITY_OT_render_spectral(Operator):
         return {"FINISHED"}
 
 
+class RELATIVITY_OT_bake_render_anywhere(Operator):
+    """Write what the add-on computes per frame into keyframes and image sequences, so that the
+    file renders these frames without the add-on (plain Blender, scripts disabled)"""
+
+    bl_idname = "relativity.bake_render_anywhere"
+    bl_label = "Bake for Render Anywhere"
+    bl_options = {"REGISTER", "UNDO"}
+
+    frame_start: IntProperty(name="First Frame", default=-1, description="-1: the scene's first frame")
+    frame_end: IntProperty(name="Last Frame", default=-1, description="-1: the scene's last frame")
+
+    @classmethod
+    def poll(cls, context: Context) -> bool:
+        if not _poll_scene(cls, context):
+            return False
+        if effect.applied_method(context.scene) is None:
+            cls.poll_message_set("Set up the relativistic render first")
+            return False
+        return True
+
+    def execute(self, context: Context) -> "set[OperatorReturnItems]":
+        scene = context.scene
+        first = scene.frame_start if self.frame_start < 0 else self.frame_start
+        last = scene.frame_end if self.frame_end < 0 else self.frame_end
+        try:
+            counts = effect.bake_for_render_anywhere(scene, first, last)
+        except RelativityError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        images = f", {counts['sequences']} image sequence(s) beside the file" if counts["sequences"] else ""
+        self.report(
+            {"INFO"},
+            f"Baked frames {first}-{last}: {counts['fcurves']} animated values{images}; "
+            "the file renders them without the add-on",
+        )
+        return {"FINISHED"}
+
+
 classes = (
     RELATIVITY_OT_setup_scene,
     RELATIVITY_OT_remove_all,
+    RELATIVITY_OT_bake_render_anywhere,
     RELATIVITY_OT_check_animation,
     RELATIVITY_OT_render_spectral,
 )

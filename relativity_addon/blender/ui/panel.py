@@ -10,7 +10,7 @@ import textwrap
 from bpy.types import Context, Panel
 
 from ..common import osl
-from ..pipeline import effect, render_notice
+from ..pipeline import bake, effect, render_notice
 
 CHARACTER_WIDTH = 7.0  # pixels per character of the sidebar's text at UI scale 1 (a mean)
 LABEL_MARGIN = 60.0  # pixels of a label row not given to its text (icon, padding, scroll bar)
@@ -85,6 +85,10 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
         column = layout.column(align=True)
         column.operator("relativity.setup_scene", icon="PLAY")
         column.operator("relativity.remove_all", icon="X")
+        baked = bake.baked_frames(scene)
+        if baked is not None:
+            layout.label(text=f"Baked frames {baked[0]}-{baked[1]}: bake again after changes", icon="INFO")
+        layout.operator("relativity.bake_render_anywhere", icon="RENDER_ANIMATION")
 
 
 class RELATIVITY_PT_observer(_RelativityPanel, Panel):

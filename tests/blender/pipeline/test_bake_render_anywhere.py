@@ -1,0 +1,182 @@
+"""Bake for Render Anywhere (issue 28, part 2): a baked file renders the add-on's frames without it.
+
+A fly-through on the exact camera: the camera accelerates along its view to 0.9c (keyframed, the
+observer velocity taken from its animation, so the shader's velocity, origin and the world's ln D
+image change every frame), a keyframed box crosses the view and a lamp moves at 0.3c (stand-in
+lamps on its path, placed anew each frame). The add-on renders frames 1-3 itself; then the file is
+baked, saved, and rendered as an animation in a fresh process where the add-on is neither enabled
+nor installed, colour-science is missing and the file's scripts are disabled (what
+``blender -b baked.blend -a`` does on a farm). Each frame must equal the add-on's own render (same
+seed) to well below the render noise, measured as the difference the seed alone makes.
+"""
+
+import importlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from blender_support import ADDON_MODULE
+from pipeline_helpers import ch
+
+FRAMES = (1, 2, 3)
+FPS = 24.0
+C = 10.0  # m/s: slow light, so 0.9c is reached within a few metres
+
+
+def _effect():
+    return importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+
+
+def _quad(bpy, scene, name, corners, material):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(corners, [], [(0, 1, 2, 3)])
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def build_flythrough(bpy):
+    """Camera at 1.6 m looking along +Y, speeds 0.6c, 0.75c, 0.9c over the frame steps (linear keys:
+    velocity per step known exactly), a floor, a wall ahead, a keyframed box, a lamp moving at 0.3c
+    along +X, a grey world (seen above the wall)."""
+    scene, camera = ch.new_scene(bpy, resolution=(48, 36), samples=8, location=(0.0, 0.0, 1.6))
+    camera.rotation_euler = (1.5707963, 0.0, 0.0)
+    camera.data.lens = 20.0
+    scene.render.fps, scene.render.fps_base = int(FPS), 1.0
+    scene.cycles.seed = 7
+    scene.cycles.use_animated_seed = False
+    world_tree = ch.compat.world_node_tree(scene.world)
+    background = next(node for node in world_tree.nodes if node.type == "BACKGROUND")
+    background.inputs["Color"].default_value = (0.2, 0.25, 0.3, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    grey = ch.diffuse_material(bpy, "Floor", (0.5, 0.5, 0.5))
+    _quad(bpy, scene, "Floor", [(-20, -5, 0), (20, -5, 0), (20, 40, 0), (-20, 40, 0)], grey)
+    _quad(bpy, scene, "Wall", [(-20, 14, 0), (20, 14, 0), (20, 14, 3), (-20, 14, 3)], grey)
+    red = ch.diffuse_material(bpy, "Red", (0.8, 0.1, 0.1))
+    box = _quad(bpy, scene, "Box", [(-0.6, 0, 0), (0.6, 0, 0), (0.6, 0, 1.2), (-0.6, 0, 1.2)], red)
+    for frame, x in ((1, 2.0), (3, -1.0)):
+        box.location = (x, 8.0, 0.3)
+        box.keyframe_insert("location", frame=frame)
+    light = bpy.data.lights.new("Lamp", "POINT")
+    light.energy = 800.0
+    lamp = bpy.data.objects.new("Lamp", light)
+    lamp.location = (-1.0, 6.0, 2.5)
+    scene.collection.objects.link(lamp)
+    lamp.relativity.enabled = True
+    lamp.relativity.motion = "CONSTANT"
+    lamp.relativity.beta = (0.3, 0.0, 0.0)
+    step = C / FPS
+    y = 0.0
+    path = [(1, (0.0, 0.0, 1.6))]
+    for frame, speed in ((2, 0.6), (3, 0.75), (4, 0.9)):
+        y += speed * step
+        path.append((frame, (0.0, y, 1.6)))
+    for frame, position in path:
+        camera.location = position
+        camera.keyframe_insert("location", frame=frame)
+    for fcurve in ch.compat.action_fcurves(camera.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    settings = scene.relativity
+    settings.speed_of_light = C
+    settings.velocity_source = "CAMERA_ANIMATION"
+    settings.method = "CAMERA"
+    scene.frame_start, scene.frame_end = FRAMES[0], FRAMES[-1]
+    scene.frame_set(FRAMES[0])
+    return scene
+
+
+def render_plain_animation(blend, out_dir, name="plain"):
+    """``blender -b blend -a`` in a fresh process: no add-on, no colour-science, scripts disabled."""
+    worker = (
+        "import os, sys\n"
+        "sys.modules['colour'] = None\n"
+        "import bpy\n"
+        "bpy.context.preferences.filepaths.use_scripts_auto_execute = False\n"
+        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, use_scripts=False)\n"
+        "scene = bpy.context.scene\n"
+        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
+        "assert not bpy.app.handlers.frame_change_pre and not bpy.app.handlers.render_pre, 'handlers installed'\n"
+        f"scene.render.filepath = {str(out_dir / (name + '_####'))!r}\n"
+        "scene.render.use_file_extension = True\n"
+        "scene.render.image_settings.file_format = 'OPEN_EXR'\n"
+        "scene.render.image_settings.color_depth = '32'\n"
+        "bpy.ops.render.render(animation=True)\n"
+        "sys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"  # bpy 4.5 can hang in exit()
+    )
+    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return [out_dir / f"{name}_{frame:04d}.exr" for frame in FRAMES]
+
+
+def test_baked_flythrough_renders_the_same_frames_without_the_add_on(relativity_addon, factory_blender, tmp_path):
+    bpy = factory_blender
+    scene = build_flythrough(bpy)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    own = []
+    for frame in FRAMES:
+        scene.frame_set(frame)
+        own.append(ch.render_exr(bpy, scene, tmp_path / f"own_{frame}.exr"))
+    scene.cycles.seed = 8  # the render noise: the same frame with another seed
+    noise = float(np.abs(ch.render_exr(bpy, scene, tmp_path / "own_seed8.exr") - own[-1]).mean())
+    scene.cycles.seed = 7
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "unbaked.blend"), check_existing=False, copy=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
+    assert bpy.ops.relativity.bake_render_anywhere(frame_start=FRAMES[0], frame_end=FRAMES[-1]) == {"FINISHED"}
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
+    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path)]
+    differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
+    # the control: the same file not baked, rendered the same way, plays frame 3's state only
+    unbaked = [ch.read_exr(bpy, p) for p in render_plain_animation(tmp_path / "unbaked.blend", tmp_path, "unbaked")]
+    stale = [float(np.abs(u - o).mean()) for u, o in zip(unbaked, own, strict=True)]
+    moving = float(np.abs(own[-1] - own[0]).mean())
+    print(
+        f"mean |baked - add-on| per frame {differences}, not baked {stale}, seed noise {noise:.4g}, "
+        f"frame 3 - frame 1 {moving:.4g}"
+    )
+    assert moving > 2.0 * noise, "the frames differ (the fly-through moves)"
+    assert stale[0] > noise, "without the bake the first frame is wrong (the control)"
+    assert max(differences) < 0.1 * noise, f"baked frames differ from the add-on's: {differences} (noise {noise:.4g})"
+
+
+def test_remove_takes_the_bake_out(relativity_addon, factory_blender, tmp_path):
+    """Remove after a bake: no F-curve, action, image or file of the bake is left, the user's keys stay."""
+    bpy = factory_blender
+    scene = build_flythrough(bpy)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "fly.blend"), check_existing=False)
+    actions = sorted(action.name for action in bpy.data.actions)
+    images = sorted(image.name for image in bpy.data.images)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert bpy.ops.relativity.bake_render_anywhere() == {"FINISHED"}
+    camera_data = scene.camera.data
+    assert camera_data.animation_data is not None and camera_data.animation_data.action is not None
+    assert any((tmp_path / "fly_relativity_bake").iterdir())
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted(action.name for action in bpy.data.actions) == actions
+    assert sorted(image.name for image in bpy.data.images) == images
+    assert camera_data.animation_data is None
+    assert not (tmp_path / "fly_relativity_bake").exists()
+    assert len(ch.compat.action_fcurves(scene.objects["Box"].animation_data)) == 3
+
+
+@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
+def test_bake_refused_with_the_reason(relativity_addon, factory_blender, monkeypatch, method):
+    """No OSL in this Blender: the exact camera cannot be baked (it is an OSL shader); Apparent
+    Geometry is refused as not baked yet. One line, nothing added."""
+    bpy = factory_blender
+    scene = build_flythrough(bpy)
+    effect = _effect()
+    osl = importlib.import_module(f"{ADDON_MODULE}.blender.common.osl")
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    if method == "CAMERA":
+        monkeypatch.setattr(osl, "unavailable_reason", lambda: "This Blender build has no OSL (Open Shading Language)")
+        expected = "OSL"
+    else:
+        monkeypatch.setattr(effect, "applied_method", lambda _scene: "GEOMETRY")
+        expected = "Apparent Geometry"
+    with pytest.raises(effect.RelativityError, match=expected):
+        effect.bake_for_render_anywhere(scene, 1, 3)
+    assert "relativity_render_anywhere" not in scene.keys()
