@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import BatchError, RelativityError
 from ..physics.shutter import ShutterModel
+from . import bake_to
 from .frame_files import format_seconds, frame_output_path, output_problem, partial_path
 
 if TYPE_CHECKING:
@@ -99,7 +100,13 @@ def build_parser(with_blend_file: bool) -> argparse.ArgumentParser:
     )
     parser.add_argument("--samples", type=_positive_int)
     parser.add_argument("--resolution", type=_resolution, help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--out", required=True, help="output image: .png, or .exr for linear float")
+    parser.add_argument("--out", help="output image: .png, or .exr for linear float (required unless --bake-to)")
+    parser.add_argument(
+        "--bake-to",
+        metavar="BAKED.blend",
+        help="render nothing: set up, bake --frames (default: the scene's range) and save as BAKED.blend, "
+        "which plain Blender renders without the add-on (blender -b BAKED.blend -a); exact camera only",
+    )
     parser.add_argument("--no-doppler", action="store_true")
     parser.add_argument("--no-searchlight", action="store_true")
     parser.add_argument("--no-geometry", action="store_true", help="no aberration (testing aid)")
@@ -403,7 +410,9 @@ def parse(argv: Sequence[str]) -> tuple[argparse.Namespace, argparse.ArgumentPar
     """(options, parser) for the command line ``argv`` (either invocation form)."""
     arguments, with_blend_file = _split_argv(argv)
     parser = build_parser(with_blend_file)
-    return parser.parse_args(arguments), parser
+    options = parser.parse_args(arguments)
+    bake_to.check_options(options, parser)
+    return options, parser
 
 
 def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
@@ -413,7 +422,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
 
     options, _ = parse(argv)
     with_blend_file = not _running_inside_blender(argv)
-    out_path = os.path.abspath(options.out)
+    out_path = os.path.abspath(options.out or options.bake_to)  # check_options: one of them
 
     if with_blend_file:
         if not os.path.isfile(options.blend_file):
@@ -426,7 +435,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     effect = addon_module("pipeline.effect")
 
     scene = bpy.context.scene
-    frames = _frames(scene, options)
+    frames = bake_to.frames(scene, options) or _frames(scene, options)
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     if options.samples is not None:
@@ -439,7 +448,8 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     if options.threads is not None:
         scene.render.threads_mode = "FIXED"
         scene.render.threads = options.threads
-    _output_format(scene, out_path)
+    if options.bake_to is None:
+        _output_format(scene, out_path)
     if options.stereo:
         if options.spectral:
             raise BatchError("--stereo and --spectral cannot be combined")
@@ -470,6 +480,8 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
             effect.apply(scene, frame_range=(scene_frames[0], scene_frames[-1]))
     except (RelativityError, effect.RelativityError) as error:
         raise BatchError(str(error)) from None
+    if options.bake_to is not None:
+        return [bake_to.bake(bpy, scene, effect, options.bake_to, frames, log)]
 
     several = len(frames) > 1
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
@@ -525,7 +537,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
     try:
         options, parser = parse(argv)
-        problem = output_problem(options.out)
+        problem = output_problem(options.out) if options.out is not None else None
         if problem is not None:  # before loading or rendering anything
             raise BatchError(problem)
         if options.workers is not None or options.scheduler is not None:

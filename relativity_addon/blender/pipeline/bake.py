@@ -225,18 +225,24 @@ def _write_sequence(scene, image, frames, pixels):
     stem = bpy.path.clean_name(image.name)
     width, height = image.size
     scratch = bpy.data.images.new(names.BAKE_SCRATCH_IMAGE, width, height, alpha=True, float_buffer=True)
+    scratch.colorspace_settings.is_data = True  # written as computed
+    settings = scene.render.image_settings
+    media = ("media_type",) if hasattr(settings, "media_type") else ()  # 5.x: image, multilayer or video
+    kept = (*media, "file_format", "color_depth", "color_mode")
+    saved = [getattr(settings, name) for name in kept]
     files = []
     try:
-        scratch.file_format = "OPEN_EXR"
-        scratch.use_half_precision = False
-        scratch.colorspace_settings.is_data = True  # written as computed (linear would be display-encoded)
+        # save_render in 32-bit OpenEXR: Image.save writes 8 bits (values clamped to 1) in 5.2
+        for name, value in zip(kept, ("IMAGE",) * len(media) + ("OPEN_EXR", "32", "RGBA"), strict=True):
+            setattr(settings, name, value)
         for frame, frame_pixels in zip(frames, pixels, strict=True):
             path = os.path.join(absolute, f"{stem}_{frame:04d}.exr")
             scratch.pixels.foreach_set(frame_pixels)
-            scratch.filepath_raw = path
-            scratch.save()
+            scratch.save_render(path, scene=scene)
             files.append(path)
     finally:
+        for name, value in zip(kept, saved, strict=True):
+            setattr(settings, name, value)
         bpy.data.images.remove(scratch)
     sequence = bpy.data.images.load(files[0])
     sequence.name = f"{image.name}{names.BAKE_IMAGE_SUFFIX}"
@@ -383,7 +389,7 @@ def unbake(scene: Scene) -> int:
 
 
 def _users_of(action):
-    for collection, _name, _embedded, block in _owners():
+    for _collection, _name, _embedded, block in _owners():
         animation = getattr(block, "animation_data", None)
         if animation is not None and animation.action == action:
             yield block
