@@ -151,7 +151,7 @@ def record_frame() -> dict[Key, Any]:
     return values
 
 
-def _image_pixels(image) -> np.ndarray | None:
+def _image_pixels(image):
     if image.source not in ("GENERATED", "FILE") or (image.source == "FILE" and not image.packed_file):
         return None
     pixels = np.empty(len(image.pixels), dtype=np.float32)
@@ -175,7 +175,7 @@ def _owner(collection, name, embedded):
     return getattr(block, embedded, None)
 
 
-def _animated_paths(block) -> set[tuple[str, int]]:
+def _animated_paths(block):
     animation = block.animation_data
     if animation is None:
         return set()

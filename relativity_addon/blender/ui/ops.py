@@ -175,8 +175,12 @@ class RELATIVITY_OT_bake_render_anywhere(Operator):
     bl_label = "Bake for Render Anywhere"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: IntProperty(name="First Frame", default=-1, description="-1: the scene's first frame")
-    frame_end: IntProperty(name="Last Frame", default=-1, description="-1: the scene's last frame")
+    frame_start: IntProperty(  # type: ignore[valid-type]
+        name="First Frame", default=-1, description="-1: the scene's first frame"
+    )
+    frame_end: IntProperty(  # type: ignore[valid-type]
+        name="Last Frame", default=-1, description="-1: the scene's last frame"
+    )
 
     @classmethod
     def poll(cls, context: Context) -> bool:
