@@ -203,8 +203,8 @@ class RELATIVITY_OT_bake_render_anywhere(Operator):
         images = f", {counts['sequences']} image sequence(s) beside the file" if counts["sequences"] else ""
         self.report(
             {"INFO"},
-            f"Baked frames {first}-{last}: {counts['fcurves']} animated values{images}; "
-            "the file renders them without the add-on",
+            f"Baked frames {first}-{last}: {counts['fcurves']} animated values{images}; the file renders "
+            "them without the add-on, in a Blender with OSL (Cycles on the CPU: the exact camera is an OSL shader)",
         )
         return {"FINISHED"}
 
