@@ -306,6 +306,14 @@ def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], obje
             f"Cannot bake frames {first}-{last}: the add-on's datablocks change within them "
             f"({', '.join(differ[:3])}); bake shorter ranges"
         )
+    changing_images = [
+        name
+        for name, per_frame in images.items()
+        if len(per_frame) == len(frames) and any(not np.array_equal(per_frame[0], p) for p in per_frame[1:])
+    ]
+    if changing_images and not bpy.data.filepath:
+        scene.frame_set(start)
+        _sequence_folder(scene)  # refused before anything is added: the file must be saved
     record: dict[str, Any] = {"frames": [first, last], "fcurves": [], "actions": [], "sequences": []}
     grouped: dict[tuple[str, str, str], list[tuple[str, int]]] = {}
     for key in sorted(keys):
@@ -322,9 +330,8 @@ def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], obje
                 values = [state[(*owner_key, path, index)] for state in states]
                 _keyframe(block, path, index, frames, values, record["actions"])
                 record["fcurves"].append([*owner_key, path, index])
-        for name, per_frame in images.items():
-            if len(per_frame) == len(frames) and any(not np.array_equal(per_frame[0], p) for p in per_frame[1:]):
-                record["sequences"].append(_write_sequence(scene, bpy.data.images[name], frames, per_frame))
+        for name in changing_images:
+            record["sequences"].append(_write_sequence(scene, bpy.data.images[name], frames, images[name]))
     finally:
         scene[names.BAKE_RECORD_KEY] = json.dumps(record)
     scene.frame_set(start)

@@ -200,3 +200,30 @@ def test_render_script_bakes_a_file_that_renders_its_frames_without_the_add_on(
     differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
     print(f"mean |baked - render.py| per frame {differences}")
     assert max(differences) < 1e-3 * float(np.mean([o.mean() for o in own])), differences
+
+
+def test_unsaved_file_is_refused_before_anything_is_added(relativity_addon, factory_blender):
+    """The world's per-frame image goes beside the file: an unsaved file is refused in one line, and
+    nothing of a bake is left (no record, no F-curve on the camera)."""
+    bpy = factory_blender
+    scene = build_flythrough(bpy)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    with pytest.raises(_effect().RelativityError, match="Save the file first"):
+        _effect().bake_for_render_anywhere(scene, 1, 3)
+    assert "relativity_render_anywhere" not in scene.keys()
+    assert scene.camera.data.animation_data is None
+
+
+@pytest.mark.parametrize(
+    ("options", "expected"),
+    [
+        ((), "--out"),
+        (("--bake-to=baked.blend", "--spectral=2"), "not with --spectral"),
+        (("--bake-to=baked.png",), "must name a .blend"),
+    ],
+)
+def test_render_script_bake_options(options, expected):
+    from relativity_addon import batch
+
+    with pytest.raises(batch.BatchError, match=expected):
+        batch.parse(["render.py", "scene.blend", *options])
