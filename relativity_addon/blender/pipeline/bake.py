@@ -5,8 +5,8 @@ every frame change syncs the camera's shader parameters, the stand-in lamps of m
 colour factors and, before each render, the world's ``ln D`` image). :func:`bake` steps through a
 frame range, lets the sync write each frame as it does before a render, records every animatable
 number the add-on's writes reach (ID properties such as the OSL camera's ``cycles_custom``, RNA
-properties of objects, cameras, lamps, worlds, materials and scenes, node-socket values of every
-node tree) and keyframes those that change (LINEAR for floats, CONSTANT for integers and booleans,
+properties of objects, cameras, lamps, worlds, materials and scenes, the nodes and node-socket
+values of every node tree) and keyframes those that change (LINEAR for floats, CONSTANT for integers and booleans,
 one key per frame: exact at every frame). An image whose pixels change (the world's ``ln D``) is
 written per frame as OpenEXR files beside the .blend and read back as an image sequence. Then plain
 ``blender -b baked.blend -a`` renders the same frames with no add-on and with scripts disabled.
@@ -114,6 +114,7 @@ def _rna_properties(struct, prefix, out):
 
 def _sockets(tree, out):
     for node in tree.nodes:
+        _rna_properties(node, f'nodes["{node.name}"].', out)  # a node muted per frame, say
         for kind, sockets in (("inputs", node.inputs), ("outputs", node.outputs)):
             for index, socket in enumerate(sockets):
                 if socket.bl_rna.properties.get("default_value") is None:
