@@ -102,3 +102,47 @@ def test_job_type_compiles_tasks_the_batch_script_accepts():
         timeout=60,
     )
     assert bad.returncode != 0 and "frames must be FIRST-LAST" in bad.stderr
+
+
+BAKED_JOB_TYPE = REPO_ROOT / "flamenco" / "relativistic_render_baked.js"
+
+
+def test_baked_job_type_parses_as_javascript():
+    import esprima
+
+    program = esprima.parseScript(BAKED_JOB_TYPE.read_text(encoding="utf-8"))
+    names = {node.id.name for node in program.body if node.type == "FunctionDeclaration"}
+    assert "compileJob" in names
+
+
+@pytest.mark.skipif(NODE is None, reason="no node (JavaScript engine) on PATH; the esprima parse above still runs")
+def test_baked_job_type_renders_with_plain_blender_and_scripts_disabled():
+    """The variant for baked files: each task is plain Blender's animation render of its chunk
+    (no --python), with scripts disabled after Flamenco's own arguments, covering the range once."""
+    assert subprocess.run([NODE, "--check", str(BAKED_JOB_TYPE)], capture_output=True).returncode == 0
+    settings = {
+        "frames": "1-10",
+        "chunk_size": 4,
+        "render_output_root": "/farm/out",
+        "file_format": "exr",
+        "blendfile": "/farm/shot_baked.blend",
+    }
+    result = subprocess.run(
+        [NODE, "-e", HARNESS, str(BAKED_JOB_TYPE), json.dumps(settings)], capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 0, result.stderr
+    compiled = json.loads(result.stdout)
+    assert set(settings) <= set(compiled["keys"])
+    covered = []
+    for task in compiled["tasks"]:
+        (command,) = task["commands"]
+        parameters = command["parameters"]
+        assert parameters["blendfile"] == "/farm/shot_baked.blend" and parameters["exeArgs"] == "{blenderArgs}"
+        assert parameters["argsBefore"] == ["--disable-autoexec"]
+        args = parameters["args"]
+        assert "--python" not in args and args[-1] == "--render-anim"
+        values = dict(zip(args[:-1:2], args[1:-1:2], strict=True))
+        assert values["--render-output"] == "/farm/out/shot/frame_####"
+        assert values["--render-format"] == "OPEN_EXR"
+        covered += range(int(values["--frame-start"]), int(values["--frame-end"]) + 1)
+    assert covered == list(range(1, 11)) and len(compiled["tasks"]) == 3

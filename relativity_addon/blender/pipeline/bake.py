@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -143,7 +144,10 @@ def record_frame() -> dict[Key, Any]:
     """Every animatable number of the file's local datablocks, by (owner, data path, index)."""
     values = {}
     for collection, name, embedded, block in _owners():
-        for path, value in _state(block, embedded).items():
+        with warnings.catch_warnings():  # 5.x: reading use_nodes and the like warns (deprecated)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            state = _state(block, embedded)
+        for path, value in state.items():
             if isinstance(value, tuple):
                 for index, item in enumerate(value):
                     values[collection, name, embedded, path, index] = item
