@@ -111,3 +111,10 @@ VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-r
 VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material
 VOLUME_COLOUR_GROUP = "Relativity Spectral Volume Colour"  # shader group: a volume colour, spectral in the passes
 VOLUME_COLOUR_NODE_PREFIX = "Relativity Spectral Volume"  # its nodes in front of volume colour inputs
+
+# Objects moving with the camera (camera/cockpit.py): a scene of their copies rendered at rest and
+# laid over the relativistic render in the compositor.
+COCKPIT_PREFIX = "Relativity Cockpit"  # the cockpit scene "<prefix> <scene>", its camera, its nodes
+COCKPIT_KEY = "relativity_cockpit"  # on the scene: what the stage added and changed
+COCKPIT_HIDDEN_KEY = "relativity_cockpit_hidden"  # on an object moving with the camera: the user's hide_render
+COCKPIT_COPY_KEY = "relativity_cockpit_copy"  # on a copy in the cockpit scene: the original object's name

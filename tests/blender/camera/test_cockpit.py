@@ -1,0 +1,146 @@
+"""Objects moving with the camera (issue 28 part 1; Gray et al. 2020, appendix A), measured on real
+Cycles renders with the exact camera at 0.9c.
+
+A cockpit: an emissive frame one unit in front of the camera with an open window, parented to the
+camera and marked *Moves With Camera*; outside, emissive spheres at rest in the scene. Acceptance:
+
+- the cockpit's pixels equal a render of the cockpit alone by a camera at rest (plain Blender, no
+  add-on), mean difference below the render noise (two seeds of that render);
+- the pixels seen through the window equal the relativistic render without the cockpit;
+- Remove gives the file back exactly (``scene_dump``).
+
+Before this change the cockpit was photographed as a body at rest in the scene flying past at
+0.9c: aberrated toward the direction of motion and brightened by the searchlight.
+"""
+
+import importlib
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import camera_helpers as ch
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "pipeline"))
+import scene_dump  # noqa: E402
+
+from blender_support import ADDON_MODULE  # noqa: E402
+
+RESOLUTION = (64, 48)
+SAMPLES = 16
+BETA = (0.0, 0.0, -0.9)  # the camera looks down -Z: straight ahead
+COCKPIT_COLOUR = (0.8, 0.4, 0.1)
+SPHERES = ((-2.0, 0.8, -8.0, (1.0, 0.2, 0.2)), (1.5, -0.6, -6.0, (0.2, 1.0, 0.3)), (0.3, 0.2, -12.0, (0.3, 0.4, 1.0)))
+
+
+def _effect():
+    return importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+
+
+def _coloured_emitter(bpy, name, colour):
+    material = ch.emission_material(bpy, name)
+    tree = material.node_tree
+    tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
+    return material
+
+
+def _frame(bpy, scene, camera, name="Cockpit", depth=1.0, outer=0.25, inner=0.12):
+    """A square frame (outer half-size ``outer``) with a square window (half-size ``inner``),
+    ``depth`` in front of the camera, parented to it."""
+    mesh = bpy.data.meshes.new(name)
+    o, i = outer, inner
+    verts = [(-o, -o, 0), (o, -o, 0), (o, o, 0), (-o, o, 0), (-i, -i, 0), (i, -i, 0), (i, i, 0), (-i, i, 0)]
+    faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    mesh.from_pydata(verts, [], faces)
+    mesh.materials.append(_coloured_emitter(bpy, f"{name} Emission", COCKPIT_COLOUR))
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    obj.parent = camera
+    obj.location = (0.03, 0.01, -depth)  # off centre: aberration would move it
+    return obj
+
+
+def _scene(bpy):
+    scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=SAMPLES)
+    scene.cycles.seed = 0
+    spheres = []
+    for number, (x, y, z, colour) in enumerate(SPHERES):
+        material = _coloured_emitter(bpy, f"Sphere {number}", colour)
+        material.node_tree.nodes["Emission"].inputs["Strength"].default_value = 0.05  # D^4 ~ 360 ahead
+        spheres.append(ch.add_sphere(bpy, scene, (x, y, z), 0.8, material, name=f"Sphere {number}"))
+    cockpit = _frame(bpy, scene, camera)
+    # the property by its stored value: the same test runs on the code before the setting existed
+    cockpit.relativity["moves_with_camera"] = True
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    return scene, camera, cockpit, spheres
+
+
+def _rest_cockpit_alone(bpy, scene, spheres, tmp_path, seed=0):
+    """Blender's own render (no add-on applied) of the cockpit alone, the camera at rest."""
+    for sphere in spheres:
+        sphere.hide_render = True
+    scene.cycles.seed = seed
+    image = ch.render_exr(bpy, scene, tmp_path / f"rest_{seed}.exr")
+    for sphere in spheres:
+        sphere.hide_render = False
+    scene.cycles.seed = 0
+    return image
+
+
+def _masks(rest):
+    """Cockpit pixels (fully covered by the frame at rest) and window pixels (none of it)."""
+    cover = rest.sum(axis=-1) / sum(COCKPIT_COLOUR)
+    return cover > 0.999, cover < 1e-6
+
+
+def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
+    relativity_addon, factory_blender, tmp_path
+):
+    bpy = factory_blender
+    scene, camera, cockpit, spheres = _scene(bpy)
+    rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
+    rest_noise_image = _rest_cockpit_alone(bpy, scene, spheres, tmp_path, seed=1)
+    frame, window = _masks(rest)
+    assert frame.sum() > 300 and window.sum() > 300  # both parts are in view
+    effect = _effect()
+    effect.apply(scene)
+    image = ch.render_exr(bpy, scene, tmp_path / "cockpit.exr")
+    assert np.all(np.isfinite(image))
+
+    # the relativistic render without the cockpit (same seed), and its noise (another seed)
+    bpy.data.objects.remove(cockpit)
+    effect.sync(scene)
+    without = ch.render_exr(bpy, scene, tmp_path / "without.exr")
+    scene.cycles.seed = 1
+    effect.sync(scene)
+    without_noise_image = ch.render_exr(bpy, scene, tmp_path / "without_seed1.exr")
+
+    cockpit_error = np.abs(image[frame] - rest[frame]).mean()
+    cockpit_noise = np.abs(rest_noise_image - rest)[frame].mean()
+    window_error = np.abs(image[window] - without[window]).mean()
+    window_noise = np.abs(without_noise_image - without)[window].mean()
+    window_level = without[window].mean()
+    print(
+        f"cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} (noise {cockpit_noise:.5f}, "
+        f"level {rest[frame].mean():.3f}); window pixels {window.sum()}: mean |render - render without cockpit| "
+        f"{window_error:.5f} (noise {window_noise:.5f}, level {window_level:.3f})"
+    )
+    assert window_level > 0.01  # the spheres are seen through the window
+    assert cockpit_error <= max(cockpit_noise, 1e-4)
+    assert window_error <= max(window_noise, 1e-4)
+
+
+def test_remove_gives_the_file_back(relativity_addon, factory_blender):
+    bpy = factory_blender
+    scene, _camera, cockpit, _spheres = _scene(bpy)
+    before = scene_dump.dump(bpy)
+    effect = _effect()
+    effect.apply(scene)
+    assert scene_dump.differences(before, scene_dump.dump(bpy))
+    assert cockpit.hide_render
+    assert len(bpy.data.scenes) == 2
+    effect.remove(scene)
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, "\n".join(lines[:20])
+    assert len(bpy.data.scenes) == 1
