@@ -196,10 +196,8 @@ def _write_objects(scene, cockpit, snap):
         if name not in wanted or copy.type != wanted[name].type:
             bpy.data.objects.remove(copy)
     for name, original in wanted.items():
-        copy = copies.get(name)
-        if copy is None or copy.type != original.type:
-            copy = _new_copy(original, cockpit)
-        _write_copy(copy, original)
+        if name not in copies or copies[name].type != original.type:
+            _new_copy(original, cockpit)
         if original.type != "LIGHT":  # a light: drawn by the moving-light stage (or at rest, Blender's)
             _hide(original)
     for obj in scene.objects:
@@ -242,14 +240,25 @@ def _compose(scene, cockpit):
     tree.links.new(over.outputs[0], result)
 
 
-def write(scene: Scene, snap: Snapshot) -> None:
+def write(scene: Scene, snap: Snapshot, structural: bool = True) -> None:
     """Bring the cockpit scene, the copies, the hidden originals and the compositor up to date with
-    the snapshot; with no object moving with the camera, remove everything."""
+    the snapshot; with no object moving with the camera, remove everything. ``structural=False``
+    (a depsgraph handler's sync) adds and removes nothing: a scene made while Blender evaluates
+    one crashes the evaluation's caller (a ``ray_cast`` on it, measured on 5.2)."""
+    if not structural:
+        if cockpit_scene(scene) is not None and snap.cockpit:
+            _write_values(scene, snap)
+        return
     if not snap.cockpit:
         remove(scene)
         return
     if not is_applied(scene):
-        scene[KEY] = {"scene": "", "created_tree": "", "use_compositing": bool(scene.render.use_compositing)}
+        scene[KEY] = {
+            "scene": "",
+            "created_tree": "",
+            "use_compositing": bool(scene.render.use_compositing),
+            "first": names.COMPOSITOR_SAVED_KEY not in scene,  # before the colour stage's compositor
+        }
     cockpit = cockpit_scene(scene)
     camera = bpy.data.objects.get(snap.camera)
     if cockpit is None:
@@ -265,12 +274,24 @@ def write(scene: Scene, snap: Snapshot) -> None:
         cockpit.collection.objects.link(rest_camera)
         cockpit.camera = rest_camera
         scene[KEY]["scene"] = cockpit.name
-    _write_camera(cockpit.camera, camera)
-    _write_render(scene, cockpit)
     _write_objects(scene, cockpit, snap)
     _compose(scene, cockpit)
     if not scene.render.use_compositing:
         scene.render.use_compositing = True
+    _write_values(scene, snap)
+
+
+def _write_values(scene, snap):
+    """The settings of what exists: the camera at rest, the render settings, the copies."""
+    cockpit = cockpit_scene(scene)
+    camera = bpy.data.objects.get(snap.camera)
+    if camera is not None and camera.type == "CAMERA":
+        _write_camera(cockpit.camera, camera)
+    _write_render(scene, cockpit)
+    for copy in copies(scene):
+        original = scene.objects.get(copy[COPY_KEY])
+        if original is not None and original.type == copy.type:
+            _write_copy(copy, original)
 
 
 def apply(scene: Scene, snap: Snapshot) -> None:
@@ -292,6 +313,14 @@ def _uncompose(scene, record):
         layers = tree.nodes.get(LAYERS_NODE)
         if layers is not None:
             tree.nodes.remove(layers)
+    colour = scene.get(names.COMPOSITOR_SAVED_KEY)
+    if record.get("first") and colour is not None:
+        # the colour stage came after this one (a sync before it) and took this compositor for the
+        # user's: it gives back what this stage found when it goes
+        if record.get("created_tree"):
+            colour["tree"], colour["created_tree"] = "", record["created_tree"]
+        colour["use_compositing"] = bool(record["use_compositing"])
+        return
     if record.get("created_tree"):
         compat.restore_compositor_tree(scene, "")
         created = bpy.data.node_groups.get(record["created_tree"])

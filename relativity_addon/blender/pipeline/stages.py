@@ -132,7 +132,7 @@ STAGES: tuple[Stage, ...] = (
         "objects moving with the camera",
         cockpit,
         apply=cockpit.apply,  # last: it lays its render over the output of every other compositor node
-        write=lambda scene, snap, sync: cockpit.write(scene, snap),
+        write=lambda scene, snap, sync: cockpit.write(scene, snap, structural=sync.depsgraph is None),
         remove=cockpit.remove,
         warnings=cockpit.warnings,
     ),

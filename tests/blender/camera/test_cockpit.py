@@ -1,8 +1,9 @@
 """Objects moving with the camera (issue 28 part 1; Gray et al. 2020, appendix A), measured on real
 Cycles renders with the exact camera at 0.9c.
 
-A cockpit: an emissive frame one unit in front of the camera with an open window, parented to the
-camera and marked *Moves With Camera*; outside, emissive spheres at rest in the scene. Acceptance:
+A cockpit: a frame one unit in front of the camera with an open window (emissive, and diffuse lit by
+a lamp that moves with the camera too), parented to the camera and marked *Moves With Camera*;
+outside, emissive spheres at rest in the scene. Acceptance:
 
 - the cockpit's pixels equal a render of the cockpit alone by a camera at rest (plain Blender, no
   add-on), mean difference below the render noise (two seeds of that render);
@@ -52,7 +53,14 @@ def _frame(bpy, scene, camera, name="Cockpit", depth=1.0, outer=0.25, inner=0.12
     verts = [(-o, -o, 0), (o, -o, 0), (o, o, 0), (-o, o, 0), (-i, -i, 0), (i, -i, 0), (i, i, 0), (-i, i, 0)]
     faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
     mesh.from_pydata(verts, [], faces)
-    mesh.materials.append(_coloured_emitter(bpy, f"{name} Emission", COCKPIT_COLOUR))
+    material = _coloured_emitter(bpy, f"{name} Emission", COCKPIT_COLOUR)
+    tree = material.node_tree
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    add = tree.nodes.new("ShaderNodeAddShader")
+    tree.links.new(tree.nodes["Emission"].outputs[0], add.inputs[0])
+    tree.links.new(diffuse.outputs[0], add.inputs[1])
+    tree.links.new(add.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    mesh.materials.append(material)
     obj = bpy.data.objects.new(name, mesh)
     scene.collection.objects.link(obj)
     obj.parent = camera
@@ -69,21 +77,30 @@ def _scene(bpy):
         material.node_tree.nodes["Emission"].inputs["Strength"].default_value = 0.05  # D^4 ~ 360 ahead
         spheres.append(ch.add_sphere(bpy, scene, (x, y, z), 0.8, material, name=f"Sphere {number}"))
     cockpit = _frame(bpy, scene, camera)
+    light = bpy.data.lights.new("Cockpit Lamp", "POINT")
+    light.energy = 5.0
+    lamp = bpy.data.objects.new("Cockpit Lamp", light)
+    scene.collection.objects.link(lamp)
+    lamp.parent = camera
+    lamp.location = (0.0, 0.15, -0.6)  # between the camera and the frame
     # the property by its stored value: the same test runs on the code before the setting existed
-    cockpit.relativity["moves_with_camera"] = True
+    for obj in (cockpit, lamp):
+        obj.relativity["moves_with_camera"] = True
     scene.relativity.method = "CAMERA"
     scene.relativity.beta = BETA
+    bpy.context.view_layer.update()
     return scene, camera, cockpit, spheres
 
 
-def _rest_cockpit_alone(bpy, scene, spheres, tmp_path, seed=0):
-    """Blender's own render (no add-on applied) of the cockpit alone, the camera at rest."""
-    for sphere in spheres:
-        sphere.hide_render = True
+def _rest_cockpit_alone(bpy, scene, hidden, tmp_path, seed=0):
+    """Blender's own render (no add-on applied) of the cockpit alone (with its lamp unless hidden),
+    the camera at rest."""
+    for obj in hidden:
+        obj.hide_render = True
     scene.cycles.seed = seed
-    image = ch.render_exr(bpy, scene, tmp_path / f"rest_{seed}.exr")
-    for sphere in spheres:
-        sphere.hide_render = False
+    image = ch.render_exr(bpy, scene, tmp_path / f"rest_{seed}_{len(hidden)}.exr")
+    for obj in hidden:
+        obj.hide_render = False
     scene.cycles.seed = 0
     return image
 
@@ -99,9 +116,11 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
 ):
     bpy = factory_blender
     scene, camera, cockpit, spheres = _scene(bpy)
+    lamp = bpy.data.objects["Cockpit Lamp"]
+    frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))  # emission alone
     rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
     rest_noise_image = _rest_cockpit_alone(bpy, scene, spheres, tmp_path, seed=1)
-    frame, window = _masks(rest)
+    assert rest[frame].mean() > 1.2 * sum(COCKPIT_COLOUR) / 3.0  # the lamp lights the cockpit
     assert frame.sum() > 300 and window.sum() > 300  # both parts are in view
     effect = _effect()
     effect.apply(scene)
@@ -140,6 +159,7 @@ def test_remove_gives_the_file_back(relativity_addon, factory_blender):
     assert scene_dump.differences(before, scene_dump.dump(bpy))
     assert cockpit.hide_render
     assert len(bpy.data.scenes) == 2
+    assert len(bpy.data.scenes[f"Relativity Cockpit {scene.name}"].objects) == 3  # the camera at rest, two copies
     effect.remove(scene)
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, "\n".join(lines[:20])
