@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import camera_helpers as ch
 
@@ -111,11 +112,14 @@ def _masks(rest):
     return cover > 0.999, cover < 1e-6
 
 
+@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
 def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
-    relativity_addon, factory_blender, tmp_path
+    relativity_addon, factory_blender, tmp_path, method
 ):
+    """With the exact camera, and with Apparent Geometry's final render (the exact camera too)."""
     bpy = factory_blender
     scene, camera, cockpit, spheres = _scene(bpy)
+    scene.relativity.method = method
     lamp = bpy.data.objects["Cockpit Lamp"]
     frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))  # emission alone
     rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
@@ -141,7 +145,8 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
     window_noise = np.abs(without_noise_image - without)[window].mean()
     window_level = without[window].mean()
     print(
-        f"cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} (noise {cockpit_noise:.5f}, "
+        f"{method}: cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} "
+        f"(noise {cockpit_noise:.5f}, "
         f"level {rest[frame].mean():.3f}); window pixels {window.sum()}: mean |render - render without cockpit| "
         f"{window_error:.5f} (noise {window_noise:.5f}, level {window_level:.3f})"
     )
