@@ -112,14 +112,18 @@ def _masks(rest):
     return cover > 0.999, cover < 1e-6
 
 
-@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
+@pytest.mark.parametrize(
+    ("method", "final_render"), [("CAMERA", "EXACT"), ("GEOMETRY", "EXACT"), ("GEOMETRY", "PREVIEW")]
+)
 def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
-    relativity_addon, factory_blender, tmp_path, method
+    relativity_addon, factory_blender, tmp_path, method, final_render
 ):
-    """With the exact camera, and with Apparent Geometry's final render (the exact camera too)."""
+    """With the exact camera, with Apparent Geometry's final render (the exact camera too) and with
+    its boosted-mesh preview as the final render."""
     bpy = factory_blender
     scene, camera, cockpit, spheres = _scene(bpy)
     scene.relativity.method = method
+    scene.relativity.geometry_final_render = final_render
     lamp = bpy.data.objects["Cockpit Lamp"]
     frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))  # emission alone
     rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
@@ -145,7 +149,7 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
     window_noise = np.abs(without_noise_image - without)[window].mean()
     window_level = without[window].mean()
     print(
-        f"{method}: cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} "
+        f"{method} {final_render}: cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} "
         f"(noise {cockpit_noise:.5f}, "
         f"level {rest[frame].mean():.3f}); window pixels {window.sum()}: mean |render - render without cockpit| "
         f"{window_error:.5f} (noise {window_noise:.5f}, level {window_level:.3f})"
