@@ -113,10 +113,16 @@ def _masks(rest):
 
 
 @pytest.mark.parametrize(
-    ("method", "final_render"), [("CAMERA", "EXACT"), ("GEOMETRY", "EXACT"), ("GEOMETRY", "PREVIEW")]
+    ("method", "final_render", "lamp"),
+    [
+        ("CAMERA", "EXACT", True),
+        ("GEOMETRY", "EXACT", False),
+        ("GEOMETRY", "PREVIEW", True),
+        ("GEOMETRY", "EXACT", True),  # the preview: refused through the exact camera (no crash)
+    ],
 )
 def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
-    relativity_addon, factory_blender, tmp_path, method, final_render
+    relativity_addon, factory_blender, tmp_path, method, final_render, lamp
 ):
     """With the exact camera, with Apparent Geometry's final render (the exact camera too) and with
     its boosted-mesh preview as the final render."""
@@ -124,14 +130,20 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
     scene, camera, cockpit, spheres = _scene(bpy)
     scene.relativity.method = method
     scene.relativity.geometry_final_render = final_render
-    lamp = bpy.data.objects["Cockpit Lamp"]
-    frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))  # emission alone
+    if not lamp:
+        bpy.data.objects.remove(bpy.data.objects["Cockpit Lamp"])
+    lamp = bpy.data.objects.get("Cockpit Lamp")
+    emission_alone = _rest_cockpit_alone(bpy, scene, [*spheres, lamp] if lamp else spheres, tmp_path)
+    frame, window = _masks(emission_alone)
     rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
     rest_noise_image = _rest_cockpit_alone(bpy, scene, spheres, tmp_path, seed=1)
-    assert rest[frame].mean() > 1.2 * sum(COCKPIT_COLOUR) / 3.0  # the lamp lights the cockpit
+    assert (rest[frame].mean() > 1.2 * sum(COCKPIT_COLOUR) / 3.0) == bool(lamp)  # the lamp lights the cockpit
     assert frame.sum() > 300 and window.sum() > 300  # both parts are in view
     effect = _effect()
     effect.apply(scene)
+    effect.sync(scene)
+    refused = [line for line in effect.scene_warnings(scene) if "do not render together" in line]
+    assert bool(refused) == (method == "GEOMETRY" and final_render == "EXACT" and bool(lamp)), refused
     image = ch.render_exr(bpy, scene, tmp_path / "cockpit.exr")
     assert np.all(np.isfinite(image))
 
@@ -149,7 +161,8 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
     window_noise = np.abs(without_noise_image - without)[window].mean()
     window_level = without[window].mean()
     print(
-        f"{method} {final_render}: cockpit pixels {frame.sum()}: mean |render - rest render| {cockpit_error:.5f} "
+        f"{method} {final_render} {'lamp' if lamp else 'no lamp'}: cockpit pixels {frame.sum()}: "
+        f"mean |render - rest render| {cockpit_error:.5f} "
         f"(noise {cockpit_noise:.5f}, "
         f"level {rest[frame].mean():.3f}); window pixels {window.sum()}: mean |render - render without cockpit| "
         f"{window_error:.5f} (noise {window_noise:.5f}, level {window_level:.3f})"
