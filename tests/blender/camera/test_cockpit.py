@@ -186,3 +186,30 @@ def test_remove_gives_the_file_back(relativity_addon, factory_blender):
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, "\n".join(lines[:20])
     assert len(bpy.data.scenes) == 1
+
+
+def test_batch_script_renders_the_cockpit(relativity_addon, factory_blender, tmp_path):
+    """``examples/render.py`` in a fresh process, on a file never set up (``--beta``) and on one
+    set up and saved (what a farm worker gets): the same frame as F12 here (same seed), the cockpit
+    as at rest."""
+    bpy = factory_blender
+    scene, _camera, _cockpit, spheres = _scene(bpy)
+    lamp = bpy.data.objects["Cockpit Lamp"]
+    frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))
+    rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
+    plain = ch.save_blend(bpy, tmp_path / "plain.blend")
+    effect = _effect()
+    effect.apply(scene)
+    here = ch.render_exr(bpy, scene, tmp_path / "here.exr")
+    saved = ch.save_blend(bpy, tmp_path / "saved.blend")
+    beta = ",".join(repr(b) for b in BETA)
+    for name, blend, options in (("plain", plain, (f"--beta={beta}",)), ("saved", saved, ())):
+        ch.run_render_script(blend, tmp_path / f"{name}.exr", "--seed=0", *options)
+        image = ch.read_exr(bpy, tmp_path / f"{name}.exr")
+        cockpit_error = np.abs(image[frame] - rest[frame]).mean()
+        error = np.abs(image - here).mean()
+        print(
+            f"render.py, {name} file: mean |image - F12| {error:.5f}; cockpit pixels against rest {cockpit_error:.5f}"
+        )
+        assert cockpit_error < 2e-3
+        assert error < 2e-3
