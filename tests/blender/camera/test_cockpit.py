@@ -213,3 +213,32 @@ def test_batch_script_renders_the_cockpit(relativity_addon, factory_blender, tmp
         )
         assert cockpit_error < 2e-3
         assert error < 2e-3
+
+
+def test_equirectangular_camera(relativity_addon, factory_blender, tmp_path):
+    """A panoramic (equirectangular) camera: the camera at rest is panoramic too, the cockpit's
+    pixels are Blender's panorama of it at rest and the rest of the sphere is the relativistic one."""
+    bpy = factory_blender
+    scene, camera, cockpit, spheres = _scene(bpy)
+    scene.render.resolution_x, scene.render.resolution_y = 256, 128
+    camera.data.type = "PANO"
+    camera.data.panorama_type = "EQUIRECTANGULAR"
+    lamp = bpy.data.objects["Cockpit Lamp"]
+    frame, window = _masks(_rest_cockpit_alone(bpy, scene, [*spheres, lamp], tmp_path))
+    rest = _rest_cockpit_alone(bpy, scene, spheres, tmp_path)
+    assert frame.sum() > 50 and window.sum() > 1000
+    effect = _effect()
+    effect.apply(scene)
+    image = ch.render_exr(bpy, scene, tmp_path / "cockpit.exr")
+    assert bpy.data.scenes[f"Relativity Cockpit {scene.name}"].camera.data.type == "PANO"
+    bpy.data.objects.remove(cockpit)
+    effect.sync(scene)
+    without = ch.render_exr(bpy, scene, tmp_path / "without.exr")
+    cockpit_error = np.abs(image[frame] - rest[frame]).mean()
+    window_error = np.abs(image[window] - without[window]).mean()
+    print(
+        f"equirectangular: cockpit pixels {frame.sum()}: {cockpit_error:.5f} from the rest panorama; "
+        f"{window.sum()} others: {window_error:.5f} from the relativistic one without cockpit "
+        f"(level {without[window].mean():.4f})"
+    )
+    assert cockpit_error < 1e-3 and window_error < 1e-3
