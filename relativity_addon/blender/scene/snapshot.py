@@ -323,8 +323,8 @@ def moving_lights(
     scene: Scene, frame: float, depsgraph: Depsgraph | None = None, observer: Sequence[float] = (0.0, 0.0, 0.0)
 ) -> tuple[MovingLight, ...]:
     """Every light of ``scene`` with constant velocity or keyframed motion that renders, at ``frame``; RelativityError
-    for a light at or above the speed of light. A light moving with the camera moves with the observer's velocity
-    ``observer``: by the camera's keyframes (its parents') when they give it, else uniformly."""
+    for a light at or above the speed of light. A light moving with the camera moves uniformly with the observer's
+    velocity ``observer`` at the frame."""
     found = []
     for obj in scene.objects:
         motion = obj.relativity.motion
@@ -332,14 +332,15 @@ def moving_lights(
             found += _emitter_light(scene, obj, frame, depsgraph)
             continue
         if obj.type == "LIGHT" and cockpit.moves_with_camera(obj) and not light_render_hidden(obj):
-            keyed = scene.relativity.velocity_source == "CAMERA_ANIMATION"
-            motion = "ANIMATION" if keyed else "CONSTANT"
+            # uniform at the camera's velocity at the frame, also when that comes from its keyframes
+            # (the keyframed path crashed Blender 5.2 at frame changes with the cockpit's layer)
+            motion = "CONSTANT"
             if not any(observer):
                 continue  # at rest with the camera at rest: Blender's own light
         elif obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
         if cockpit.moves_with_camera(obj):
-            beta = tuple(observer) if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
+            beta = tuple(observer)
         else:
             beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
         beta = check_velocity(beta, f"light {obj.name!r} velocity beta")
