@@ -299,3 +299,24 @@ def test_animation_follows_the_frame(relativity_addon, factory_blender, tmp_path
             f"({other:.3f} from the other frame's)"
         )
         assert error < 2e-3 < other
+
+
+def test_offered_for_objects_under_the_camera_and_switched_off_after_set_up(relativity_addon, factory_blender):
+    """The panel offers Moves With Camera for the camera's children and their children only;
+    switching it off after Set Up takes the cockpit away and shows the object in renders again."""
+    bpy = factory_blender
+    scene, camera, cockpit, spheres = _scene(bpy)
+    cockpit_reader = importlib.import_module(f"{ADDON_MODULE}.blender.scene.cockpit")
+    child = bpy.data.objects.new("Needle", None)
+    scene.collection.objects.link(child)
+    child.parent = cockpit
+    assert cockpit_reader.offered(scene, cockpit) and cockpit_reader.offered(scene, child)
+    assert not cockpit_reader.offered(scene, spheres[0]) and not cockpit_reader.offered(scene, camera)
+    effect = _effect()
+    effect.apply(scene)
+    assert cockpit.hide_render and len(bpy.data.scenes) == 2
+    for obj in (cockpit, bpy.data.objects["Cockpit Lamp"]):
+        obj.relativity.moves_with_camera = False  # the update callback syncs
+    assert not cockpit.hide_render and len(bpy.data.scenes) == 1
+    tree = compat.compositor_tree(scene)
+    assert not any(node.name.startswith("Relativity Cockpit") for node in tree.nodes)
