@@ -372,6 +372,6 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if snap.velocity_source == "CAMERA_ANIMATION" and compat.has_compositor_node_groups():
         found.append(
             "Objects moving with the camera, velocity from the camera's keyframes: Render Animation crashed "
-            "Blender 5.2; render the frames one by one (examples/render.py --frames) (docs/cockpit.md)"
+            "Blender 5.2; render the frames one by one (F12 at each frame, or the batch script) (docs/cockpit.md)"
         )
     return found
