@@ -320,3 +320,25 @@ def test_offered_for_objects_under_the_camera_and_switched_off_after_set_up(rela
     assert not cockpit.hide_render and len(bpy.data.scenes) == 1
     tree = compat.compositor_tree(scene)
     assert not any(node.name.startswith("Relativity Cockpit") for node in tree.nodes)
+
+
+def test_saved_reopened_and_removed(relativity_addon, factory_blender, tmp_path, capfd):
+    """Set up, saved, opened again (the cockpit scene travels in the file), then Remove: the file
+    as it was, with no error on the console."""
+    bpy = factory_blender
+    scene, _camera, _cockpit, _spheres = _scene(bpy)
+    before = scene_dump.dump(bpy)
+    _effect().apply(scene)
+    name = scene.name
+    path = tmp_path / "set_up.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), check_existing=False)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    assert len(bpy.data.scenes) == 2
+    capfd.readouterr()
+    _effect().remove(bpy.data.scenes[name])
+    bpy.context.view_layer.update()
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Error" not in err, err
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, "\n".join(lines[:20])
+    assert len(bpy.data.scenes) == 1
