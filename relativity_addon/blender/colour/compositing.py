@@ -344,7 +344,12 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
                     aov.name = aov_name
                     aov.type = "VALUE"
                     saved["added_aovs"].append([view_layer.name, aov_name])
-        for layers in [node for node in tree.nodes if node.bl_idname == "CompositorNodeRLayers"]:
+        # (not a Render Layers node of another scene: the cockpit's, camera/cockpit.py, is at rest)
+        for layers in [
+            node
+            for node in tree.nodes
+            if node.bl_idname == "CompositorNodeRLayers" and getattr(node, "scene", None) in (None, scene)
+        ]:
             image = layers.outputs["Image"]
             targets = [(link.to_node.name, link.to_socket.identifier) for link in image.links]
             node = tree.nodes.new("CompositorNodeGroup")

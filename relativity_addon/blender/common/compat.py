@@ -22,6 +22,8 @@ if TYPE_CHECKING:
         Light,
         Material,
         Modifier,
+        Node,
+        NodeSocket,
         NodeTree,
         Scene,
         ShaderNodeTree,
@@ -163,6 +165,22 @@ def restore_compositor_tree(scene: Scene, name: str) -> None:
         scene.use_nodes = bool(name)
         return
     scene.compositing_node_group = bpy.data.node_groups.get(name) if name else None
+
+
+def compositor_output(tree: NodeTree) -> Node | None:
+    """The node whose first input is the compositor's result: the active Composite node (4.5) or
+    the active Group Output (5.x)."""
+    kind = "NodeGroupOutput" if has_compositor_node_groups() else "CompositorNodeComposite"
+    outputs = [node for node in tree.nodes if node.bl_idname == kind]
+    return next((node for node in outputs if getattr(node, "is_active_output", True)), outputs[0] if outputs else None)
+
+
+def alpha_over_inputs(node: Node) -> tuple[NodeSocket, NodeSocket]:
+    """``(background, foreground)`` of a compositor Alpha Over node: named sockets in 5.x, the
+    two unnamed Image inputs after the factor in 4.5."""
+    if "Background" in node.inputs:
+        return node.inputs["Background"], node.inputs["Foreground"]
+    return node.inputs[1], node.inputs[2]
 
 
 def map_uv_nearest() -> tuple[dict[str, str], dict[str, str]]:

@@ -118,3 +118,10 @@ BAKE_ACTION_PREFIX = "Relativity Bake"  # actions the bake made for datablocks t
 BAKE_IMAGE_SUFFIX = " (baked)"  # the image sequence standing for a per-frame image
 BAKE_SCRATCH_IMAGE = "Relativity Bake Scratch"  # writes the sequence's files, removed at once
 BAKE_FOLDER_SUFFIX = "_relativity_bake"  # the folder beside the .blend holding the sequences
+
+# Objects moving with the camera (camera/cockpit.py): a scene of their copies rendered at rest and
+# laid over the relativistic render in the compositor.
+COCKPIT_PREFIX = "Relativity Cockpit"  # the cockpit scene "<prefix> <scene>", its camera, its nodes
+COCKPIT_KEY = "relativity_cockpit"  # on the scene: what the stage added and changed
+COCKPIT_HIDDEN_KEY = "relativity_cockpit_hidden"  # on an object moving with the camera: the user's hide_render
+COCKPIT_COPY_KEY = "relativity_cockpit_copy"  # on a copy in the cockpit scene: the original object's name

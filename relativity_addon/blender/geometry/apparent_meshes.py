@@ -351,7 +351,12 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
     """
     if objects is None:
         objects = [
-            obj for obj in scene.objects if obj.type == "MESH" and obj.relativity.enabled and not modifier.is_cache(obj)
+            obj
+            for obj in scene.objects
+            if obj.type == "MESH"
+            and obj.relativity.enabled
+            and not obj.relativity.moves_with_camera  # at rest with the camera: camera/cockpit.py
+            and not modifier.is_cache(obj)
         ]
     linked = next((obj for obj in objects if obj.library is not None), None)
     if linked is not None:

@@ -314,6 +314,7 @@ def object_changed(scene: Scene, obj: Object) -> None:
         applied_method(scene) == "GEOMETRY"
         and obj.type == "MESH"
         and obj.relativity.enabled
+        and not obj.relativity.moves_with_camera
         and modifier.find_modifier(obj) is None
     ):
         try:

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ..camera import clamping
+from ..camera import clamping, cockpit
 from ..colour import doppler_colour, light_groups, volumes, world_doppler
 from ..lights import lamps_on_moving_objects, lamps_seen_directly, moving_lights
 from . import metadata
@@ -127,5 +127,13 @@ STAGES: tuple[Stage, ...] = (
         write=lambda scene, snap, sync: lamps_seen_directly.write(scene, snap),
         remove=lamps_seen_directly.remove,
         warnings=lamps_seen_directly.warnings,
+    ),
+    Stage(
+        "objects moving with the camera",
+        cockpit,
+        apply=cockpit.apply,  # last: it lays its render over the output of every other compositor node
+        write=lambda scene, snap, sync: cockpit.write(scene, snap, structural=sync.depsgraph is None),
+        remove=cockpit.remove,
+        warnings=cockpit.warnings,
     ),
 )

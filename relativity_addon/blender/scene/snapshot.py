@@ -24,7 +24,7 @@ from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
 from ..common import compat, names, osl
-from . import animation, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
+from . import animation, cockpit, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Sequence
@@ -104,6 +104,8 @@ class Snapshot:
     # parameters) and whether it renders a stereo pair: stages take these, not the camera anew
     projection: tuple = ()
     stereo: bool = False
+    # objects moving with the camera (``scene/cockpit.py``), rendered at rest by ``camera/cockpit.py``
+    cockpit: tuple[str, ...] = ()
 
     @property
     def time(self) -> float:
@@ -317,18 +319,30 @@ def _keyframe_beta(scene, obj, frame, step=0.01):
     return tuple(float(v) for v in per_frame * animation.frames_per_second(scene) / c)
 
 
-def moving_lights(scene: Scene, frame: float, depsgraph: Depsgraph | None = None) -> tuple[MovingLight, ...]:
+def moving_lights(
+    scene: Scene, frame: float, depsgraph: Depsgraph | None = None, observer: Sequence[float] = (0.0, 0.0, 0.0)
+) -> tuple[MovingLight, ...]:
     """Every light of ``scene`` with constant velocity or keyframed motion that renders, at ``frame``; RelativityError
-    for a light at or above the speed of light."""
+    for a light at or above the speed of light. A light moving with the camera moves uniformly with the observer's
+    velocity ``observer`` at the frame."""
     found = []
     for obj in scene.objects:
         motion = obj.relativity.motion
         if emitting_meshes.is_emitter_light(obj) and not obj.hide_render:
             found += _emitter_light(scene, obj, frame, depsgraph)
             continue
-        if obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
+        if obj.type == "LIGHT" and cockpit.moves_with_camera(obj) and not light_render_hidden(obj):
+            # uniform at the camera's velocity at the frame, also when that comes from its keyframes
+            # (the keyframed path crashed Blender 5.2 at frame changes with the cockpit's layer)
+            motion = "CONSTANT"
+            if not any(observer):
+                continue  # at rest with the camera at rest: Blender's own light
+        elif obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
-        beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
+        if cockpit.moves_with_camera(obj):
+            beta = tuple(observer)
+        else:
+            beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)
         beta = check_velocity(beta, f"light {obj.name!r} velocity beta")
         matrix = camera_matrix(scene, obj, frame, depsgraph)
         axis = -matrix[:3, 2] / max(np.linalg.norm(matrix[:3, 2]), 1e-30)
@@ -453,7 +467,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         raise RelativityError("The Lorentz window time must be finite")
     temperatures.check_temperatures(scene)
     matrix = camera_matrix(scene, camera, frame, depsgraph)
-    lights = moving_lights(scene, frame, depsgraph)
+    lights = moving_lights(scene, frame, depsgraph, beta)
     time_of_flight = bool(settings.use_time_of_flight)
     if time_of_flight:
         check_time_of_flight(settings, lights)
@@ -503,4 +517,5 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         else (),
         projection=lens.projection(scene, camera),
         stereo=lens.stereo_eyes(scene),
+        cockpit=cockpit.object_names(scene),
     )

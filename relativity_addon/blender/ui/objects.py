@@ -66,6 +66,14 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         default=False,
         update=_settings_changed,
     )
+    moves_with_camera: BoolProperty(
+        name="Moves With Camera",
+        description="At rest in the camera's frame, as a cockpit, window frame, visor or HUD (Gray et al. 2020, "
+        "appendix A): rendered as at rest in front of a camera at rest and laid over the relativistic render; "
+        "a light moves with the camera's velocity (docs/cockpit.md)",
+        default=False,
+        update=_settings_changed,
+    )
     tessellation: IntProperty(
         name="Tessellation",
         description="Subdivision levels added before deforming (straight edges can look curved)",

@@ -11,6 +11,7 @@ from bpy.types import Context, Panel
 
 from ..common import osl
 from ..pipeline import bake, effect, render_notice
+from ..scene import cockpit
 
 CHARACTER_WIDTH = 7.0  # pixels per character of the sidebar's text at UI scale 1 (a mean)
 LABEL_MARGIN = 60.0  # pixels of a label row not given to its text (icon, padding, scroll bar)
@@ -213,6 +214,10 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         settings = obj.relativity
         layout = _split(self.layout)
         layout.label(text=obj.name, icon="OBJECT_DATA")
+        if settings.moves_with_camera or cockpit.offered(context.scene, obj):
+            layout.prop(settings, "moves_with_camera")
+            if settings.moves_with_camera and obj.type != "LIGHT":
+                return
         if obj.type == "LIGHT":
             _draw_light(layout, obj)
             return

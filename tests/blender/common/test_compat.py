@@ -121,3 +121,36 @@ def test_light_node_tree(factory_blender):
         assert compat.light_node_tree(light) is None
     else:  # 5.x: always there and used
         assert compat.light_node_tree(light) == light.node_tree
+
+
+def test_compositor_output_and_alpha_over_inputs(factory_blender, tmp_path):
+    """The output node of a new compositor tree is fed (by its Render Layers node; 4.5 through a
+    Reroute); Alpha Over's
+    ``(background, foreground)``: an opaque green foreground over red gives green (swapped: red)."""
+    bpy = factory_blender
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 1
+    scene.render.resolution_x = scene.render.resolution_y = 4
+    scene.render.resolution_percentage = 100
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    tree = compat.new_compositor_tree(scene, "Compat Compositing")
+    output = compat.compositor_output(tree)
+    assert output is not None and output.inputs[0].is_linked
+    over = tree.nodes.new("CompositorNodeAlphaOver")
+    background, foreground = compat.alpha_over_inputs(over)
+    for socket, colour in ((background, (1.0, 0.0, 0.0, 1.0)), (foreground, (0.0, 1.0, 0.0, 1.0))):
+        rgb = tree.nodes.new("CompositorNodeRGB")
+        rgb.outputs[0].default_value = colour
+        tree.links.new(rgb.outputs[0], socket)
+    tree.links.new(over.outputs[0], output.inputs[0])
+    scene.render.use_compositing = True
+    scene.render.filepath = str(tmp_path / "over.exr")
+    scene.render.use_file_extension = False
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    bpy.ops.render.render(write_still=True)
+    image = bpy.data.images.load(str(tmp_path / "over.exr"))
+    red, green = image.pixels[0], image.pixels[1]
+    assert green > 0.9 and red < 0.1
