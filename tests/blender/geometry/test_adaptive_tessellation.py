@@ -8,6 +8,8 @@ seen at its retarded time ``|x_o - x_e(t_e)| = c (t_o - t_e)`` for uniform motio
 pinhole; no add-on code computes the expected outline.
 """
 
+import os
+
 import numpy as np
 
 import geometry_helpers as gh
@@ -86,6 +88,14 @@ def _outline_error(coverage, analytic, hits, supersample=8):
     return float(distances.max())
 
 
+def _save_png(bpy, grey, path):
+    image = bpy.data.images.new("debug", grey.shape[1], grey.shape[0])
+    image.pixels.foreach_set(np.repeat(grey[::-1].ravel(), 4).astype(np.float32))
+    image.filepath_raw = path
+    image.file_format = "PNG"
+    image.save()
+
+
 def _box_scene(bpy, tessellation=None, adaptive=True):
     scene, camera_object = ch.new_scene(bpy, resolution=(200, 150), samples=16)
     camera_object.data.lens = 30.0
@@ -115,14 +125,8 @@ def _render_outline_error(bpy, tmp_path, name, **settings):
     coverage = np.clip(ch.luminance(image), 0.0, 1.0)
     analytic, hits = _analytic_coverage(camera, rest_corners, origin)
     error = _outline_error(coverage, analytic, hits)
-    import os
     if os.environ.get("TESS_DEBUG"):
-        both = np.concatenate((coverage, analytic), axis=1)
-        img = bpy.data.images.new("dbg", both.shape[1], both.shape[0])
-        img.pixels.foreach_set(np.repeat(both[::-1].ravel(), 4).astype(np.float32))
-        img.filepath_raw = f"/tmp/tess_{name}.png"
-        img.file_format = "PNG"
-        img.save()
+        _save_png(bpy, np.concatenate((coverage, analytic), axis=1), f"/tmp/tess_{name}.png")
     print(f"{name}: {vertices} vertices, outline error {error:.2f} px, covered {coverage.sum():.0f} / {analytic.sum():.0f}")
     return error, vertices, coverage, analytic
 
@@ -170,3 +174,51 @@ def test_fine_grid_at_0_9c_gets_few_new_vertices(relativity_addon, factory_blend
     # and it moved: the apparent grid is not the rest grid
     assert np.abs(evaluated[:, 0].mean() - grid.location.x) > 0.1
 
+
+
+def _floor_scene(bpy, adaptive):
+    """A white floor 1 m below a camera (15 mm) moving forward at 0.6c, 12 m wide, from 0.5 m to 30 m
+    ahead, of 6 x 40 quads, rendered as the boosted-mesh preview: aberration bends its near edges, its far
+    quads stay straight."""
+    scene, _ = ch.new_scene(bpy, resolution=(200, 150), samples=16)
+    scene.camera.data.lens = 15.0
+    scene.relativity.speed_of_light = C
+    scene.relativity.beta = (0.0, 0.0, -0.6)
+    scene.relativity.geometry_final_render = "PREVIEW"
+    scene.relativity.use_doppler = False
+    scene.relativity.use_searchlight = False
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=40, size=1.0)
+    floor = bpy.context.object
+    floor.scale = (12.0, 29.5, 1.0)
+    floor.rotation_euler = (np.pi / 2.0, 0.0, 0.0)  # local y -> world -z (ahead), local z -> world y
+    floor.location = (0.0, -1.0, -15.25)
+    bpy.ops.object.transform_apply(location=False, rotation=True, scale=True)
+    floor.data.materials.append(ch.emission_material(bpy))
+    floor.relativity.use_adaptive_tessellation = adaptive
+    return scene, floor
+
+
+def test_partly_subdivided_floor_has_no_cracks(relativity_addon, factory_blender, tmp_path):
+    """Where subdivided faces meet faces left whole, the new vertices on the shared edges sit on
+    the whole faces' straight edges: the render has no crack, and matches every face subdivided."""
+    bpy = factory_blender
+    rendered, counts = {}, {}
+    for adaptive in (True, False):
+        scene, floor = _floor_scene(bpy, adaptive)
+        gh.apply_geometry(scene)
+        counts[adaptive] = len(gh.evaluated_points(bpy, floor)[0])
+        image = ch.render_exr(bpy, scene, tmp_path / f"floor_{adaptive}.exr")
+        rendered[adaptive] = np.clip(ch.luminance(image), 0.0, 1.0)
+        gh.remove_effect(scene)
+    uniform, adaptive = rendered[False], rendered[True]
+    print(f"floor: {counts[True]} vertices adaptive, {counts[False]} with every face at level 4")
+    assert len(floor.data.vertices) < counts[True] < counts[False]  # a seam: some faces left whole
+    if os.environ.get("TESS_DEBUG"):
+        _save_png(bpy, np.concatenate((adaptive, uniform), axis=1), "/tmp/tess_floor.png")
+    inside = uniform >= 0.5
+    for _ in range(3):  # three pixels in from the outline (where the two renders' edges may differ)
+        inside[1:-1, 1:-1] &= inside[:-2, 1:-1] & inside[2:, 1:-1] & inside[1:-1, :-2] & inside[1:-1, 2:]
+    assert inside.sum() > 3000
+    print(f"darkest pixel inside: {adaptive[inside].min():.3f}; largest difference {np.abs(adaptive - uniform).max():.3f}")
+    assert adaptive[inside].min() > 0.95
+    assert np.abs(adaptive - uniform).max() < 0.5
