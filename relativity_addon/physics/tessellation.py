@@ -50,7 +50,9 @@ def perspective_pixels(
     return pixels
 
 
-def segment_bends(rest_a: ArrayLike, rest_b: ArrayLike, parts: int, apparent: ApparentMap, project: Projection) -> FloatArray:
+def segment_bends(
+    rest_a: ArrayLike, rest_b: ArrayLike, parts: int, apparent: ApparentMap, project: Projection
+) -> FloatArray:
     """The largest image error in pixels (``(E,)``) over the ``parts`` equal pieces of each edge
     ``rest_a[i] -> rest_b[i]`` (rest positions, ``(E, 3)``) drawn as straight segments between
     the pieces' apparent end points: for each piece, the distance between the image of the

@@ -31,6 +31,7 @@ Menu = Literal
 class Links(tuple):
     """Several references into one multi-input socket (Join Geometry), linked in order."""
 
+
 TreeType = typing.Literal["GeometryNodeTree", "CompositorNodeTree", "ShaderNodeTree"]
 
 

@@ -43,13 +43,19 @@ def _subdivision_nodes() -> dict[str, Node]:
             {"A": "group.Face Codes", "B": "in_size.Face Count"},
             {"data_type": "INT", "operation": "EQUAL"},
         ),
-        "adaptive": Node("FunctionNodeBooleanMath", {0: "codes_given.Result", 1: "codes_fit.Result"}, {"operation": "AND"}),
+        "adaptive": Node(
+            "FunctionNodeBooleanMath", {0: "codes_given.Result", 1: "codes_fit.Result"}, {"operation": "AND"}
+        ),
         "codes_start": Node(
             "FunctionNodeIntegerMath", {0: "cache_size.Point Count", 1: "group.Face Codes"}, {"operation": "SUBTRACT"}
         ),
         "face_index": Node("GeometryNodeInputIndex"),
-        "code_index": Node("FunctionNodeIntegerMath", {0: "codes_start.Value", 1: "face_index.Index"}, {"operation": "ADD"}),
-        "cache_code": Node("GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}),
+        "code_index": Node(
+            "FunctionNodeIntegerMath", {0: "codes_start.Value", 1: "face_index.Index"}, {"operation": "ADD"}
+        ),
+        "cache_code": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
+        ),
         "sample_code": Node(
             "GeometryNodeSampleIndex",
             {"Geometry": "cache_info.Geometry", "Value": "cache_code.Attribute", "Index": "code_index.Value"},
@@ -60,7 +66,9 @@ def _subdivision_nodes() -> dict[str, Node]:
             {"Geometry": "group.Geometry", "Name": Literal(names.FACE_CODE_ATTRIBUTE), "Value": "sample_code.Value"},
             face_code,
         ),
-        "code": Node("GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}),
+        "code": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
+        ),
         "is_subdivided": Node(
             "FunctionNodeCompare",
             {"A": "code.Attribute", "B": 1.0, "Epsilon": 0.25},
@@ -71,12 +79,16 @@ def _subdivision_nodes() -> dict[str, Node]:
             {"Geometry": "store_code.Geometry", "Selection": "is_subdivided.Result"},
             {"domain": "FACE"},
         ),
-        "subdivide_part": Node("GeometryNodeSubdivideMesh", {"Mesh": "separate.Selection", "Level": "group.Tessellation"}),
+        "subdivide_part": Node(
+            "GeometryNodeSubdivideMesh", {"Mesh": "separate.Selection", "Level": "group.Tessellation"}
+        ),
         "join": Node("GeometryNodeJoinGeometry", {"Geometry": Links(("separate.Inverted", "subdivide_part.Mesh"))}),
         # points of the faces on either side of the seam (codes 1 and 2; a code read on the points is
         # the mean of their faces'), where the two parts' copies of a vertex are welded again
         "seam_point": Node(
-            "FunctionNodeCompare", {"A": "code.Attribute", "B": 0.05}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+            "FunctionNodeCompare",
+            {"A": "code.Attribute", "B": 0.05},
+            {"data_type": "FLOAT", "operation": "GREATER_THAN"},
         ),
         "weld": Node(
             "GeometryNodeMergeByDistance",
@@ -105,18 +117,26 @@ def _seam_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT", "operation": "EQUAL"},
         ),
         "ring": Node(
-            "GeometryNodeSeparateGeometry", {"Geometry": "store_beta.Geometry", "Selection": "is_ring.Result"}, {"domain": "FACE"}
+            "GeometryNodeSeparateGeometry",
+            {"Geometry": "store_beta.Geometry", "Selection": "is_ring.Result"},
+            {"domain": "FACE"},
         ),
         "store_seen": Node(
             "GeometryNodeStoreNamedAttribute",
             {"Geometry": "ring.Selection", "Name": Literal(names.SEEN_ATTRIBUTE), "Value": "position.Position"},
             vector,
         ),
-        "rest": Node("GeometryNodeInputNamedAttribute", {"Name": Literal(names.REST_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}),
-        "ring_at_rest": Node("GeometryNodeSetPosition", {"Geometry": "store_seen.Geometry", "Position": "rest.Attribute"}),
+        "rest": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.REST_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
+        ),
+        "ring_at_rest": Node(
+            "GeometryNodeSetPosition", {"Geometry": "store_seen.Geometry", "Position": "rest.Attribute"}
+        ),
         "ring_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "ring.Selection"}, {"component": "MESH"}),
         "has_ring": Node(
-            "FunctionNodeCompare", {"A": "ring_size.Face Count", "B": 0}, {"data_type": "INT", "operation": "GREATER_THAN"}
+            "FunctionNodeCompare",
+            {"A": "ring_size.Face Count", "B": 0},
+            {"data_type": "INT", "operation": "GREATER_THAN"},
         ),
         "proximity": Node(
             "GeometryNodeProximity",
@@ -129,8 +149,12 @@ def _seam_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
         ),
         "snap": Node("FunctionNodeBooleanMath", {0: "on_ring.Result", 1: "has_ring.Result"}, {"operation": "AND"}),
-        "snap_moved": Node("FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "counts_match.Result"}, {"operation": "AND"}),
-        "seen": Node("GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}),
+        "snap_moved": Node(
+            "FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "counts_match.Result"}, {"operation": "AND"}
+        ),
+        "seen": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
+        ),
         "interpolated": Node(
             "GeometryNodeSampleNearestSurface",
             {"Mesh": "ring_at_rest.Geometry", "Value": "seen.Attribute", "Sample Position": "rest.Attribute"},
@@ -145,7 +169,9 @@ def _seam_nodes() -> dict[str, Node]:
             {"Switch": "adaptive.Boolean", "False": "store_beta.Geometry", "True": "snapped.Geometry"},
             {"input_type": "GEOMETRY"},
         ),
-        "unmarked": Node("GeometryNodeRemoveAttribute", {"Geometry": "seamless.Output", "Name": Literal(names.FACE_CODE_ATTRIBUTE)}),
+        "unmarked": Node(
+            "GeometryNodeRemoveAttribute", {"Geometry": "seamless.Output", "Name": Literal(names.FACE_CODE_ATTRIBUTE)}
+        ),
     }
 
 
@@ -414,7 +440,9 @@ def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray, face_codes:
     # The attribute API copies the float32 buffer in one go; vertices.foreach_set("co") was
     # measured 150x slower (70 ms for a million vertices).
     if count:  # an empty mesh has no position attribute
-        mesh.attributes["position"].data.foreach_set("vector", np.ascontiguousarray(positions, dtype=np.float32).ravel())
+        mesh.attributes["position"].data.foreach_set(
+            "vector", np.ascontiguousarray(positions, dtype=np.float32).ravel()
+        )
     _write_face_codes(mesh, count, face_codes)
     attribute = mesh.attributes.get(names.BETA_ATTRIBUTE)
     if attribute is None:

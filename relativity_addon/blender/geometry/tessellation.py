@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import zlib
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import bpy
 import numpy as np
@@ -89,6 +89,11 @@ def render_size(scene: Scene) -> tuple[float, float]:
     return max(1.0, render.resolution_x * scale), max(1.0, render.resolution_y * scale)
 
 
+def _rendering():
+    """Whether a render job runs (its handlers must not evaluate the depsgraph again)."""
+    return bool(getattr(bpy.app, "is_job_running")("RENDER"))  # noqa: B009 - the stubs say it returns None
+
+
 def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decision | None:
     """The subdivision of ``obj`` for the snapshot (None: keep the last one). Raises ValueError
     from the physics core (superluminal motion), as the update does."""
@@ -96,9 +101,9 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     uniform = Decision(int(settings.tessellation))
     if not settings.use_adaptive_tessellation or settings.tessellation == 0:
         return uniform
-    if snap.exact_camera or bpy.app.is_job_running("RENDER"):
+    if snap.exact_camera or _rendering():
         return None
-    mesh = obj.data
+    mesh = cast("Mesh", obj.data)
     if (
         not _own_mesh(obj)
         or (settings.motion == "ANIMATION" and settings.use_deformation)
@@ -154,21 +159,22 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
     whether anything changed (the object must then be evaluated again before its rest positions
     are read)."""
     group = mod.node_group
+    data = cast("Mesh", cache.data)
     count = 0 if decision.codes is None else len(decision.codes)
     wanted = {"Tessellation": decision.level, "Face Codes": count, "Weld Distance": decision.weld}
-    changed = cache.data.get(names.TESSELLATION_KEY) != decision.key()
+    changed = data.get(names.TESSELLATION_KEY) != decision.key()
     for name, value in wanted.items():
         identifier = interface_identifier(group, name)
         if compat.modifier_input(mod, identifier) != value:
             compat.set_modifier_input(mod, identifier, value)
             changed = True
     if decision.warning is not None:
-        cache.data[names.TESSELLATION_WARNING_KEY] = decision.warning
-    elif names.TESSELLATION_WARNING_KEY in cache.data:
-        del cache.data[names.TESSELLATION_WARNING_KEY]
+        data[names.TESSELLATION_WARNING_KEY] = decision.warning
+    elif names.TESSELLATION_WARNING_KEY in data:
+        del data[names.TESSELLATION_WARNING_KEY]
     if changed:
-        modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), decision.codes)
-        cache.data[names.TESSELLATION_KEY] = decision.key()
+        modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), decision.codes)
+        data[names.TESSELLATION_KEY] = decision.key()
         obj.update_tag()
     return changed
 

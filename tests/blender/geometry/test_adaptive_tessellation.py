@@ -55,7 +55,11 @@ def _analytic_coverage(camera, rest_corners, origin, supersample=8, per_face=140
     grid = np.linspace(0.0, 1.0, per_face)
     s, t = (g.ravel() for g in np.meshgrid(grid, grid))
     for a, b, _, d in quads:
-        rest = rest_corners[a] + np.outer(s, rest_corners[b] - rest_corners[a]) + np.outer(t, rest_corners[d] - rest_corners[a])
+        rest = (
+            rest_corners[a]
+            + np.outer(s, rest_corners[b] - rest_corners[a])
+            + np.outer(t, rest_corners[d] - rest_corners[a])
+        )
         now = origin + gh.contract(rest, BETA)
         seen = _retarded(now, camera.location, BETA)
         local = (camera.rotation.T @ (seen - camera.location).T).T
@@ -127,7 +131,10 @@ def _render_outline_error(bpy, tmp_path, name, **settings):
     error = _outline_error(coverage, analytic, hits)
     if os.environ.get("TESS_DEBUG"):
         _save_png(bpy, np.concatenate((coverage, analytic), axis=1), f"/tmp/tess_{name}.png")
-    print(f"{name}: {vertices} vertices, outline error {error:.2f} px, covered {coverage.sum():.0f} / {analytic.sum():.0f}")
+    print(
+        f"{name}: {vertices} vertices, outline error {error:.2f} px, "
+        f"covered {coverage.sum():.0f} / {analytic.sum():.0f}"
+    )
     return error, vertices, coverage, analytic
 
 
@@ -153,7 +160,9 @@ def _grid_scene(bpy, side, resolution):
     scene, camera_object = ch.new_scene(bpy, resolution=resolution, samples=1)
     camera_object.data.lens = 50.0
     scene.relativity.speed_of_light = 10.0
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=2.0, location=(0.0, 0.0, -6.0))
+    bpy.ops.mesh.primitive_grid_add(
+        x_subdivisions=side - 1, y_subdivisions=side - 1, size=2.0, location=(0.0, 0.0, -6.0)
+    )
     grid = bpy.context.object
     grid.relativity.motion = "CONSTANT"
     grid.relativity.beta = tuple(BETA)
@@ -173,7 +182,6 @@ def test_fine_grid_at_0_9c_gets_few_new_vertices(relativity_addon, factory_blend
     assert len(evaluated) <= 1.2 * count
     # and it moved: the apparent grid is not the rest grid
     assert np.abs(evaluated[:, 0].mean() - grid.location.x) > 0.1
-
 
 
 def _floor_scene(bpy, adaptive):
@@ -219,6 +227,8 @@ def test_partly_subdivided_floor_has_no_cracks(relativity_addon, factory_blender
     for _ in range(3):  # three pixels in from the outline (where the two renders' edges may differ)
         inside[1:-1, 1:-1] &= inside[:-2, 1:-1] & inside[2:, 1:-1] & inside[1:-1, :-2] & inside[1:-1, 2:]
     assert inside.sum() > 3000
-    print(f"darkest pixel inside: {adaptive[inside].min():.3f}; largest difference {np.abs(adaptive - uniform).max():.3f}")
+    print(
+        f"darkest pixel inside: {adaptive[inside].min():.3f}; largest difference {np.abs(adaptive - uniform).max():.3f}"
+    )
     assert adaptive[inside].min() > 0.95
     assert np.abs(adaptive - uniform).max() < 0.5
