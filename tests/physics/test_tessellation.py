@@ -42,7 +42,7 @@ def test_fewest_levels_within_the_tolerance():
     edges = np.arange(2 * len(thetas)).reshape(-1, 2)
     tolerance, max_level = 0.5, 3
     levels, left = tessellation.edge_levels(rest, edges, _onto_circle, _plane, tolerance, max_level)
-    for theta, level, error in zip(thetas, levels, left):
+    for theta, level, error in zip(thetas, levels, left, strict=True):
         sagitta = [RADIUS * (1.0 - math.cos(theta / 2**k / 2.0)) for k in range(max_level + 1)]
         wanted = next((k for k, s in enumerate(sagitta) if s <= tolerance), max_level)
         if RADIUS * theta <= tolerance:  # an image no longer than the tolerance is not measured

@@ -108,7 +108,11 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         if rest is None:
             raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
         obj_eval = obj.evaluated_get(depsgraph)
-        world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
+        measured = decision.vertices if decision is not None and decision.codes is None else None
+        if measured is not None and np.array_equal(measured[0], rest):
+            world, delay, beta_seen = measured[1:]  # the measure computed them for these points
+        else:
+            world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))

@@ -50,6 +50,9 @@ class Decision:
     codes: np.ndarray | None = None
     weld: float = 0.0
     warning: str | None = None
+    # the measured mesh's vertices and what the update computes for them (apparent positions,
+    # light delays, velocities): reused when the evaluated rest points are these vertices
+    vertices: tuple | None = None
 
     def key(self) -> str:
         codes = None if self.codes is None else (len(self.codes), zlib.crc32(self.codes.tobytes()))
@@ -118,7 +121,12 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     window = tuple(snap.projection[1:5])
     size = render_size(scene)
 
+    seen = []
+
     def apparent(points: FloatArray) -> FloatArray:
+        if points is rest and not seen:  # every vertex: as the update computes them
+            seen.extend(motion.apparent_world_positions(scene, obj, obj_eval, points, snap, with_delay=True))
+            return seen[0]
         return motion.apparent_world_positions(scene, obj, obj_eval, points, snap, shape_keys_too=False)[0]
 
     def project(points: FloatArray) -> FloatArray:
@@ -136,7 +144,9 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
         )
     face_level, across = tessellation.face_levels(levels, loop_edges, starts, totals)
     level = int(face_level.max(initial=0))
-    if level == 0 or np.all(face_level > 0):
+    if level == 0:
+        return Decision(0, warning=warning, vertices=(rest, *seen) if seen else None)
+    if np.all(face_level > 0):
         return Decision(level, warning=warning)
     subdivided = face_level > 0
     codes = np.where(subdivided, SUBDIVIDED, np.where(across, ACROSS_SEAM, 0.0)).astype(np.float32)

@@ -232,3 +232,17 @@ def test_partly_subdivided_floor_has_no_cracks(relativity_addon, factory_blender
     )
     assert adaptive[inside].min() > 0.95
     assert np.abs(adaptive - uniform).max() < 0.5
+
+
+def test_too_few_levels_are_named_in_pixels(relativity_addon, factory_blender):
+    """At Tessellation 1 the box's edges still bend beyond the tolerance: the panel's warning
+    names the error left in pixels; at the default (4 levels) there is none."""
+    bpy = factory_blender
+    effect = gh.addon_module("pipeline.effect")
+    scene, _, box, _ = _box_scene(bpy, tessellation=1)
+    gh.apply_geometry(scene)
+    warnings = effect.object_warnings(scene, box)
+    print(warnings)
+    assert len(warnings) == 1 and "px at Tessellation 1" in warnings[0] and "raise Tessellation" in warnings[0]
+    box.relativity.tessellation = 4
+    assert effect.object_warnings(scene, box) == []
