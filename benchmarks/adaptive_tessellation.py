@@ -82,8 +82,13 @@ def main():
     times = {True: [], False: []}
     for _ in range(options.repeats):
         for on in (True, False):
-            grid.relativity.use_adaptive_tessellation = on
-            grid.relativity.tessellation = 4 if on else 0
+            # each setting syncs at once: never every face at 4 levels on the way
+            if on:
+                grid.relativity.use_adaptive_tessellation = True
+                grid.relativity.tessellation = 4
+            else:
+                grid.relativity.tessellation = 0
+                grid.relativity.use_adaptive_tessellation = False
             update()  # the switch itself (a new subdivision) is not what is timed
             times[on].append(update())
     ratio = statistics.median(a / b for a, b in zip(times[True], times[False], strict=True))
@@ -92,8 +97,8 @@ def main():
         f"{statistics.median(times[False]):.2f} s: {ratio:.2f}x (median of {options.repeats} alternating rounds)"
     )
 
-    grid.relativity.use_adaptive_tessellation = False
     grid.relativity.tessellation = 1
+    grid.relativity.use_adaptive_tessellation = False
     update()
     uniform = evaluated_count(bpy, grid)
     print(f"every face at Tessellation 1 (the old default): {uniform:,} = {uniform / own:.3f}x")

@@ -87,6 +87,7 @@ def edge_levels(
     project: Projection,
     tolerance: float,
     max_level: int,
+    frame: tuple[float, float] | None = None,
 ) -> tuple[IndexArray, FloatArray]:
     """For each edge (``edges``: ``(E, 2)`` indices into the rest points ``rest``, ``(V, 3)``) the
     fewest subdivision levels ``k <= max_level`` after which every piece's image error
@@ -95,7 +96,8 @@ def edge_levels(
 
     Edges whose image (the segment between the images of its apparent end points) is at most
     ``tolerance`` pixels long are not measured: an image arc of about that length cannot stray
-    further than its length from its chord's middle, so they need no level. The apparent map is
+    further than its length from its chord's middle, so they need no level; nor, given the
+    picture's ``frame`` (width, height in pixels), edges further out of it than their length. The apparent map is
     evaluated once for every vertex and then only for the edges still too bent, level by level."""
     if not np.isfinite(tolerance) or tolerance <= 0.0:
         raise ValueError(f"tolerance must be a positive number of pixels, got {tolerance!r}")
@@ -114,15 +116,42 @@ def edge_levels(
     neither_seen = ~np.isfinite(ends_a[:, 0]) & ~np.isfinite(ends_b[:, 0])
     # short images need nothing, nor edges with both ends out of the camera's sight; an edge with
     # one end behind the camera is measured (and split)
-    todo = np.flatnonzero(~(both_seen & (length <= tolerance)) & ~neither_seen)
+    todo = np.flatnonzero(
+        ~(both_seen & (length <= tolerance)) & ~neither_seen & ~_off_frame(ends_a, ends_b, length, frame)
+    )
     for level in range(max_level + 1):
         if len(todo) == 0:
             break
-        bend = segment_bends(rest[edges[todo, 0]], rest[edges[todo, 1]], 2**level, apparent, project)
+        bend = np.concatenate(
+            [
+                segment_bends(rest[edges[chunk, 0]], rest[edges[chunk, 1]], 2**level, apparent, project)
+                for chunk in np.array_split(todo, -(-len(todo) // CHUNK))
+            ]
+        )
         levels[todo] = level
         left[todo] = bend
         todo = todo[bend > tolerance]
     return levels, left
+
+
+# edges measured at once (bounds the memory of the pieces' points)
+CHUNK = 200_000
+
+
+def _off_frame(
+    ends_a: FloatArray, ends_b: FloatArray, length: FloatArray, frame: tuple[float, float] | None
+) -> BoolArray:
+    """Edges whose image lies beyond one side of the ``frame`` (width, height in pixels) by more
+    than its length: as for short images, the arc cannot reach back into the picture."""
+    if frame is None:
+        return np.zeros(len(length), dtype=bool)
+    width, height = frame
+    with np.errstate(invalid="ignore"):
+        x_low = np.maximum(ends_a[:, 0], ends_b[:, 0]) < -length
+        x_high = np.minimum(ends_a[:, 0], ends_b[:, 0]) > width + length
+        y_low = np.maximum(ends_a[:, 1], ends_b[:, 1]) < -length
+        y_high = np.minimum(ends_a[:, 1], ends_b[:, 1]) > height + length
+    return np.asarray(x_low | x_high | y_low | y_high)
 
 
 def face_levels(

@@ -102,3 +102,16 @@ def test_face_levels_and_the_faces_across_the_seam():
 def test_bad_tolerance_is_refused():
     with pytest.raises(ValueError, match="tolerance"):
         tessellation.edge_levels(np.zeros((2, 3)), [[0, 1]], lambda p: p, _plane, 0.0, 2)
+
+
+def test_edges_far_out_of_the_picture_are_not_measured():
+    """An arc bending 2.4 px, its image wholly left of a 100 x 100 picture by more than its length:
+    no level given the frame; without it, split as any other."""
+    rest = np.array([[0.0, 0.0, 0.0], [0.8, 0.0, 0.0]])
+
+    def far_left(points):
+        return _plane(_onto_circle(points)) - np.array([300.0, 0.0])
+
+    measured, _ = tessellation.edge_levels(rest, [[0, 1]], lambda p: p, far_left, 0.5, 3)
+    framed, _ = tessellation.edge_levels(rest, [[0, 1]], lambda p: p, far_left, 0.5, 3, frame=(100.0, 100.0))
+    assert measured[0] > 0 and framed[0] == 0

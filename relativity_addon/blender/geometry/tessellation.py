@@ -70,19 +70,24 @@ def _own_mesh(obj: Object) -> bool:
     return True
 
 
-def _mesh_arrays(mesh: Mesh) -> tuple[FloatArray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Vertices (object space), edges, and the faces' loop edges, loop starts and loop totals."""
+def _mesh_arrays(mesh: Mesh) -> tuple[FloatArray, np.ndarray]:
+    """Vertices (object space) and edges."""
     rest = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", rest)
     edges = np.empty(len(mesh.edges) * 2, dtype=np.int32)
     mesh.edges.foreach_get("vertices", edges)
+    return rest.reshape(-1, 3).astype(np.float64), edges.reshape(-1, 2)
+
+
+def _face_arrays(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The faces' loop edges, loop starts and loop totals."""
     loop_edges = np.empty(len(mesh.loops), dtype=np.int32)
     mesh.loops.foreach_get("edge_index", loop_edges)
     starts = np.empty(len(mesh.polygons), dtype=np.int32)
     mesh.polygons.foreach_get("loop_start", starts)
     totals = np.empty(len(mesh.polygons), dtype=np.int32)
     mesh.polygons.foreach_get("loop_total", totals)
-    return rest.reshape(-1, 3).astype(np.float64), edges.reshape(-1, 2), loop_edges, starts, totals
+    return loop_edges, starts, totals
 
 
 def render_size(scene: Scene) -> tuple[float, float]:
@@ -115,7 +120,7 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
         or len(mesh.polygons) == 0
     ):
         return uniform
-    rest, edges, loop_edges, starts, totals = _mesh_arrays(mesh)
+    rest, edges = _mesh_arrays(mesh)
     eye = snap.mesh_observer[1]
     world_to_camera = snap.world_to_camera
     window = tuple(snap.projection[1:5])
@@ -133,7 +138,7 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
         return tessellation.perspective_pixels(points, eye, world_to_camera, window, size)
 
     tolerance = float(settings.tessellation_tolerance)
-    levels, left = tessellation.edge_levels(rest, edges, apparent, project, tolerance, int(settings.tessellation))
+    levels, left = tessellation.edge_levels(rest, edges, apparent, project, tolerance, int(settings.tessellation), size)
     warning = ""
     if np.any(left > tolerance):
         worst = float(np.max(left))
@@ -142,9 +147,12 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
             f"Mesh {obj.name!r}: edges {bend} at Tessellation {settings.tessellation} "
             f"(tolerance {tolerance:g} px): raise Tessellation"
         )
+    if not np.any(levels):
+        return Decision(0, warning=warning, vertices=(rest, *seen) if seen else None)
+    loop_edges, starts, totals = _face_arrays(mesh)
     face_level, across = tessellation.face_levels(levels, loop_edges, starts, totals)
     level = int(face_level.max(initial=0))
-    if level == 0:
+    if level == 0:  # only loose edges bend
         return Decision(0, warning=warning, vertices=(rest, *seen) if seen else None)
     if np.all(face_level > 0):
         return Decision(level, warning=warning)
