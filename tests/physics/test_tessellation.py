@@ -110,8 +110,8 @@ def test_edges_far_out_of_the_picture_are_not_measured():
     rest = np.array([[0.0, 0.0, 0.0], [0.8, 0.0, 0.0]])
 
     def far_left(points):
-        return _plane(_onto_circle(points)) - np.array([300.0, 0.0])
+        return _plane(points) - np.array([300.0, 0.0])
 
-    measured, _ = tessellation.edge_levels(rest, [[0, 1]], lambda p: p, far_left, 0.5, 3)
-    framed, _ = tessellation.edge_levels(rest, [[0, 1]], lambda p: p, far_left, 0.5, 3, frame=(100.0, 100.0))
+    measured, _ = tessellation.edge_levels(rest, [[0, 1]], _onto_circle, far_left, 0.5, 3)
+    framed, _ = tessellation.edge_levels(rest, [[0, 1]], _onto_circle, far_left, 0.5, 3, frame=(100.0, 100.0))
     assert measured[0] > 0 and framed[0] == 0
