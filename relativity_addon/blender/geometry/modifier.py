@@ -92,8 +92,8 @@ def _subdivision_nodes() -> dict[str, Node]:
         ),
         "weld": Node(
             "GeometryNodeMergeByDistance",
+            # mode All, the default on both lines (a property in 4.5, a menu socket in 5.2)
             {"Geometry": "join.Geometry", "Selection": "seam_point.Result", "Distance": "group.Weld Distance"},
-            {"mode": "ALL"},
         ),
         "subdivide_all": Node("GeometryNodeSubdivideMesh", {"Mesh": "group.Geometry", "Level": "group.Tessellation"}),
         "subdivided": Node(
