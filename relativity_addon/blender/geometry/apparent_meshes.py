@@ -381,7 +381,10 @@ def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | No
     if adaptive is not None:
         return adaptive or None
     # the modifier halves every edge once per tessellation level before moving the vertices
-    fraction = longest_edge_fraction(obj, camera_position) / 2**obj.relativity.tessellation
+    level = obj.relativity.tessellation
+    if obj.relativity.use_adaptive_tessellation:
+        level = min(level, tessellation.UNMEASURED_LEVELS)  # where nothing was measured
+    fraction = longest_edge_fraction(obj, camera_position) / 2**level
     if fraction > COARSE_EDGE_FRACTION:
         return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
     return None

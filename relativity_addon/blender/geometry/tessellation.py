@@ -10,8 +10,9 @@ from a subdivided one are marked too (code 2): the modifier puts the seam's new 
 straight edges, so the surface has no crack there.
 
 The decision is made on the object's own mesh: with an enabled modifier before the relativity
-one, a deformation bake, or a camera that is not a perspective one, every face gets
-*Tessellation* levels, as without *Adaptive*. While a render runs (and behind the exact camera of
+one, a deformation bake, or a camera that is not a perspective one, every face gets one level
+(at most *Tessellation*), the default before *Adaptive*; *Adaptive* off gives every face the
+*Tessellation* levels. While a render runs (and behind the exact camera of
 the final render) the decision of the last update is kept: its topology must not change where
 the depsgraph cannot be evaluated again.
 """
@@ -37,6 +38,9 @@ if TYPE_CHECKING:
     from ..scene.snapshot import Snapshot
 
 SUBDIVIDED, ACROSS_SEAM = 1.0, 2.0  # face codes (0: left as it is)
+# Adaptive where the edges cannot be measured: every face gets at most this many levels (the
+# default before adaptive tessellation), not Tessellation's most
+UNMEASURED_LEVELS = 1
 
 
 @dataclass(frozen=True)
@@ -106,9 +110,9 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     """The subdivision of ``obj`` for the snapshot (None: keep the last one). Raises ValueError
     from the physics core (superluminal motion), as the update does."""
     settings = obj.relativity
-    uniform = Decision(int(settings.tessellation))
     if not settings.use_adaptive_tessellation or settings.tessellation == 0:
-        return uniform
+        return Decision(int(settings.tessellation))
+    uniform = Decision(min(int(settings.tessellation), UNMEASURED_LEVELS))
     if snap.exact_camera or _rendering():
         return None
     mesh = cast("Mesh", obj.data)
