@@ -71,13 +71,30 @@ def segment_bends(
     image_middle = np.asarray(project(middles.reshape(-1, 3))).reshape(len(a), parts, 2)
     image_drawn = np.asarray(project(((ends_a + ends_b) / 2.0).reshape(-1, 3))).reshape(len(a), parts, 2)
     image_ends = np.asarray(project(seen[:, 0::2].reshape(-1, 3))).reshape(len(a), parts + 1, 2)
-    bend = np.linalg.norm(image_middle - image_drawn, axis=2)
-    visible = np.isfinite(image_middle[..., 0]) | np.isfinite(image_drawn[..., 0])
-    visible |= np.isfinite(image_ends[:, :-1, 0]) | np.isfinite(image_ends[:, 1:, 0])
-    hidden = ~np.isfinite(image_middle[..., 0]) | ~np.isfinite(image_drawn[..., 0])
-    hidden |= ~np.isfinite(image_ends[:, :-1, 0]) | ~np.isfinite(image_ends[:, 1:, 0])
-    bend = np.where(visible & hidden, np.inf, np.where(visible, bend, 0.0))
-    return np.max(bend, axis=1)
+    return np.max(_piece_bends(image_middle, image_drawn, image_ends[:, :-1], image_ends[:, 1:]), axis=1)
+
+
+def _piece_bends(
+    image_middle: FloatArray, image_drawn: FloatArray, image_a: FloatArray, image_b: FloatArray
+) -> FloatArray:
+    """The pieces' errors from the images of their middles, drawn middles and ends (``(..., 2)``):
+    infinite where some of these are seen and some not, zero where none is."""
+    bend = np.linalg.norm(image_middle - image_drawn, axis=-1)
+    seen = [np.isfinite(image[..., 0]) for image in (image_middle, image_drawn, image_a, image_b)]
+    visible = seen[0] | seen[1] | seen[2] | seen[3]
+    hidden = ~(seen[0] & seen[1] & seen[2] & seen[3])
+    return np.where(visible & hidden, np.inf, np.where(visible, bend, 0.0))
+
+
+def _whole_edge_bends(
+    rest: FloatArray, edges: IndexArray, seen: FloatArray, image: FloatArray, apparent: ApparentMap, project: Projection
+) -> FloatArray:
+    """:func:`segment_bends` of whole edges (one piece) given their ends' apparent positions
+    ``seen`` and images ``image`` (per vertex): one apparent position more per edge, not three."""
+    a, b = edges[:, 0], edges[:, 1]
+    middles = np.asarray(apparent((rest[a] + rest[b]) / 2.0), dtype=np.float64)
+    image_drawn = np.asarray(project((seen[a] + seen[b]) / 2.0))
+    return _piece_bends(np.asarray(project(middles)), image_drawn, image[a], image[b])
 
 
 def edge_levels(
@@ -109,7 +126,8 @@ def edge_levels(
     left = np.zeros(len(edges))
     if len(edges) == 0:
         return levels, left
-    image = np.asarray(project(np.asarray(apparent(rest), dtype=np.float64)))
+    seen = np.asarray(apparent(rest), dtype=np.float64)
+    image = np.asarray(project(seen))
     ends_a, ends_b = image[edges[:, 0]], image[edges[:, 1]]
     length = np.linalg.norm(ends_b - ends_a, axis=1)
     both_seen = np.isfinite(length)
@@ -124,7 +142,9 @@ def edge_levels(
             break
         bend = np.concatenate(
             [
-                segment_bends(rest[edges[chunk, 0]], rest[edges[chunk, 1]], 2**level, apparent, project)
+                _whole_edge_bends(rest, edges[chunk], seen, image, apparent, project)
+                if level == 0
+                else segment_bends(rest[edges[chunk, 0]], rest[edges[chunk, 1]], 2**level, apparent, project)
                 for chunk in np.array_split(todo, -(-len(todo) // CHUNK))
             ]
         )

@@ -133,7 +133,8 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     seen = []
 
     def apparent(points: FloatArray) -> FloatArray:
-        if points is rest and not seen:  # every vertex: as the update computes them
+        if not seen and points.shape == rest.shape and np.may_share_memory(points, rest):
+            # every vertex (edge_levels' first call, a view of ``rest``): as the update computes them
             seen.extend(motion.apparent_world_positions(scene, obj, obj_eval, points, snap, with_delay=True))
             return seen[0]
         return motion.apparent_world_positions(scene, obj, obj_eval, points, snap, shape_keys_too=False)[0]
