@@ -375,18 +375,21 @@ def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:
 
 def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | None:
     """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None:
-    with adaptive tessellation, edges left bent beyond the tolerance at the last update; without
-    (or where the edges were not measured), edges long for their distance to the camera."""
-    adaptive = tessellation.warning(obj) if obj.relativity.use_adaptive_tessellation else None
-    if adaptive is not None:
-        return adaptive or None
-    # the modifier halves every edge once per tessellation level before moving the vertices
+    with adaptive tessellation, edges left bent beyond the tolerance at the last update (nothing
+    before Set Up: the update measures them); without, or where the update could not measure them,
+    edges long for their distance to the camera."""
     level = obj.relativity.tessellation
+    advice = "raise Tessellation"
     if obj.relativity.use_adaptive_tessellation:
-        level = min(level, tessellation.UNMEASURED_LEVELS)  # where nothing was measured
+        measured = tessellation.warning(obj)
+        if measured is not None or modifier.find_modifier(obj) is None:
+            return measured or None
+        level = min(level, tessellation.UNMEASURED_LEVELS)  # what the update gives every face then
+        advice = "set Adaptive off and raise Tessellation (Adaptive cannot measure this mesh)"
+    # the modifier halves every edge once per tessellation level before moving the vertices
     fraction = longest_edge_fraction(obj, camera_position) / 2**level
     if fraction > COARSE_EDGE_FRACTION:
-        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
+        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, {advice}"
     return None
 
 

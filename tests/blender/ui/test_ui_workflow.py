@@ -210,8 +210,9 @@ def test_coarse_mesh_warning_for_the_geometry_method(relativity_addon, factory_b
     scene.collection.objects.link(wall)
     bpy.context.view_layer.update()
     scene.relativity.method = "GEOMETRY"
-    # Before Set Up nothing is measured in pixels (adaptive tessellation measures at each update,
-    # tests/blender/geometry/test_adaptive_tessellation.py): the coarse-edge measure applies.
+    # Without Adaptive, the coarse-edge measure (adaptive tessellation measures edges in pixels at
+    # each update: tests/blender/geometry/test_adaptive_tessellation.py)
+    wall.relativity.use_adaptive_tessellation = False
     wall.relativity.tessellation = 1
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, wall)
     # The quad's four sides are 4 long; their midpoints are sqrt(2^2 + 4^2) from the camera:
