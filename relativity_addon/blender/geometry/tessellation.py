@@ -19,6 +19,7 @@ the depsgraph cannot be evaluated again.
 
 from __future__ import annotations
 
+import math
 import zlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
@@ -188,7 +189,9 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
     changed = data.get(names.TESSELLATION_KEY) != decision.key()
     for name, value in wanted.items():
         identifier = interface_identifier(group, name)
-        if compat.modifier_input(mod, identifier) != value:
+        current = compat.modifier_input(mod, identifier)
+        # a float socket may hold the value in single precision: equal within its rounding
+        if current is None or not math.isclose(float(current), float(value), rel_tol=1e-6, abs_tol=0.0):
             compat.set_modifier_input(mod, identifier, value)
             changed = True
     if decision.warning is not None:
