@@ -249,20 +249,21 @@ def test_too_few_levels_are_named_in_pixels(relativity_addon, factory_blender):
 
 
 def test_an_unchanged_decision_evaluates_nothing_again(relativity_addon, factory_blender):
-    """After Set Up, the same snapshot makes the same decision, and applying it changes nothing
-    (no second evaluation of the object at every update); a faster box changes it."""
+    """After Set Up, the same snapshot makes the same decision for the partly subdivided floor,
+    and applying it changes nothing (no second evaluation of the object at every update: the
+    modifier holds the weld distance in single precision); a slower observer changes it."""
     bpy = factory_blender
     tessellation = gh.addon_module("geometry.tessellation")
     modifier = gh.addon_module("geometry.modifier")
     snapshot = gh.addon_module("scene.snapshot")
-    scene, _, box, _ = _box_scene(bpy)
+    scene, floor = _floor_scene(bpy, True)
     gh.apply_geometry(scene)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    mod, cache = modifier.ensure_modifier(box)
-    decision = tessellation.decide(scene, box, box.evaluated_get(depsgraph), snapshot.read(scene, depsgraph))
-    assert decision.level == 3  # every face at 3 levels (578 vertices, as measured above)
-    assert not tessellation.apply(box, mod, cache, decision)
-    box.relativity.beta = (0.3, 0.0, 0.0)
+    mod, cache = modifier.ensure_modifier(floor)
+    decision = tessellation.decide(scene, floor, floor.evaluated_get(depsgraph), snapshot.read(scene, depsgraph))
+    assert decision.codes is not None and decision.weld > 0.0  # partly subdivided
+    assert not tessellation.apply(floor, mod, cache, decision)
+    scene.relativity.beta = (0.0, 0.0, -0.2)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    slower = tessellation.decide(scene, box, box.evaluated_get(depsgraph), snapshot.read(scene, depsgraph))
+    slower = tessellation.decide(scene, floor, floor.evaluated_get(depsgraph), snapshot.read(scene, depsgraph))
     assert slower.key() != decision.key()
