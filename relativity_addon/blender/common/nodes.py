@@ -26,6 +26,12 @@ class Literal(str):
 
 
 Menu = Literal
+
+
+class Links(tuple):
+    """Several references into one multi-input socket (Join Geometry), linked in order."""
+
+
 TreeType = typing.Literal["GeometryNodeTree", "CompositorNodeTree", "ShaderNodeTree"]
 
 
@@ -124,7 +130,10 @@ def build_group(spec: Group) -> NodeTree:
     for name, node_spec in spec.nodes.items():
         for key, value in node_spec.inputs.items():
             target = _socket(built[name].inputs, key)
-            if isinstance(value, str) and not isinstance(value, Literal):
+            if isinstance(value, Links):
+                for reference in value:
+                    tree.links.new(resolve(reference), target)
+            elif isinstance(value, str) and not isinstance(value, Literal):
                 tree.links.new(resolve(value), target)
             else:
                 target.default_value = value

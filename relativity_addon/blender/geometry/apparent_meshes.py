@@ -29,7 +29,7 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import lens, moving_objects, snapshot
-from . import modifier, motion
+from . import modifier, motion, tessellation
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
@@ -75,6 +75,10 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
         relativity.motion,
         tuple(relativity.beta),
         relativity.tessellation,
+        (relativity.use_adaptive_tessellation, relativity.tessellation_tolerance, snap.projection)
+        if relativity.use_adaptive_tessellation
+        else None,
+        _render_size(snap) if relativity.use_adaptive_tessellation else None,
         relativity.samples_per_frame,
         snap.fps,
         relativity.use_deformation,
@@ -85,24 +89,37 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
     return repr(parts)
 
 
+def _render_size(snap: Snapshot) -> tuple[float, float] | None:
+    scene = bpy.data.scenes.get(snap.scene)
+    return tessellation.render_size(scene) if scene is not None else None
+
+
 def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None) -> int:
     """Recompute the cache of one object for the snapshot's frame. Raises RelativityError."""
-    _, cache = modifier.ensure_modifier(obj)
+    mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
-    rest = modifier.evaluated_rest_positions(obj, depsgraph)
-    if rest is None:
-        raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
-    obj_eval = obj.evaluated_get(depsgraph)
     try:
-        world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
+        decision = tessellation.decide(scene, obj, obj.evaluated_get(depsgraph), snap)
+        if decision is not None and tessellation.apply(obj, mod, cache, decision):
+            depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
+        codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
+        rest = modifier.evaluated_rest_positions(obj, depsgraph)
+        if rest is None:
+            raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
+        obj_eval = obj.evaluated_get(depsgraph)
+        measured = decision.vertices if decision is not None and decision.codes is None else None
+        if measured is not None and np.array_equal(measured[0], rest):
+            world, delay, beta_seen = measured[1:]  # the measure computed them for these points
+        else:
+            world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))
     inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
     # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
-    modifier.write_cache(cache.data, local, beta_seen)
+    modifier.write_cache(cache.data, local, beta_seen, codes)
     cache.data[names.DEPTH_KEY] = farthest_seen_depth(scene, snap, world)
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
     if names.ERROR_KEY in cache.data:
@@ -460,11 +477,22 @@ def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:
 
 
 def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | None:
-    """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None."""
+    """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None:
+    with adaptive tessellation, edges left bent beyond the tolerance at the last update (nothing
+    before Set Up: the update measures them); without, or where the update could not measure them,
+    edges long for their distance to the camera."""
+    level = obj.relativity.tessellation
+    advice = "raise Tessellation"
+    if obj.relativity.use_adaptive_tessellation:
+        measured = tessellation.warning(obj)
+        if measured is not None or modifier.find_modifier(obj) is None:
+            return measured or None
+        level = min(level, tessellation.UNMEASURED_LEVELS)  # what the update gives every face then
+        advice = "set Adaptive off and raise Tessellation (Adaptive cannot measure this mesh)"
     # the modifier halves every edge once per tessellation level before moving the vertices
-    fraction = longest_edge_fraction(obj, camera_position) / 2**obj.relativity.tessellation
+    fraction = longest_edge_fraction(obj, camera_position) / 2**level
     if fraction > COARSE_EDGE_FRACTION:
-        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, raise Tessellation"
+        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, {advice}"
     return None
 
 
@@ -513,3 +541,9 @@ def clip_end_warnings(scene: Scene, snap: Snapshot) -> list[str]:
         f"Camera {camera.name!r}: Clip End {camera.data.clip_end * scale:.5g} m cuts off mesh {name!r}, "
         f"seen {depth * scale:.5g} m away at this speed: set Clip End to {_round_up(depth * scale * 1.01):.5g} m"
     ]
+
+
+def tessellation_warning(obj: Object) -> str | None:
+    """The adaptive tessellation's line about edges still too bent at the last update
+    (``tessellation.warning``)."""
+    return tessellation.warning(obj)

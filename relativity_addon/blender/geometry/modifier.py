@@ -19,7 +19,7 @@ import bpy
 import numpy as np
 
 from ..common import compat, names
-from ..common.nodes import Group, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
+from ..common.nodes import Group, Links, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
 
 if TYPE_CHECKING:
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
@@ -27,27 +27,179 @@ if TYPE_CHECKING:
     from ...physics.arrays import FloatArray
 
 
+def _subdivision_nodes() -> dict[str, Node]:
+    """The subdivision: every face at Tessellation levels (``Face Codes`` 0, or not this mesh's face
+    count), else only the faces whose code, read from the last ``Face Codes`` points of the cache
+    (one per face of the incoming mesh), is 1; the two parts are welded again along their seam
+    (``Weld Distance``). Output: ``subdivided.Output``."""
+    face_code = {"data_type": "FLOAT", "domain": "FACE"}
+    return {
+        "in_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "group.Geometry"}, {"component": "MESH"}),
+        "codes_given": Node(
+            "FunctionNodeCompare", {"A": "group.Face Codes", "B": 0}, {"data_type": "INT", "operation": "GREATER_THAN"}
+        ),
+        "codes_fit": Node(
+            "FunctionNodeCompare",
+            {"A": "group.Face Codes", "B": "in_size.Face Count"},
+            {"data_type": "INT", "operation": "EQUAL"},
+        ),
+        "adaptive": Node(
+            "FunctionNodeBooleanMath", {0: "codes_given.Result", 1: "codes_fit.Result"}, {"operation": "AND"}
+        ),
+        "codes_start": Node(
+            "FunctionNodeIntegerMath", {0: "cache_size.Point Count", 1: "group.Face Codes"}, {"operation": "SUBTRACT"}
+        ),
+        "face_index": Node("GeometryNodeInputIndex"),
+        "code_index": Node(
+            "FunctionNodeIntegerMath", {0: "codes_start.Value", 1: "face_index.Index"}, {"operation": "ADD"}
+        ),
+        "cache_code": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
+        ),
+        "sample_code": Node(
+            "GeometryNodeSampleIndex",
+            {"Geometry": "cache_info.Geometry", "Value": "cache_code.Attribute", "Index": "code_index.Value"},
+            {"data_type": "FLOAT", "domain": "POINT"},
+        ),
+        "store_code": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "group.Geometry", "Name": Literal(names.FACE_CODE_ATTRIBUTE), "Value": "sample_code.Value"},
+            face_code,
+        ),
+        "code": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
+        ),
+        "is_subdivided": Node(
+            "FunctionNodeCompare",
+            {"A": "code.Attribute", "B": 1.0, "Epsilon": 0.25},
+            {"data_type": "FLOAT", "operation": "EQUAL"},
+        ),
+        "separate": Node(
+            "GeometryNodeSeparateGeometry",
+            {"Geometry": "store_code.Geometry", "Selection": "is_subdivided.Result"},
+            {"domain": "FACE"},
+        ),
+        "subdivide_part": Node(
+            "GeometryNodeSubdivideMesh", {"Mesh": "separate.Selection", "Level": "group.Tessellation"}
+        ),
+        "join": Node("GeometryNodeJoinGeometry", {"Geometry": Links(("separate.Inverted", "subdivide_part.Mesh"))}),
+        # points of the faces on either side of the seam (codes 1 and 2; a code read on the points is
+        # the mean of their faces'), where the two parts' copies of a vertex are welded again
+        "seam_point": Node(
+            "FunctionNodeCompare",
+            {"A": "code.Attribute", "B": 0.05},
+            {"data_type": "FLOAT", "operation": "GREATER_THAN"},
+        ),
+        "weld": Node(
+            "GeometryNodeMergeByDistance",
+            # mode All, the default on both lines (a property in 4.5, a menu socket in 5.2)
+            {"Geometry": "join.Geometry", "Selection": "seam_point.Result", "Distance": "group.Weld Distance"},
+        ),
+        "subdivide_all": Node("GeometryNodeSubdivideMesh", {"Mesh": "group.Geometry", "Level": "group.Tessellation"}),
+        "subdivided": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "adaptive.Boolean", "False": "subdivide_all.Mesh", "True": "weld.Geometry"},
+            {"input_type": "GEOMETRY"},
+        ),
+    }
+
+
+def _seam_nodes() -> dict[str, Node]:
+    """Points of the subdivided faces on the seam's edges (which the faces of code 2 across the seam
+    do not have) are put on those faces' straight edges, so the surface has no crack: each takes the
+    apparent position interpolated on the code-2 faces at its rest position. Input: ``store_beta``;
+    output: ``unmarked.Geometry``."""
+    vector = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
+    return {
+        "is_ring": Node(
+            "FunctionNodeCompare",
+            {"A": "code.Attribute", "B": 2.0, "Epsilon": 0.25},
+            {"data_type": "FLOAT", "operation": "EQUAL"},
+        ),
+        "ring": Node(
+            "GeometryNodeSeparateGeometry",
+            {"Geometry": "store_beta.Geometry", "Selection": "is_ring.Result"},
+            {"domain": "FACE"},
+        ),
+        "store_seen": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "ring.Selection", "Name": Literal(names.SEEN_ATTRIBUTE), "Value": "position.Position"},
+            vector,
+        ),
+        "rest": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.REST_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
+        ),
+        "ring_at_rest": Node(
+            "GeometryNodeSetPosition", {"Geometry": "store_seen.Geometry", "Position": "rest.Attribute"}
+        ),
+        "ring_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "ring.Selection"}, {"component": "MESH"}),
+        "has_ring": Node(
+            "FunctionNodeCompare",
+            {"A": "ring_size.Face Count", "B": 0},
+            {"data_type": "INT", "operation": "GREATER_THAN"},
+        ),
+        "proximity": Node(
+            "GeometryNodeProximity",
+            {0: "ring_at_rest.Geometry", "Sample Position": "rest.Attribute"},
+            {"target_element": "FACES"},
+        ),
+        "on_ring": Node(
+            "FunctionNodeCompare",
+            {"A": "proximity.Distance", "B": "group.Weld Distance"},
+            {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
+        ),
+        "snap": Node("FunctionNodeBooleanMath", {0: "on_ring.Result", 1: "has_ring.Result"}, {"operation": "AND"}),
+        "snap_moved": Node(
+            "FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "counts_match.Result"}, {"operation": "AND"}
+        ),
+        "seen": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
+        ),
+        "interpolated": Node(
+            "GeometryNodeSampleNearestSurface",
+            {"Mesh": "ring_at_rest.Geometry", "Value": "seen.Attribute", "Sample Position": "rest.Attribute"},
+            {"data_type": "FLOAT_VECTOR"},
+        ),
+        "snapped": Node(
+            "GeometryNodeSetPosition",
+            {"Geometry": "store_beta.Geometry", "Selection": "snap_moved.Boolean", "Position": "interpolated.Value"},
+        ),
+        "seamless": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "adaptive.Boolean", "False": "store_beta.Geometry", "True": "snapped.Geometry"},
+            {"input_type": "GEOMETRY"},
+        ),
+        "unmarked": Node(
+            "GeometryNodeRemoveAttribute", {"Geometry": "seamless.Output", "Name": Literal(names.FACE_CODE_ATTRIBUTE)}
+        ),
+    }
+
+
 def node_group_spec() -> Group:
     store = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
     mesh_size = {"component": "MESH"}
     nodes = {
-        "subdivide": Node("GeometryNodeSubdivideMesh", {"Mesh": "group.Geometry", "Level": "group.Tessellation"}),
+        "cache_info": Node("GeometryNodeObjectInfo", {"Object": "group.Cache"}, {"transform_space": "ORIGINAL"}),
+        "cache_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "cache_info.Geometry"}, mesh_size),
+        **_subdivision_nodes(),
         "position": Node("GeometryNodeInputPosition"),
         "store_rest": Node(
             "GeometryNodeStoreNamedAttribute",
             {
-                "Geometry": "subdivide.Mesh",
+                "Geometry": "subdivided.Output",
                 "Name": Literal(names.REST_ATTRIBUTE),
                 "Value": "position.Position",
             },
             store,
         ),
-        "cache_info": Node("GeometryNodeObjectInfo", {"Object": "group.Cache"}, {"transform_space": "ORIGINAL"}),
-        "cache_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "cache_info.Geometry"}, mesh_size),
         "mesh_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "store_rest.Geometry"}, mesh_size),
+        # the cache holds a position per point, then the face codes
+        "cache_points": Node(
+            "FunctionNodeIntegerMath", {0: "cache_size.Point Count", 1: "group.Face Codes"}, {"operation": "SUBTRACT"}
+        ),
         "counts_match": Node(
             "FunctionNodeCompare",
-            {"A": "cache_size.Point Count", "B": "mesh_size.Point Count"},
+            {"A": "cache_points.Value", "B": "mesh_size.Point Count"},
             {"data_type": "INT", "operation": "EQUAL"},
         ),
         "index": Node("GeometryNodeInputIndex"),
@@ -90,6 +242,7 @@ def node_group_spec() -> Group:
             },
             store,
         ),
+        **_seam_nodes(),
     }
     return Group(
         names.GEOMETRY_GROUP,
@@ -98,8 +251,10 @@ def node_group_spec() -> Group:
             ("Geometry", "NodeSocketGeometry", None),
             ("Tessellation", "NodeSocketInt", {"min_value": 0, "max_value": 6, "default_value": 1}),
             ("Cache", "NodeSocketObject", None),
+            ("Face Codes", "NodeSocketInt", {"min_value": 0, "default_value": 0}),
+            ("Weld Distance", "NodeSocketFloat", {"min_value": 0.0, "default_value": 0.0}),
         ),
-        (("Geometry", "NodeSocketGeometry", "store_beta.Geometry"),),
+        (("Geometry", "NodeSocketGeometry", "unmarked.Geometry"),),
         nodes,
     )
 
@@ -151,6 +306,7 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     """The object's modifier and cache object, created if missing. Returns (modifier, cache)."""
     group = ensure_node_group()
     modifier = find_modifier(obj)
+    created = modifier is None
     if modifier is None:
         modifier = obj.modifiers.new(names.GEOMETRY_MODIFIER, "NODES")
         modifier.node_group = group
@@ -163,10 +319,15 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
         compat.set_modifier_input(modifier, interface_identifier(group, "Cache"), cache)
     if cache.data.get(names.OWNER_KEY) != obj.name:
         cache.data[names.OWNER_KEY] = obj.name  # set on creation, and follows a rename
-    identifier = interface_identifier(group, "Tessellation")
-    if compat.modifier_input(modifier, identifier) != int(obj.relativity.tessellation):
-        compat.set_modifier_input(modifier, identifier, int(obj.relativity.tessellation))
-        obj.update_tag()  # a modifier input is no tagged property: re-evaluate before reading the rest
+    # with adaptive tessellation the update sets the level (geometry/tessellation.py); a new
+    # modifier starts with none, so Set Up never subdivides a large mesh it may not need to
+    adaptive = bool(obj.relativity.use_adaptive_tessellation)
+    if created or not adaptive:
+        identifier = interface_identifier(group, "Tessellation")
+        level = 0 if adaptive else int(obj.relativity.tessellation)
+        if compat.modifier_input(modifier, identifier) != level:
+            compat.set_modifier_input(modifier, identifier, level)
+            obj.update_tag()  # a modifier input is no tagged property: re-evaluate before reading the rest
     enabled = bool(obj.relativity.enabled)
     if modifier.show_viewport != enabled or modifier.show_render != enabled:
         modifier.show_viewport = modifier.show_render = enabled
@@ -263,16 +424,26 @@ def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph) -> FloatArray | 
     return rest.reshape(-1, 3).astype(np.float64)
 
 
-def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray) -> None:
+def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray, face_codes: FloatArray | None = None) -> None:
     """Object-space positions ``(N, 3)`` and observer-frame velocities ``beta`` (``(N, 3)``, or
-    ``(1, 3)`` shared by every point) into the cache mesh."""
-    count = len(positions)
+    ``(1, 3)`` shared by every point) into the cache mesh; then, with adaptive tessellation, one
+    point per face of the modifier's incoming mesh holding its code (``geometry/tessellation.py``)."""
+    codes = 0 if face_codes is None else len(face_codes)
+    count = len(positions) + codes
     if len(mesh.vertices) != count:
         mesh.clear_geometry()
         mesh.vertices.add(count)
+    if codes:
+        positions = np.concatenate((positions, np.zeros((codes, 3))))
+        if len(beta) > 1:
+            beta = np.concatenate((beta, np.zeros((codes, 3))))
     # The attribute API copies the float32 buffer in one go; vertices.foreach_set("co") was
     # measured 150x slower (70 ms for a million vertices).
-    mesh.attributes["position"].data.foreach_set("vector", np.ascontiguousarray(positions, dtype=np.float32).ravel())
+    if count:  # an empty mesh has no position attribute
+        mesh.attributes["position"].data.foreach_set(
+            "vector", np.ascontiguousarray(positions, dtype=np.float32).ravel()
+        )
+    _write_face_codes(mesh, count, face_codes)
     attribute = mesh.attributes.get(names.BETA_ATTRIBUTE)
     if attribute is None:
         attribute = mesh.attributes.new(names.BETA_ATTRIBUTE, "FLOAT_VECTOR", "POINT")
@@ -289,3 +460,16 @@ def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray) -> None:
         values[:] = beta
         attribute.data.foreach_set("vector", values.ravel())
     mesh.update()
+
+
+def _write_face_codes(mesh, count, face_codes):
+    attribute = mesh.attributes.get(names.FACE_CODE_ATTRIBUTE)
+    if face_codes is None or len(face_codes) == 0:
+        if attribute is not None:
+            mesh.attributes.remove(attribute)
+        return
+    if attribute is None:
+        attribute = mesh.attributes.new(names.FACE_CODE_ATTRIBUTE, "FLOAT", "POINT")
+    values = np.zeros(count, dtype=np.float32)
+    values[count - len(face_codes) :] = face_codes
+    attribute.data.foreach_set("value", values)

@@ -401,6 +401,8 @@ def _mesh_warnings(obj, snap):
         len(obj.data.edges),
         tuple(snap.camera_position),
         obj.relativity.tessellation,
+        obj.relativity.use_adaptive_tessellation and apparent_meshes.tessellation_warning(obj),
+        modifier.find_modifier(obj) is not None,
     )
     known = _object_warnings.get(obj.name)
     if known is not None and known[0] == inputs:

@@ -76,10 +76,29 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
     )
     tessellation: IntProperty(
         name="Tessellation",
-        description="Subdivision levels added before deforming (straight edges can look curved)",
-        default=1,
+        description="Subdivision levels added before deforming, so that straight edges can look curved; "
+        "with Adaptive, the most levels, given only to faces whose edges need them (0: never subdivide)",
+        default=4,
         min=0,
         max=6,
+        update=_settings_changed,
+    )
+    use_adaptive_tessellation: BoolProperty(
+        name="Adaptive",
+        description="Subdivide only the faces with an edge whose image, drawn straight between the moved "
+        "vertices, strays from the true curved image by more than the Tolerance; the other faces keep their "
+        "topology (off: every face gets the Tessellation levels)",
+        default=True,
+        update=_settings_changed,
+    )
+    tessellation_tolerance: FloatProperty(
+        name="Tolerance",
+        description="Largest error left on an edge's image, in pixels at the render resolution (the camera's "
+        "view of the boosted-mesh preview): an edge straying further is subdivided, up to Tessellation levels",
+        default=0.5,
+        min=0.01,
+        soft_max=10.0,
+        subtype="PIXEL",
         update=_settings_changed,
     )
     use_deformation: BoolProperty(

@@ -237,6 +237,9 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         if settings.motion != "STATIC":
             column.prop(settings, "use_proper_time")
         column.prop(settings, "tessellation")
+        column.prop(settings, "use_adaptive_tessellation")
+        if settings.use_adaptive_tessellation:
+            column.prop(settings, "tessellation_tolerance")
         column.prop(settings, "temperature")
         bake = effect.bake_status(context.scene, obj)
         if bake is not None:

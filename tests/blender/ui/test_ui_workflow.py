@@ -210,10 +210,13 @@ def test_coarse_mesh_warning_for_the_geometry_method(relativity_addon, factory_b
     scene.collection.objects.link(wall)
     bpy.context.view_layer.update()
     scene.relativity.method = "GEOMETRY"
+    # Without Adaptive, the coarse-edge measure (adaptive tessellation measures edges in pixels at
+    # each update: tests/blender/geometry/test_adaptive_tessellation.py)
+    wall.relativity.use_adaptive_tessellation = False
+    wall.relativity.tessellation = 1
     log = draw_panel(bpy, "RELATIVITY_PT_object", scene, wall)
     # The quad's four sides are 4 long; their midpoints are sqrt(2^2 + 4^2) from the camera:
-    # 4 / sqrt(20) = 0.894, halved by the default tessellation level (1): 0.447 > 0.25.
-    assert wall.relativity.tessellation == 1
+    # 4 / sqrt(20) = 0.894, halved by one tessellation level: 0.447 > 0.25.
     warnings = [e[1] for e in log if e[0] == "label" and e[2] == "ERROR"]
     assert len(warnings) == 1 and "0.45x" in warnings[0], warnings
     wall.relativity.tessellation = 2  # 0.224: fine enough

@@ -1,0 +1,199 @@
+"""Where a mesh must be subdivided so that its apparent image stays right (adaptive tessellation).
+
+The apparent-geometry path moves only vertices: between two vertices the renderer draws a straight
+segment, while the apparent image of a straight edge is curved (light-travel time, aberration;
+docs/physics.md, "Light-travel time (retarded positions)"). The error an edge leaves is measured
+where it is largest for a gently curved image, at its middle: the image of the edge's apparent
+midpoint against the image of the midpoint of the drawn segment (the point the renderer puts there,
+texture included), in pixels. An edge split into ``2**k`` parts (``k`` levels of subdivision) is
+measured the same way on each part.
+
+Everything is vectorised over edges; the apparent map and the projection are given as functions
+of arrays of points, so this module knows no camera model and no motion.
+"""
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .arrays import ArrayLike, BoolArray, FloatArray, IndexArray
+
+# rest points (M, 3) -> apparent positions (M, 3), any frame the projection takes
+ApparentMap = Callable[[FloatArray], FloatArray]
+# positions (M, 3) -> image positions in pixels (M, 2); NaN for points the camera cannot see
+# (behind it)
+Projection = Callable[[FloatArray], FloatArray]
+
+
+def perspective_pixels(
+    points: ArrayLike,
+    eye: ArrayLike,
+    world_to_camera: ArrayLike,
+    window: tuple[float, float, float, float],
+    resolution: tuple[float, float],
+) -> FloatArray:
+    """Pixel positions ``(M, 2)`` (x right, y up, from the image's lower-left corner) of world
+    points seen by a pinhole camera at ``eye`` with rotation ``world_to_camera`` (3, 3; the camera
+    looks down its local -Z, Blender's convention) whose image on the plane at unit distance is
+    ``window = (left, right, bottom, top)``, rendered at ``resolution = (width, height)`` pixels.
+    Points at or behind the camera's plane are NaN."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    local = (np.asarray(world_to_camera, dtype=np.float64) @ (points - np.asarray(eye, dtype=np.float64)).T).T
+    depth = -local[:, 2]
+    left, right, bottom, top = window
+    width, height = resolution
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = (local[:, 0] / depth - left) * (width / (right - left))
+        y = (local[:, 1] / depth - bottom) * (height / (top - bottom))
+    pixels = np.stack((x, y), axis=1)
+    pixels[~(depth > 1e-9 * (1.0 + np.abs(local[:, 0]) + np.abs(local[:, 1])))] = np.nan
+    return pixels
+
+
+def segment_bends(
+    rest_a: ArrayLike, rest_b: ArrayLike, parts: int, apparent: ApparentMap, project: Projection
+) -> FloatArray:
+    """The largest image error in pixels (``(E,)``) over the ``parts`` equal pieces of each edge
+    ``rest_a[i] -> rest_b[i]`` (rest positions, ``(E, 3)``) drawn as straight segments between
+    the pieces' apparent end points: for each piece, the distance between the image of the
+    apparent position of its rest midpoint and the image of the midpoint of its apparent end
+    points. Infinite where a piece is partly in front of the camera and partly not (it must be
+    split); zero where the camera sees none of it."""
+    a = np.asarray(rest_a, dtype=np.float64).reshape(-1, 3)
+    b = np.asarray(rest_b, dtype=np.float64).reshape(-1, 3)
+    if len(a) == 0:
+        return np.zeros(0)
+    # 2 * parts + 1 points along each edge: the pieces' end points are the even ones
+    fractions = np.arange(2 * parts + 1, dtype=np.float64) / (2 * parts)
+    rest = a[:, None, :] + fractions[None, :, None] * (b - a)[:, None, :]
+    seen = np.asarray(apparent(rest.reshape(-1, 3)), dtype=np.float64).reshape(rest.shape)
+    ends_a, middles, ends_b = seen[:, 0:-1:2], seen[:, 1::2], seen[:, 2::2]
+    image_middle = np.asarray(project(middles.reshape(-1, 3))).reshape(len(a), parts, 2)
+    image_drawn = np.asarray(project(((ends_a + ends_b) / 2.0).reshape(-1, 3))).reshape(len(a), parts, 2)
+    image_ends = np.asarray(project(seen[:, 0::2].reshape(-1, 3))).reshape(len(a), parts + 1, 2)
+    return np.max(_piece_bends(image_middle, image_drawn, image_ends[:, :-1], image_ends[:, 1:]), axis=1)
+
+
+def _piece_bends(
+    image_middle: FloatArray, image_drawn: FloatArray, image_a: FloatArray, image_b: FloatArray
+) -> FloatArray:
+    """The pieces' errors from the images of their middles, drawn middles and ends (``(..., 2)``):
+    infinite where some of these are seen and some not, zero where none is."""
+    bend = np.linalg.norm(image_middle - image_drawn, axis=-1)
+    seen = [np.isfinite(image[..., 0]) for image in (image_middle, image_drawn, image_a, image_b)]
+    visible = seen[0] | seen[1] | seen[2] | seen[3]
+    hidden = ~(seen[0] & seen[1] & seen[2] & seen[3])
+    return np.where(visible & hidden, np.inf, np.where(visible, bend, 0.0))
+
+
+def _whole_edge_bends(
+    rest: FloatArray, edges: IndexArray, seen: FloatArray, image: FloatArray, apparent: ApparentMap, project: Projection
+) -> FloatArray:
+    """:func:`segment_bends` of whole edges (one piece) given their ends' apparent positions
+    ``seen`` and images ``image`` (per vertex): one apparent position more per edge, not three."""
+    a, b = edges[:, 0], edges[:, 1]
+    middles = np.asarray(apparent((rest[a] + rest[b]) / 2.0), dtype=np.float64)
+    image_drawn = np.asarray(project((seen[a] + seen[b]) / 2.0))
+    return _piece_bends(np.asarray(project(middles)), image_drawn, image[a], image[b])
+
+
+def edge_levels(
+    rest: ArrayLike,
+    edges: ArrayLike,
+    apparent: ApparentMap,
+    project: Projection,
+    tolerance: float,
+    max_level: int,
+    frame: tuple[float, float] | None = None,
+) -> tuple[IndexArray, FloatArray]:
+    """For each edge (``edges``: ``(E, 2)`` indices into the rest points ``rest``, ``(V, 3)``) the
+    fewest subdivision levels ``k <= max_level`` after which every piece's image error
+    (:func:`segment_bends`) is at most ``tolerance`` pixels, and the error left at that level
+    (above ``tolerance`` only where ``max_level`` is not enough).
+
+    Edges whose image (the segment between the images of its apparent end points) is at most
+    ``tolerance`` pixels long are not measured: an image arc of about that length cannot stray
+    further than its length from its chord's middle, so they need no level; nor, given the
+    picture's ``frame`` (width, height in pixels), edges further out of it than their length. The apparent map is
+    evaluated once for every vertex and then only for the edges still too bent, level by level."""
+    if not np.isfinite(tolerance) or tolerance <= 0.0:
+        raise ValueError(f"tolerance must be a positive number of pixels, got {tolerance!r}")
+    if max_level < 0:
+        raise ValueError(f"max_level must be 0 or more, got {max_level!r}")
+    rest = np.asarray(rest, dtype=np.float64).reshape(-1, 3)
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    levels = np.zeros(len(edges), dtype=np.int64)
+    left = np.zeros(len(edges))
+    if len(edges) == 0:
+        return levels, left
+    seen = np.asarray(apparent(rest), dtype=np.float64)
+    image = np.asarray(project(seen))
+    ends_a, ends_b = image[edges[:, 0]], image[edges[:, 1]]
+    length = np.linalg.norm(ends_b - ends_a, axis=1)
+    both_seen = np.isfinite(length)
+    neither_seen = ~np.isfinite(ends_a[:, 0]) & ~np.isfinite(ends_b[:, 0])
+    # short images need nothing, nor edges with both ends out of the camera's sight; an edge with
+    # one end behind the camera is measured (and split)
+    todo = np.flatnonzero(
+        ~(both_seen & (length <= tolerance)) & ~neither_seen & ~_off_frame(ends_a, ends_b, length, frame)
+    )
+    for level in range(max_level + 1):
+        if len(todo) == 0:
+            break
+        bend = np.concatenate(
+            [
+                _whole_edge_bends(rest, edges[chunk], seen, image, apparent, project)
+                if level == 0
+                else segment_bends(rest[edges[chunk, 0]], rest[edges[chunk, 1]], 2**level, apparent, project)
+                for chunk in np.array_split(todo, -(-len(todo) // CHUNK))
+            ]
+        )
+        levels[todo] = level
+        left[todo] = bend
+        todo = todo[bend > tolerance]
+    return levels, left
+
+
+# edges measured at once (bounds the memory of the pieces' points)
+CHUNK = 200_000
+
+
+def _off_frame(
+    ends_a: FloatArray, ends_b: FloatArray, length: FloatArray, frame: tuple[float, float] | None
+) -> BoolArray:
+    """Edges whose image lies beyond one side of the ``frame`` (width, height in pixels) by more
+    than its length: as for short images, the arc cannot reach back into the picture."""
+    if frame is None:
+        return np.zeros(len(length), dtype=bool)
+    width, height = frame
+    with np.errstate(invalid="ignore"):
+        x_low = np.maximum(ends_a[:, 0], ends_b[:, 0]) < -length
+        x_high = np.minimum(ends_a[:, 0], ends_b[:, 0]) > width + length
+        y_low = np.maximum(ends_a[:, 1], ends_b[:, 1]) < -length
+        y_high = np.minimum(ends_a[:, 1], ends_b[:, 1]) > height + length
+    return np.asarray(x_low | x_high | y_low | y_high)
+
+
+def face_levels(
+    edge_level: ArrayLike, loop_edges: ArrayLike, loop_starts: ArrayLike, loop_totals: ArrayLike
+) -> tuple[IndexArray, BoolArray]:
+    """Per face the largest level of its edges (``edge_level`` per edge; a face's edges are
+    ``loop_edges[loop_starts[f]:loop_starts[f] + loop_totals[f]]``, Blender's loops), and which
+    unsubdivided faces share an edge with a subdivided one (the seam, where the subdivided side
+    has vertices the other side's edge does not)."""
+    edge_level = np.asarray(edge_level, dtype=np.int64)
+    loop_edges = np.asarray(loop_edges, dtype=np.int64)
+    starts = np.asarray(loop_starts, dtype=np.int64)
+    totals = np.asarray(loop_totals, dtype=np.int64)
+    levels = np.zeros(len(totals), dtype=np.int64)
+    if len(loop_edges) == 0:
+        return levels, np.zeros(len(totals), dtype=bool)
+    # a face's loops are contiguous from its loop start (Blender's offsets)
+    by_start = np.argsort(starts, kind="stable")
+    face_of_loop = np.repeat(by_start, totals[by_start])
+    np.maximum.at(levels, face_of_loop, edge_level[loop_edges])
+    subdivided_edge = np.zeros(len(edge_level), dtype=bool)
+    subdivided_edge[loop_edges[levels[face_of_loop] > 0]] = True
+    touches = np.zeros(len(totals), dtype=bool)
+    np.logical_or.at(touches, face_of_loop, subdivided_edge[loop_edges])
+    return levels, touches & (levels == 0)
