@@ -30,6 +30,12 @@ mirror=${RELATIVITY_DEBIAN_MIRROR:-$(grep -hoE '^URIs: *[^ ]+/debian/?$' /etc/ap
 mirror=${mirror:-http://deb.debian.org/debian}
 
 mkdir -p "$cache"
+exec 9>"$cache/blender-sid.lock"  # one build at a time; a second run waits, then finds the root built
+flock 9
+if [ -f "$root/.complete" ]; then
+    echo "$root"
+    exit 0
+fi
 for old in "$cache"/blender-sid-*; do  # stale roots (another key) and half-built ones
     [ -e "$old" ] || continue
     case "$old" in "$root" | "$root".*) ;; *) echo "removing the stale Blender root $old" >&2 ;; esac

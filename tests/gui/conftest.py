@@ -63,7 +63,8 @@ def in_root(root, script, timeout=TIMEOUT):
     ]
     if os.geteuid() != 0:
         command.insert(0, "sudo")
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+    clean = {"PATH": "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"}  # nothing of the host's
+    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=clean)
 
 
 class GuiSession:
@@ -100,7 +101,8 @@ def gui_session(tmp_path_factory):
     for script in ("gui_driver.py", "gui_scene.py"):
         shutil.copy(HERE / script, work / script)
     script = f"""
-export HOME={inside}/home LANG=C.UTF-8
+export HOME={inside}/home TMPDIR={inside}/tmp LANG=C.UTF-8
+mkdir -p $HOME $TMPDIR
 cd {inside}
 blender --version | head -n 1
 blender --command extension install-file -r user_default -e {inside}/{zip_path.name}

@@ -45,6 +45,12 @@ def blob(pixels, threshold):
     return ((columns + 0.5) * weight).sum() / total, ((rows + 0.5) * weight).sum() / total, int((weight > 0).sum())
 
 
+def sphere_colour(pixels):
+    """Median display colour of the pixels brighter than half the brightest (the sphere's disc)."""
+    brightness = pixels.mean(axis=2)
+    return np.median(pixels[brightness > 0.5 * brightness.max()], axis=0)
+
+
 def user_facing(message):
     assert message[:1].isupper(), message
     for name in INTERNAL:
@@ -145,12 +151,14 @@ def test_f12_matches_the_bpy_wheel(gui_session, wheel_render, factory_blender):
     print(f"mean brightness Debian {mean:.5f}, wheel {mean_ref:.5f}")
     assert abs(mean / mean_ref - 1.0) < 0.05
     x_rest, y_rest = rest_pixel()
+    print(f"at rest ({x_rest:.2f}, {y_rest:.2f}) px: {np.hypot(x - x_rest, y - y_rest):.1f} px away")
     assert np.hypot(x - x_rest, y - y_rest) > 5.0, ((x, y), (x_rest, y_rest))
 
 
 def test_rendered_viewport_shows_the_preview(gui_session, factory_blender):
     """The Rendered viewport through the camera: the sphere where F12 puts it (the preview), to 2 %
-    of the frame's width, measured in the screenshot inside the camera frame."""
+    of the frame's width, and of its colour (Doppler-shifted orange to blue), measured in the
+    screenshot inside the camera frame."""
     report = gui_session.report
     shot = read_png(factory_blender, gui_session.out / "07_viewport_rendered.png")
     x0, y0, x1, y1 = report["viewport_camera_frame"]
@@ -165,6 +173,9 @@ def test_rendered_viewport_shows_the_preview(gui_session, factory_blender):
     x, y = x * scale, y * scale
     print(f"viewport centroid ({x:.2f}, {y:.2f}) render px ({count} screen px); F12 ({x_f12:.2f}, {y_f12:.2f})")
     assert np.hypot(x - x_f12, y - y_f12) < 0.02 * WIDTH
+    colour, colour_f12 = sphere_colour(frame), sphere_colour(read_png(factory_blender, gui_session.out / "f12.png"))
+    print(f"sphere colour: viewport {np.round(colour, 3)}, F12 {np.round(colour_f12, 3)}")
+    assert np.abs(colour - colour_f12).max() < 0.02
 
 
 def test_remove_from_the_button_restores_the_scene(gui_session):

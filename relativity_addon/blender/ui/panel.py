@@ -176,7 +176,7 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         colour.prop(settings, "use_searchlight")
         row = colour.row()
         row.active = settings.use_searchlight and not time_of_flight
-        row.prop(settings, "use_chang_searchlight", text="Chang (Wrong, Comparison)")
+        row.prop(settings, "use_chang_searchlight", text="Chang (Wrong)")
         row = colour.row()
         row.active = settings.use_doppler and not settings.use_searchlight and not time_of_flight
         row.prop(settings, "doppler_only_brightness")
@@ -235,7 +235,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         if settings.motion != "STATIC":
             column.prop(settings, "use_proper_time")
         column.prop(settings, "tessellation")
-        column.prop(settings, "temperature")
+        column.prop(settings, "temperature", text="Temperature")
         bake = effect.bake_status(context.scene, obj)
         if bake is not None:
             operator, baked, _ = bake
