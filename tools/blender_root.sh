@@ -60,6 +60,9 @@ echo "building the Debian sid root with Blender in $root (log: $log)" >&2
     $sudo debootstrap --variant=minbase sid "$work" "$mirror"
     # sid's Release file may be older than its Valid-Until (a mirror snapshot): accept it.
     echo 'Acquire::Check-Valid-Until "false";' | $sudo tee "$work/etc/apt/apt.conf.d/99relativity-no-valid-until" >/dev/null
+    # No manual pages or documentation in the root (and no man-db database to rebuild at each install).
+    printf 'path-exclude=/usr/share/man/*\npath-exclude=/usr/share/doc/*\npath-include=/usr/share/doc/*/copyright\n' |
+        $sudo tee "$work/etc/dpkg/dpkg.cfg.d/01relativity-nodoc" >/dev/null
     $sudo cp /etc/resolv.conf "$work/etc/resolv.conf"
     $sudo mount -t proc proc "$work/proc"
     $sudo mount --rbind /dev "$work/dev"
