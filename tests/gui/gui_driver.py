@@ -244,13 +244,35 @@ def steps():
     report["popups"] = list(_popups)
     yield from draw_and_shoot("08_after_f12", wait=1.5)
 
-    # 6. Remove from the button: the scene as before Set Up.
+    # 6. Still set up: Method switched to Exact Camera (kept on Apparent Geometry, and said why), and
+    #    a moving light (rendered at rest, and said why); then both taken back.
+    _popups.clear()
+    scene.relativity.method = "CAMERA"
+    yield 2.0  # the handlers sync, the notice timer shows the popup
+    report["switch_popups"] = list(_popups)
+    report["method_after_switch"] = scene.relativity.method
+    yield from draw_and_shoot("09_method_switched")
+    scene.relativity.method = "GEOMETRY"
+    data = bpy.data.lights.new("Lamp", "POINT")
+    lamp = bpy.data.objects.new("Lamp", data)
+    lamp.location = (0.0, 2.0, -4.0)
+    scene.collection.objects.link(lamp)
+    lamp.relativity.motion = "CONSTANT"
+    lamp.relativity.beta = (0.3, 0.0, 0.0)
+    select_only(lamp)
+    yield from draw_and_shoot("10_moving_light")
+    bpy.data.objects.remove(lamp)
+    bpy.data.lights.remove(data)
+    select_only(sphere)
+    yield 1.0
+
+    # 7. Remove from the button: the scene as before Set Up.
     call("remove", bpy.ops.relativity.remove_all)
     report["after_remove"] = {
         "modifiers": [m.name for m in sphere.modifiers],
         "objects": sorted(o.name for o in bpy.data.objects),
     }
-    yield from draw_and_shoot("09_removed")
+    yield from draw_and_shoot("11_removed")
 
 
 _steps = None

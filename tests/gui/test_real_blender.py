@@ -178,6 +178,22 @@ def test_rendered_viewport_shows_the_preview(gui_session, factory_blender):
     assert np.abs(colour - colour_f12).max() < 0.02
 
 
+def test_switching_method_and_moving_light_say_why(gui_session):
+    """Method switched to Exact Camera after Set Up: kept on Apparent Geometry, a popup and the
+    panel say why; a moving light is rendered at rest, and the panel says why (no OSL)."""
+    report = gui_session.report
+    switched = [
+        reason for title, reason in report["switch_popups"] if "not switched" in title and "has no OSL" in reason
+    ]
+    assert switched, report["switch_popups"]
+    user_facing(switched[0])
+    said = [m for m in report["panel_messages"]["09_method_switched"] if "has no OSL" in m and "Apparent" in m]
+    assert said, report["panel_messages"]["09_method_switched"]
+    at_rest = [m for m in report["panel_messages"]["10_moving_light"] if "'Lamp'" in m]
+    assert at_rest and "at rest" in at_rest[0] and "has no OSL" in at_rest[0], report["panel_messages"]
+    assert not any("final render is exact" in m for m in report["panel_messages"]["10_moving_light"])
+
+
 def test_remove_from_the_button_restores_the_scene(gui_session):
     report = gui_session.report
     assert "result" in report["operators"]["remove"], report["operators"]
