@@ -192,6 +192,7 @@ def test_switching_method_and_moving_light_say_why(gui_session):
     at_rest = [m for m in report["panel_messages"]["10_moving_light"] if "'Lamp'" in m]
     assert at_rest and "at rest" in at_rest[0] and "has no OSL" in at_rest[0], report["panel_messages"]
     assert not any("final render is exact" in m for m in report["panel_messages"]["10_moving_light"])
+    assert not any(m.startswith("Still set up") for m in report["panel_messages"]["10_moving_light"])  # Method back
 
 
 def test_remove_from_the_button_restores_the_scene(gui_session):
