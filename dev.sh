@@ -173,7 +173,7 @@ case "${1:-}" in
         exit "$failed"
         ;;
     *)
-        echo "usage: $0 demo | test [pytest arguments]   (BLENDER=4.5 or 5.2 picks one version)" >&2
+        echo "usage: $0 demo | test [pytest arguments]   (BLENDER=4.5 or 5.2 picks one version, BLENDER=gui the real-application stage)" >&2
         exit 2
         ;;
 esac
