@@ -181,11 +181,11 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row.active = settings.use_doppler and not settings.use_searchlight and not time_of_flight
         row.prop(settings, "doppler_only_brightness")
         if settings.method == "CAMERA":
-            row = colour.row(align=True)
+            row = colour.column(align=True)  # one line each: side by side the sidebar cut "Blackbody"
             row.active = settings.use_doppler and not time_of_flight
             row.prop(settings, "fast_illuminant")
             if settings.fast_illuminant == "BLACKBODY":
-                row.prop(settings, "fast_illuminant_temperature", text="")
+                row.prop(settings, "fast_illuminant_temperature", text="Temperature")
             snap = effect.last_snapshot(context.scene)
             if snap is not None and snap.lit_groups and settings.fast_illuminant == "AUTO":
                 kelvins = ", ".join(f"{group.temperature:.0f} K" for group in snap.lit_groups)
