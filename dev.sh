@@ -4,8 +4,10 @@
 # virtual environment .venv-X.Y.
 #   ./dev.sh demo   set up .venv-5.2, render the README's demo image (three panels) to out/demo.png
 #   ./dev.sh test   run ruff, then set up each venv and run the whole suite on every supported version, one
-#                   after the other (extra arguments go to pytest); non-zero if any version fails
-# BLENDER=4.5 or BLENDER=5.2 picks one version (e.g. BLENDER=5.2 ./dev.sh test -k register).
+#                   after the other (extra arguments go to pytest), then the real-application stage
+#                   (tests/gui/: Debian's Blender in a window under Xvfb); non-zero if any of them fails
+# BLENDER=4.5 or BLENDER=5.2 picks one version (e.g. BLENDER=5.2 ./dev.sh test -k register);
+# BLENDER=gui runs only the real-application stage; RELATIVITY_SKIP_GUI=1 skips it (said in the summary).
 # PYTHON311 / PYTHON313 name the interpreters to use; without PYTHON313 a python3.13 is looked
 # for on PATH and in pyenv, else built once from Debian's python3.13 source package
 # (tools/build_python313.sh; RELATIVITY_BUILD_PYTHON313=1 forces that route).
@@ -80,7 +82,7 @@ setup() {  # setup X.Y: create .venv-X.Y and install requirements/blender-X.Y.tx
 run_tests() {  # run_tests X.Y [pytest arguments]
     local version=$1 status=0
     shift
-    ".venv-$version/bin/python" -m pytest -n 2 tests "$@" || status=$?
+    ".venv-$version/bin/python" -m pytest -n 2 tests --ignore=tests/gui "$@" || status=$?
     if [ "$status" -eq 5 ]; then
         echo "error: pytest collected no tests (Blender $version)" >&2
         return 1
@@ -104,8 +106,21 @@ lint() {  # ruff (check and format), mypy and codespell over the repository, in 
     return "$status"
 }
 
+run_gui() {  # run_gui [pytest arguments]: Debian's Blender under Xvfb against the 5.2 wheel (tests/gui/)
+    local status=0 root
+    root=$(tools/blender_root.sh) || return 1
+    gui_setup_seconds=$((SECONDS - gui_start))
+    RELATIVITY_BLENDER_ROOT=$root .venv-5.2/bin/python -m pytest -p no:cacheprovider tests/gui "$@" || status=$?
+    if [ "$status" -eq 5 ] && [ "$#" -gt 0 ]; then
+        echo "no real-application test selected by: $*"
+        return 0
+    fi
+    return "$status"
+}
+
 versions() {
     local chosen=${BLENDER:-$SUPPORTED}
+    [ "$chosen" != gui ] || return 0
     for version in $chosen; do
         case " $SUPPORTED " in
             *" $version "*) ;;
@@ -140,11 +155,25 @@ case "${1:-}" in
             [ "$status" -eq 0 ] || { result="FAILED (exit $status)"; failed=1; }
             summary+=("Blender $version: $result; setup $((tests_start - start)) s, tests $((SECONDS - tests_start)) s")
         done
+        if [ -z "${BLENDER:-}" ] || [ "${BLENDER:-}" = gui ]; then
+            echo "=== the real Blender application (Debian sid's Blender, no OSL, under Xvfb) ==="
+            if [ -n "${RELATIVITY_SKIP_GUI:-}" ] && [ "${RELATIVITY_SKIP_GUI}" != 0 ]; then
+                summary+=("real Blender application: SKIPPED (RELATIVITY_SKIP_GUI is set)")
+            else
+                gui_start=$SECONDS
+                gui_setup_seconds=0
+                status=0
+                setup 5.2 && run_gui "$@" || status=$?
+                result=passed
+                [ "$status" -eq 0 ] || { result="FAILED (exit $status)"; failed=1; }
+                summary+=("real Blender application: $result; root and venv $gui_setup_seconds s, tests $((SECONDS - gui_start - gui_setup_seconds)) s")
+            fi
+        fi
         printf '%s\n' "${summary[@]}"
         exit "$failed"
         ;;
     *)
-        echo "usage: $0 demo | test [pytest arguments]   (BLENDER=4.5 or 5.2 picks one version)" >&2
+        echo "usage: $0 demo | test [pytest arguments]   (BLENDER=4.5 or 5.2 picks one version, BLENDER=gui the real-application stage)" >&2
         exit 2
         ;;
 esac

@@ -304,6 +304,8 @@ def setting_changed(scene: Scene) -> None:
             _refused(scene, error)
             _setup_refused(scene, error)
         return
+    if method is not None:  # the Method is the applied one again: a refused switch is no longer news
+        _setup_notices.pop(scene.name, None)
     sync(scene)
 
 

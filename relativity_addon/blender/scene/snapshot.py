@@ -471,12 +471,12 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
     time_of_flight = bool(settings.use_time_of_flight)
     if time_of_flight:
         check_time_of_flight(settings, lights)
+    if settings.method == "CAMERA" and osl.unavailable_reason() is not None:  # first: nothing else helps
+        raise RelativityError(f"{osl.unavailable_reason()}: Method Exact Camera needs it (use Apparent Geometry)")
     moving_objects.check_object_velocities(scene, objects_for or settings.method)
     if settings.method == "CAMERA" and scene.render.engine != "CYCLES":
         engine = compat.engine_label(scene.render.engine)
         raise RelativityError(f"Render Engine is {engine}: the exact camera renders with Cycles only")
-    if settings.method == "CAMERA" and osl.unavailable_reason() is not None:
-        raise RelativityError(f"{osl.unavailable_reason()}: Method Exact Camera needs it (use Apparent Geometry)")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
         lens.check_detector_image(scene, camera, matrix)

@@ -72,7 +72,7 @@ class RELATIVITY_PT_main(_RelativityPanel, Panel):
         no_osl = osl.unavailable_reason()
         if scene.relativity.method == "GEOMETRY":
             layout.prop(scene.relativity, "geometry_final_render")
-            layout.label(text="The viewport shows the boosted-mesh preview", icon="INFO")
+            _message(layout, context, "The viewport shows the boosted-mesh preview", icon="INFO")
             if no_osl is not None and scene.relativity.geometry_final_render == "EXACT":
                 _message(layout, context, f"{no_osl}: the final render is the boosted-mesh preview too")
         notice = effect.setup_notice(scene)
@@ -112,13 +112,17 @@ class RELATIVITY_PT_observer(_RelativityPanel, Panel):
         else:
             speed = settings.speed
         box = layout.box()
-        box.label(text=f"Speed: {speed:.6g} c")
-        gamma = 1.0 / math.sqrt(1.0 - speed * speed) if speed < 1.0 else math.nan
-        box.label(text=f"Gamma: {gamma:.6g}" if speed < 1.0 else "Gamma: undefined (speed >= c)")
+        if math.isnan(speed):  # the camera's animation was not read: the last sync was refused
+            box.label(text="Speed: unknown (see the warning above)")
+        else:
+            box.label(text=f"Speed: {speed:.6g} c")
+            gamma = 1.0 / math.sqrt(1.0 - speed * speed) if speed < 1.0 else math.nan
+            box.label(text=f"Gamma: {gamma:.6g}" if speed < 1.0 else "Gamma: undefined (speed >= c)")
         tau = effect.traveller_time(context.scene)  # as of the last sync
         if tau is not None:
             fps = context.scene.render.fps / context.scene.render.fps_base
-            box.label(text=f"Time: scene {context.scene.frame_current / fps:.4g} s, traveller {tau:.4g} s")
+            box.label(text=f"Scene time: {context.scene.frame_current / fps:.4g} s")
+            box.label(text=f"Traveller's time: {tau:.4g} s")
         if settings.velocity_source == "CAMERA_ANIMATION":
             layout.operator("relativity.check_animation", icon="TIME")
         _preset_row(layout, "speed_of_light", "Speed of Light")
@@ -139,8 +143,8 @@ class RELATIVITY_PT_shutter(_RelativityPanel, Panel):
         if settings.shutter_model == "DETECTOR_PLANE":
             layout.prop(settings, "imaging_element")
         if settings.shutter_model == "ARBITRARY_PLANE":
-            layout.prop(settings, "shutter_plane_point")
-            layout.prop(settings, "shutter_plane_normal")
+            layout.prop(settings, "shutter_plane_point", text="Plane Point")
+            layout.prop(settings, "shutter_plane_normal", text="Plane Normal")
         layout.prop(settings, "use_lorentz_window")
         if settings.use_lorentz_window:
             layout.prop(settings, "lorentz_window_shutter")
@@ -163,27 +167,30 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         row.prop(settings, "use_time_of_flight")
         time_of_flight = settings.use_time_of_flight
         if time_of_flight:
-            column.label(
-                text="Light delay only (Galilean, Gray Fig. 1c): no contraction, searchlight or Doppler", icon="INFO"
+            _message(
+                column,
+                context,
+                "Light delay only (Galilean, Gray Fig. 1c): no contraction, searchlight or Doppler",
+                icon="INFO",
             )
         elif settings.method != "CAMERA":
-            column.label(text="Time of Flight Only: exact camera only", icon="INFO")
+            _message(column, context, "Time of Flight Only: exact camera only", icon="INFO")
         colour = column.column()
         colour.active = not time_of_flight
         colour.prop(settings, "use_doppler")
         colour.prop(settings, "use_searchlight")
         row = colour.row()
         row.active = settings.use_searchlight and not time_of_flight
-        row.prop(settings, "use_chang_searchlight")
+        row.prop(settings, "use_chang_searchlight", text="Chang (Wrong)")
         row = colour.row()
         row.active = settings.use_doppler and not settings.use_searchlight and not time_of_flight
         row.prop(settings, "doppler_only_brightness")
         if settings.method == "CAMERA":
-            row = colour.row(align=True)
+            row = colour.column(align=True)  # one line each: side by side the sidebar cut "Blackbody"
             row.active = settings.use_doppler and not time_of_flight
             row.prop(settings, "fast_illuminant")
             if settings.fast_illuminant == "BLACKBODY":
-                row.prop(settings, "fast_illuminant_temperature", text="")
+                row.prop(settings, "fast_illuminant_temperature", text="Temperature")
             snap = effect.last_snapshot(context.scene)
             if snap is not None and snap.lit_groups and settings.fast_illuminant == "AUTO":
                 kelvins = ", ".join(f"{group.temperature:.0f} K" for group in snap.lit_groups)
@@ -219,10 +226,10 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
             if settings.moves_with_camera and obj.type != "LIGHT":
                 return
         if obj.type == "LIGHT":
-            _draw_light(layout, obj)
+            _draw_light(layout, context, obj)
             return
         if obj.type != "MESH":
-            layout.label(text="Apparent geometry moves meshes only", icon="INFO")
+            _message(layout, context, "Apparent geometry moves meshes only", icon="INFO")
             return
         layout.prop(settings, "enabled")
         column = layout.column()
@@ -240,7 +247,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         column.prop(settings, "use_adaptive_tessellation")
         if settings.use_adaptive_tessellation:
             column.prop(settings, "tessellation_tolerance")
-        column.prop(settings, "temperature")
+        column.prop(settings, "temperature", text="Temperature")
         bake = effect.bake_status(context.scene, obj)
         if bake is not None:
             operator, baked, _ = bake
@@ -251,7 +258,7 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
             _message(layout, context, warning)
 
 
-def _draw_light(layout, obj):
+def _draw_light(layout, context, obj):
     """Lights: the same motion settings as meshes (blender/lights/moving_lights.py: point and spot lights
     with constant velocity on both paths; with the exact camera also sun and area lights and
     keyframed lights)."""
@@ -261,14 +268,18 @@ def _draw_light(layout, obj):
     if settings.motion == "CONSTANT":
         layout.prop(settings, "beta")
         if kind not in ("POINT", "SPOT"):
-            layout.label(
-                text=f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent Geometry)",
+            _message(
+                layout,
+                context,
+                f"Moving {kind.lower()} lights: exact camera only (rendered at rest with Apparent Geometry)",
                 icon="INFO",
             )
     elif settings.motion == "ANIMATION":
-        layout.label(text="Animated lights: exact camera only (rendered at rest with Apparent Geometry)", icon="INFO")
+        _message(
+            layout, context, "Animated lights: exact camera only (rendered at rest with Apparent Geometry)", icon="INFO"
+        )
         if kind == "SUN":
-            layout.label(text="A sun moves with its keyframes' velocity at the frame", icon="INFO")
+            _message(layout, context, "A sun moves with its keyframes' velocity at the frame", icon="INFO")
 
 
 classes = (

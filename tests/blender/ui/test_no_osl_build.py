@@ -121,6 +121,21 @@ def test_exact_camera_refused_in_one_line_and_said_before_set_up(relativity_addo
     assert camera.data.type == "PERSP"
 
 
+def test_no_osl_is_said_first_whatever_else_the_exact_camera_refuses(relativity_addon, factory_blender, no_osl):
+    """A moving object refuses the exact camera too; without OSL the first reason given is the
+    build (changing the object would not help). Found in Debian's Blender (tests/gui/)."""
+    bpy = factory_blender
+    scene, _, sphere = wh.new_scene(bpy, resolution=(32, 24), samples=1)
+    sphere.relativity.motion = "CONSTANT"
+    sphere.relativity.beta = (0.3, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    messages, _ = _errors(bpy, scene)
+    assert messages and "has no OSL" in messages[0] and "Apparent Geometry" in messages[0], messages
+    with pytest.raises(RuntimeError) as refused:
+        bpy.ops.relativity.setup_scene()
+    assert "has no OSL" in str(refused.value), refused.value
+
+
 def test_geometry_final_render_is_the_preview_and_says_so(
     relativity_addon, factory_blender, no_osl, capfd, tmp_path, monkeypatch
 ):
@@ -176,6 +191,10 @@ def test_switching_method_after_set_up_says_why(relativity_addon, factory_blende
     messages, _ = _errors(bpy, scene)
     said = [m for m in messages if "Apparent Geometry" in m and "has no OSL" in m]
     assert said, messages
+    scene.relativity.method = "GEOMETRY"  # back: the refused switch is no longer news (seen in Debian's Blender)
+    bpy.context.view_layer.update()
+    messages, _ = _errors(bpy, scene)
+    assert not any(m.startswith("Still set up") for m in messages), messages
 
 
 def _moving_light(bpy, scene):
