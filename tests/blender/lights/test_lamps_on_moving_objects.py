@@ -124,8 +124,8 @@ def _renders(bpy, scene, monkeypatch, tmp_path):
     effect.apply(scene)
     with_eq18 = _render(bpy, scene, tmp_path / "with.exr")
     stage = _module("lights.lamps_on_moving_objects")
-    placement = stage.placement
-    monkeypatch.setattr(stage, "placement", lambda *args: (1.0, placement(*args)[1]))
+    copy_colour = stage.copy_colour
+    monkeypatch.setattr(stage, "copy_colour", lambda lamp, _doppler, snap: copy_colour(lamp, 1.0, snap))
     without = _render(bpy, scene, tmp_path / "without.exr")
     monkeypatch.undo()
     edges = _edge(without)
