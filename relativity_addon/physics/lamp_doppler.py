@@ -200,7 +200,7 @@ def stand_in_weights(offsets: ArrayLike, stand_ins: ArrayLike) -> FloatArray:
     at = finite_array(stand_ins, "stand_ins").ravel()
     before = np.concatenate([[-np.inf], at[:-1]])
     after = np.concatenate([at[1:], [np.inf]])
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         rising = np.where(np.isfinite(before), (u - before) / (at - before), 1.0)
         falling = np.where(np.isfinite(after), (after - u) / (after - at), 1.0)
     return np.clip(np.minimum(rising, falling), 0.0, 1.0)

@@ -37,6 +37,7 @@ ALBEDO = 0.8
 LAMP = np.array([0.0, -2.1213, 2.1213])  # 3 radii from the seen centre (the origin), across +X
 POWER = 2000.0
 AREA_SIZE = 1.0
+SPOT_SIZE, SPOT_BLEND = math.radians(30.0), 0.3  # the cone's edge crosses the sphere (19.5 deg half-width)
 AREA_POWER = 2000.0
 GAMMA = 1.0 / math.sqrt(1.0 - BETA**2)
 VELOCITY = np.array([BETA, 0.0, 0.0])
@@ -68,9 +69,12 @@ def _scene(bpy, kind, samples):
     light = bpy.data.lights.new("Lamp", kind)
     lamp = bpy.data.objects.new("Lamp", light)
     lamp.location = tuple(LAMP)
-    if kind == "POINT":
+    if kind in ("POINT", "SPOT"):
         light.energy = POWER
         light.shadow_soft_size = 0.0
+        lamp.rotation_euler = (math.radians(45.0), 0.0, math.radians(10.0))  # -Z near the origin
+        if kind == "SPOT":
+            light.spot_size, light.spot_blend = SPOT_SIZE, SPOT_BLEND
     else:
         light.energy = AREA_POWER
         light.size = AREA_SIZE
@@ -137,8 +141,14 @@ def _received(points, rest, source, intensity):
 def _model(kind, lamp_matrix):
     """Per-pixel radiance by eqs. 18 and 14 (NaN off the sphere)."""
     points, rest, rays = _seen_sphere()
-    if kind == "POINT":
+    if kind in ("POINT", "SPOT"):
         irradiance = _received(points, rest, LAMP, POWER / (4.0 * math.pi))
+        if kind == "SPOT":  # Cycles' cone: smoothstep over the blend, in the cosine of the angle
+            offset = points - LAMP
+            cosine = (offset / np.linalg.norm(offset, axis=-1, keepdims=True)) @ -lamp_matrix[:3, 2]
+            cos_half = math.cos(SPOT_SIZE / 2.0)
+            t = np.clip((cosine - cos_half) / ((1.0 - cos_half) * SPOT_BLEND), 0.0, 1.0)
+            irradiance = irradiance * t * t * (3.0 - 2.0 * t)
     else:  # a Lambertian panel: radiance P / (pi A); an element's intensity L cos_e dA along k
         count = 24
         grid = (np.arange(count) + 0.5) / count - 0.5
@@ -205,7 +215,7 @@ def _compare(bpy, kind, tmp_path, samples):
     return pattern, total, shift
 
 
-@pytest.mark.parametrize("kind", ["POINT", "AREA"])
+@pytest.mark.parametrize("kind", ["POINT", "SPOT", "AREA"])
 def test_close_lamp_lights_each_point_with_its_own_doppler_factor(relativity_addon, factory_blender, tmp_path, kind):
     """3 radii: the lit part's per-pixel brightness within 6 % of eqs. 18 and 14 on average (mean
     absolute difference over the mean; sampling noise included), its total within 3 %, its
