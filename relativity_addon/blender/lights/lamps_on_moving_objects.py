@@ -68,7 +68,7 @@ class Mover:
     name: str
     centre: tuple  # world, scene frame: the centre's retarded position for the camera event
     beta: tuple  # scene-frame velocity there, fraction of c
-    corners: tuple = ()  # the bounding box's corners, retarded like the centre
+    corners: tuple = ()  # the bounding box's corners, edge midpoints and face centres, retarded like the centre
 
 
 def is_copy(obj: Object) -> bool:
@@ -94,16 +94,19 @@ def lamps(scene: Scene) -> list[Object]:
 
 
 def _local_box(obj):
-    """The centre and the 8 corners of the mesh's bounding box (object space), centre first."""
+    """The centre, then the corners, edge midpoints and face centres of the mesh's bounding box
+    (object space): where the receiving points' apparent lamp offsets reach their extremes closely
+    enough (the offset is not monotonic over a face)."""
     count = len(obj.data.vertices)
     if count == 0:
-        return np.zeros((9, 3))
+        return np.zeros((27, 3))
     co = np.empty(count * 3)
     obj.data.vertices.foreach_get("co", co)
     co = co.reshape(-1, 3)
     low, high = co.min(axis=0), co.max(axis=0)
-    corners = [(x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])]
-    return np.array([(low + high) / 2.0, *corners])
+    steps = np.array(list(np.ndindex(3, 3, 3))) - 1
+    grid = (low + high) / 2.0 + steps * (high - low) / 2.0
+    return grid[np.argsort(np.abs(steps).sum(axis=1), kind="stable")]  # the centre first
 
 
 def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
