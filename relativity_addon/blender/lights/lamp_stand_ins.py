@@ -16,7 +16,10 @@ per receiving point (Cycles' SVM nodes, no OSL):
   (the copies are point lamps); an area lamp's emitter cosine of ``k`` over the copy's;
 - colour ``exp(s l + q l^2)`` per channel, ``l = ln(D / D_c)``: eq. 18's colour factor
   (``lamp_doppler.lamp_rgb_factor``, ``D^2`` with the searchlight alone), relative to its value at
-  the centre's ``D_c`` (the copy's colour), fitted through three values of ``D`` over the object.
+  the centre's ``D_c`` (the copy's colour), fitted through three values of ``D`` over the object;
+- ``Scale``: the inverse of the factor on the copy's own power, which is set for renderers that do
+  not run light trees (EEVEE: the stand-ins' plain powers then sum to the lamp's eq. 18 light at
+  the object's centre, one ``D`` and direction per object).
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ def _group_spec():
             ("Cone", "NodeSocketFloat", -2.0),
             ("Blend", "NodeSocketFloat", 1.0e-6),
             ("Lambert", "NodeSocketFloat", 0.0),
+            ("Scale", "NodeSocketFloat", 1.0),
         ),
         outputs=(("Color", "NodeSocketColor", "colour"), ("Strength", "NodeSocketFloat", "strength")),
         nodes={
@@ -104,7 +108,8 @@ def _group_spec():
             "emitter": fmath("MULTIPLY_ADD", "group.Lambert", "emitter_less_one", 1.0),
             "weighted": fmath("MULTIPLY", "weight", "ratio2"),
             "masked": fmath("MULTIPLY", "weighted", "mask.Result"),
-            "strength": fmath("MULTIPLY", "masked", "emitter"),
+            "unscaled": fmath("MULTIPLY", "masked", "emitter"),
+            "strength": fmath("MULTIPLY", "unscaled", "group.Scale"),
             # colour: exp(s l + q l^2), l = ln D - ln D_c
             "log_doppler": fmath("LOGARITHM", "doppler", math.e),
             "l": fmath("SUBTRACT", "log_doppler", "group.Log Doppler"),

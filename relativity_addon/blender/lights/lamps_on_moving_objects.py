@@ -290,12 +290,13 @@ def _set(owner, attribute, value):
     setattr(owner, attribute, value)
 
 
-def _follow(copy_data, light):
-    """Take over the lamp's settings (size, energy, spot cone, ...) except its colour."""
+def _follow(copy_data, light, own=frozenset()):
+    """Take over the lamp's settings (size, energy, spot cone, ...) except its colour (and ``own``)."""
     for prop in light.bl_rna.properties:
         key = prop.identifier
         if (
             key in _OWN
+            or key in own
             or prop.is_readonly
             or prop.type not in {"BOOLEAN", "INT", "FLOAT", "ENUM"}
             or key not in copy_data.bl_rna.properties  # a spot's cone on its point-lamp stand-ins
@@ -354,8 +355,10 @@ def write(scene: Scene, snap: Snapshot) -> int:
     return len(layout)
 
 
-def _write_copy(copy, lamp, colour, matrix):
-    _follow(copy.data, lamp.data)
+def _write_copy(copy, lamp, colour, matrix, power_factor=None):
+    _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
+    if power_factor is not None:
+        _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
     _set(copy.data, "use_temperature", False)
     _set(copy.data, "color", colour)
     if not np.allclose(np.array(copy.matrix_world), matrix, rtol=1e-6, atol=1e-9):
@@ -376,10 +379,14 @@ def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
         cone, smooth = moving_lights.spot_cone(lamp.data.spot_size, lamp.data.spot_blend)
         blend = 1.0 / smooth if smooth > 0.0 else 1e-6
     far = lamp_stand_ins.FAR
+    centre = np.array(mover.centre)
+    lamp_distance = max(float(np.linalg.norm(centre - matrix[:3, 3])), 1e-9)
     for index, copy in enumerate(copies):
         moved = matrix.copy()
         moved[:3, 3] += offsets[index] * beta / speed
-        _write_copy(copy, lamp, base, moved)
+        # without the tree (EEVEE) the copies share the lamp's light at the centre: (t / r)^2 / n each
+        share = (max(float(np.linalg.norm(centre - moved[:3, 3])), 1e-9) / lamp_distance) ** 2 / len(copies)
+        _write_copy(copy, lamp, base, moved, share)
         values = {
             "Offset": float(offsets[index]),
             "Previous": float(offsets[index - 1]) if index > 0 else float(offsets[index]) - far,
@@ -394,6 +401,7 @@ def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
             "Cone": float(cone),
             "Blend": float(blend),
             "Lambert": 1.0 if lamp.data.type == "AREA" else 0.0,
+            "Scale": 1.0 / share,
         }
         sockets = lamp_stand_ins.inputs(copy.data)
         for name, value in values.items():
