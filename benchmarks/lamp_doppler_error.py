@@ -45,7 +45,7 @@ DIRECTIONS = {
 }
 PANEL = 1.0  # m, the area lamp's side
 PANEL_ELEMENTS = 24
-MAX_ANGLE, MAX_STAND_INS = 0.1, 6  # as blender/lights/lamps_on_moving_objects.py
+MAX_ANGLE, MAX_STAND_INS = 0.2, 3  # as blender/lights/lamps_on_moving_objects.py
 
 
 # --- the reference, from docs/physics.md ----------------------------------------------------

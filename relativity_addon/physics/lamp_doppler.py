@@ -28,11 +28,12 @@ that Cycles' scene-frame irradiance ``cos(alpha) I / r^2`` becomes the object-fr
 
 Per receiving point (point, spot and area lamps): a point ``x`` sees the lamp, in its own frame,
 along ``-k'`` at the distance ``r' = D r``, i.e. at ``x - D r k'``, which lies on the line through
-the lamp parallel to ``beta`` (:func:`apparent_lamp_offset`). Stand-in lamps on that line, each
-weighted per receiving point (:func:`stand_in_weights`), give each point its own ``D`` and its own
-aberrated direction (:func:`stand_in_irradiance` models what they render). Suns (plane waves) and
-the former renderer's one ``D`` and one direction per lamp and object (:func:`aberrated_lamp_matrix`)
-are measured against :func:`exact_irradiance` by :func:`one_factor_irradiance` (docs/lamp-doppler.md).
+the lamp parallel to ``beta`` (:func:`apparent_lamp_offset`). Stand-in lamps on that line, the two
+around that place weighted per receiving point (:func:`stand_in_weights`), give each point its own
+``D`` and, exactly, its own aberrated direction (:func:`stand_in_irradiance` models what they
+render). Suns (plane waves) and the former renderer's one ``D`` and one direction per lamp and
+object (:func:`aberrated_lamp_matrix`) are measured against :func:`exact_irradiance` by
+:func:`one_factor_irradiance` (docs/lamp-doppler.md).
 
 numpy only (Blender's Python has no colour-science): the colour tables are those of
 :mod:`.spectral_render`.
@@ -215,9 +216,13 @@ def stand_in_irradiance(
     intensity: float = 1.0,
 ) -> FloatArray:
     """What the stand-ins render (bolometric): each at ``lamp + u_i bhat`` with strength
-    ``w_i D^2 (t_i / r)^2`` for the point (``t_i`` its distance to the stand-in, ``r`` to the lamp),
-    so Cycles' ``cos_i / t_i^2`` on the rest normal sums to ``D^2 sum_i w_i cos_i / r^2``; with
-    enough stand-ins ``sum_i w_i cos_i -> cos(alpha')`` (:func:`exact_irradiance`)."""
+    ``w_i D^2 (t_i / r)^2 t_i / (D r)`` for the point (``t_i`` its distance to the stand-in, ``r``
+    to the lamp, ``D r`` to where it sees the lamp), so Cycles' ``cos_i / t_i^2`` on the rest
+    normal sums to ``D^2 cos(alpha') / r^2`` (:func:`exact_irradiance`) wherever both cosines are
+    positive: the two stand-ins around the point and the apparent lamp ``P`` lie on one line, so
+    with the linear weights ``P - x = sum_i w_i (P_i - x)``, i.e. ``-k' = sum_i w_i t_i / (D r) e_i``
+    (``e_i`` toward stand-in ``i``), and the cosine is linear in that direction. Left: near the
+    terminator one stand-in's cosine is clamped at 0 while the other's is not."""
     points = finite_array(points, "points")
     lamp = finite_array(lamp, "lamp")
     beta = velocity_array(beta_object, "beta_object")
@@ -231,8 +236,9 @@ def stand_in_irradiance(
     total = np.zeros_like(r)
     for index, u in enumerate(finite_array(stand_ins, "stand_ins").ravel()):
         towards = lamp + u * bhat - points
-        cosine = np.maximum(np.sum(normals * towards, axis=-1) / np.linalg.norm(towards, axis=-1), 0.0)
-        total += weights[..., index] * cosine
+        t = np.linalg.norm(towards, axis=-1)
+        cosine = np.maximum(np.sum(normals * towards, axis=-1) / t, 0.0)
+        total += weights[..., index] * cosine * t / (doppler * r)
     return irradiance_factor(doppler) * total / r**2 * intensity
 
 

@@ -169,9 +169,10 @@ def test_stand_in_weights_interpolate_linearly(stand_ins, u):
 
 
 def test_stand_ins_converge_to_eq_18_per_point():
-    """On a unit sphere at 0.5c with a lamp 3 radii to the side: with the stand-ins the stage
-    places (at most 0.1 rad apart) the rendered irradiance is eq. 18 per point within 0.3 %
-    (mean over the lit side); one copy per lamp and object was 42 % off."""
+    """On a unit sphere at 0.5c with a lamp 3 radii to the side: with two or three stand-ins (0.2 rad
+    apart at most, as the stage places them) the rendered irradiance is eq. 18 per point within
+    0.5 % (mean over the lit side), and exactly wherever both stand-ins' cosines are positive;
+    one copy per lamp and object was 42 % off."""
     beta = np.array([0.5, 0.0, 0.0])
     points, scene_normals, rest_normals = lamp_doppler.contracted_sphere(1.0, (0.0, 0.0, 0.0), beta, 4000)
     lamp = np.array([0.0, -3.0, 0.0])
@@ -181,9 +182,11 @@ def test_stand_ins_converge_to_eq_18_per_point():
     distances = lamp_doppler.lamp_to_object_doppler(points[lit] - lamp, beta) * np.linalg.norm(
         points[lit] - lamp, axis=-1
     )
-    stand_ins = lamp_doppler.stand_in_offsets(offsets, distances, 0.1, 6)
-    assert 1 < len(stand_ins) <= 6
+    stand_ins = lamp_doppler.stand_in_offsets(offsets, distances, 0.2, 3)
+    assert 1 < len(stand_ins) <= 3
     rendered = lamp_doppler.stand_in_irradiance(points, rest_normals, lamp, beta, stand_ins)
     one = lamp_doppler.one_factor_irradiance(points, rest_normals, lamp, (0.0, 0.0, 0.0), beta)
-    assert np.sum(np.abs(rendered - exact)) / np.sum(exact) < 0.003
+    assert np.sum(np.abs(rendered - exact)) / np.sum(exact) < 0.005
+    well_lit = exact > 0.2 * exact.max()
+    np.testing.assert_allclose(rendered[well_lit], exact[well_lit], rtol=1e-9)
     assert np.sum(np.abs(one - exact)) / np.sum(exact) > 0.3

@@ -11,8 +11,11 @@ per receiving point (Cycles' SVM nodes, no OSL):
   the point, ``t`` Light Path > Ray Length); ``P - u_i bhat`` the matching point of the lamp itself;
 - ``k``, ``r`` from there to ``x``, ``D = gamma (1 - beta . k)``, ``u = r ((1 - gamma) (k . bhat) +
   gamma |beta|)``, and the copy's linear weight ``w`` between its neighbours' offsets;
-- strength ``w (t / r)^2``, so Cycles' ``cos / t^2`` toward the copy (on the rest normal) becomes
-  ``cos(alpha') / r^2`` with the point's own aberrated direction; a spot's cone of the true ``k``
+- strength ``w (t / r)^2 t / (D r)``: the point's apparent lamp ``x - D r k'`` lies between the two
+  copies around it on their line, at ``sum w_i P_i``, so ``-k' = sum w_i (t_i / (D r)) e_i`` (``e_i``
+  toward copy ``i``) and Cycles' ``cos_i / t_i^2`` toward them (on the rest normal) sums to
+  ``cos(alpha') / r^2`` exactly, with the point's own aberrated direction (but near the terminator,
+  where one copy's cosine is clamped at 0); a spot's cone of the true ``k``
   (the copies are point lamps); an area lamp's emitter cosine of ``k`` over the copy's;
 - colour ``exp(s l + q l^2)`` per channel, ``l = ln(D / D_c)``: eq. 18's colour factor
   (``lamp_doppler.lamp_rgb_factor``, ``D^2`` with the searchlight alone), relative to its value at
@@ -106,7 +109,11 @@ def _group_spec():
             "emitter_ratio": fmath("DIVIDE", "true_cos", "copy_cos"),
             "emitter_less_one": fmath("SUBTRACT", "emitter_ratio", 1.0),
             "emitter": fmath("MULTIPLY_ADD", "group.Lambert", "emitter_less_one", 1.0),
-            "weighted": fmath("MULTIPLY", "weight", "ratio2"),
+            # t / (D r): the two stand-ins' directions, so weighted, sum to -k' exactly
+            "apparent_distance": fmath("MULTIPLY", "doppler", "r.Value"),
+            "direction_weight": fmath("DIVIDE", "path.Ray Length", "apparent_distance"),
+            "ratio3": fmath("MULTIPLY", "ratio2", "direction_weight"),
+            "weighted": fmath("MULTIPLY", "weight", "ratio3"),
             "masked": fmath("MULTIPLY", "weighted", "mask.Result"),
             "unscaled": fmath("MULTIPLY", "masked", "emitter"),
             "strength": fmath("MULTIPLY", "unscaled", "group.Scale"),

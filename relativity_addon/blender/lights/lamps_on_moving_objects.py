@@ -54,8 +54,8 @@ COPY_KEY = names.LAMP_DOPPLER_COPY_KEY
 PREFIX = names.LAMP_DOPPLER_PREFIX
 KINDS = ("POINT", "SPOT", "AREA", "SUN")
 PER_POINT = ("POINT", "SPOT", "AREA")  # stand-ins on the line of apparent positions; a sun: one copy
-MAX_ANGLE = 0.1  # radians between neighbouring stand-ins seen from the nearest receiving point
-MAX_STAND_INS = 6  # per lamp and object: two light a point, more add noise (benchmarks/lamp_doppler_cost.py)
+MAX_ANGLE = 0.2  # radians between neighbouring stand-ins seen from the nearest receiving point
+MAX_STAND_INS = 3  # per lamp and object: two light a point; more add noise (benchmarks/lamp_doppler_cost.py)
 # Light data settings the copy does not take over from its lamp (the colour carries the factor).
 _OWN = {"name", "color", "use_temperature", "temperature", "rna_type", "type", "use_nodes"}
 

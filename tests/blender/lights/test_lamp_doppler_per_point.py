@@ -238,10 +238,11 @@ def test_close_lamp_lights_each_point_with_its_own_doppler_factor(relativity_add
 
 def test_lamp_half_a_radius_from_the_surface(relativity_addon, factory_blender, tmp_path):
     """1.5 radii (the point lamp 0.5 m from the surface): the per-point light within 8 % per pixel,
-    3 % in total, 0.5 px; one D and direction per lamp and object: 96 %, 7.2 px off."""
+    5 % in total (the issue's bar; the stand-ins' cosines clamped at the terminator add light
+    there), 0.5 px; one D and direction per lamp and object: 96 %, 7.2 px off."""
     pattern, total, shift = _compare(factory_blender, "POINT", tmp_path, samples=64, lamp_at=LAMP / 2.0)
     assert pattern < 0.08
-    assert total == pytest.approx(1.0, abs=0.03)
+    assert total == pytest.approx(1.0, abs=0.05)
     assert shift < 0.5
 
 
