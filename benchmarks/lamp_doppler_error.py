@@ -45,7 +45,7 @@ DIRECTIONS = {
 }
 PANEL = 1.0  # m, the area lamp's side
 PANEL_ELEMENTS = 24
-MAX_ANGLE, MAX_STAND_INS = 0.2, 3  # as blender/lights/lamps_on_moving_objects.py
+MAX_ANGLE, MAX_STAND_INS, MAX_AREA_STAND_INS = 0.2, 3, 6  # as blender/lights/lamps_on_moving_objects.py
 
 
 # --- the reference, from docs/physics.md ----------------------------------------------------
@@ -89,13 +89,13 @@ def panel(centre, axis):
     return elements, matrix, (PANEL / PANEL_ELEMENTS) ** 2
 
 
-def stand_ins(receivers, corners, beta):
+def stand_ins(receivers, corners, beta, most):
     """The stage's placement: offsets over the receivers (the box's 3 x 3 x 3 points) and the lamp's corners."""
     separation = receivers[None, :, :] - corners[:, None, :]
     distance = np.linalg.norm(separation, axis=-1)
     offsets = lamp_doppler.apparent_lamp_offset(receivers[None, :, :], corners[:, None, :], beta)
     dopplers = lamp_doppler.lamp_to_object_doppler(separation, beta)
-    return lamp_doppler.stand_in_offsets(offsets, dopplers * distance, MAX_ANGLE, MAX_STAND_INS)
+    return lamp_doppler.stand_in_offsets(offsets, dopplers * distance, MAX_ANGLE, most)
 
 
 def _errors(rendered, exact):
@@ -107,7 +107,7 @@ def _errors(rendered, exact):
 def point_case(points, rest_normals, receivers, beta, lamp):
     exact = reference(points, rest_normals, lamp, beta, 1.0)
     before = lamp_doppler.one_factor_irradiance(points, rest_normals, lamp, (0.0, 0.0, 0.0), beta)
-    offsets = stand_ins(receivers, lamp[None], beta)
+    offsets = stand_ins(receivers, lamp[None], beta, MAX_STAND_INS)
     now = lamp_doppler.stand_in_irradiance(points, rest_normals, lamp, beta, offsets)
     return exact, before, now, len(offsets)
 
@@ -118,7 +118,7 @@ def area_case(points, rest_normals, receivers, beta, centre, axis):
     corners = np.array(
         [matrix[:3, :3] @ (sx * PANEL / 2, sy * PANEL / 2, 0.0) + centre for sx in (-1, 1) for sy in (-1, 1)]
     )
-    offsets = stand_ins(receivers, np.vstack([centre[None], corners]), beta)
+    offsets = stand_ins(receivers, np.vstack([centre[None], corners]), beta, MAX_AREA_STAND_INS)
     turned = lamp_doppler.aberrated_lamp_matrix(matrix, (0.0, 0.0, 0.0), -centre, beta)
     turned_axis = -turned[:3, 2]
     centre_factor = lamp_doppler.irradiance_factor(lamp_doppler.lamp_to_object_doppler(-centre, beta))

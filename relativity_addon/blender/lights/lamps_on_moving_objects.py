@@ -56,6 +56,7 @@ KINDS = ("POINT", "SPOT", "AREA", "SUN")
 PER_POINT = ("POINT", "SPOT", "AREA")  # stand-ins on the line of apparent positions; a sun: one copy
 MAX_ANGLE = 0.2  # radians between neighbouring stand-ins seen from the nearest receiving point
 MAX_STAND_INS = 3  # per lamp and object: two light a point; more add noise (benchmarks/lamp_doppler_cost.py)
+MAX_AREA_STAND_INS = 6  # an area lamp's extent widens the span (a 1 m panel 1 m away: 6.6 % off with 3)
 # Light data settings the copy does not take over from its lamp (the colour carries the factor).
 _OWN = {"name", "color", "use_temperature", "temperature", "rna_type", "type", "use_nodes"}
 
@@ -186,7 +187,8 @@ def stand_in_placement(matrix: FloatArray, light: Light, mover: Mover) -> tuple[
     beta = np.array(mover.beta)
     offsets = lamp_doppler.apparent_lamp_offset(receivers[None, :, :], elements[:, None, :], beta)[usable]
     dopplers = lamp_doppler.lamp_to_object_doppler(separation[usable], beta)
-    stand_ins = lamp_doppler.stand_in_offsets(offsets, dopplers * distance[usable], MAX_ANGLE, MAX_STAND_INS)
+    most = MAX_AREA_STAND_INS if light.type == "AREA" else MAX_STAND_INS
+    stand_ins = lamp_doppler.stand_in_offsets(offsets, dopplers * distance[usable], MAX_ANGLE, most)
     centre = float(lamp_doppler.lamp_to_object_doppler(incidence(matrix, light.type, mover), beta))
     spread = (min(float(dopplers.min()), centre * math.exp(-0.01)), max(float(dopplers.max()), centre * math.exp(0.01)))
     return stand_ins, (spread[0], centre, spread[1])
