@@ -26,14 +26,20 @@ white, docs/spectral-model.md), and for a blackbody lamp at ``T`` a blackbody at
 luminance ``Y(D T) / Y(T)``. :func:`lamp_rgb_factor` gives the colour a copy of the lamp needs so
 that Cycles' scene-frame irradiance ``cos(alpha) I / r^2`` becomes the object-frame one.
 
-The renderer applies one ``D`` per lamp and object (at the object's centre) and lights the object
-from the lamp's object-frame (aberrated) direction at the centre (:func:`aberrated_lamp_matrix`);
-:func:`exact_irradiance` and :func:`one_factor_irradiance` measure what that leaves out
-(docs/lamp-doppler.md).
+Per receiving point (point, spot and area lamps): a point ``x`` sees the lamp, in its own frame,
+along ``-k'`` at the distance ``r' = D r``, i.e. at ``x - D r k'``, which lies on the line through
+the lamp parallel to ``beta`` (:func:`apparent_lamp_offset`). Stand-in lamps on that line, the two
+around that place weighted per receiving point (:func:`stand_in_weights`), give each point its own
+``D`` and, exactly, its own aberrated direction (:func:`stand_in_irradiance` models what they
+render). Suns (plane waves) and the former renderer's one ``D`` and one direction per lamp and
+object (:func:`aberrated_lamp_matrix`) are measured against :func:`exact_irradiance` by
+:func:`one_factor_irradiance` (docs/lamp-doppler.md).
 
 numpy only (Blender's Python has no colour-science): the colour tables are those of
 :mod:`.spectral_render`.
 """
+
+import math
 
 import numpy as np
 
@@ -120,8 +126,8 @@ def lamp_rgb_factor(
     if not use_doppler:
         return np.full(3, irradiance_factor(doppler) if use_searchlight else 1.0)
     if temperature_k is not None:
-        rest = _blackbody_unit_rgb(temperature_k)
-        shifted = _blackbody_unit_rgb(doppler * temperature_k)
+        rest = blackbody_unit_rgb(temperature_k)
+        shifted = blackbody_unit_rgb(doppler * temperature_k)
         if use_searchlight:
             log_ratio = spectral_render.log_blackbody_luminance(
                 doppler * temperature_k
@@ -139,7 +145,7 @@ def lamp_rgb_factor(
     return np.clip(factor, 0.0, 1e30)
 
 
-def _blackbody_unit_rgb(temperature_k: float) -> FloatArray:
+def blackbody_unit_rgb(temperature_k: float) -> FloatArray:
     """Linear Rec.709 colour of a blackbody at ``temperature_k``, gamut-mapped, luminance 1 (Blender's)."""
     rgb = spectral_render.xyz_to_linear_rec709(spectral_render.blackbody_xyz(temperature_k))
     mapped = spectral_render.gamut_map(rgb)
@@ -150,6 +156,90 @@ def _blackbody_unit_rgb(temperature_k: float) -> FloatArray:
 def _same_luminance(rgb: FloatArray, reference: FloatArray) -> FloatArray:
     y, y0 = spectral_render.luminance(rgb), spectral_render.luminance(reference)
     return rgb * (y0 / y) if y > 0.0 else rgb * 0.0
+
+
+# --- per receiving point: stand-in lamps on the line of apparent positions ---------------------
+
+
+def apparent_lamp_offset(points: ArrayLike, lamp: ArrayLike, beta_object: ArrayLike) -> FloatArray:
+    """Where a receiving point at ``points`` (scene frame) sees a lamp at rest at ``lamp`` in its
+    own frame, as the offset ``u`` along ``bhat`` (the unit velocity): ``x - D r k' = lamp + u bhat``
+    with ``u = r ((1 - gamma) (k . bhat) + gamma |beta|)``.
+
+    The aberrated direction ``k'`` (:func:`aberrated_direction`) differs from ``k`` only along
+    ``bhat`` and by the factor ``1 / D`` across it, so going back ``D r`` (the object-frame distance,
+    eq. 25) along ``k'`` from ``x`` lands on the line through the lamp parallel to ``beta``: a light
+    on that line at ``u`` is seen from ``x`` exactly along ``-k'``. 0 for an object at rest."""
+    points = finite_array(points, "points")
+    offset = points - finite_array(lamp, "lamp")
+    r = np.linalg.norm(offset, axis=-1)
+    k = offset / np.where(r > 0.0, r, 1.0)[..., None]
+    beta = velocity_array(beta_object, "beta_object")
+    speed = float(np.linalg.norm(beta))
+    if speed == 0.0:
+        return np.zeros_like(r)
+    gamma = float(_gamma(beta))
+    return r * ((1.0 - gamma) * (k @ (beta / speed)) + gamma * speed)
+
+
+def stand_in_offsets(offsets: ArrayLike, distances: ArrayLike, max_angle: float, max_count: int) -> FloatArray:
+    """Evenly spaced offsets (ascending) spanning the receiving points' ``offsets`` (from
+    :func:`apparent_lamp_offset`), as many as keep neighbours within ``max_angle`` (radians) seen
+    from the nearest point (object-frame ``distances`` ``D r``), at most ``max_count``."""
+    offsets = finite_array(offsets, "offsets").ravel()
+    low, high = float(offsets.min()), float(offsets.max())
+    nearest = float(np.min(positive_array(distances, "distances")))
+    count = 1 + math.ceil((high - low) / (max_angle * nearest)) if high > low else 1
+    count = max(1, min(int(max_count), count))
+    return np.array([0.5 * (low + high)]) if count == 1 else np.linspace(low, high, count)
+
+
+def stand_in_weights(offsets: ArrayLike, stand_ins: ArrayLike) -> FloatArray:
+    """Linear weights (..., n) of the stand-ins at ``stand_ins`` (ascending) for points whose lamp
+    appears at ``offsets``: the two around it share 1; beyond the ends the end one takes all."""
+    u = finite_array(offsets, "offsets")[..., None]
+    at = finite_array(stand_ins, "stand_ins").ravel()
+    before = np.concatenate([[-np.inf], at[:-1]])
+    after = np.concatenate([at[1:], [np.inf]])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        rising = np.where(np.isfinite(before), (u - before) / (at - before), 1.0)
+        falling = np.where(np.isfinite(after), (after - u) / (after - at), 1.0)
+    return np.clip(np.minimum(rising, falling), 0.0, 1.0)
+
+
+def stand_in_irradiance(
+    points: ArrayLike,
+    rest_normals: ArrayLike,
+    lamp: ArrayLike,
+    beta_object: ArrayLike,
+    stand_ins: ArrayLike,
+    intensity: float = 1.0,
+) -> FloatArray:
+    """What the stand-ins render (bolometric): each at ``lamp + u_i bhat`` with strength
+    ``w_i D^2 (t_i / r)^2 t_i / (D r)`` for the point (``t_i`` its distance to the stand-in, ``r``
+    to the lamp, ``D r`` to where it sees the lamp), so Cycles' ``cos_i / t_i^2`` on the rest
+    normal sums to ``D^2 cos(alpha') / r^2`` (:func:`exact_irradiance`) wherever both cosines are
+    positive: the two stand-ins around the point and the apparent lamp ``P`` lie on one line, so
+    with the linear weights ``P - x = sum_i w_i (P_i - x)``, i.e. ``-k' = sum_i w_i t_i / (D r) e_i``
+    (``e_i`` toward stand-in ``i``), and the cosine is linear in that direction. Left: near the
+    terminator one stand-in's cosine is clamped at 0 while the other's is not."""
+    points = finite_array(points, "points")
+    lamp = finite_array(lamp, "lamp")
+    beta = velocity_array(beta_object, "beta_object")
+    normals = unit_vectors(rest_normals, "rest_normals")
+    speed = float(np.linalg.norm(beta))
+    bhat = beta / speed if speed > 0.0 else np.zeros(3)
+    offset = points - lamp
+    r = np.linalg.norm(offset, axis=-1)
+    doppler = lamp_to_object_doppler(offset, beta)
+    weights = stand_in_weights(apparent_lamp_offset(points, lamp, beta), stand_ins)
+    total = np.zeros_like(r)
+    for index, u in enumerate(finite_array(stand_ins, "stand_ins").ravel()):
+        towards = lamp + u * bhat - points
+        t = np.linalg.norm(towards, axis=-1)
+        cosine = np.maximum(np.sum(normals * towards, axis=-1) / t, 0.0)
+        total += weights[..., index] * cosine * t / (doppler * r)
+    return irradiance_factor(doppler) * total / r**2 * intensity
 
 
 # --- what one factor per lamp and object leaves out --------------------------------------------

@@ -92,7 +92,9 @@ SHADING_SYSTEM_SAVED_KEY = "relativity_shading_system_saved"  # on the scene: th
 # --- lamps at rest lighting moving objects (eq. 18) -------------------------------------------
 LAMP_DOPPLER_PREFIX = "Relativity Eq18"  # copies of lamps and their light-linking collections
 LAMP_DOPPLER_KEY = "relativity_lamp_doppler"  # on the scene: what the stage added and changed
-LAMP_DOPPLER_COPY_KEY = "relativity_lamp_copy"  # on a lamp copy: (lamp name, object name)
+LAMP_DOPPLER_COPY_KEY = "relativity_lamp_copy"  # on a lamp copy: (lamp name, object name, index)
+LAMP_STAND_IN_GROUP = "Relativity Eq18 Lamp"  # shader group in the copies' light trees: per-point D and direction
+LAMP_STAND_IN_GROUP_VERSION = 3
 REST_NORMAL_ATTRIBUTE = "relativity_rest_normal"  # corner normals of the rest shape (object space)
 REST_NORMAL_KEY = "relativity_rest_normals"  # on the scene: the meshes given that attribute
 REST_NORMAL_MESH_KEY = (

@@ -2,18 +2,22 @@
 
 For every lamp at rest (point, spot, area, sun) and every moving object of the Apparent Geometry
 path (CONSTANT or rigid ANIMATION motion), the lamp's light on that object is received with
-``D = gamma (1 - beta . k)`` (``beta`` the object's scene-frame velocity, ``k`` the direction lamp
--> object centre): the object-frame irradiance is ``D^2`` times what Cycles computes in the scene
-frame, its spectrum shifted by ``D``, and it arrives from the aberrated direction ``k'``
-(``physics/lamp_doppler.py``). Cycles cannot vary a lamp per receiver, so the stage adds, per lamp
-and object, a **copy of the lamp** whose colour carries that factor, turned about the object's
-centre from ``k`` to ``k'``, light-linked to receive only that object, and excludes the moving
-objects from the lamp's own light linking; the objects lit this way are shaded with their
-rest-frame normals (``rest_normals.py``: eq. 18's cosine). The observer's Doppler factor (eq. 14)
-stays the materials' job.
+``D = gamma (1 - beta . k)`` (``beta`` the object's scene-frame velocity, ``k`` the photon
+direction lamp -> receiving point): the object-frame irradiance is ``D^2`` times what Cycles
+computes in the scene frame, its spectrum shifted by ``D``, and it arrives from the aberrated
+direction ``k'`` (``physics/lamp_doppler.py``). The stage excludes the moving objects from the
+lamp's own light linking and adds, per lamp and object, copies light-linked to that object alone:
 
-One ``D`` per lamp and object (at the object's centre, its retarded position for the camera
-event in the scene frame): docs/lamp-doppler.md measures what that leaves out.
+- point, spot and area lamps: a few **stand-ins** (point lamps for point and spot lamps, the panel
+  for area lamps) on the line through the lamp parallel to ``beta``, where the receiving points
+  see the lamp in their own frame; their light trees (``lamp_stand_ins.py``) give each receiving
+  point its own ``D``, colour and aberrated direction (eq. 18 per point);
+- suns: one copy with the colour of ``D`` turned to ``k'``: a plane wave has one ``k``, so one
+  ``D`` and one ``k'`` for the whole object (exact for an object that does not turn).
+
+The objects lit this way are shaded with their rest-frame normals (``rest_normals.py``: eq. 18's
+cosine). The observer's Doppler factor (eq. 14) stays the materials' job. docs/lamp-doppler.md
+measures what is left.
 
 Everything added is recorded on the scene (``names.LAMP_DOPPLER_KEY``): the copies, their light
 data, the collections, and each lamp's own receiver collection; :func:`remove` deletes and
@@ -33,14 +37,14 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import lamp_doppler
-from ..common import names
+from ..common import compat, names, nodes
 from ..geometry import modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
-from . import rest_normals
+from . import lamp_stand_ins, moving_lights, rest_normals
 
 if TYPE_CHECKING:
-    from bpy.types import Object, Scene
+    from bpy.types import Light, Object, Scene
 
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
@@ -49,6 +53,10 @@ KEY = names.LAMP_DOPPLER_KEY
 COPY_KEY = names.LAMP_DOPPLER_COPY_KEY
 PREFIX = names.LAMP_DOPPLER_PREFIX
 KINDS = ("POINT", "SPOT", "AREA", "SUN")
+PER_POINT = ("POINT", "SPOT", "AREA")  # stand-ins on the line of apparent positions; a sun: one copy
+MAX_ANGLE = 0.2  # radians between neighbouring stand-ins seen from the nearest receiving point
+MAX_STAND_INS = 3  # per lamp and object: two light a point; more add noise (benchmarks/lamp_doppler_cost.py)
+MAX_AREA_STAND_INS = 6  # an area lamp's extent widens the span (a 1 m panel 1 m away: 6.6 % off with 3)
 # Light data settings the copy does not take over from its lamp (the colour carries the factor).
 _OWN = {"name", "color", "use_temperature", "temperature", "rna_type", "type", "use_nodes"}
 
@@ -61,6 +69,7 @@ class Mover:
     name: str
     centre: tuple  # world, scene frame: the centre's retarded position for the camera event
     beta: tuple  # scene-frame velocity there, fraction of c
+    corners: tuple = ()  # the bounding box's corners, edge midpoints and face centres, retarded like the centre
 
 
 def is_copy(obj: Object) -> bool:
@@ -85,14 +94,20 @@ def lamps(scene: Scene) -> list[Object]:
     ]
 
 
-def _local_centre(obj):
+def _local_box(obj):
+    """The centre, then the corners, edge midpoints and face centres of the mesh's bounding box
+    (object space): where the receiving points' apparent lamp offsets reach their extremes closely
+    enough (the offset is not monotonic over a face)."""
     count = len(obj.data.vertices)
     if count == 0:
-        return np.zeros(3)
+        return np.zeros((27, 3))
     co = np.empty(count * 3)
     obj.data.vertices.foreach_get("co", co)
     co = co.reshape(-1, 3)
-    return (co.min(axis=0) + co.max(axis=0)) / 2.0
+    low, high = co.min(axis=0), co.max(axis=0)
+    steps = np.array(list(np.ndindex(3, 3, 3))) - 1
+    grid = (low + high) / 2.0 + steps * (high - low) / 2.0
+    return grid[np.argsort(np.abs(steps).sum(axis=1), kind="stable")]  # the centre first
 
 
 def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
@@ -107,15 +122,15 @@ def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
         if motion not in ("CONSTANT", "ANIMATION") or (motion == "ANIMATION" and obj.relativity.use_deformation):
             continue
         try:
-            centre = _local_centre(obj)[None]
             world, beta = world_lines.apparent_world_positions(
-                scene, obj, obj, centre, at_rest_observer, shape_keys_too=False
+                scene, obj, obj, _local_box(obj), at_rest_observer, shape_keys_too=False
             )
         except ValueError as error:
             raise RelativityError(f"Object {obj.name!r}: {error}") from None
         beta = tuple(float(b) for b in np.asarray(beta)[0])
         if math.hypot(*beta) > 0.0:
-            found.append(Mover(obj.name, tuple(float(x) for x in world[0]), beta))
+            corners = tuple(tuple(float(x) for x in point) for point in world[1:])
+            found.append(Mover(obj.name, tuple(float(x) for x in world[0]), beta, corners))
     return found
 
 
@@ -140,6 +155,62 @@ def placement(matrix: FloatArray, kind: str, mover: Mover) -> tuple[float, Float
     k = incidence(matrix, kind, mover)
     doppler_factor = float(lamp_doppler.lamp_to_object_doppler(k, mover.beta))
     return doppler_factor, lamp_doppler.aberrated_lamp_matrix(matrix, mover.centre, k, mover.beta)
+
+
+def lamp_points(matrix: FloatArray, light: Light) -> FloatArray:
+    """World points of the lamp that span its light: its position; an area lamp's corners too."""
+    if light.type != "AREA":
+        return matrix[None, :3, 3]
+    half_x = 0.5 * float(light.size)
+    half_y = 0.5 * float(light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size)
+    local = [
+        (0.0, 0.0, 0.0),
+        (-half_x, -half_y, 0.0),
+        (half_x, -half_y, 0.0),
+        (-half_x, half_y, 0.0),
+        (half_x, half_y, 0.0),
+    ]
+    return np.array([matrix[:3, :3] @ point + matrix[:3, 3] for point in local])
+
+
+def stand_in_placement(matrix: FloatArray, light: Light, mover: Mover) -> tuple[FloatArray, tuple[float, float, float]]:
+    """``(offsets, (D low, D centre, D high))``: the stand-ins' offsets along ``bhat`` from the
+    lamp (``lamp_doppler.stand_in_offsets`` over the object's box and the lamp's extent) and the
+    range of ``D`` over the object (its centre's from the lamp's position)."""
+    receivers = np.array([mover.centre, *mover.corners])
+    elements = lamp_points(matrix, light)
+    separation = receivers[None, :, :] - elements[:, None, :]
+    distance = np.linalg.norm(separation, axis=-1)
+    usable = distance > 1e-6
+    if not usable.any():
+        return np.zeros(1), (1.0, 1.0, 1.0)
+    beta = np.array(mover.beta)
+    offsets = lamp_doppler.apparent_lamp_offset(receivers[None, :, :], elements[:, None, :], beta)[usable]
+    dopplers = lamp_doppler.lamp_to_object_doppler(separation[usable], beta)
+    most = MAX_AREA_STAND_INS if light.type == "AREA" else MAX_STAND_INS
+    stand_ins = lamp_doppler.stand_in_offsets(offsets, dopplers * distance[usable], MAX_ANGLE, most)
+    centre = float(lamp_doppler.lamp_to_object_doppler(incidence(matrix, light.type, mover), beta))
+    spread = (min(float(dopplers.min()), centre * math.exp(-0.01)), max(float(dopplers.max()), centre * math.exp(0.01)))
+    return stand_ins, (spread[0], centre, spread[1])
+
+
+def _tree_rest_colour(light):
+    """What the lamp's node tree multiplies its colour by, for the stand-ins (whose tree is the
+    add-on's): its Emission's unlinked Strength, and its unlinked Color or its blackbody (Blender's
+    luminance-1 colour at that temperature); 1 where the tree does something else."""
+    tree = compat.light_node_tree(light)
+    node = sources.light_emission_node(tree) if tree is not None else None
+    if node is None:
+        return np.ones(3)
+    strength = node.inputs["Strength"]
+    colour = node.inputs["Color"]
+    scale = float(strength.default_value) if not strength.is_linked else 1.0
+    if not colour.is_linked:
+        return scale * np.array(colour.default_value[:3], dtype=np.float64)
+    temperature = sources.light_blackbody(light)
+    if temperature is not None and not light.use_temperature:
+        return scale * lamp_doppler.blackbody_unit_rgb(temperature)
+    return np.full(3, scale)
 
 
 def copy_colour(lamp: Object, doppler_factor: float, snap: Snapshot) -> tuple[float, ...]:
@@ -175,32 +246,38 @@ def _collection(name, objects, state):
     return collection
 
 
-def _build(scene, pairs, mover_names):
+def _build(scene, layout, mover_names):
+    """``layout``: (lamp, mover, number of copies) for every pair."""
     record = {"copies": [], "lights": [], "collections": [], "lamps": {}}
     scene[KEY] = record  # recorded first: a failure half-way is still removed
     excluded = [scene.objects[name] for name in mover_names]
-    for lamp in {lamp.name: lamp for lamp, _ in pairs}.values():
+    for lamp in {lamp.name: lamp for lamp, _, _ in layout}.values():
         exclude = _collection(f"{PREFIX} not {lamp.name}", excluded, "EXCLUDE")
         record["collections"].append(exclude.name)
         record["lamps"][lamp.name] = ""
         lamp[KEY] = True
         lamp.light_linking.receiver_collection = exclude
-    for lamp, mover in pairs:
+    for lamp, mover, count in layout:
         obj = scene.objects[mover.name]
         receive = _collection(f"{PREFIX} {lamp.name} on {obj.name}", [obj], "INCLUDE")
-        data = lamp.data.copy()
-        copy = bpy.data.objects.new(f"{PREFIX} {lamp.name} on {obj.name}", data)
-        copy[COPY_KEY] = [lamp.name, obj.name]
-        scene.collection.objects.link(copy)
-        for key in ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter"):
-            setattr(copy, key, getattr(lamp, key))
-        copy.visible_camera = False  # the lamp itself is seen once
-        copy.hide_select = True
-        copy.light_linking.receiver_collection = receive
-        copy.light_linking.blocker_collection = lamp.light_linking.blocker_collection
         record["collections"].append(receive.name)
-        record["copies"].append(copy.name)
-        record["lights"].append(data.name)
+        for index in range(count):
+            data = lamp.data.copy()
+            if lamp.data.type in PER_POINT:
+                if data.type == "SPOT":
+                    data.type = "POINT"  # the cone is the tree's, of the true direction
+                lamp_stand_ins.make_tree(data)
+            copy = bpy.data.objects.new(f"{PREFIX} {lamp.name} on {obj.name} {index}", data)
+            copy[COPY_KEY] = [lamp.name, obj.name, str(index)]  # ID property arrays: one type
+            scene.collection.objects.link(copy)
+            for key in ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter"):
+                setattr(copy, key, getattr(lamp, key))
+            copy.visible_camera = False  # the lamp itself is seen once
+            copy.hide_select = True
+            copy.light_linking.receiver_collection = receive
+            copy.light_linking.blocker_collection = lamp.light_linking.blocker_collection
+            record["copies"].append(copy.name)
+            record["lights"].append(data.name)
     scene[KEY] = record
 
 
@@ -215,11 +292,17 @@ def _set(owner, attribute, value):
     setattr(owner, attribute, value)
 
 
-def _follow(copy_data, light):
-    """Take over the lamp's settings (size, energy, spot cone, ...) except its colour."""
+def _follow(copy_data, light, own=frozenset()):
+    """Take over the lamp's settings (size, energy, spot cone, ...) except its colour (and ``own``)."""
     for prop in light.bl_rna.properties:
         key = prop.identifier
-        if key in _OWN or prop.is_readonly or prop.type not in {"BOOLEAN", "INT", "FLOAT", "ENUM"}:
+        if (
+            key in _OWN
+            or key in own
+            or prop.is_readonly
+            or prop.type not in {"BOOLEAN", "INT", "FLOAT", "ENUM"}
+            or key not in copy_data.bl_rna.properties  # a spot's cone on its point-lamp stand-ins
+        ):
             continue
         value = getattr(light, key)
         _set(copy_data, key, tuple(value) if getattr(prop, "is_array", False) else value)
@@ -234,7 +317,16 @@ def write(scene: Scene, snap: Snapshot) -> int:
         found = movers(scene, snap)
         pairs = [(lamp, mover) for lamp in lamps(scene) for mover in found]
     record = _record(scene)
-    layout = sorted([lamp.name, mover.name] for lamp, mover in pairs)
+    placed = []
+    for lamp, mover in pairs:
+        matrix = lamp_matrix(scene, lamp, snap)
+        stand_ins = stand_in_placement(matrix, lamp.data, mover) if lamp.data.type in PER_POINT else None
+        placed.append((lamp, mover, matrix, stand_ins))
+    layout = sorted(
+        [lamp.name, mover.name, str(index)]
+        for lamp, mover, _, stand_ins in placed
+        for index in range(1 if stand_ins is None else len(stand_ins[0]))
+    )
     if record is not None and sorted(_copy_pairs(record)) != layout:
         remove(scene)
         record = None
@@ -243,17 +335,79 @@ def write(scene: Scene, snap: Snapshot) -> int:
         return 0
     rest_normals.write(scene, [scene.objects[name] for name in sorted({mover.name for _, mover in pairs})])
     if record is None:
-        _build(scene, pairs, sorted({mover.name for _, mover in pairs}))
+        counts = [(lamp, mover, 1 if stand_ins is None else len(stand_ins[0])) for lamp, mover, _, stand_ins in placed]
+        _build(scene, counts, sorted({mover.name for _, mover in pairs}))
     copies = {tuple(bpy.data.objects[name][COPY_KEY]): bpy.data.objects[name] for name in _record(scene)["copies"]}
-    for lamp, mover in pairs:
-        copy = copies[(lamp.name, mover.name)]
-        doppler_factor, matrix = placement(lamp_matrix(scene, lamp, snap), lamp.data.type, mover)
-        _follow(copy.data, lamp.data)
-        _set(copy.data, "use_temperature", False)
-        _set(copy.data, "color", copy_colour(lamp, doppler_factor, snap))
-        if not np.allclose(np.array(copy.matrix_world), matrix, rtol=1e-6, atol=1e-9):
-            copy.matrix_world = mathutils.Matrix(matrix.tolist())
-    return len(pairs)
+    for lamp, mover, matrix, stand_ins in placed:
+        if stand_ins is None:
+            copy = copies[(lamp.name, mover.name, "0")]
+            doppler_factor, turned = placement(matrix, lamp.data.type, mover)
+            _write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
+            continue
+        offsets, dopplers = stand_ins
+        _write_stand_ins(
+            lamp,
+            mover,
+            matrix,
+            offsets,
+            dopplers,
+            snap,
+            [copies[(lamp.name, mover.name, str(i))] for i in range(len(offsets))],
+        )
+    return len(layout)
+
+
+def _write_copy(copy, lamp, colour, matrix, power_factor=None):
+    _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
+    if power_factor is not None:
+        _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
+    _set(copy.data, "use_temperature", False)
+    _set(copy.data, "color", colour)
+    if not np.allclose(np.array(copy.matrix_world), matrix, rtol=1e-6, atol=1e-9):
+        copy.matrix_world = mathutils.Matrix(matrix.tolist())
+
+
+def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
+    """The stand-ins of ``lamp`` for ``mover``: moved along ``bhat`` to their offsets, the colour of
+    the centre's ``D`` and the inputs of their trees (``lamp_stand_ins.py``)."""
+    beta = np.array(mover.beta)
+    speed = float(np.linalg.norm(beta))
+    colours = [np.array(copy_colour(lamp, doppler, snap)) for doppler in dopplers]
+    slope, curvature = lamp_stand_ins.colour_fit(dopplers, colours)
+    base = tuple(float(v) for v in colours[1] * _tree_rest_colour(lamp.data))
+    axis = -matrix[:3, 2] / max(float(np.linalg.norm(matrix[:3, 2])), 1e-12)
+    cone, blend = -2.0, 1e-6
+    if lamp.data.type == "SPOT":
+        cone, smooth = moving_lights.spot_cone(lamp.data.spot_size, lamp.data.spot_blend)
+        blend = 1.0 / smooth if smooth > 0.0 else 1e-6
+    far = lamp_stand_ins.FAR
+    centre = np.array(mover.centre)
+    lamp_distance = max(float(np.linalg.norm(centre - matrix[:3, 3])), 1e-9)
+    for index, copy in enumerate(copies):
+        moved = matrix.copy()
+        moved[:3, 3] += offsets[index] * beta / speed
+        # without the tree (EEVEE) the copies share the lamp's light at the centre: (t / r)^2 / n each
+        share = (max(float(np.linalg.norm(centre - moved[:3, 3])), 1e-9) / lamp_distance) ** 2 / len(copies)
+        _write_copy(copy, lamp, base, moved, share)
+        values = {
+            "Offset": float(offsets[index]),
+            "Previous": float(offsets[index - 1]) if index > 0 else float(offsets[index]) - far,
+            "Next": float(offsets[index + 1]) if index + 1 < len(offsets) else float(offsets[index]) + far,
+            "Direction": tuple(float(v) for v in beta / speed),
+            "Speed": speed,
+            "Gamma": 1.0 / math.sqrt(1.0 - speed * speed),
+            "Log Doppler": math.log(dopplers[1]),
+            "Slope": slope,
+            "Curvature": curvature,
+            "Axis": tuple(float(v) for v in axis),
+            "Cone": float(cone),
+            "Blend": float(blend),
+            "Lambert": 1.0 if lamp.data.type == "AREA" else 0.0,
+            "Scale": 1.0 / share,
+        }
+        sockets = lamp_stand_ins.inputs(copy.data)
+        for name, value in values.items():
+            _set(sockets[name], "default_value", value)
 
 
 def _copy_pairs(record):
@@ -300,6 +454,7 @@ def remove(scene: Scene) -> int:
         if collection is not None:
             bpy.data.collections.remove(collection)
     del scene[KEY]
+    nodes.remove_unused_groups([names.LAMP_STAND_IN_GROUP])
     return len(copies)
 
 
