@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     import numpy.typing as npt
     from bpy.types import Depsgraph, Object, Scene
 
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 # An edge longer than this fraction of its distance to the camera is too coarse for the
@@ -45,23 +46,78 @@ if TYPE_CHECKING:
 COARSE_EDGE_FRACTION = 0.25
 
 
-def rest_fingerprint(obj_eval: Object) -> tuple[int, int] | None:
+def rest_fingerprint(obj_eval: Object, values: FloatArray | None = None) -> tuple[int, int] | None:
     """``(point count, CRC-32)`` of the tessellated rest positions on the evaluated mesh, or None:
     an edit of the mesh or of a modifier (an Array's count or offset) changes it, which nothing
-    else in the signature sees. One read of the attribute, no mesh copy."""
-    attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
-    if attribute is None:
+    else in the signature sees. One read of the attribute, no mesh copy; none with ``values``
+    (the attribute's float32 values, read already)."""
+    if values is None:
+        attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
+        if attribute is None:
+            return None
+        values = np.empty(len(attribute.data) * 3, dtype=np.float32)
+        attribute.data.foreach_get("vector", values)
+    return len(values) // 3, zlib.crc32(np.ascontiguousarray(values, dtype=np.float32).data)
+
+
+# Object name -> (evaluated mesh key, fingerprint, read number) of its rest positions as read
+# since the depsgraph last evaluated its geometry (:func:`note_updates` forgets it then): an
+# object Blender did not evaluate again has the same rest shape, and is not read again at every
+# sync. The read number tells others (the lamp stage) that the geometry may have changed.
+_known_rest = {}
+_reads = [0]
+
+
+def note_updates(depsgraph: Depsgraph) -> None:
+    """Forget the rest fingerprints of the objects whose geometry ``depsgraph`` evaluated again
+    (called by every sync that gets a handler's depsgraph, also while the add-on computes)."""
+    if not _known_rest:
+        return
+    for update in depsgraph.updates:
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Object):
+            _known_rest.pop(update.id.name, None)
+
+
+def _evaluated_key(obj_eval):
+    """The evaluated mesh's address and point count: a known fingerprint of another mesh (another
+    file's object of the same name) is not taken."""
+    return (obj_eval.data.as_pointer(), len(obj_eval.data.vertices)) if obj_eval.type == "MESH" else None
+
+
+def _remember(obj_eval, fingerprint):
+    _reads[0] += 1
+    _known_rest[obj_eval.name] = (_evaluated_key(obj_eval), fingerprint, _reads[0])
+
+
+def _rest_fingerprint(obj_eval):
+    """The object's rest fingerprint, read only when its geometry was evaluated since the last read."""
+    known = _known_rest.get(obj_eval.name)
+    if known is not None and known[0] == _evaluated_key(obj_eval):
+        return known[1]
+    fingerprint = rest_fingerprint(obj_eval)
+    _remember(obj_eval, fingerprint)
+    return fingerprint
+
+
+def geometry_key(obj: Object) -> tuple | None:
+    """A key that stays the same while Blender has not evaluated the geometry of ``obj`` again
+    since the add-on last read it (its mesh, that read), or None (unknown: it may have changed).
+    Reads nothing: what the lamp stage computes from the mesh is kept under it."""
+    known = _known_rest.get(obj.name)
+    if known is None or obj.type != "MESH":
         return None
-    values = np.empty(len(attribute.data) * 3, dtype=np.float32)
-    attribute.data.foreach_get("vector", values)
-    return len(attribute.data), zlib.crc32(values.data)
+    return obj.data.name, obj.data.as_pointer(), len(obj.data.vertices), known[2]
 
 
-def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None) -> str:
+def object_signature(
+    snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None, fingerprint: tuple[int, int] | None = None
+) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache
-    (the evaluated rest shape too, given the update's ``depsgraph``)."""
+    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
+    if fingerprint is None and depsgraph is not None:
+        fingerprint = _rest_fingerprint(evaluated)
     parts = [
         snap.frame,
         snap.speed_of_light,
@@ -80,7 +136,7 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
         relativity.use_deformation,
         relativity.use_proper_time,
         len(obj.data.vertices),
-        rest_fingerprint(evaluated) if depsgraph is not None else None,
+        fingerprint,
     ]
     return repr(parts)
 
@@ -90,10 +146,14 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     _, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
-    rest = modifier.evaluated_rest_positions(obj, depsgraph)
-    if rest is None:
+    rest32 = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
+    if rest32 is None:
         raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
+    fingerprint = rest_fingerprint(obj_eval, rest32.reshape(-1))
+    _remember(obj_eval, fingerprint)
+    rest = rest32.astype(np.float64)
+    del rest32
     try:
         world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
@@ -104,7 +164,7 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
     modifier.write_cache(cache.data, local, beta_seen)
     cache.data[names.DEPTH_KEY] = farthest_seen_depth(scene, snap, world)
-    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, fingerprint)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
     if warning is not None:

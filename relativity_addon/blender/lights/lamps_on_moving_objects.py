@@ -34,7 +34,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import lamp_doppler
 from ..common import names
-from ..geometry import modifier
+from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
 from . import rest_normals
@@ -85,14 +85,32 @@ def lamps(scene: Scene) -> list[Object]:
     ]
 
 
+# Object name -> (key, centre): the centre of its mesh while its geometry key
+# (``apparent_meshes.geometry_key``: Blender has not evaluated it again) stays the same.
+_centres = {}
+
+
 def _local_centre(obj):
-    count = len(obj.data.vertices)
+    """The centre of the mesh's bounding box (object space), from its float32 positions."""
+    mesh = obj.data
+    count = len(mesh.vertices)
     if count == 0:
         return np.zeros(3)
-    co = np.empty(count * 3)
-    obj.data.vertices.foreach_get("co", co)
+    co = np.empty(count * 3, dtype=np.float32)
+    mesh.attributes["position"].data.foreach_get("vector", co)
     co = co.reshape(-1, 3)
-    return (co.min(axis=0) + co.max(axis=0)) / 2.0
+    return (co.min(axis=0).astype(np.float64) + co.max(axis=0).astype(np.float64)) / 2.0
+
+
+def _centre(obj):
+    """:func:`_local_centre`, read again only when the object's geometry may have changed."""
+    key = apparent_meshes.geometry_key(obj)
+    known = _centres.get(obj.name)
+    if key is not None and known is not None and known[0] == key:
+        return known[1]
+    centre = _local_centre(obj)
+    _centres[obj.name] = (key, centre)
+    return centre
 
 
 def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
@@ -107,7 +125,7 @@ def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
         if motion not in ("CONSTANT", "ANIMATION") or (motion == "ANIMATION" and obj.relativity.use_deformation):
             continue
         try:
-            centre = _local_centre(obj)[None]
+            centre = _centre(obj)[None]
             world, beta = world_lines.apparent_world_positions(
                 scene, obj, obj, centre, at_rest_observer, shape_keys_too=False
             )
@@ -231,8 +249,9 @@ def write(scene: Scene, snap: Snapshot) -> int:
     off the Apparent Geometry path."""
     pairs = []
     if snap.method == "GEOMETRY" and (snap.use_doppler or snap.use_searchlight):
-        found = movers(scene, snap)
-        pairs = [(lamp, mover) for lamp in lamps(scene) for mover in found]
+        lit_by = lamps(scene)
+        found = movers(scene, snap) if lit_by else []  # no lamps: nothing to place
+        pairs = [(lamp, mover) for lamp in lit_by for mover in found]
     record = _record(scene)
     layout = sorted([lamp.name, mover.name] for lamp, mover in pairs)
     if record is not None and sorted(_copy_pairs(record)) != layout:
