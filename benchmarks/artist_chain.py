@@ -126,14 +126,17 @@ def _linear(obj):
             point.interpolation = "LINEAR"
 
 
-def build(bpy, kind, size, motion, tessellation, resolution, samples):
-    """The ``Effect`` scene (context scene, not set up yet) and the ``Plain`` scene."""
+def build(bpy, kind, size, motion, tessellation, resolution, samples, only=None):
+    """The ``Effect`` scene (context scene, not set up yet) and the ``Plain`` scene (``only``: the
+    one named; the other is empty)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     effect_scene = bpy.context.scene
     effect_scene.name = "Effect"
     plain_scene = bpy.data.scenes.new("Plain")
-    scenes = {}
+    scenes = {"Effect": [], "Plain": []}
     for scene in (effect_scene, plain_scene):
+        if only not in (None, scene.name):
+            continue
         scene.render.engine = "CYCLES"
         scene.cycles.device = "CPU"
         scene.cycles.samples = samples
@@ -270,7 +273,14 @@ def measure_case(bpy, options, kind, size, motion):
 def child_memory(bpy, options, kind, size, motion, with_effect):
     """Peak resident memory (bytes) of a process doing the case with or without the effect."""
     effect_scene, plain_scene, movers, plain = build(
-        bpy, kind, size, motion, options.tessellation, options.resolution, options.samples
+        bpy,
+        kind,
+        size,
+        motion,
+        options.tessellation,
+        options.resolution,
+        options.samples,
+        only="Effect" if with_effect else "Plain",
     )
     if with_effect:
         assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
@@ -285,7 +295,7 @@ def child_memory(bpy, options, kind, size, motion, with_effect):
             plain_scene.frame_set(13)
             plain_rewrite(bpy, plain_scene, plain, 1e-3)
             bpy.ops.render.render(scene=plain_scene.name)
-    # Both processes hold both scenes (the same build); Linux reports ru_maxrss in kilobytes.
+    # Each process holds its own scene only; Linux reports ru_maxrss in kilobytes.
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
