@@ -44,6 +44,9 @@ if TYPE_CHECKING:
 # An edge longer than this fraction of its distance to the camera is too coarse for the
 # apparent-geometry path to curve (aberration bends straight lines; only vertices move).
 COARSE_EDGE_FRACTION = 0.25
+# Points of a closed-form motion computed at a time: bounds the float64 temporaries, which for
+# every point at once are several times the float32 positions the cache holds.
+CHUNK_POINTS = 1 << 20
 
 
 def rest_fingerprint(obj_eval: Object, values: FloatArray | None = None) -> tuple[int, int] | None:
@@ -152,18 +155,10 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     obj_eval = obj.evaluated_get(depsgraph)
     fingerprint = rest_fingerprint(obj_eval, rest32.reshape(-1))
     _remember(obj_eval, fingerprint)
-    rest = rest32.astype(np.float64)
-    del rest32
-    try:
-        world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
-    except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
-        raise RelativityError(f"Object {obj.name!r}: {error}") from None
-    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))
-    inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
-    # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
-    local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
+    local, beta_seen, delay, depth = _apparent_local(scene, obj, obj_eval, rest32, snap)
+    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - delay)
     modifier.write_cache(cache.data, local, beta_seen)
-    cache.data[names.DEPTH_KEY] = farthest_seen_depth(scene, snap, world)
+    cache.data[names.DEPTH_KEY] = depth
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, fingerprint)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
@@ -173,6 +168,30 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
+
+
+def _apparent_local(scene, obj, obj_eval, rest32, snap):
+    """``(object-space apparent positions (N, 3) float32, velocities seen, the largest light
+    delay, the farthest seen depth)`` of the rest positions ``rest32``. The closed form
+    (``motion.closed_form``) goes CHUNK_POINTS at a time: each point depends on its own rest
+    position only, and a part's float64 temporaries are what the peak memory holds."""
+    inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
+    step = CHUNK_POINTS if motion.closed_form(obj, scene) else max(len(rest32), 1)
+    local = np.empty(rest32.shape, dtype=np.float32)
+    delay, depth, beta_seen = 0.0, 0.0, []
+    for start in range(0, max(len(rest32), 1), step):
+        rest = rest32[start : start + step].astype(np.float64)
+        try:
+            world, delays, beta = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
+        except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
+            raise RelativityError(f"Object {obj.name!r}: {error}") from None
+        delay = max(delay, float(np.max(delays, initial=0.0)))
+        depth = max(depth, farthest_seen_depth(scene, snap, world))
+        # On coordinate rows (3, n): numpy multiplies the transposed views without copying them.
+        local[start : start + step] = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
+        beta_seen.append(beta)
+    shared = all(len(beta) == 1 for beta in beta_seen)  # one velocity for every point
+    return local, beta_seen[0] if shared else np.concatenate(beta_seen), delay, depth
 
 
 def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed: bool = False) -> int:

@@ -87,7 +87,7 @@ def apparent_world_positions(
         world, delay, beta_seen = animated_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too
         )
-    elif motion == "CONSTANT" and plays_own_animation(obj, scene):
+    elif not closed_form(obj, scene):  # CONSTANT, playing its own animation
         beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
         world, delay, beta_seen = proper_time_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too
@@ -104,6 +104,14 @@ def apparent_world_positions(
         world, delay, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
         beta_seen = beta_seen[:1]  # one velocity for every vertex
     return (world, delay, beta_seen) if with_delay else (world, beta_seen)
+
+
+def closed_form(obj: Object, scene: Scene) -> bool:
+    """Whether the object's apparent positions have the closed form (STATIC, or CONSTANT without
+    an animation of its own to play): each point's from its own rest position alone, so the
+    points can be computed a part at a time."""
+    motion = obj.relativity.motion
+    return motion != "ANIMATION" and not (motion == "CONSTANT" and plays_own_animation(obj, scene))
 
 
 def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:
