@@ -26,8 +26,8 @@ is divided by that round's plain time, and the median ratio is printed with the 
     the velocity, steps a frame and renders, against one doing the plain scene's equivalent.
 
 ``--tessellation`` says what the meshes get (``default``: the add-on's default; ``0``: none);
-the printed rows name it. ``--profile FILE`` writes a cProfile of one velocity change and one
-frame step of the first case (read it with ``python -m pstats FILE``).
+the printed rows name it. ``--profile FILE`` writes a cProfile of a Set Up, a velocity change and a
+frame step of the first case, after a Set Up (read it with ``python -m pstats FILE``).
 """
 
 import argparse
@@ -257,6 +257,7 @@ def measure_case(bpy, options, kind, size, motion):
     alternate("frame step", frame_step, lambda r: plain_rewrite(bpy, plain_scene, plain, 1e-3))
     if options.profile:
         profile = cProfile.Profile()
+        profile.runcall(run_setup, 0)
         profile.runcall(velocity_change, 0)
         profile.runcall(frame_step, options.rounds + 1)
         profile.dump_stats(options.profile)

@@ -175,7 +175,7 @@ def _apparent_local(scene, obj, obj_eval, rest32, snap):
     delay, the farthest seen depth)`` of the rest positions ``rest32``. The closed form
     (``motion.closed_form``) goes CHUNK_POINTS at a time: each point depends on its own rest
     position only, and a part's float64 temporaries are what the peak memory holds."""
-    inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
+    inverse = motion.affine_inverse(motion.matrix_array(obj_eval.matrix_world))
     step = CHUNK_POINTS if motion.closed_form(obj, scene) else max(len(rest32), 1)
     local = np.empty(rest32.shape, dtype=np.float32)
     delay, depth, beta_seen = 0.0, 0.0, []

@@ -59,6 +59,18 @@ def matrix_array(matrix: Matrix | Iterable[Iterable[float]]) -> FloatArray:
     return np.array([list(row) for row in matrix], dtype=np.float64)
 
 
+def affine_inverse(matrix: FloatArray) -> FloatArray:
+    """The inverse of an affine 4x4 ``matrix`` (last row 0 0 0 1, float64) by the adjugate of its
+    3x3 part: elementwise numpy, no LAPACK call (whose threads cost milliseconds per call on a
+    loaded machine, once per object and update)."""
+    a = matrix[:3, :3]
+    adjugate = np.array([np.cross(a[1], a[2]), np.cross(a[2], a[0]), np.cross(a[0], a[1])]).T
+    inverse = np.eye(4)
+    inverse[:3, :3] = adjugate / float(a[0] @ adjugate[:, 0])
+    inverse[:3, 3] = -(inverse[:3, :3] @ matrix[:3, 3])
+    return inverse
+
+
 def to_world(matrix: FloatArray, points: FloatArray) -> FloatArray:
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
