@@ -2,7 +2,7 @@
 
     python benchmarks/artist_chain.py [--sizes 0.5M,2M,8M] [--scenes grid,objects]
         [--motions constant,keyframed] [--tessellation default|0|N] [--rounds 3]
-        [--resolution 64x48] [--samples 4] [--no-memory] [--profile chain.prof]
+        [--resolution 64x48] [--samples 4] [--lamp] [--no-memory] [--profile chain.prof]
 
 Generated scenes: one grid mesh of about SIZE vertices, or SIZE / 2,000 small grids of 2,025
 vertices each (1,000 objects at 2M), each a mesh of its own, 5 m in front of the camera, with
@@ -22,12 +22,15 @@ is divided by that round's plain time, and the median ratio is printed with the 
     every vertex (a frame step moves every vertex).
 (c) Set Up (the operator) against the plain rewrite.
 (d) F12: ``render.render`` of each scene (small resolution, few samples), the observer at rest.
-(e) peak memory (``ru_maxrss``) of a separate process that builds the scene, sets it up, changes
-    the velocity, steps a frame and renders, against one doing the plain scene's equivalent.
+(e) peak memory (``VmHWM``, else ``ru_maxrss``) of a separate process that builds the scene,
+    sets it up, changes the velocity, steps a frame and renders, against one doing the plain
+    scene's equivalent (each builds its own scene only).
 
 ``--tessellation`` says what the meshes get (``default``: the add-on's default; ``0``: none);
-the printed rows name it. ``--profile FILE`` writes a cProfile of a Set Up, a velocity change and a
-frame step of the first case, after a Set Up (read it with ``python -m pstats FILE``).
+the printed rows name it. ``--lamp`` adds a sun to both scenes: the lamp stage then adds a
+light-linked copy of it per moving object (Blender links at most 64). ``--profile FILE`` writes
+a cProfile of a Set Up, a velocity change and a frame step of the first case (read it with
+``python -m pstats FILE``).
 """
 
 import argparse
@@ -126,7 +129,7 @@ def _linear(obj):
             point.interpolation = "LINEAR"
 
 
-def build(bpy, kind, size, motion, tessellation, resolution, samples, only=None):
+def build(bpy, kind, size, motion, tessellation, resolution, samples, only=None, lamp=False):
     """The ``Effect`` scene (context scene, not set up yet) and the ``Plain`` scene (``only``: the
     one named; the other is empty)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -149,8 +152,9 @@ def build(bpy, kind, size, motion, tessellation, resolution, samples, only=None)
         camera.location = (0.0, 0.0, 5.0)
         scene.collection.objects.link(camera)
         scene.camera = camera
-        light = bpy.data.objects.new(f"{scene.name} sun", bpy.data.lights.new(f"{scene.name} sun", "SUN"))
-        scene.collection.objects.link(light)
+        if lamp:  # the lamp stage then adds a light-linked copy per moving object
+            light = bpy.data.objects.new(f"{scene.name} sun", bpy.data.lights.new(f"{scene.name} sun", "SUN"))
+            scene.collection.objects.link(light)
         scene.frame_set(12)
         scenes[scene.name] = build_objects(bpy, scene, kind, size, motion, tessellation)
     effect_scene.relativity.speed_of_light = C
@@ -212,7 +216,7 @@ def measure_case(bpy, options, kind, size, motion):
     from relativity_addon.blender.pipeline import effect
 
     effect_scene, plain_scene, movers, plain = build(
-        bpy, kind, size, motion, options.tessellation, options.resolution, options.samples
+        bpy, kind, size, motion, options.tessellation, options.resolution, options.samples, lamp=options.lamp
     )
     results = {}
 
@@ -282,6 +286,7 @@ def child_memory(bpy, options, kind, size, motion, with_effect):
         options.resolution,
         options.samples,
         only="Effect" if with_effect else "Plain",
+        lamp=options.lamp,
     )
     if with_effect:
         assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
@@ -296,8 +301,21 @@ def child_memory(bpy, options, kind, size, motion, with_effect):
             plain_scene.frame_set(13)
             plain_rewrite(bpy, plain_scene, plain, 1e-3)
             bpy.ops.render.render(scene=plain_scene.name)
-    # Each process holds its own scene only; Linux reports ru_maxrss in kilobytes.
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    return peak_resident_bytes()
+
+
+def peak_resident_bytes():
+    """This process's peak resident memory: ``VmHWM`` (Linux), else ``ru_maxrss``. A child started
+    from a large process inherits that process's ``ru_maxrss`` across exec (measured: every case
+    read the parent's 2.06 GB); ``VmHWM`` is its own address space's high-water mark."""
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kilobytes on Linux
 
 
 def peak_memory(options, kind, size, motion):
@@ -310,7 +328,7 @@ def peak_memory(options, kind, size, motion):
             f"{kind},{size},{motion},{int(with_effect)}",
         ]
         command += ["--tessellation", options.tessellation_text, "--samples", str(options.samples)]
-        command += ["--resolution", "x".join(map(str, options.resolution))]
+        command += ["--resolution", "x".join(map(str, options.resolution))] + ["--lamp"] * options.lamp
         output = subprocess.run(command, capture_output=True, text=True, check=False).stdout
         lines = [line for line in output.splitlines() if line.startswith("peak_bytes ")]
         if not lines:
@@ -343,6 +361,7 @@ def main():
     parser.add_argument("--resolution", default="64x48")
     parser.add_argument("--samples", type=int, default=4)
     parser.add_argument("--no-memory", action="store_true")
+    parser.add_argument("--lamp", action="store_true", help="a sun in each scene (the lamp stage's copies)")
     parser.add_argument("--profile", default=None)
     parser.add_argument("--child-memory", default=None, help=argparse.SUPPRESS)
     options = parser.parse_args()
