@@ -60,15 +60,20 @@ def matrix_array(matrix: Matrix | Iterable[Iterable[float]]) -> FloatArray:
 
 
 def affine_inverse(matrix: FloatArray) -> FloatArray:
-    """The inverse of an affine 4x4 ``matrix`` (last row 0 0 0 1, float64) by the adjugate of its
-    3x3 part: elementwise numpy, no LAPACK call (whose threads cost milliseconds per call on a
-    loaded machine, once per object and update)."""
-    a = matrix[:3, :3]
-    adjugate = np.array([np.cross(a[1], a[2]), np.cross(a[2], a[0]), np.cross(a[0], a[1])]).T
-    inverse = np.eye(4)
-    inverse[:3, :3] = adjugate / float(a[0] @ adjugate[:, 0])
-    inverse[:3, 3] = -(inverse[:3, :3] @ matrix[:3, 3])
-    return inverse
+    """The inverse of an affine 4x4 ``matrix`` (last row 0 0 0 1) by the adjugate of its 3x3 part,
+    in float64 scalars: no LAPACK call (whose threads cost milliseconds per call on a loaded
+    machine) and no small-array numpy calls (``np.cross`` was as slow), once per object update."""
+    (a, b, c, x), (d, e, f, y), (g, h, i, z) = matrix[:3].tolist()
+    rows = (
+        (e * i - f * h, c * h - b * i, b * f - c * e),
+        (f * g - d * i, a * i - c * g, c * d - a * f),
+        (d * h - e * g, b * g - a * h, a * e - b * d),
+    )
+    scale = 1.0 / (a * rows[0][0] + b * rows[1][0] + c * rows[2][0])
+    inverse = [[value * scale for value in row] for row in rows]
+    for row in inverse:
+        row.append(-(row[0] * x + row[1] * y + row[2] * z))
+    return np.array([*inverse, [0.0, 0.0, 0.0, 1.0]])
 
 
 def to_world(matrix: FloatArray, points: FloatArray) -> FloatArray:
