@@ -105,9 +105,18 @@ def xyz_to_linear_rec709(xyz: ArrayLike) -> FloatArray:
     return np.asarray(xyz, dtype=np.float64) @ _tables()["xyz_to_rgb"].T
 
 
+@functools.lru_cache(maxsize=1)
+def _rgb_to_y() -> FloatArray:
+    """The ``Y`` row of the Rec.709 -> XYZ matrix (inverted once: a LAPACK call per colour cost
+    milliseconds on a loaded machine, and the lamp stage makes one per lamp and object)."""
+    row = np.linalg.inv(_tables()["xyz_to_rgb"])[1]
+    row.flags.writeable = False
+    return row
+
+
 def luminance(rgb: ArrayLike) -> FloatArray:
     """CIE ``Y`` of linear Rec.709 colours."""
-    return np.asarray(rgb, dtype=np.float64) @ np.linalg.inv(_tables()["xyz_to_rgb"])[1]
+    return np.asarray(rgb, dtype=np.float64) @ _rgb_to_y()
 
 
 def gamut_map(rgb: ArrayLike) -> FloatArray:

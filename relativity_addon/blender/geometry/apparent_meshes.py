@@ -38,30 +38,89 @@ if TYPE_CHECKING:
     import numpy.typing as npt
     from bpy.types import Depsgraph, Object, Scene
 
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 # An edge longer than this fraction of its distance to the camera is too coarse for the
 # apparent-geometry path to curve (aberration bends straight lines; only vertices move).
 COARSE_EDGE_FRACTION = 0.25
+# Points of a closed-form motion computed at a time: bounds the float64 temporaries, which for
+# every point at once are several times the float32 positions the cache holds.
+CHUNK_POINTS = 1 << 20
 
 
-def rest_fingerprint(obj_eval: Object) -> tuple[int, int] | None:
+def rest_fingerprint(obj_eval: Object, values: FloatArray | None = None) -> tuple[int, int] | None:
     """``(point count, CRC-32)`` of the tessellated rest positions on the evaluated mesh, or None:
     an edit of the mesh or of a modifier (an Array's count or offset) changes it, which nothing
-    else in the signature sees. One read of the attribute, no mesh copy."""
-    attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
-    if attribute is None:
+    else in the signature sees. One read of the attribute, no mesh copy; none with ``values``
+    (the attribute's float32 values, read already)."""
+    if values is None:
+        attribute = obj_eval.data.attributes.get(names.REST_ATTRIBUTE) if obj_eval.type == "MESH" else None
+        if attribute is None:
+            return None
+        values = np.empty(len(attribute.data) * 3, dtype=np.float32)
+        attribute.data.foreach_get("vector", values)
+    return len(values) // 3, zlib.crc32(np.ascontiguousarray(values, dtype=np.float32).data)
+
+
+# Object name -> (evaluated mesh key, fingerprint, read number) of its rest positions as read
+# since the depsgraph last evaluated its geometry (:func:`note_updates` forgets it then): an
+# object Blender did not evaluate again has the same rest shape, and is not read again at every
+# sync. The read number tells others (the lamp stage) that the geometry may have changed.
+_known_rest = {}
+_reads = [0]
+
+
+def note_updates(depsgraph: Depsgraph) -> None:
+    """Forget the rest fingerprints of the objects whose geometry ``depsgraph`` evaluated again
+    (called by every sync that gets a handler's depsgraph, also while the add-on computes)."""
+    if not _known_rest:
+        return
+    for update in depsgraph.updates:
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Object):
+            _known_rest.pop(update.id.name, None)
+
+
+def _evaluated_key(obj_eval):
+    """The evaluated mesh's address and point count: a known fingerprint of another mesh (another
+    file's object of the same name) is not taken."""
+    return (obj_eval.data.as_pointer(), len(obj_eval.data.vertices)) if obj_eval.type == "MESH" else None
+
+
+def _remember(obj_eval, fingerprint):
+    _reads[0] += 1
+    _known_rest[obj_eval.name] = (_evaluated_key(obj_eval), fingerprint, _reads[0])
+
+
+def _rest_fingerprint(obj_eval):
+    """The object's rest fingerprint, read only when its geometry was evaluated since the last read."""
+    known = _known_rest.get(obj_eval.name)
+    if known is not None and known[0] == _evaluated_key(obj_eval):
+        return known[1]
+    fingerprint = rest_fingerprint(obj_eval)
+    _remember(obj_eval, fingerprint)
+    return fingerprint
+
+
+def geometry_key(obj: Object) -> tuple | None:
+    """A key that stays the same while Blender has not evaluated the geometry of ``obj`` again
+    since the add-on last read it (its mesh, that read), or None (unknown: it may have changed).
+    Reads nothing: what the lamp stage computes from the mesh is kept under it."""
+    known = _known_rest.get(obj.name)
+    if known is None or obj.type != "MESH":
         return None
-    values = np.empty(len(attribute.data) * 3, dtype=np.float32)
-    attribute.data.foreach_get("vector", values)
-    return len(attribute.data), zlib.crc32(values.data)
+    return obj.data.name, obj.data.as_pointer(), len(obj.data.vertices), known[2]
 
 
-def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None) -> str:
+def object_signature(
+    snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None, fingerprint: tuple[int, int] | None = None
+) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache
-    (the evaluated rest shape too, given the update's ``depsgraph``)."""
+    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
+    if fingerprint is None and depsgraph is not None:
+        fingerprint = _rest_fingerprint(evaluated)
     parts = [
         snap.frame,
         snap.speed_of_light,
@@ -84,7 +143,7 @@ def object_signature(snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = 
         relativity.use_deformation,
         relativity.use_proper_time,
         len(obj.data.vertices),
-        rest_fingerprint(evaluated) if depsgraph is not None else None,
+        fingerprint,
     ]
     return repr(parts)
 
@@ -103,25 +162,27 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         decision = tessellation.decide(scene, obj, obj.evaluated_get(depsgraph), snap)
         if decision is not None and tessellation.apply(obj, mod, cache, decision):
             depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
-        codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
-        rest = modifier.evaluated_rest_positions(obj, depsgraph)
-        if rest is None:
-            raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
-        obj_eval = obj.evaluated_get(depsgraph)
-        measured = decision.vertices if decision is not None and decision.codes is None else None
-        if measured is not None and np.array_equal(measured[0], rest):
-            world, delay, beta_seen = measured[1:]  # the measure computed them for these points
-        else:
-            world, delay, beta_seen = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
-    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - float(np.max(delay, initial=0.0)))
-    inverse = np.linalg.inv(motion.matrix_array(obj_eval.matrix_world))
-    # On coordinate rows (3, N): numpy multiplies the transposed views without copying them.
-    local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
+    codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
+    rest32 = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
+    if rest32 is None:
+        raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
+    obj_eval = obj.evaluated_get(depsgraph)
+    fingerprint = rest_fingerprint(obj_eval, rest32.reshape(-1))
+    _remember(obj_eval, fingerprint)
+    measured = decision.vertices if decision is not None and decision.codes is None else None
+    if measured is not None and np.array_equal(measured[0], rest32):
+        world, delays, beta_seen = measured[1:]  # the measure computed them for these points
+        inverse = motion.affine_inverse(motion.matrix_array(obj_eval.matrix_world))
+        local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T.astype(np.float32)
+        delay, depth = float(np.max(delays, initial=0.0)), farthest_seen_depth(scene, snap, world)
+    else:
+        local, beta_seen, delay, depth = _apparent_local(scene, obj, obj_eval, rest32, snap)
+    warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - delay)
     modifier.write_cache(cache.data, local, beta_seen, codes)
-    cache.data[names.DEPTH_KEY] = farthest_seen_depth(scene, snap, world)
-    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+    cache.data[names.DEPTH_KEY] = depth
+    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, fingerprint)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
     if warning is not None:
@@ -130,6 +191,30 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
+
+
+def _apparent_local(scene, obj, obj_eval, rest32, snap):
+    """``(object-space apparent positions (N, 3) float32, velocities seen, the largest light
+    delay, the farthest seen depth)`` of the rest positions ``rest32``. The closed form
+    (``motion.closed_form``) goes CHUNK_POINTS at a time: each point depends on its own rest
+    position only, and a part's float64 temporaries are what the peak memory holds."""
+    inverse = motion.affine_inverse(motion.matrix_array(obj_eval.matrix_world))
+    step = CHUNK_POINTS if motion.closed_form(obj, scene) else max(len(rest32), 1)
+    local = np.empty(rest32.shape, dtype=np.float32)
+    delay, depth, beta_seen = 0.0, 0.0, []
+    for start in range(0, max(len(rest32), 1), step):
+        rest = rest32[start : start + step].astype(np.float64)
+        try:
+            world, delays, beta = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
+        except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
+            raise RelativityError(f"Object {obj.name!r}: {error}") from None
+        delay = max(delay, float(np.max(delays, initial=0.0)))
+        depth = max(depth, farthest_seen_depth(scene, snap, world))
+        # On coordinate rows (3, n): numpy multiplies the transposed views without copying them.
+        local[start : start + step] = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
+        beta_seen.append(beta)
+    shared = all(len(beta) == 1 for beta in beta_seen)  # one velocity for every point
+    return local, beta_seen[0] if shared else np.concatenate(beta_seen), delay, depth
 
 
 def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed: bool = False) -> int:

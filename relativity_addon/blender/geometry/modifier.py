@@ -408,20 +408,18 @@ def remove_unused_group() -> None:
     remove_unused_groups((names.GEOMETRY_GROUP,))
 
 
-def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph) -> FloatArray | None:
-    """The tessellated rest positions (object space, float64 ``(N, 3)``) the modifier stored on
-    the evaluated mesh, or None without the attribute."""
+def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph, dtype: type = np.float64) -> FloatArray | None:
+    """The tessellated rest positions (object space, ``(N, 3)`` of ``dtype``) the modifier stored
+    on the evaluated mesh, or None without the attribute. Read from the evaluated mesh itself:
+    ``to_mesh`` would copy the whole mesh first."""
     obj_eval = obj.evaluated_get(depsgraph)
-    mesh = obj_eval.to_mesh()
-    try:
-        attribute = mesh.attributes.get(names.REST_ATTRIBUTE)
-        if attribute is None:
-            return None
-        rest = np.empty(len(attribute.data) * 3, dtype=np.float32)
-        attribute.data.foreach_get("vector", rest)
-    finally:
-        obj_eval.to_mesh_clear()
-    return rest.reshape(-1, 3).astype(np.float64)
+    mesh = obj_eval.data if obj_eval.type == "MESH" else None
+    attribute = mesh.attributes.get(names.REST_ATTRIBUTE) if mesh is not None else None
+    if attribute is None:
+        return None
+    rest = np.empty(len(attribute.data) * 3, dtype=np.float32)
+    attribute.data.foreach_get("vector", rest)
+    return rest.reshape(-1, 3).astype(dtype, copy=False)
 
 
 def write_cache(mesh: Mesh, positions: FloatArray, beta: FloatArray, face_codes: FloatArray | None = None) -> None:

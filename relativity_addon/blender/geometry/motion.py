@@ -59,6 +59,23 @@ def matrix_array(matrix: Matrix | Iterable[Iterable[float]]) -> FloatArray:
     return np.array([list(row) for row in matrix], dtype=np.float64)
 
 
+def affine_inverse(matrix: FloatArray) -> FloatArray:
+    """The inverse of an affine 4x4 ``matrix`` (last row 0 0 0 1) by the adjugate of its 3x3 part,
+    in float64 scalars: no LAPACK call (whose threads cost milliseconds per call on a loaded
+    machine) and no small-array numpy calls (``np.cross`` was as slow), once per object update."""
+    (a, b, c, x), (d, e, f, y), (g, h, i, z) = matrix[:3].tolist()
+    rows = (
+        (e * i - f * h, c * h - b * i, b * f - c * e),
+        (f * g - d * i, a * i - c * g, c * d - a * f),
+        (d * h - e * g, b * g - a * h, a * e - b * d),
+    )
+    scale = 1.0 / (a * rows[0][0] + b * rows[1][0] + c * rows[2][0])
+    inverse = [[value * scale for value in row] for row in rows]
+    for row in inverse:
+        row.append(-(row[0] * x + row[1] * y + row[2] * z))
+    return np.array([*inverse, [0.0, 0.0, 0.0, 1.0]])
+
+
 def to_world(matrix: FloatArray, points: FloatArray) -> FloatArray:
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
@@ -87,7 +104,7 @@ def apparent_world_positions(
         world, delay, beta_seen = animated_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, obj_eval=obj_eval, shape_keys_too=shape_keys_too
         )
-    elif motion == "CONSTANT" and plays_own_animation(obj, scene):
+    elif not closed_form(obj, scene):  # CONSTANT, playing its own animation
         beta_u = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
         world, delay, beta_seen = proper_time_apparent_positions(
             obj, scene, rest, t_o, x_o, beta_o, c, beta_u=beta_u, matrix_now=matrix_now, shape_keys_too=shape_keys_too
@@ -104,6 +121,14 @@ def apparent_world_positions(
         world, delay, beta_seen = apparent.apparent_positions_uniform(t_o, x_o, world_now, beta_u, c, beta_o)
         beta_seen = beta_seen[:1]  # one velocity for every vertex
     return (world, delay, beta_seen) if with_delay else (world, beta_seen)
+
+
+def closed_form(obj: Object, scene: Scene) -> bool:
+    """Whether the object's apparent positions have the closed form (STATIC, or CONSTANT without
+    an animation of its own to play): each point's from its own rest position alone, so the
+    points can be computed a part at a time."""
+    motion = obj.relativity.motion
+    return motion != "ANIMATION" and not (motion == "CONSTANT" and plays_own_animation(obj, scene))
 
 
 def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:

@@ -38,7 +38,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import lamp_doppler
 from ..common import compat, names, nodes
-from ..geometry import modifier
+from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
 from . import lamp_stand_ins, moving_lights, rest_normals
@@ -97,17 +97,34 @@ def lamps(scene: Scene) -> list[Object]:
 def _local_box(obj):
     """The centre, then the corners, edge midpoints and face centres of the mesh's bounding box
     (object space): where the receiving points' apparent lamp offsets reach their extremes closely
-    enough (the offset is not monotonic over a face)."""
-    count = len(obj.data.vertices)
+    enough (the offset is not monotonic over a face). From the mesh's float32 positions."""
+    mesh = obj.data
+    count = len(mesh.vertices)
     if count == 0:
         return np.zeros((27, 3))
-    co = np.empty(count * 3)
-    obj.data.vertices.foreach_get("co", co)
+    co = np.empty(count * 3, dtype=np.float32)
+    mesh.attributes["position"].data.foreach_get("vector", co)
     co = co.reshape(-1, 3)
-    low, high = co.min(axis=0), co.max(axis=0)
+    low, high = co.min(axis=0).astype(np.float64), co.max(axis=0).astype(np.float64)
     steps = np.array(list(np.ndindex(3, 3, 3))) - 1
     grid = (low + high) / 2.0 + steps * (high - low) / 2.0
     return grid[np.argsort(np.abs(steps).sum(axis=1), kind="stable")]  # the centre first
+
+
+# Object name -> (key, box): the points of :func:`_local_box` while the object's geometry key
+# (``apparent_meshes.geometry_key``: Blender has not evaluated it again) stays the same.
+_boxes = {}
+
+
+def _box(obj):
+    """:func:`_local_box`, read again only when the object's geometry may have changed."""
+    key = apparent_meshes.geometry_key(obj)
+    known = _boxes.get(obj.name)
+    if key is not None and known is not None and known[0] == key:
+        return known[1]
+    box = _local_box(obj)
+    _boxes[obj.name] = (key, box)
+    return box
 
 
 def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
@@ -123,7 +140,7 @@ def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
             continue
         try:
             world, beta = world_lines.apparent_world_positions(
-                scene, obj, obj, _local_box(obj), at_rest_observer, shape_keys_too=False
+                scene, obj, obj, _box(obj), at_rest_observer, shape_keys_too=False
             )
         except ValueError as error:
             raise RelativityError(f"Object {obj.name!r}: {error}") from None
@@ -314,8 +331,9 @@ def write(scene: Scene, snap: Snapshot) -> int:
     off the Apparent Geometry path."""
     pairs = []
     if snap.method == "GEOMETRY" and (snap.use_doppler or snap.use_searchlight):
-        found = movers(scene, snap)
-        pairs = [(lamp, mover) for lamp in lamps(scene) for mover in found]
+        lit_by = lamps(scene)
+        found = movers(scene, snap) if lit_by else []  # no lamps: nothing to place
+        pairs = [(lamp, mover) for lamp in lit_by for mover in found]
     record = _record(scene)
     placed = []
     for lamp, mover in pairs:

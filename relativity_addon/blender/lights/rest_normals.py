@@ -25,6 +25,7 @@ import bpy
 import numpy as np
 
 from ..common import names, nodes
+from ..geometry import apparent_meshes
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -71,6 +72,10 @@ def _corner_normals(mesh):
     values = np.empty(len(mesh.loops) * 3, dtype=np.float32)
     mesh.corner_normals.foreach_get("vector", values)
     return values
+
+
+# Mesh name -> the geometry key (``apparent_meshes.geometry_key``) its rest normals were written at.
+_written = {}
 
 
 def _write_attribute(mesh):
@@ -147,13 +152,17 @@ def write(scene: Scene, objects: Sequence[Object]) -> None:
             mesh[MESH_KEY] = True
             record["meshes"].append(mesh.name)
             scene[KEY] = record
-        _write_attribute(mesh)
+        key = apparent_meshes.geometry_key(obj)
+        if key is None or _written.get(mesh.name) != key:  # else the normals written are current
+            _write_attribute(mesh)
+            _written[mesh.name] = key
         for slot in obj.material_slots:
             attach(slot.material, group)
 
 
 def remove(scene: Scene) -> None:
     """Detach the group from every material, delete the attributes the stage added and the group."""
+    _written.clear()
     for material in bpy.data.materials:
         detach(material)
     added: list[Mesh | None] = [mesh for mesh in bpy.data.meshes if MESH_KEY in mesh and mesh.library is None]

@@ -263,6 +263,8 @@ def sync(
     since Set Up; ``before_render`` (``render_pre``) also writes what only a render reads (the
     world's direction image).
     Never raises."""
+    if depsgraph is not None:
+        apparent_meshes.note_updates(depsgraph)  # also while computing: what Blender evaluated again
     if busy.is_computing():
         return None
     apparent_meshes.unlink_caches()  # brought into a collection by Append
