@@ -29,7 +29,7 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, modifier, shape_keys
+from ..geometry import apparent_meshes, instancing, modifier, shape_keys
 from ..scene import animation, moving_objects, snapshot, traveller
 from . import bake, render_notice
 from .stages import STAGES, Sync
@@ -123,7 +123,7 @@ def apply(
         undo = lambda: apparent_meshes.remove(scene, result)  # noqa: E731
     try:
         if snap.method == "GEOMETRY":
-            apparent_meshes.check_instancing(scene, preview=_preview(scene, snap))
+            instancing.check_instancing(scene, preview=_preview(scene, snap))
         for stage in STAGES:
             stage.apply(scene, snap)
     except RelativityError:
@@ -185,7 +185,7 @@ def final_render_problem(scene: Scene, snap: Snapshot) -> str | None:
 def _preview(scene, snap):
     """Where the boosted-mesh preview of a moving observer is seen: None (the meshes are not boosted),
     "RENDER" (the final render is the preview too) or "VIEWPORT"."""
-    if not apparent_meshes.boosted(snap):
+    if not instancing.boosted(snap):
         return None
     return "RENDER" if final_render_problem(scene, snap) is not None else "VIEWPORT"
 
@@ -279,7 +279,7 @@ def sync(
         if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
             exact_camera.write(scene, snap)
         if method == "GEOMETRY":
-            apparent_meshes.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
+            instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
         if method == "GEOMETRY" and update_geometry:
             apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
         if method is not None:
@@ -382,7 +382,7 @@ def _record(scene, snap):
     if snap.method == "GEOMETRY":
         warnings += apparent_meshes.clip_end_warnings(scene, snap)
         warnings += apparent_meshes.update_warnings(scene)
-        warnings += apparent_meshes.instancing_warnings(scene, snap)
+        warnings += instancing.instancing_warnings(scene, snap)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)

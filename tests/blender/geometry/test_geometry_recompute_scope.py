@@ -43,7 +43,7 @@ def _count_reads(monkeypatch):
     for module, name in (
         (meshes, "rest_fingerprint"),
         (modifier, "evaluated_rest_positions"),
-        (lamps, "_local_centre"),
+        (lamps, "_local_box"),
     ):
         original = getattr(module, name)
 
