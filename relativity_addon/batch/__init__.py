@@ -406,14 +406,10 @@ def parse(argv: Sequence[str]) -> tuple[argparse.Namespace, argparse.ArgumentPar
     return parser.parse_args(arguments), parser
 
 
-def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
-    import time
-
+def prepare(options: argparse.Namespace, with_blend_file: bool) -> Scene:
+    """Open the file (if given), enable the add-on, set the scene up as ``options`` say; the effect
+    comes later (:func:`apply_effect`). Shared by the batch script and the farm's Blender process."""
     import bpy
-
-    options, _ = parse(argv)
-    with_blend_file = not _running_inside_blender(argv)
-    out_path = os.path.abspath(options.out)
 
     if with_blend_file:
         if not os.path.isfile(options.blend_file):
@@ -423,10 +419,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}") from None
     enable_addon()
-    effect = addon_module("pipeline.effect")
-
     scene = bpy.context.scene
-    frames = _frames(scene, options)
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     if options.samples is not None:
@@ -439,38 +432,57 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     if options.threads is not None:
         scene.render.threads_mode = "FIXED"
         scene.render.threads = options.threads
-    _output_format(scene, out_path)
+    _output_format(scene, options.out)
     if options.stereo:
         if options.spectral:
             raise BatchError("--stereo and --spectral cannot be combined")
         _stereo_output(scene, options.stereo)
-
-    relativistic = not options.reference
     if options.spectral and options.reference:
         raise BatchError("--spectral needs the exact camera (--method camera), not --reference")
-    scene_frames = list(frames)
+    if options.proper_time and options.reference:
+        raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
+    if not options.reference:
+        _apply_options(scene, options)
+    return scene
+
+
+def scene_frames_of(scene: Scene, options: argparse.Namespace, frames: Sequence[int]) -> list[float]:
+    """Scene frames of output ``frames``: the same, or with --proper-time where the clock reads frame / fps."""
+    if not options.proper_time:
+        return list(frames)
+    traveller = addon_module("scene.traveller")
     try:
-        if options.proper_time:
-            if options.reference:
-                raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
-            _apply_options(scene, options)
-            scene_frames = [
-                float(f)
-                for f in addon_module("scene.traveller").frames_at_proper_times(
-                    scene, [frame / animation_fps(scene) for frame in frames]
-                )
-            ]
+        return [float(f) for f in traveller.frames_at_proper_times(scene, [f / animation_fps(scene) for f in frames])]
+    except (RelativityError, traveller.RelativityError) as error:
+        raise BatchError(str(error)) from None
+
+
+def apply_effect(scene: Scene, options: argparse.Namespace, first: float, last: float) -> None:
+    """Apply the effect at scene frame ``first`` (the camera's speed checked up to ``last``); --reference: remove it."""
+    effect = addon_module("pipeline.effect")
+    try:
         if options.reference:
             effect.remove(scene)
             if scene.camera is None:
                 raise BatchError("scene has no active camera")
         else:
-            _apply_options(scene, options)
-            _set_frame(scene, scene_frames[0])
-            effect.apply(scene, frame_range=(scene_frames[0], scene_frames[-1]))
+            _set_frame(scene, first)
+            effect.apply(scene, frame_range=(first, last))
     except (RelativityError, effect.RelativityError) as error:
         raise BatchError(str(error)) from None
 
+
+def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
+    import time
+
+    import bpy
+
+    options, _ = parse(argv)
+    out_path, relativistic = os.path.abspath(options.out), not options.reference
+    scene = prepare(options, with_blend_file=not _running_inside_blender(argv))
+    frames = _frames(scene, options)
+    scene_frames = scene_frames_of(scene, options, frames)
+    apply_effect(scene, options, scene_frames[0], scene_frames[-1])
     several = len(frames) > 1
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
