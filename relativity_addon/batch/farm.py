@@ -112,14 +112,21 @@ def _frames(options):
     raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
-def _connect(options, log):
-    """(client, cluster or None) for --workers or --scheduler."""
+def _connect(options, log, arguments, job_name):
+    """(client, cluster or None) for --workers or --scheduler, every worker with the job's
+    Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
+    ``job_name``): a local cluster's workers start loading the file as they start, a running
+    cluster's when the plugin is registered; any worker that joins later, when it joins."""
     try:
         import dask
         from distributed import Client, LocalCluster
+
+        from . import farm_worker
     except ImportError:
         raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
+
+    plugin = farm_worker.BlenderProcesses(arguments, job_name)
 
     if options.scheduler is not None:
         try:
@@ -131,6 +138,7 @@ def _connect(options, log):
         log(f"render.py: Dask scheduler {options.scheduler}, {workers} worker(s)", flush=True)
         if "dashboard" in services:
             log(f"render.py: dashboard {client.dashboard_link}", flush=True)
+        client.register_plugin(plugin, name=job_name)
         return client, None
     dashboard = importlib.util.find_spec("bokeh") is not None  # Dask's dashboard needs bokeh
     # A worker that dies while running a task counts against the task as one failure; after
@@ -142,6 +150,7 @@ def _connect(options, log):
             processes=True,
             dashboard_address=":0" if dashboard else None,
             silence_logs=logging.CRITICAL,
+            plugins=(plugin,),
         )
     client = Client(cluster)
     log(
@@ -253,23 +262,18 @@ def render(
         threads = max(1, (os.cpu_count() or 1) // options.workers)
     if threads is not None:
         common.append(f"--threads={threads}")
-    client, cluster = _connect(options, log)
     job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
-    plugin_name = None
+    client, cluster = _connect(options, log, common, job_name)
     try:
         from distributed import as_completed
 
         from . import farm_worker
 
-        # Every worker starts loading the file into its Blender process now (and any worker that
-        # joins later, when it joins); unregistering the plugin at the end stops them.
-        client.register_plugin(farm_worker.BlenderProcesses(common), name=job_name)
-        plugin_name = job_name
         futures = {}
         for run in chunks(todo, options.chunk):
             future = client.submit(
                 farm_worker.render_task,
-                plugin_name,
+                job_name,
                 run,
                 retries=options.retries,
                 pure=False,
@@ -286,9 +290,9 @@ def render(
                 results, seconds, worker = [{"frame": frame, "reason": reason} for frame in run], 0.0, None
             job.finished(results, seconds, worker)
     finally:
-        if plugin_name is not None:
+        if cluster is None:  # a running cluster: its workers stop the job's Blender processes
             try:
-                client.unregister_worker_plugin(plugin_name)
+                client.unregister_worker_plugin(job_name)
             except Exception:  # noqa: BLE001, S110 - a cluster going away stops its workers' processes too
                 pass
         client.close()

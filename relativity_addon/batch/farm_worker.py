@@ -1,10 +1,11 @@
 """What a Dask worker runs for a distributed render (imports Dask; the coordinator, ``farm.py``,
 imports this module only once it has decided to use Dask).
 
-The coordinator registers one :class:`BlenderProcesses` plugin per job: on every worker, also one
-that joins later (a lost worker's replacement), it starts a Blender process loading the file at
-once (``blender_pool.py``), and when the job is over (the plugin is unregistered) or the worker
-closes, it stops them. A task (:func:`render_task`) renders its frames in that process.
+The coordinator gives every worker one :class:`BlenderProcesses` plugin per job (a local
+cluster's workers when they start, a running cluster's when it registers the plugin, and any worker
+that joins later, a lost worker's replacement too): it starts a Blender process loading the file
+at once (``blender_pool.py``), and when the job is over (the plugin is unregistered, or the local
+cluster closed) or the worker closes, it stops them. A task (:func:`render_task`) renders its frames in that process.
 """
 
 from __future__ import annotations
@@ -26,10 +27,11 @@ if TYPE_CHECKING:
 
 class BlenderProcesses(WorkerPlugin):
     """A worker's Blender processes for one job; ``arguments``: the batch-script command line
-    every frame shares (file, --out pattern, options; no frames)."""
+    every frame shares (file, --out pattern, options; no frames); ``name``: the job's, unique."""
 
-    def __init__(self, arguments: Sequence[str]) -> None:
+    def __init__(self, arguments: Sequence[str], name: str) -> None:
         self.arguments = list(arguments)
+        self.name = name  # the key of ``worker.plugins`` (Dask reads the attribute)
         self.pool: BlenderPool | None = None
 
     def setup(self, worker: Worker) -> None:
