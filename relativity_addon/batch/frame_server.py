@@ -95,15 +95,19 @@ class _Frames:
         return None, True
 
 
-def _requests(stream):
-    """Request lines until stdin closes, a stop request or IDLE_SECONDS without one."""
+def _requests(fd):
+    """Request lines read from ``fd`` (stdin) until it closes, a stop request or IDLE_SECONDS
+    without one. Read from the descriptor, not through a buffered file: a line already in a
+    buffer would not wake ``select``."""
+    pending = b""
     while True:
-        readable, _, _ = select.select([stream], [], [], IDLE_SECONDS)
-        if not readable:
-            return
-        line = stream.readline()
-        if not line:
-            return
+        while b"\n" not in pending:
+            readable, _, _ = select.select([fd], [], [], IDLE_SECONDS)
+            chunk = os.read(fd, 65536) if readable else b""
+            if not chunk:
+                return
+            pending += chunk
+        line, pending = pending.split(b"\n", 1)
         request = json.loads(line)
         if request.get("stop"):
             return
@@ -123,7 +127,7 @@ def serve(argv: Sequence[str], reply_fd: int) -> int:
         _reply(channel, ready=False, reason=_one_line(error))
         return 1
     _reply(channel, ready=True, pid=os.getpid())
-    for request in _requests(sys.stdin):
+    for request in _requests(sys.stdin.fileno()):
         frame = int(request["frame"])
         started = time.monotonic()
         reason, clean = frames.render(frame)

@@ -15,7 +15,7 @@ import psutil
 import pytest
 
 import pipeline_helpers as wh
-from relativity_addon.batch import blender_pool, frame_files
+from relativity_addon.batch import blender_pool, frame_files, frame_server
 
 DONE = re.compile(r"render\.py: frame (\d+) done in [\d.]+ s \(task [\d.]+ s\) on (\S+), Blender pid (\d+) ")
 
@@ -130,3 +130,18 @@ def test_frames_in_any_order_in_one_process_equal_one_process_in_turn(method, mo
         np.testing.assert_array_equal(images[-1], wh.read_image(bpy, single.parent / name), err_msg=name)
         assert images[-1][..., 0].max() > 0.5, name
     assert not np.array_equal(images[0], images[3])
+
+
+def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkeypatch):
+    """Requests that arrive together are all served (none left waiting in a read buffer until
+    the idle limit), a stop request ends the loop, and so does a silent, open stdin."""
+    monkeypatch.setattr(frame_server, "IDLE_SECONDS", 0.5)
+    read_fd, write_fd = os.pipe()
+    try:
+        os.write(write_fd, b'{"frame": 1}\n{"frame": 2}\n{"stop": true}\n{"frame": 3}\n')
+        assert [request["frame"] for request in frame_server._requests(read_fd)] == [1, 2]
+        os.write(write_fd, b'{"frame": 4}\n')
+        assert [request["frame"] for request in frame_server._requests(read_fd)] == [4]  # then idle: ends
+    finally:
+        os.close(read_fd)
+        os.close(write_fd)
