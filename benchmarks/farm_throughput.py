@@ -17,6 +17,9 @@ start and every Blender start included). Printed, medians over the rounds:
 - per-task overhead: a task's time on its worker minus the frame's time in the Blender process
   (what a frame on the farm costs beyond rendering it), median and largest (the largest is a
   worker's first task, which waits for its Blender process to load the file);
+- the CPU time (user + system) of all the processes of each command, and their ratio: the
+  throughput ratio that both would reach on an idle machine whose cores they keep busy, less
+  sensitive to the load of a shared machine than the wall times;
 - start: launch to the first finished frame, and the amortised overhead per frame: the cluster's
   wall time times its workers minus the frames' render times, over the frames (everything a
   frame pays besides its own render, the cluster's and the processes' starts included).
@@ -28,6 +31,7 @@ Start the measurement with ``uptime`` and read the ratios: the machine may be sh
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -55,8 +59,16 @@ CLUSTER_FRAME = re.compile(
 )
 
 
-def run(command):
-    """(wall seconds, stdout lines with their arrival time since launch)."""
+def _cpu_seconds():
+    """CPU time (user + system) of every finished descendant process (each one waited for)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def run(command, cpu=None):
+    """(wall seconds, stdout lines with their arrival time since launch); the CPU seconds of the
+    command's processes are appended to ``cpu``."""
+    cpu_before = _cpu_seconds()
     start = time.perf_counter()
     process = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV, cwd=REPO_ROOT
@@ -69,6 +81,8 @@ def run(command):
     wall = time.perf_counter() - start
     if process.returncode != 0:
         sys.exit(f"farm_throughput: {' '.join(command[2:4])} failed ({process.returncode}): {errors[-1500:]}")
+    if cpu is not None:
+        cpu.append(_cpu_seconds() - cpu_before)
     return wall, lines
 
 
@@ -92,15 +106,26 @@ def measure(blend, work, options):
         "--threads=1",
         "--no-resume",
     ]
-    keys = ("single", "cluster", "single_frame", "frame", "task_overhead", "max_overhead", "start", "amortised")
+    keys = (
+        "single",
+        "cluster",
+        "single_cpu",
+        "cluster_cpu",
+        "single_frame",
+        "frame",
+        "task_overhead",
+        "max_overhead",
+        "start",
+        "amortised",
+    )
     result = {key: [] for key in keys}
     run([*single[:3], "--frames=1-1", *single[4:]])  # warm-up: file cache, bytecode, kernels
     for _ in range(options.repeats):
-        wall, lines = run(single)
+        wall, lines = run(single, result["single_cpu"])
         result["single"].append(wall)
         frames = [float(m.group(2)) for _, text in lines if (m := SINGLE_FRAME.match(text))]
         result["single_frame"].append(statistics.median(frames[1:] or frames))
-        wall, lines = run(cluster)
+        wall, lines = run(cluster, result["cluster_cpu"])
         result["cluster"].append(wall)
         tasks = [(at, m) for at, text in lines if (m := CLUSTER_FRAME.match(text))]
         if len(tasks) != options.frames:
@@ -149,6 +174,11 @@ def main():
     print(f"  single process:  {m['single']:7.2f} s, {options.frames / m['single']:.3f} frames/s")
     print(f"  cluster:         {m['cluster']:7.2f} s, {options.frames / m['cluster']:.3f} frames/s")
     print(f"  throughput, cluster / single process: {m['single'] / m['cluster']:.2f}")
+    print(
+        f"  CPU time of all their processes: single {m['single_cpu']:.1f} s, cluster {m['cluster_cpu']:.1f} s; "
+        f"single / cluster {m['single_cpu'] / m['cluster_cpu']:.2f} (what the ratio would tend to on an idle machine "
+        "kept busy by both)"
+    )
     print(
         f"  a frame in a running Blender process: {m['frame']:.2f} s (worker, 1 thread); "
         f"{m['single_frame']:.2f} s (single process, {os.cpu_count()} threads)"
