@@ -2,7 +2,7 @@
 long-lived Blender process) against one process rendering the frames in turn on every core, side by
 side in one run.
 
-    python benchmarks/farm_throughput.py [--frames 16] [--resolution 160x120] [--samples 96]
+    python benchmarks/farm_throughput.py [--frames 16] [--resolution 160x120] [--samples 256]
         [--workers CORES] [--repeats 2]
 
 The two commands run alternately (single process, cluster, then again), so that load from other
@@ -148,7 +148,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=16)
     parser.add_argument("--resolution", default="160x120")
-    parser.add_argument("--samples", type=int, default=96)
+    parser.add_argument("--samples", type=int, default=256)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="default: one per core")
     parser.add_argument("--repeats", type=int, default=2)
     options = parser.parse_args()

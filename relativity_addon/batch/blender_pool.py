@@ -73,6 +73,9 @@ class BlenderProcess:
         command = [sys.executable, "-c", LAUNCH, str(os.getpid()), PACKAGE_ROOT, str(write_fd), *arguments]
         env = dict(os.environ)
         env.pop("PYTHONPATH", None)
+        # Dask's nanny sets this for its workers (``distributed.nanny.pre-spawn-environ``); in Blender
+        # it makes malloc hand memory back all the time: measured 15-17 % more CPU per frame.
+        env.pop("MALLOC_TRIM_THRESHOLD_", None)
         try:
             self.process = subprocess.Popen(
                 command,

@@ -142,8 +142,10 @@ def _connect(options, log, arguments, job_name):
         return client, None
     dashboard = importlib.util.find_spec("bokeh") is not None  # Dask's dashboard needs bokeh
     # A worker that dies while running a task counts against the task as one failure; after
-    # ``retries`` more the task is given up (KilledWorker).
-    with dask.config.set({"distributed.scheduler.allowed-failures": options.retries}):
+    # ``retries`` more the task is given up (KilledWorker). No statistical profiler in the workers:
+    # it samples their stacks every 10 ms for a dashboard page, while Blender does the work.
+    settings = {"distributed.scheduler.allowed-failures": options.retries, "distributed.worker.profile.enabled": False}
+    with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=options.workers,
             threads_per_worker=1,
