@@ -17,9 +17,9 @@ start and every Blender start included). Printed, medians over the rounds:
 - per-task overhead: a task's time on its worker minus the frame's time in the Blender process
   (what a frame on the farm costs beyond rendering it), median and largest (the largest is a
   worker's first task, which waits for its Blender process to load the file);
-- the CPU time (user + system) of all the processes of each command, and their ratio: the
-  throughput ratio that both would reach on an idle machine whose cores they keep busy, less
-  sensitive to the load of a shared machine than the wall times;
+- the CPU time (user + system) of all the processes of each command, and their ratio: what the
+  cluster costs in CPU beyond the frames (its Dask processes, a Blender start per worker), read
+  along with the wall times on a shared machine, where a session's share of the cores varies;
 - start: launch to the first finished frame, and the amortised overhead per frame: the cluster's
   wall time times its workers minus the frames' render times, over the frames (everything a
   frame pays besides its own render, the cluster's and the processes' starts included).
@@ -176,8 +176,7 @@ def main():
     print(f"  throughput, cluster / single process: {m['single'] / m['cluster']:.2f}")
     print(
         f"  CPU time of all their processes: single {m['single_cpu']:.1f} s, cluster {m['cluster_cpu']:.1f} s; "
-        f"single / cluster {m['single_cpu'] / m['cluster_cpu']:.2f} (what the ratio would tend to on an idle machine "
-        "kept busy by both)"
+        f"single / cluster {m['single_cpu'] / m['cluster_cpu']:.2f}"
     )
     print(
         f"  a frame in a running Blender process: {m['frame']:.2f} s (worker, 1 thread); "
