@@ -18,8 +18,9 @@ output is already a complete image). Prints one progress line per frame with the
 Exits non-zero with a one-line reason on any failure.
 
 On a Dask cluster (docs/farm.md): --workers N (a local cluster of N worker processes) or
---scheduler tcp://HOST:8786, with --chunk N (frames per task) and --retries N; each task renders
-in a fresh Blender process, --resume is on, and the exit status is 1 if any frame failed:
+--scheduler tcp://HOST:8786, with --chunk N (frames per task) and --retries N; each worker renders
+its tasks in one long-lived Blender process (restarted if it dies), --resume is on, and the exit
+status is 1 if any frame failed:
 
     python examples/render.py flythrough.blend --frames 1-240 --out out/f.png --workers 4
 """

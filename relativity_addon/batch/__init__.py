@@ -14,9 +14,9 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..errors import BatchError, RelativityError
-from ..physics.shutter import ShutterModel
 from . import bake_to
 from .frame_files import format_seconds, frame_output_path, output_problem, partial_path
+from .options import LENS_CHOICES, _running_inside_blender, _split_argv, build_parser
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -25,190 +25,6 @@ if TYPE_CHECKING:
     from bpy.types import Scene
 
 ADDON_PACKAGE = "relativity_addon"
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):
-        raise BatchError(f"bad option: {message}")
-
-
-def _vector3(text):
-    parts = text.split(",")
-    if len(parts) != 3:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}")
-    try:
-        return tuple(float(part) for part in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}") from None
-
-
-def _resolution(text):
-    try:
-        width, height = (int(part) for part in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
-    if width < 1 or height < 1:
-        raise argparse.ArgumentTypeError(f"resolution must be positive, got {text!r}")
-    return width, height
-
-
-def _positive_int(text):
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
-    return value
-
-
-def _frame_range(text):
-    import re
-
-    match = re.fullmatch(r"\s*(-?\d+)\s*-\s*(-?\d+)\s*", text)
-    if not match:
-        raise argparse.ArgumentTypeError(f"expected FIRST-LAST, got {text!r}")
-    first, last = int(match.group(1)), int(match.group(2))
-    if last < first:
-        raise argparse.ArgumentTypeError(f"last frame before first in {text!r}")
-    return first, last
-
-
-SHUTTER_CHOICES = tuple(model.name.lower() for model in ShutterModel)
-LENS_CHOICES = {"ideal": "IDEAL_LENS", "phase-hologram": "PHASE_HOLOGRAM"}
-
-
-def build_parser(with_blend_file: bool) -> argparse.ArgumentParser:
-    parser = _Parser(
-        prog="render.py",
-        description="Render a .blend with the relativistic camera (Cycles, CPU).",
-    )
-    if with_blend_file:
-        parser.add_argument("blend_file", help=".blend file to render")
-    parser.add_argument(
-        "--beta",
-        type=_vector3,
-        help="observer velocity X,Y,Z (world axes, fraction of c); write --beta=-0.5,0,0 when a value starts with '-'",
-    )
-    parser.add_argument(
-        "--method",
-        choices=("camera", "geometry"),
-        help="render method (default: the file's setting, Exact Camera in a new file)",
-    )
-    parser.add_argument(
-        "--reference", action="store_true", help="render the file's own camera unchanged (no relativistic camera)"
-    )
-    parser.add_argument("--samples", type=_positive_int)
-    parser.add_argument("--resolution", type=_resolution, help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--out", help="output image: .png, or .exr for linear float (required unless --bake-to)")
-    parser.add_argument(
-        "--bake-to",
-        metavar="BAKED.blend",
-        help="render nothing: set up, bake --frames (default: the scene's range) and save as BAKED.blend, "
-        "which plain Blender renders without the add-on (blender -b BAKED.blend -a); exact camera only",
-    )
-    parser.add_argument("--no-doppler", action="store_true")
-    parser.add_argument("--no-searchlight", action="store_true")
-    parser.add_argument("--no-geometry", action="store_true", help="no aberration (testing aid)")
-    parser.add_argument("--lorentz-window", action="store_true")
-    parser.add_argument(
-        "--time-of-flight",
-        action="store_true",
-        help="light-travel time only, Galilean (Gray et al. 2020 Fig. 1c; no searchlight or Doppler)",
-    )
-    parser.add_argument("--shutter", type=str.lower, choices=SHUTTER_CHOICES)
-    parser.add_argument("--shutter-time", type=float, help="shutter time t_S in seconds")
-    parser.add_argument(
-        "--shutter-plane-point",
-        type=_vector3,
-        metavar="X,Y,Z",
-        help="a point of the arbitrary shutter plane, camera-local axes (the camera looks down -Z)",
-    )
-    parser.add_argument(
-        "--shutter-plane-normal",
-        type=_vector3,
-        metavar="X,Y,Z",
-        help="the arbitrary shutter plane's normal, camera-local axes",
-    )
-    parser.add_argument(
-        "--lens",
-        choices=LENS_CHOICES,
-        help="the detector-plane shutter's lens: ideal, or its phase hologram (Gray Fig. 6b)",
-    )
-    parser.add_argument(
-        "--window-time",
-        type=float,
-        metavar="T_W",
-        help="Lorentz window in the plane of spatial fixed points for T_W (seconds), the shutter "
-        "model timing the rays (Gray Fig. 10); implies --lorentz-window",
-    )
-    parser.add_argument("--speed-of-light", type=float, help="scene units per second")
-    frames = parser.add_mutually_exclusive_group()
-    frames.add_argument("--frame", type=int, help="render this frame (default: the file's current frame)")
-    frames.add_argument(
-        "--frames",
-        type=_frame_range,
-        help="render frames A-B (inclusive); the frame "
-        "number is inserted before the extension of --out, or replaces a run of '#'",
-    )
-    parser.add_argument(
-        "--velocity-from-animation",
-        action="store_true",
-        help="observer velocity from the active camera's keyframed motion",
-    )
-    parser.add_argument("--seed", type=int)
-    parser.add_argument(
-        "--stereo",
-        choices=STEREO_CHOICES,
-        help="render Blender's stereo pair (the camera's Stereoscopy settings): one anaglyph or "
-        "side-by-side image, or the two views as OUT_L and OUT_R",
-    )
-    parser.add_argument(
-        "--spectral",
-        type=_positive_int,
-        metavar="PASSES",
-        help="spectral colour (exact camera): PASSES renders of three wavelengths each, plus "
-        "per-pixel integration; exact for lit scenes at rest (default: the fast RGB colour)",
-    )
-    parser.add_argument(
-        "--proper-time",
-        action="store_true",
-        help="step frames in the traveller's proper time: frame K is rendered at the scene time "
-        "where the observer's clock (0 at frame 0) reads K / fps",
-    )
-    parser.add_argument("--threads", type=_positive_int, help="Cycles render threads (default: all cores)")
-    parser.add_argument(
-        "--resume",
-        action=argparse.BooleanOptionalAction,
-        help="skip frames whose output exists and reads back as a complete image "
-        "(default: on with --workers/--scheduler, off otherwise)",
-    )
-    cluster = parser.add_argument_group("distributed rendering (Dask; docs/farm.md)")
-    where = cluster.add_mutually_exclusive_group()
-    where.add_argument(
-        "--workers",
-        type=_positive_int,
-        help="render on a local Dask cluster of N worker processes, one frame task each",
-    )
-    where.add_argument("--scheduler", metavar="ADDRESS", help="render on a running Dask cluster, e.g. tcp://HOST:8786")
-    cluster.add_argument("--chunk", type=_positive_int, default=1, help="frames per task (default 1)")
-    cluster.add_argument(
-        "--retries",
-        type=int,
-        default=2,
-        help="times a task whose worker or Blender process died is run again (default 2)",
-    )
-    return parser
-
-
-def _running_inside_blender(argv):
-    return "--python" in argv or "-P" in argv or "--python-expr" in argv
-
-
-def _split_argv(argv):
-    if _running_inside_blender(argv):
-        return (argv[argv.index("--") + 1 :] if "--" in argv else []), False
-    return argv[1:], True
 
 
 def enable_addon() -> None:
@@ -293,9 +109,6 @@ def _apply_options(scene, options):
 
 def animation_fps(scene: Scene) -> float:
     return scene.render.fps / scene.render.fps_base
-
-
-STEREO_CHOICES = ("anaglyph", "side-by-side", "views")
 
 
 def _stereo_output(scene, mode):
@@ -415,14 +228,10 @@ def parse(argv: Sequence[str]) -> tuple[argparse.Namespace, argparse.ArgumentPar
     return options, parser
 
 
-def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
-    import time
-
+def prepare(options: argparse.Namespace, with_blend_file: bool) -> Scene:
+    """Open the file (if given), enable the add-on, set the scene up as ``options`` say; the effect
+    comes later (:func:`apply_effect`). Shared by the batch script and the farm's Blender process."""
     import bpy
-
-    options, _ = parse(argv)
-    with_blend_file = not _running_inside_blender(argv)
-    out_path = os.path.abspath(options.out or options.bake_to)  # check_options: one of them
 
     if with_blend_file:
         if not os.path.isfile(options.blend_file):
@@ -432,10 +241,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
         except RuntimeError as error:
             raise BatchError(f"cannot open {options.blend_file}: {str(error).strip().splitlines()[-1]}") from None
     enable_addon()
-    effect = addon_module("pipeline.effect")
-
     scene = bpy.context.scene
-    frames = bake_to.frames(scene, options) or _frames(scene, options)
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     if options.samples is not None:
@@ -449,40 +255,60 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
         scene.render.threads_mode = "FIXED"
         scene.render.threads = options.threads
     if options.bake_to is None:
-        _output_format(scene, out_path)
+        _output_format(scene, options.out)
     if options.stereo:
         if options.spectral:
             raise BatchError("--stereo and --spectral cannot be combined")
         _stereo_output(scene, options.stereo)
-
-    relativistic = not options.reference
     if options.spectral and options.reference:
         raise BatchError("--spectral needs the exact camera (--method camera), not --reference")
-    scene_frames = list(frames)
+    if options.proper_time and options.reference:
+        raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
+    if not options.reference:
+        _apply_options(scene, options)
+    return scene
+
+
+def scene_frames_of(scene: Scene, options: argparse.Namespace, frames: Sequence[int]) -> list[float]:
+    """Scene frames of output ``frames``: the same, or with --proper-time where the clock reads frame / fps."""
+    if not options.proper_time:
+        return list(frames)
+    traveller = addon_module("scene.traveller")
     try:
-        if options.proper_time:
-            if options.reference:
-                raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
-            _apply_options(scene, options)
-            scene_frames = [
-                float(f)
-                for f in addon_module("scene.traveller").frames_at_proper_times(
-                    scene, [frame / animation_fps(scene) for frame in frames]
-                )
-            ]
+        return [float(f) for f in traveller.frames_at_proper_times(scene, [f / animation_fps(scene) for f in frames])]
+    except (RelativityError, traveller.RelativityError) as error:
+        raise BatchError(str(error)) from None
+
+
+def apply_effect(scene: Scene, options: argparse.Namespace, first: float, last: float) -> None:
+    """Apply the effect at scene frame ``first`` (the camera's speed checked up to ``last``); --reference: remove it."""
+    effect = addon_module("pipeline.effect")
+    try:
         if options.reference:
             effect.remove(scene)
             if scene.camera is None:
                 raise BatchError("scene has no active camera")
         else:
-            _apply_options(scene, options)
-            _set_frame(scene, scene_frames[0])
-            effect.apply(scene, frame_range=(scene_frames[0], scene_frames[-1]))
+            _set_frame(scene, first)
+            effect.apply(scene, frame_range=(first, last))
     except (RelativityError, effect.RelativityError) as error:
         raise BatchError(str(error)) from None
-    if options.bake_to is not None:
-        return [bake_to.bake(bpy, scene, effect, options.bake_to, frames, log)]
 
+
+def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
+    import time
+
+    import bpy
+
+    options, _ = parse(argv)
+    out_path = os.path.abspath(options.out or options.bake_to)  # bake_to.check_options: one of them
+    relativistic = not options.reference
+    scene = prepare(options, with_blend_file=not _running_inside_blender(argv))
+    frames = bake_to.frames(scene, options) or _frames(scene, options)
+    scene_frames = scene_frames_of(scene, options, frames)
+    apply_effect(scene, options, scene_frames[0], scene_frames[-1])
+    if options.bake_to is not None:
+        return [bake_to.bake(bpy, scene, addon_module("pipeline.effect"), options.bake_to, frames, log)]
     several = len(frames) > 1
     paths = [frame_output_path(out_path, frame, several) for frame in frames]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)

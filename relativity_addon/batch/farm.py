@@ -1,15 +1,16 @@
 """Render a frame range on a Dask cluster: ``render.py FILE.blend --frames A-B --workers N`` (a local
 cluster of N worker processes) or ``--scheduler tcp://HOST:8786`` (a running one).
 
-Each task (one frame, or ``--chunk`` frames) runs the batch script in a fresh Blender process (the
-``bpy`` wheel of the worker's Python), so a crash takes down one task, not the worker. The batch
-script writes each frame to a hidden partial name and renames it when complete, so an output
-file is either whole or absent. A task whose Blender process or worker dies is run again (Dask's
-``retries`` and the scheduler's ``allowed-failures``); a frame that fails for a reason of its own
-(exit status 1 with a one-line reason: bad scene, speed above c at that frame) is reported once and
-not retried. Frames whose output already reads back as a complete image are skipped (``--resume``,
-on by default here). The coordinator (this module) imports neither bpy nor, before it is called,
-Dask: the single-process path stays free of both.
+Each worker keeps a long-lived Blender process (the ``bpy`` wheel of the worker's Python) that
+loads the file once and renders the frames of its tasks (one frame, or ``--chunk`` frames, each)
+on request (``farm_worker.py``, ``blender_pool.py``, ``frame_server.py``); a process that dies is
+replaced and its frame rendered again. Each frame is written to a hidden partial name and renamed
+when complete, so an output file is either whole or absent. A task whose worker dies, or whose
+Blender process dies twice, is run again (Dask's ``retries`` and the scheduler's
+``allowed-failures``); a frame that fails for a reason of its own (a one-line reason: bad scene,
+speed above c at that frame) is reported once and not retried. Frames whose output already reads
+back as a complete image are skipped (``--resume``, on by default here). The coordinator (this
+module) imports neither bpy nor, before it is called, Dask: the single-process path stays free of both.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from . import frame_files
 
 if TYPE_CHECKING:
     import argparse
-    from collections.abc import Callable, Iterable, Sequence
+    from collections.abc import Callable, Iterable
 
 # Options of the coordinator, not passed on to the per-task batch script.
 COORDINATOR_OPTIONS = {
@@ -42,53 +43,6 @@ COORDINATOR_OPTIONS = {
     "retries",
     "threads",
 }
-ERROR_PREFIX = "render.py: error: "
-
-# The per-task process: dies with the worker thread that started it (Linux), then runs the batch
-# script from the worker's own copy of the add-on. argv: parent pid, package root, script options.
-LAUNCH = """
-import os, sys
-parent = int(sys.argv.pop(1))
-root = sys.argv.pop(1)
-if sys.platform.startswith("linux"):
-    import ctypes, signal
-    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    if os.getppid() != parent:
-        sys.exit("render.py: error: the worker that started this task is gone")
-sys.path.insert(0, root)
-from relativity_addon import batch
-from relativity_addon.blender.common import compat
-compat.run_main(batch.main)
-"""
-
-
-class LostProcessError(Exception):
-    """The Blender process of a task was killed by a signal (out of memory, a lost machine, a
-    user): Dask runs the task again, elsewhere if it can."""
-
-
-def render_task(arguments: Sequence[str], label: str) -> tuple[int, str | None, float, str]:
-    """Run on a worker: render ``arguments`` (batch script options, ``--frames`` included) in a
-    fresh Blender process. Returns (exit status, one-line reason or None, seconds, worker host:pid);
-    raises LostProcessError when the process was killed, so Dask retries it."""
-    import socket
-    import subprocess
-
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    command = [sys.executable, "-c", LAUNCH, str(os.getpid()), root, *arguments]
-    env = dict(os.environ)
-    env.pop("PYTHONPATH", None)
-    started = time.monotonic()
-    process = subprocess.run(command, capture_output=True, text=True, env=env, stdin=subprocess.DEVNULL)
-    seconds = time.monotonic() - started
-    if process.returncode < 0:
-        raise LostProcessError(f"{label}: the Blender process was killed by signal {-process.returncode}")
-    reason = None
-    if process.returncode != 0:
-        errors = [line[len(ERROR_PREFIX) :] for line in process.stderr.splitlines() if line.startswith(ERROR_PREFIX)]
-        last = (process.stderr.strip().splitlines() or ["no output"])[-1]
-        reason = errors[-1] if errors else f"exit status {process.returncode}: {last}"
-    return process.returncode, reason, seconds, f"{socket.gethostname()}:{os.getpid()}"
 
 
 def output_pattern(out_path: str, several: bool) -> str:
@@ -158,14 +112,21 @@ def _frames(options):
     raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
-def _connect(options, log):
-    """(client, cluster or None) for --workers or --scheduler."""
+def _connect(options, log, arguments, job_name):
+    """(client, cluster or None) for --workers or --scheduler, every worker with the job's
+    Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
+    ``job_name``): a local cluster's workers start loading the file as they start, a running
+    cluster's when the plugin is registered; any worker that joins later, when it joins."""
     try:
         import dask
         from distributed import Client, LocalCluster
+
+        from . import farm_worker
     except ImportError:
         raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
+
+    plugin = farm_worker.BlenderProcesses(arguments, job_name)
 
     if options.scheduler is not None:
         try:
@@ -177,17 +138,21 @@ def _connect(options, log):
         log(f"render.py: Dask scheduler {options.scheduler}, {workers} worker(s)", flush=True)
         if "dashboard" in services:
             log(f"render.py: dashboard {client.dashboard_link}", flush=True)
+        client.register_plugin(plugin, name=job_name)
         return client, None
     dashboard = importlib.util.find_spec("bokeh") is not None  # Dask's dashboard needs bokeh
     # A worker that dies while running a task counts against the task as one failure; after
-    # ``retries`` more the task is given up (KilledWorker).
-    with dask.config.set({"distributed.scheduler.allowed-failures": options.retries}):
+    # ``retries`` more the task is given up (KilledWorker). No statistical profiler in the workers:
+    # it samples their stacks every 10 ms for a dashboard page, while Blender does the work.
+    settings = {"distributed.scheduler.allowed-failures": options.retries, "distributed.worker.profile.enabled": False}
+    with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=options.workers,
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0" if dashboard else None,
             silence_logs=logging.CRITICAL,
+            plugins=(plugin,),
         )
     client = Client(cluster)
     log(
@@ -218,29 +183,35 @@ class _Job:
         # gives it a new inode): an old output of a frame a failed chunk never reached is no result.
         self.before = {frame: _identity(path) for frame, path in paths.items()}
 
-    def finished(self, frames, reason, seconds, worker):
-        """A task of ``frames`` ended; ``reason``: why it failed (a chunk fails at its first bad
-        frame; the frames before it are complete)."""
-        for frame in frames:
+    def finished(self, results, task_seconds, worker):
+        """A task ended; ``results``: per frame, its ``reason`` (None when the Blender process says
+        it wrote the frame), ``seconds`` and ``pid`` in Blender, ``lost`` (why a Blender process
+        was replaced before it)."""
+        for result in results:
+            frame, reason = result["frame"], result["reason"]
+            if result.get("lost"):
+                self.log(f"render.py: on {worker}: {result['lost']}; frame {frame} rendered again", flush=True)
             path = self.paths[frame]
             problem = frame_files.problem(path)
             if problem is None and _identity(path) == self.before[frame]:
                 problem = "not written by this job"
-            if problem is None:
+            if reason is None and problem is None:
                 self.rendered.append(frame)
             else:
                 self.failed[frame] = reason or f"no complete output ({problem}): {path}"
-        done = len(self.rendered) + len(self.failed)
-        todo = self.total - self.skipped
-        elapsed = time.monotonic() - self.started
-        left = elapsed / done * (todo - done) if done else 0.0
-        status = "failed" if any(frame in self.failed for frame in frames) else "done"
-        where = f" in {frame_files.format_seconds(seconds)} on {worker}" if worker else ""
-        self.log(
-            f"render.py: {_label(frames)} {status}{where} ({done}/{todo}; {len(self.failed)} failed), "
-            f"about {frame_files.format_seconds(left)} left",
-            flush=True,
-        )
+            done = len(self.rendered) + len(self.failed)
+            todo = self.total - self.skipped
+            elapsed = time.monotonic() - self.started
+            left = elapsed / done * (todo - done) if done else 0.0
+            status = "failed" if frame in self.failed else "done"
+            where = f" on {worker}" if worker else ""
+            if worker and result.get("pid"):
+                where = f" in {result['seconds']:.2f} s (task {task_seconds:.2f} s){where}, Blender pid {result['pid']}"
+            self.log(
+                f"render.py: frame {frame} {status}{where} ({done}/{todo}; {len(self.failed)} failed), "
+                f"about {frame_files.format_seconds(left)} left",
+                flush=True,
+            )
 
     def summary(self, error_log):
         elapsed = time.monotonic() - self.started
@@ -293,32 +264,39 @@ def render(
         threads = max(1, (os.cpu_count() or 1) // options.workers)
     if threads is not None:
         common.append(f"--threads={threads}")
-    client, cluster = _connect(options, log)
+    job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
+    client, cluster = _connect(options, log, common, job_name)
     try:
         from distributed import as_completed
 
+        from . import farm_worker
+
         futures = {}
         for run in chunks(todo, options.chunk):
-            arguments = [*common, f"--frames={run[0]}-{run[-1]}"]
             future = client.submit(
-                render_task,
-                arguments,
-                _label(run),
+                farm_worker.render_task,
+                job_name,
+                run,
                 retries=options.retries,
                 pure=False,
-                key=f"relativistic-render-{run[0]}-{run[-1]}-{os.getpid()}-{time.time_ns()}",
+                key=f"{job_name}-{run[0]}-{run[-1]}",
             )
             futures[future] = run
         for future in as_completed(futures):
             run = futures[future]
             try:
-                _status, reason, seconds, worker = future.result()
+                results, seconds, worker = future.result()
             except Exception as error:  # noqa: BLE001 - lost workers (KilledWorker), lost processes
                 message = (str(error).strip().splitlines() or [""])[-1]
                 reason = f"given up after {options.retries + 1} attempts: {type(error).__name__}: {message}"
-                seconds, worker = 0.0, None
-            job.finished(run, reason, seconds, worker)
+                results, seconds, worker = [{"frame": frame, "reason": reason} for frame in run], 0.0, None
+            job.finished(results, seconds, worker)
     finally:
+        if cluster is None:  # a running cluster: its workers stop the job's Blender processes
+            try:
+                client.unregister_worker_plugin(job_name)
+            except Exception:  # noqa: BLE001, S110 - a cluster going away stops its workers' processes too
+                pass
         client.close()
         if cluster is not None:
             cluster.close()

@@ -1,5 +1,5 @@
 """Distributed rendering on a real Dask cluster (``render.py --workers N``: a LocalCluster of worker
-processes, each task a fresh Blender process): frames equal a single-process render pixel for
+processes, each with a long-lived Blender process): frames equal a single-process render pixel for
 pixel, a killed worker loses nothing, a frame above c fails alone with its reason, a rerun renders
 only what is missing or corrupt. Frames are tiny (32x32, 1-2 samples): the cost is the processes."""
 
@@ -134,9 +134,10 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
                 try:
                     if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()):
                         continue
-                    # Measured with both bpy wheels: 4-6 threads up to the render, 11-13 while Cycles
-                    # renders (about 2 s of a 4-5 s process at 32x32), 2 after it. A process past 4 s
-                    # also counts (a later wheel may start fewer threads).
+                    # Measured with both bpy wheels for a process per task: 4-6 threads up to the
+                    # render, 11-13 while Cycles renders (about 2 s of a 4-5 s process at 32x32). A
+                    # worker's long-lived Blender process rendering on one thread has 7 (4.5.15), so
+                    # there its age decides: 2.8 s after it started it loads the file or renders.
                     if child.num_threads() >= 9 or time.time() - child.create_time() > 2.5:
                         rendering.setdefault(child.pid, time.monotonic())
                     if time.monotonic() - rendering.get(child.pid, time.monotonic()) > 0.3:

@@ -1,0 +1,147 @@
+"""A farm worker's long-lived Blender process (``render.py --workers N``; docs/farm.md): each worker
+loads the file once into one Blender process and renders every frame it is given there; a killed
+Blender process is replaced and its frame rendered again; frames rendered by one process in any
+order equal a single-process render pixel for pixel. Behaviour, read from the progress lines and
+the processes, not from times."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import psutil
+import pytest
+
+import pipeline_helpers as wh
+from relativity_addon.batch import blender_pool, frame_files, frame_server
+
+DONE = re.compile(r"render\.py: frame (\d+) done in [\d.]+ s \(task [\d.]+ s\) on (\S+), Blender pid (\d+) ")
+
+
+@pytest.fixture
+def moving_blend(factory_blender, tmp_path):
+    """Camera keyframed along -Z (each frame sees the sphere from elsewhere), emissive sphere."""
+    bpy = factory_blender
+    scene, camera, _ = wh.new_scene(bpy, resolution=(32, 32))
+    scene.frame_start, scene.frame_end = 1, 8
+    wh.keyframe_camera_path(camera, [(1, (0.0, 0.0, 0.0)), (8, (0.3, 0.15, -1.5))])
+    return wh.save_blend(bpy, tmp_path / "moving.blend")
+
+
+def _done(stdout):
+    """(frame, worker, Blender pid) of each progress line of a rendered frame."""
+    return [(int(frame), worker, int(pid)) for frame, worker, pid in DONE.findall(stdout)]
+
+
+def test_each_worker_renders_its_frames_in_one_blender_process(moving_blend, tmp_path):
+    """Six one-frame tasks on two workers: every frame names the Blender process that rendered it;
+    a worker's frames all come from one process, so at most two processes render six frames."""
+    out = tmp_path / "out" / "f.png"
+    result = wh.run_render_script(
+        moving_blend,
+        "--frames=1-6",
+        "--beta=0,0,-0.5",
+        "--samples=2",
+        "--resolution=32x32",
+        f"--out={out}",
+        "--workers=2",
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    done = _done(result.stdout)
+    assert sorted(frame for frame, _, _ in done) == [1, 2, 3, 4, 5, 6], result.stdout
+    processes = {}
+    for _, worker, pid in done:
+        processes.setdefault(worker, set()).add(pid)
+    assert all(len(pids) == 1 for pids in processes.values()), processes  # one Blender per worker
+    assert len({pid for _, _, pid in done}) <= 2 < len(done), done  # reused across frames
+    assert "6 frames: 6 rendered, 0 skipped (already complete), 0 failed" in result.stdout
+    assert sorted(os.listdir(out.parent)) == [f"f_{frame:04d}.png" for frame in range(1, 7)]
+    pids = {pid for _, _, pid in done}
+    assert not any(psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE for pid in pids)
+
+
+def test_killed_blender_process_is_restarted_and_its_frame_rendered_again(moving_blend, tmp_path, factory_blender):
+    """SIGKILL to a worker's Blender process as soon as it has rendered its first frame (it is then
+    rendering its next one): the worker starts a new Blender process, which renders that frame;
+    every frame ends whole, once, exit status 0."""
+    bpy = factory_blender
+    out = tmp_path / "out" / "f.png"
+    # Frames of about a second or more (one Cycles thread), so the kill lands in a render.
+    options = ("--frames=1-6", "--beta=0,0,-0.5", "--samples=256", "--resolution=64x64", "--seed=2")
+    command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *options, f"--out={out}", "--workers=2"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
+    lines, killed = [], None
+    try:
+        for line in process.stdout:
+            lines.append(line)
+            match = DONE.match(line)
+            if killed is None and match:
+                killed = int(match.group(3))
+                os.kill(killed, signal.SIGKILL)
+        stderr = process.stderr.read()
+        process.wait(timeout=240)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    stdout = "".join(lines)
+    assert process.returncode == 0, stderr[-3000:]
+    assert killed is not None, stdout
+    again = re.findall(
+        rf"Blender process {killed} ended \(killed by signal 9\)[^\n]*; frame (\d+) rendered again", stdout
+    )
+    assert len(again) == 1, stdout
+    done = _done(stdout)
+    assert sorted(frame for frame, _, _ in done) == [1, 2, 3, 4, 5, 6], stdout  # each frame once
+    lost_worker = next(worker for _, worker, pid in done if pid == killed)
+    worker, pid = next((worker, pid) for frame, worker, pid in done if frame == int(again[0]))
+    assert worker == lost_worker and pid != killed  # a new process on the same worker rendered it
+    assert "6 frames: 6 rendered, 0 skipped (already complete), 0 failed" in stdout
+    names = [f"f_{frame:04d}.png" for frame in range(1, 7)]
+    assert sorted(os.listdir(out.parent)) == names  # nothing half-written left behind
+    for name in names:
+        assert frame_files.problem(out.parent / name) is None
+        assert wh.read_image(bpy, out.parent / name)[..., 0].max() > 0.5, name  # the sphere
+
+
+@pytest.mark.parametrize("method", ["camera", "geometry"])
+def test_frames_in_any_order_in_one_process_equal_one_process_in_turn(method, moving_blend, tmp_path, factory_blender):
+    """One long-lived Blender process (the worker side's pool, without Dask) renders frames 4, 1,
+    3 and 2, in that order; the batch script renders 1-4 in turn in one process: equal pixel for
+    pixel, all four from the same process."""
+    bpy = factory_blender
+    common = ["--beta=0,0,-0.5", "--samples=2", "--seed=3", "--resolution=32x32", f"--method={method}"]
+    pool = blender_pool.BlenderPool([str(moving_blend), f"--out={tmp_path / 'pool' / 'f_####.png'}", *common])
+    try:
+        results = pool.render([4, 1, 3, 2])
+    finally:
+        pool.close()
+    assert [r["reason"] for r in results] == [None] * 4, results
+    assert len({r["pid"] for r in results}) == 1 and not any(r["lost"] for r in results), results
+    single = tmp_path / "single" / "f.png"
+    result = wh.run_render_script(moving_blend, "--frames=1-4", *common, f"--out={single}")
+    assert result.returncode == 0, result.stderr[-3000:]
+    images = []
+    for frame in range(1, 5):
+        name = f"f_{frame:04d}.png"
+        images.append(wh.read_image(bpy, tmp_path / "pool" / name))
+        np.testing.assert_array_equal(images[-1], wh.read_image(bpy, single.parent / name), err_msg=name)
+        assert images[-1][..., 0].max() > 0.5, name
+    assert not np.array_equal(images[0], images[3])
+
+
+def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkeypatch):
+    """Requests that arrive together are all served (none left waiting in a read buffer until
+    the idle limit), a stop request ends the loop, and so does a silent, open stdin."""
+    monkeypatch.setattr(frame_server, "IDLE_SECONDS", 0.5)
+    read_fd, write_fd = os.pipe()
+    try:
+        os.write(write_fd, b'{"frame": 1}\n{"frame": 2}\n{"stop": true}\n{"frame": 3}\n')
+        assert [request["frame"] for request in frame_server._requests(read_fd)] == [1, 2]
+        os.write(write_fd, b'{"frame": 4}\n')
+        assert [request["frame"] for request in frame_server._requests(read_fd)] == [4]  # then idle: ends
+    finally:
+        os.close(read_fd)
+        os.close(write_fd)
