@@ -25,6 +25,8 @@ spectral Doppler matrix per pixel after the render, with no second render:
   through the table of its blackbody (``physics/illuminants.py``): a surface it lit sends a
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
+- With the observer at rest in every frame the stage is the identity (``D = 1``) and is muted,
+  so that it costs the render nothing (``at_rest_throughout``).
 
 The group is inserted after every Render Layers node of the scene's compositor (a tree is
 created if the scene has none); :func:`remove_colour_stage` restores the compositor exactly.
