@@ -4,7 +4,8 @@ camera on its floor).
 - The compositor stage (``colour/compositing.py``) is muted while the observer is at rest in every
   frame: ``D = 1`` at every pixel, where the stage gives back the rendered values to its tables'
   rounding. The muted render equals the stage's own output; a speed, or a velocity that is keyed
-  (it may change from frame to frame), keeps the stage on.
+  (it may change from frame to frame), keeps the stage on. A compositor tree the add-on created
+  (the scene had none) is switched off with it: it would only copy the render.
 - The denoising data passes, which Cycles writes at every camera sample's first hit, are switched
   on only where the light groups' Denoise nodes use them (the denoiser on, a blackbody lamp in a
   light group); otherwise the view layer keeps the user's setting, which Remove gives back.
@@ -44,12 +45,13 @@ def test_stage_is_muted_only_while_the_observer_is_at_rest_throughout(relativity
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     nodes = _stage_nodes(relativity_addon, scene)
     assert nodes and all(node.mute for node in nodes)
+    assert not scene.render.use_compositing, "the add-on's own compositor tree would only copy the render"
     muted = dh.render(bpy, scene, tmp_path / "muted.exr")
     effect.sync(scene)
     assert all(node.mute for node in nodes)
     scene.relativity.beta = (0.0, 0.0, -0.3)
     effect.sync(scene)
-    assert not any(node.mute for node in nodes)
+    assert not any(node.mute for node in nodes) and scene.render.use_compositing
     # A keyed velocity may change from frame to frame: the stage stays on, here at rest, which
     # gives its own output at D = 1 to compare the muted render with.
     scene.relativity.beta = (0.0, 0.0, 0.0)
@@ -62,6 +64,12 @@ def test_stage_is_muted_only_while_the_observer_is_at_rest_throughout(relativity
     error = np.abs(muted - unmuted).max() / muted.max()
     print(f"at rest, muted stage against its output: max difference {error:.2e} of the brightest pixel")
     assert error < 2e-4
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    scene.animation_data_clear()
+    effect.sync(scene)
+    assert all(node.mute for node in nodes) and not scene.render.use_compositing
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert scene.render.use_compositing  # as before Set Up (Blender's default)
 
 
 def test_denoising_passes_only_for_denoised_light_groups(relativity_addon):
