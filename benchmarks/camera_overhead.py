@@ -3,23 +3,32 @@
     python benchmarks/camera_overhead.py [--samples 128] [--resolution 160x120] [--repeats 5]
 
 Same lit scene (with Blender's default constant world), same seed, Cycles on the CPU. The
-cameras are rendered alternately (perspective, relativistic at rest, relativistic at speed, then
-again) so that load from other processes hits all of them alike; each round's times are divided
-by that round's perspective time and the median ratio over the rounds is printed, next to the
-median times.
-At beta = 0 both cameras trace the same rays, so the ratio is the camera's own cost; at speed
-the view itself changes (more or less geometry in frame), which is not camera overhead.
+cameras are rendered alternately (perspective, relativistic at rest, relativistic at speed, the
+minimal OSL camera, then again) so that load from other processes hits all of them alike; each
+round's times are divided by that round's perspective time and by its minimal OSL camera's time,
+and the median ratios over the rounds are printed, next to the median times: wall-clock time and
+the process's CPU time (user + system, all threads: less disturbed by other processes than the
+wall clock, though not free of them on a loaded machine). The load average is printed with them.
+At beta = 0 the cameras trace the same rays, so the ratio is the camera's own cost; at speed
+the view itself changes (more or less geometry in frame), which is not camera overhead. The
+minimal OSL camera (``tools/osl_camera_ops.py``) traces the perspective camera's rays in three
+lines of OSL: what Cycles charges any OSL camera, the floor under the exact camera's cost.
 """
 
 import argparse
 import math
 import os
+import resource
 import statistics
 import sys
 import tempfile
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+
+MINIMAL = "minimal OSL camera"
 
 
 def build_scene(bpy, resolution, samples):
@@ -51,11 +60,32 @@ def build_scene(bpy, resolution, samples):
     return scene
 
 
-def timed_render(bpy, scene, path):
+def _cpu_seconds():
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def timed_render_clocks(bpy, scene, path):
+    """Wall-clock and CPU seconds of one render (handlers, synchronisation, compositor included)."""
     scene.render.filepath = path
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), _cpu_seconds()
     bpy.ops.render.render(write_still=True)
-    return time.perf_counter() - start
+    return time.perf_counter() - start, _cpu_seconds() - cpu_start
+
+
+def timed_render(bpy, scene, path):
+    return timed_render_clocks(bpy, scene, path)[0]
+
+
+def load_average():
+    return "load average " + ", ".join(f"{value:.2f}" for value in os.getloadavg())
+
+
+def minimal_osl_camera(projection):
+    """The case function of the minimal OSL camera for ``projection`` (``PERSP`` or ``EQUIRECTANGULAR``)."""
+    from osl_camera_ops import minimal_camera
+
+    return lambda scene: minimal_camera(scene, projection)
 
 
 def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
@@ -63,7 +93,8 @@ def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
     that sets up another camera and returns the function undoing it; the first case is the
     reference) alternately ``repeats`` times after one warm-up round (shader compilation, kernel
     loading, caches) and prints each case's median time and its median ratio to the reference's
-    time of that round."""
+    time of that round, wall clock and CPU, and to the minimal OSL camera's (a case labelled
+    ``MINIMAL``) where there is one."""
     from relativity_addon.blender.pipeline import effect
 
     def render(beta, name):
@@ -74,7 +105,7 @@ def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
         else:
             scene.relativity.beta = beta
             effect.apply(scene)
-        seconds = timed_render(bpy, scene, os.path.join(out, prefix + name))
+        seconds = timed_render_clocks(bpy, scene, os.path.join(out, prefix + name))
         if undo is not None:
             undo()
         return seconds
@@ -86,13 +117,27 @@ def compare_cameras(bpy, scene, cases, repeats, out, prefix=""):
         for label, beta in cases:
             times[label].append(render(beta, f"{round_index}.png"))
     effect.remove(scene)
-    base = times[cases[0][0]]
-    for label, _ in cases:
-        ratios = [seconds / reference for seconds, reference in zip(times[label], base, strict=True)]
-        print(
-            f"  {label:28s} {statistics.median(times[label]):7.3f} s   ratio {statistics.median(ratios):5.3f}"
-            f"   (ratios {min(ratios):.3f}-{max(ratios):.3f})"
+    labels = [label for label, _ in cases]
+    references = [labels[0]] + ([MINIMAL] if MINIMAL in labels else [])
+
+    def ratios(label, reference, clock):
+        return [mine[clock] / theirs[clock] for mine, theirs in zip(times[label], times[reference], strict=True)]
+
+    def spread(values):
+        return f"{statistics.median(values):5.3f} ({min(values):.3f}-{max(values):.3f})"
+
+    short = [reference.split()[0].removesuffix("'s") for reference in references]
+    header = "".join(f"   {'wall / ' + name:21s} {'cpu / ' + name:21s}" for name in short)
+    print(f"  {'':24s} {'wall s':>7s} {'cpu s':>7s}{header}")
+    for label in labels:
+        columns = "".join(
+            f"   {spread(ratios(label, reference, 0))}   {spread(ratios(label, reference, 1))}"
+            for reference in references
         )
+        wall = statistics.median(t[0] for t in times[label])
+        cpu = statistics.median(t[1] for t in times[label])
+        print(f"  {label:24s} {wall:7.3f} {cpu:7.3f}{columns}")
+    print(f"  ({load_average()})")
 
 
 def main():
@@ -114,8 +159,10 @@ def main():
         ("perspective", None),
         ("relativistic beta=0", (0.0, 0.0, 0.0)),
         ("relativistic beta=0.5 fwd", (0.0, 0.48, -0.13)),
+        (MINIMAL, minimal_osl_camera("PERSP")),
     )
-    print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
+    rounds = f"{options.repeats} alternating rounds"
+    print(f"{options.resolution}, {options.samples} samples, {rounds}, medians ({load_average()}):")
     compare_cameras(bpy, scene, cases, options.repeats, out)
 
 

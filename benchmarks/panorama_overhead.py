@@ -1,20 +1,28 @@
-"""Render time of the relativistic panorama and stereo pair against Blender's own cameras.
+"""Render time of the exact camera (perspective, panoramas, stereo pair) against Blender's own
+cameras and against a minimal OSL camera, in an open scene and in a room.
 
     python benchmarks/panorama_overhead.py [--samples 64] [--resolution 320x160] [--repeats 5]
-                                           [--types EQUIRECTANGULAR,FISHEYE_EQUISOLID] [--room]
+                                           [--types PERSP,EQUIRECTANGULAR] [--scenes open,room]
+                                           [--no-ops]
 
-The lit scene of camera_overhead.py seen through a panoramic camera (the whole sphere for the
-equirectangular one), Cycles on the CPU, same seed. For each panorama type the cameras are
-rendered alternately (Blender's panorama, relativistic at rest, relativistic at 0.5c, then
-again), each round's times divided by that round's Blender time, and the median ratio printed
-next to the median times. At beta = 0 both trace the same rays: the ratio is the camera's own
-cost (target <= 1.10); at speed the view changes, which is not camera overhead. STEREO renders
-the perspective camera's stereo pair (Blender's multiview) both ways.
+The lit scene of camera_overhead.py seen through the camera, Cycles on the CPU, same seed. For
+each camera type and scene the cameras are rendered alternately (Blender's camera, relativistic
+at rest, relativistic at 0.5c, the minimal OSL camera, then again), each round's times divided by
+that round's Blender time and by its minimal OSL camera's time, and the median ratios printed
+next to the median times, wall clock and CPU (camera_overhead.compare_cameras), with the load
+average. At beta = 0 the cameras trace the same rays: the ratio to the minimal OSL camera (the
+same rays in three to six lines of OSL, ``tools/osl_camera_ops.py``: what Cycles charges any OSL
+camera) is the add-on's own cost per render, camera shader, colour stage, compositor and
+handlers together (target <= 1.03, issue 26); at speed the view changes, which is not camera
+overhead. ``PERSP`` is the perspective camera, the other types Blender's panoramas (the minimal
+camera exists for PERSP and EQUIRECTANGULAR); STEREO renders the perspective camera's stereo
+pair (Blender's multiview) both ways. Scene ``open``: most of the sphere is sky; ``room``: walls
+and a ceiling close the scene, so that every ray meets a surface (an interior, the usual
+360-degree still).
 
-The equirectangular panorama is also rendered through a minimal OSL camera of its own (the same
-rays, six lines of OSL): what any OSL camera costs in Cycles, the floor under the add-on's. With
-``--room`` the scene is closed by walls and a ceiling, so that every ray meets a surface (an
-interior, the usual 360-degree still) instead of the open scene's sky.
+Unless ``--no-ops``, the operations Cycles runs per camera sample after OSL's runtime optimiser
+are counted first (``tools/osl_camera_ops.py``): the exact camera at rest against the minimal
+camera, a check that the machine's load cannot disturb.
 """
 
 import argparse
@@ -23,41 +31,13 @@ import os
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
 
-from camera_overhead import build_scene, compare_cameras  # noqa: E402
-
-MINIMAL_EQUIRECTANGULAR = """
-shader minimal_equirectangular(output point position = point(0.0), output vector direction = vector(0.0, 0.0, 1.0),
-                               output color throughput = color(1.0))
-{
-  point raster = camera_shader_raster_position();
-  float longitude = mix(-M_PI, M_PI, raster[0]);
-  float latitude = mix(-M_PI_2, M_PI_2, raster[1]);
-  direction = vector(cos(latitude) * sin(longitude), sin(latitude), cos(latitude) * cos(longitude));
-}
-"""
-
-
-def minimal_osl_camera(scene):
-    """Turn the scene's camera into the minimal equirectangular OSL camera; return the undo."""
-    import bpy
-
-    from relativity_addon.blender.common import osl
-
-    data = scene.camera.data
-    text = bpy.data.texts.get("minimal_equirectangular.osl") or bpy.data.texts.new("minimal_equirectangular.osl")
-    text.from_string(MINIMAL_EQUIRECTANGULAR)
-    data.type, data.custom_mode, data.custom_shader = "CUSTOM", "INTERNAL", text
-    errors = osl.compile_custom_camera(data)
-    if errors:
-        raise RuntimeError(f"minimal OSL camera: {errors[0]}")
-
-    def undo():
-        data.type = "PANO"
-
-    return undo
+from camera_overhead import MINIMAL, build_scene, compare_cameras, load_average, minimal_osl_camera  # noqa: E402
+from osl_camera_ops import MINIMAL_SHADERS, optimised_camera_ops, work_ops  # noqa: E402
 
 
 def close_room(bpy):
@@ -72,6 +52,21 @@ def close_room(bpy):
         bpy.ops.mesh.primitive_plane_add(size=20.0, location=location, rotation=rotation)
 
 
+def print_operation_counts(types):
+    """Operations per camera sample after OSL's runtime optimiser, exact camera at rest against
+    the minimal camera (fresh processes; independent of the machine's load)."""
+    print("Operations per camera sample (OSL's optimised code; tools/osl_camera_ops.py):")
+    for camera_type in types:
+        if camera_type not in MINIMAL_SHADERS:
+            continue
+        counts = {camera: work_ops(optimised_camera_ops(camera_type, camera)) for camera in ("exact", "minimal")}
+        extra = counts["exact"] - counts["minimal"]
+        print(
+            f"  {camera_type}: exact camera at rest {sum(counts['exact'].values())}, minimal "
+            f"{sum(counts['minimal'].values())}; beyond the minimal: {dict(extra) or 'none'}"
+        )
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=64)
@@ -79,12 +74,20 @@ def main():
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument(
         "--types",
-        default="EQUIRECTANGULAR,FISHEYE_EQUISOLID,STEREO",
-        help="panorama types, and STEREO: the perspective camera's stereo pair (multiview)",
+        default="PERSP,EQUIRECTANGULAR",
+        help="PERSP (the perspective camera), panorama types (EQUIRECTANGULAR, FISHEYE_EQUISOLID, ...) "
+        "and STEREO: the perspective camera's stereo pair (multiview)",
     )
-    parser.add_argument("--room", action="store_true", help="close the scene with walls and a ceiling")
+    parser.add_argument("--scenes", default="open,room", help="open, room or both")
+    parser.add_argument("--room", action="store_true", help="the room only (as --scenes room)")
+    parser.add_argument("--no-ops", action="store_true", help="do not count the optimised operations")
     options = parser.parse_args()
     resolution = tuple(int(v) for v in options.resolution.lower().split("x"))
+    types = options.types.split(",")
+    scenes = ["room"] if options.room else options.scenes.split(",")
+
+    if not options.no_ops:
+        print_operation_counts(types)
 
     import bpy
 
@@ -97,20 +100,22 @@ def main():
         ("relativistic beta=0", (0.0, 0.0, 0.0)),
         ("relativistic beta=0.5", (0.0, 0.48, -0.13)),
     )
-    print(f"{options.resolution}, {options.samples} samples, {options.repeats} alternating rounds, medians:")
-    for panorama_type in options.types.split(","):
-        scene = build_scene(bpy, resolution, options.samples)
-        if options.room:
-            close_room(bpy)
-        if panorama_type == "STEREO":
-            scene.render.use_multiview = True
-            scene.render.views_format = "STEREO_3D"
-        else:
-            scene.camera.data.type = "PANO"
-            scene.camera.data.panorama_type = panorama_type
-        print(f" {panorama_type}{' (room)' if options.room else ''}:")
-        extra = (("minimal OSL camera", minimal_osl_camera),) if panorama_type == "EQUIRECTANGULAR" else ()
-        compare_cameras(bpy, scene, cases + extra, options.repeats, out, prefix=f"{panorama_type}-")
+    rounds = f"{options.repeats} alternating rounds"
+    print(f"{options.resolution}, {options.samples} samples, {rounds}, medians ({load_average()}):")
+    for scene_kind in scenes:
+        for camera_type in types:
+            scene = build_scene(bpy, resolution, options.samples)
+            if scene_kind == "room":
+                close_room(bpy)
+            if camera_type == "STEREO":
+                scene.render.use_multiview = True
+                scene.render.views_format = "STEREO_3D"
+            elif camera_type != "PERSP":
+                scene.camera.data.type = "PANO"
+                scene.camera.data.panorama_type = camera_type
+            print(f" {camera_type} ({scene_kind}):")
+            extra = ((MINIMAL, minimal_osl_camera(camera_type)),) if camera_type in MINIMAL_SHADERS else ()
+            compare_cameras(bpy, scene, cases + extra, options.repeats, out, prefix=f"{camera_type}-{scene_kind}-")
 
 
 if __name__ == "__main__":

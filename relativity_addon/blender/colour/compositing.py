@@ -25,6 +25,8 @@ spectral Doppler matrix per pixel after the render, with no second render:
   through the table of its blackbody (``physics/illuminants.py``): a surface it lit sends a
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
+- With the observer at rest in every frame the stage is the identity (``D = 1``) and is muted,
+  so that it costs the render nothing (``at_rest_throughout``).
 
 The group is inserted after every Render Layers node of the scene's compositor (a tree is
 created if the scene has none); :func:`remove_colour_stage` restores the compositor exactly.
@@ -249,6 +251,9 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
             lut_images.ensure_illuminant_lut(name, temperature)
     values = colour_stage_values(snap)
     held = light_groups.KEY in scene  # else the view layers have no slot groups to link
+    bypass = _stage_mode["mode"] == "COLOUR" and at_rest_throughout(scene, snap)
+    records = []
+    guided = set()  # view layers whose light groups are denoised: they need the denoising data passes
     for record in scene[SAVED_KEY]["inserted"]:
         node, layers = tree.nodes.get(record["group_node"]), tree.nodes.get(record["layers"])
         if node is None:
@@ -258,16 +263,72 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
                 node.inputs[name].default_value = value
         view_layer = scene.view_layers.get(layers.layer) if layers is not None else None
         denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
-        for slot, (name, temperature) in enumerate(zip(record.get("denoisers", ()), temperatures, strict=False), 1):
+        mutes = [not denoised or not temperature for temperature in temperatures]  # muted: the pass as rendered
+        if view_layer is not None and not all(mutes):
+            guided.add(view_layer.name)
+        records.append((record, node, layers, mutes))
+    _store_denoising_passes(scene, guided)
+    # Denoised light groups are recombined with the Image denoised apart: the stage is then no
+    # identity to the last bit even at D = 1 (max(Image - Lit, 0) + Lit), and stays on.
+    bypass = bypass and not guided
+    for _record, node, _layers, _mutes in records:
+        if node.mute != bypass:  # muted, the group passes its Image through
+            node.mute = bypass
+    _skip_own_compositor(scene, bypass)
+    for record, _node, layers, mutes in records:
+        for slot, (name, mute) in enumerate(zip(record.get("denoisers", ()), mutes, strict=False), 1):
             denoiser = tree.nodes.get(name)
             if denoiser is None:
                 continue
             if held and layers is not None:
-                _link_light_group_pass(tree, layers, denoiser, slot)
-            mute = not denoised or not temperature  # muted: the pass as rendered
+                _link_light_group_pass(tree, layers, denoiser, slot, guides=not mute)
             if denoiser.mute != mute:
                 denoiser.mute = mute
     return True
+
+
+def _skip_own_compositor(scene, bypass):
+    """With the stage muted in a compositor tree the add-on created (the scene had none), the
+    compositor would only copy the render: it is switched off then (its run cost 5.2 about 0.3 s
+    of wall clock per render), and on again with the stage."""
+    saved = scene[SAVED_KEY]
+    if not saved.get("created_tree"):
+        return
+    wanted = not bypass  # Remove gives back the user's setting (the scene had no tree for it to run)
+    if scene.render.use_compositing != wanted:
+        scene.render.use_compositing = wanted
+
+
+def at_rest_throughout(scene: Scene, snap: Snapshot) -> bool:
+    """Whether the observer is at rest in every frame, with no moving light: the velocity setting
+    (not the camera's animation) is zero and neither keyed nor driven. Then ``D = 1`` at every
+    pixel and the stage would give back the rendered values (to its tables' rounding, 2e-4), so
+    it is muted and costs nothing (about 1.6 us of CPU per pixel with 5.2's compositor). A speed
+    that changes from frame to frame keeps the stage on throughout: an animation render shows the
+    compositor what a handler wrote one frame late (``write_colour_stage``)."""
+    if snap.velocity_source == "CAMERA_ANIMATION" or snap.speed != 0.0 or snap.moving_lights:
+        return False
+    animation = scene.animation_data
+    if animation is None:
+        return True
+    if len(animation.nla_tracks):
+        return False
+    paths = [curve.data_path for curve in compat.action_fcurves(animation)]
+    paths += [driver.data_path for driver in animation.drivers]
+    return not any(path.startswith("relativity.") for path in paths)
+
+
+def _store_denoising_passes(scene, guided):
+    """The denoising data passes (normal, albedo: the light groups' denoisers' guides) only on the
+    view layers in ``guided``, the others as the user had them: Cycles writes them at every
+    camera sample's first hit, a cost of every sample for guides that a muted denoiser ignores."""
+    stored = scene[SAVED_KEY].get("denoising_passes", {})
+    for view_layer in scene.view_layers:
+        if view_layer.name not in stored:
+            continue
+        wanted = bool(stored[view_layer.name]) or view_layer.name in guided
+        if view_layer.cycles.denoising_store_passes != wanted:
+            view_layer.cycles.denoising_store_passes = wanted
 
 
 def _add_denoisers(tree, layers, node):
@@ -286,18 +347,19 @@ def _add_denoisers(tree, layers, node):
     return added
 
 
-def _link_light_group_pass(tree, layers, denoiser, slot):
-    """Link light group ``slot``'s pass and the denoising guides into ``denoiser`` (the Render
-    Layers node shows a new light group's output only once it is updated)."""
-    if denoiser.inputs["Image"].is_linked:
+def _link_light_group_pass(tree, layers, denoiser, slot, guides=True):
+    """Link light group ``slot``'s pass into ``denoiser``, and with ``guides`` the denoising data
+    passes (the Render Layers node shows a new light group's output, or the data passes switched
+    on, only once it is updated; without the passes it has no such outputs)."""
+    wanted = [(f"Combined_{light_groups.SLOTS[slot - 1]}", "Image")]
+    if guides:
+        wanted += [("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")]
+    missing = [(output, input_name) for output, input_name in wanted if not denoiser.inputs[input_name].is_linked]
+    if not missing:
         return
     layers.update()
     outputs = layers.outputs
-    for output_name, input_name in (
-        (f"Combined_{light_groups.SLOTS[slot - 1]}", "Image"),
-        ("Denoising Normal", "Normal"),
-        ("Denoising Albedo", "Albedo"),
-    ):
+    for output_name, input_name in missing:
         if output_name in outputs:
             tree.links.new(outputs[output_name], denoiser.inputs[input_name])
 
@@ -335,9 +397,10 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
             tree = compat.new_compositor_tree(scene, SCENE_TREE_NAME)
             saved["created_tree"] = tree.name
         light_groups.hold(scene)
+        # the denoising data passes (the light groups' denoisers' guides) as the user had them,
+        # switched on where they are needed (_store_denoising_passes)
         saved["denoising_passes"] = {layer.name: layer.cycles.denoising_store_passes for layer in scene.view_layers}
         for view_layer in scene.view_layers:
-            view_layer.cycles.denoising_store_passes = True  # guides for the light groups' denoisers
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
                     aov = view_layer.aovs.add()
