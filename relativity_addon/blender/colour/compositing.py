@@ -300,13 +300,16 @@ def _skip_own_compositor(scene, bypass):
 
 
 def at_rest_throughout(scene: Scene, snap: Snapshot) -> bool:
-    """Whether the observer is at rest in every frame, with no moving light: the velocity setting
+    """Whether the observer is at rest in every frame, with no moving light and no object moving
+    with the camera (its render is laid over this one by the compositor): the velocity setting
     (not the camera's animation) is zero and neither keyed nor driven. Then ``D = 1`` at every
     pixel and the stage would give back the rendered values (to its tables' rounding, 2e-4), so
     it is muted and costs nothing (about 1.6 us of CPU per pixel with 5.2's compositor). A speed
     that changes from frame to frame keeps the stage on throughout: an animation render shows the
     compositor what a handler wrote one frame late (``write_colour_stage``)."""
     if snap.velocity_source == "CAMERA_ANIMATION" or snap.speed != 0.0 or snap.moving_lights:
+        return False
+    if snap.cockpit:  # the compositor lays the cockpit over the render (camera/cockpit.py)
         return False
     animation = scene.animation_data
     if animation is None:

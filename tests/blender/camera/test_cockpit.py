@@ -173,6 +173,26 @@ def test_cockpit_renders_as_at_rest_and_the_window_shows_the_relativistic_scene(
     assert window_error <= max(window_noise, 1e-4)
 
 
+def test_cockpit_is_drawn_with_the_observer_at_rest(relativity_addon, factory_blender, tmp_path):
+    """Velocity 0 (a fly-through's first frame, or a setting being tried): the colour stage is
+    muted and the compositor it made switched off at rest; the cockpit is laid over the render by
+    that compositor, and its originals are hidden, so it must stay on. The render equals Blender's
+    own render of the scene at rest, cockpit included."""
+    bpy = factory_blender
+    scene, _camera, _cockpit, _spheres = _scene(bpy)
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    plain = _rest_cockpit_alone(bpy, scene, [], tmp_path, tag="_all")
+    noise = np.abs(_rest_cockpit_alone(bpy, scene, [], tmp_path, seed=1, tag="_all") - plain).mean()
+    effect = _effect()
+    effect.apply(scene)
+    effect.sync(scene)
+    image = ch.render_exr(bpy, scene, tmp_path / "at_rest.exr")
+    error = np.abs(image - plain).mean()
+    print(f"at rest: mean |render - Blender's render| {error:.5f} (noise {noise:.5f})")
+    assert plain.max() > 0.1
+    assert error <= max(noise, 1e-4)
+
+
 def test_remove_gives_the_file_back(relativity_addon, factory_blender):
     bpy = factory_blender
     scene, _camera, cockpit, _spheres = _scene(bpy)
