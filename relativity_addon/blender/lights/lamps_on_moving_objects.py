@@ -490,4 +490,28 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
         for obj in modifier.applied_objects(scene)
         if obj.relativity.motion == "ANIMATION" and obj.relativity.use_deformation
     ]
+    used = light_linking_collections(scene)
+    if used > MAX_LIGHT_LINKING and KEY in scene:
+        found.append(
+            f"Lamps on moving objects need {used} light-linking collections, over Cycles' {MAX_LIGHT_LINKING}: "
+            "some moving objects are lit wrongly; use fewer lamps or fewer moving objects"
+        )
     return found
+
+
+# Cycles renders at most this many light-linking collections (receivers and blockers) in a scene;
+# beyond it the others are ignored ("Maximum number of light linking collections (64) exceeded").
+MAX_LIGHT_LINKING = 64
+
+
+def light_linking_collections(scene: Scene) -> int:
+    """How many distinct collections the scene's objects use for light or shadow linking."""
+    used = set()
+    for obj in scene.objects:
+        linking = getattr(obj, "light_linking", None)
+        if linking is None:
+            continue
+        for collection in (linking.receiver_collection, linking.blocker_collection):
+            if collection is not None:
+                used.add(collection.name)
+    return len(used)

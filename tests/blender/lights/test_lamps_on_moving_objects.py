@@ -423,3 +423,33 @@ def test_moving_observer_final_render_keeps_eq_18(relativity_addon, factory_blen
     assert cameras == ["CUSTOM", "CUSTOM"] and scene.camera.data.type == "PERSP"  # exact camera for the renders
     assert ch.luminance(ahead) / ch.luminance(ahead0) == pytest.approx(D_AHEAD**2, rel=0.03)
     assert ch.luminance(behind) / ch.luminance(behind0) == pytest.approx(D_BEHIND**2, rel=0.03)
+
+
+@pytest.mark.parametrize("movers", (30, 63, 64))
+def test_more_light_linking_collections_than_cycles_renders_is_warned(relativity_addon, factory_blender, capfd, movers):
+    """Each lamp and moving object pair gets its own receiver collection; Cycles renders at most 64
+    light-linking collections and ignores the rest (its console line: "Maximum number of light
+    linking collections (64) exceeded"), so past that some moving objects are lit wrongly. Set Up
+    still works; the panel says so, exactly when Cycles drops collections."""
+    bpy = factory_blender
+    scene, cube = _scene(bpy, samples=1)
+    scene.render.resolution_x, scene.render.resolution_y = 16, 12
+    bpy.data.objects.remove(bpy.data.objects["Behind"])
+    for number in range(movers - 1):
+        extra = cube.copy()
+        extra.data = cube.data
+        extra.location = (cube.location.x + 3.0 * (number + 1), 0.0, 0.0)
+        scene.collection.objects.link(extra)
+    bpy.context.view_layer.update()
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    stage = _module("lights.lamps_on_moving_objects")
+    used = stage.light_linking_collections(scene)
+    warned = [line for line in _module("pipeline.effect").scene_warnings(scene) if "light-linking" in line]
+    capfd.readouterr()
+    ch.render_exr(bpy, scene, Path(bpy.app.tempdir) / f"linking_{movers}.exr")
+    captured = capfd.readouterr()
+    dropped = "light linking collections" in (captured.err + captured.out).lower()
+    print(f"{movers} moving objects: {used} light-linking collections, warned {bool(warned)}, Cycles dropped {dropped}")
+    assert used == movers + 1  # one for the lamp's own light, one per object
+    assert bool(warned) == (used > 64)
+    assert dropped == bool(warned)
