@@ -243,6 +243,20 @@ def _refused_at_sync(bpy, scene, *named):
     return warnings[0]
 
 
+def _refused_at_setup(bpy, scene, *named):
+    """Set Up refuses in one line naming ``named`` and leaves the file as it was; the line."""
+    bpy.context.view_layer.update()
+    before = gh.file_fingerprint(bpy)
+    with pytest.raises(RuntimeError) as raised:
+        bpy.ops.relativity.setup_scene()
+    message = str(raised.value).strip().removeprefix("Error: ").strip()
+    print(message)
+    assert all(repr(name) in message for name in named) and "\n" not in message
+    assert gh.file_fingerprint(bpy) == before
+    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+    return message
+
+
 def _add_instancing(bpy, scene, obj, kind):
     """Make the mesh ``obj`` draw instances of ``kind`` (the sweep's instancers)."""
     if kind == "NODE_INSTANCES":
@@ -318,15 +332,7 @@ def test_instances_of_a_moving_mesh_are_refused(relativity_addon, factory_blende
         _refused_at_sync(bpy, scene, instancer.name, "Mover")
         assert bpy.ops.relativity.remove_all() == {"FINISHED"}
         return
-    bpy.context.view_layer.update()
-    before = gh.file_fingerprint(bpy)
-    with pytest.raises(RuntimeError) as raised:
-        bpy.ops.relativity.setup_scene()
-    message = str(raised.value).strip().removeprefix("Error: ").strip()
-    print(message)
-    assert repr(instancer.name) in message and "'Mover'" in message and "\n" not in message
-    assert gh.file_fingerprint(bpy) == before
-    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+    _refused_at_setup(bpy, scene, instancer.name, "Mover")
     mover.relativity.motion = "STATIC"  # the way out the message gives
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
 
@@ -363,16 +369,7 @@ def test_instances_of_meshes_at_rest_on_the_boosted_preview_are_refused_or_warne
     scene, _ = _scene(bpy)
     copy = _boxes_and_copy(bpy, scene)
     scene.relativity.geometry_final_render = "PREVIEW"
-    bpy.context.view_layer.update()
-    before = gh.file_fingerprint(bpy)
-    with pytest.raises(RuntimeError) as raised:
-        bpy.ops.relativity.setup_scene()
-    message = str(raised.value).strip().removeprefix("Error: ").strip()
-    print(message)
-    assert repr(copy.name) in message and "'Box'" in message and "\n" not in message
-    assert "Final Render" in message
-    assert gh.file_fingerprint(bpy) == before
-    assert not gh.addon_module("pipeline.effect").is_applied(scene)
+    assert "Final Render" in _refused_at_setup(bpy, scene, copy.name, "Box")
 
     scene.relativity.geometry_final_render = "EXACT"
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
