@@ -172,13 +172,8 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     fingerprint = rest_fingerprint(obj_eval, rest32.reshape(-1))
     _remember(obj_eval, fingerprint)
     measured = decision.vertices if decision is not None and decision.codes is None else None
-    if measured is not None and np.array_equal(measured[0], rest32):
-        world, delays, beta_seen = measured[1:]  # the measure computed them for these points
-        inverse = motion.affine_inverse(motion.matrix_array(obj_eval.matrix_world))
-        local = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T.astype(np.float32)
-        delay, depth = float(np.max(delays, initial=0.0)), farthest_seen_depth(scene, snap, world)
-    else:
-        local, beta_seen, delay, depth = _apparent_local(scene, obj, obj_eval, rest32, snap)
+    computed = measured[1:] if measured is not None and np.array_equal(measured[0], rest32) else None
+    local, beta_seen, delay, depth = _apparent_local(scene, obj, obj_eval, rest32, snap, computed)
     warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - delay)
     modifier.write_cache(cache.data, local, beta_seen, codes)
     cache.data[names.DEPTH_KEY] = depth
@@ -193,21 +188,27 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     return len(local)
 
 
-def _apparent_local(scene, obj, obj_eval, rest32, snap):
+def _apparent_local(scene, obj, obj_eval, rest32, snap, computed=None):
     """``(object-space apparent positions (N, 3) float32, velocities seen, the largest light
-    delay, the farthest seen depth)`` of the rest positions ``rest32``. The closed form
-    (``motion.closed_form``) goes CHUNK_POINTS at a time: each point depends on its own rest
-    position only, and a part's float64 temporaries are what the peak memory holds."""
+    delay, the farthest seen depth)`` of the rest positions ``rest32``; ``computed``: the
+    ``(world positions, delays, velocities)`` the tessellation measure already found for these
+    points. The closed form (``motion.closed_form``) goes CHUNK_POINTS at a time: each point
+    depends on its own rest position only, and a part's float64 temporaries are what the peak
+    memory holds."""
     inverse = motion.affine_inverse(motion.matrix_array(obj_eval.matrix_world))
-    step = CHUNK_POINTS if motion.closed_form(obj, scene) else max(len(rest32), 1)
+    whole = computed is not None or not motion.closed_form(obj, scene)
+    step = max(len(rest32), 1) if whole else CHUNK_POINTS
     local = np.empty(rest32.shape, dtype=np.float32)
     delay, depth, beta_seen = 0.0, 0.0, []
     for start in range(0, max(len(rest32), 1), step):
-        rest = rest32[start : start + step].astype(np.float64)
-        try:
-            world, delays, beta = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
-        except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
-            raise RelativityError(f"Object {obj.name!r}: {error}") from None
+        if computed is not None:
+            world, delays, beta = computed
+        else:
+            rest = rest32[start : start + step].astype(np.float64)
+            try:
+                world, delays, beta = motion.apparent_world_positions(scene, obj, obj_eval, rest, snap, with_delay=True)
+            except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
+                raise RelativityError(f"Object {obj.name!r}: {error}") from None
         delay = max(delay, float(np.max(delays, initial=0.0)))
         depth = max(depth, farthest_seen_depth(scene, snap, world))
         # On coordinate rows (3, n): numpy multiplies the transposed views without copying them.
