@@ -5,10 +5,15 @@ scene rendered by the ``bpy`` wheel here.
 """
 
 import re
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 from gui_scene import HEIGHT, WIDTH, rest_pixel
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "blender" / "camera"))
+import camera_helpers as ch  # noqa: E402
 
 INTERNAL = ("oslquery", "_cycles", "with_osl", "OSLUnavailableError", "BLENDER_EEVEE")
 PANELS = (
@@ -24,14 +29,7 @@ BLENDER_LINES = (re.compile(r"Error: Not freed memory blocks"),)
 
 def read_png(bpy, path):
     """RGB float pixels [row (top first), column, channel]."""
-    image = bpy.data.images.load(str(path), check_existing=False)
-    try:
-        width, height = image.size
-        pixels = np.empty(width * height * 4, dtype=np.float32)
-        image.pixels.foreach_get(pixels)
-    finally:
-        bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[::-1, :, :3]
+    return ch.read_image(bpy, path)[..., :3]
 
 
 def blob(pixels, threshold):
