@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import bpy
 import numpy as np
-from mathutils import Vector
+from mathutils import Matrix, Vector
 
 from ...errors import RelativityError
 from ...physics import spectral_render
@@ -46,6 +46,9 @@ if TYPE_CHECKING:
 
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
+KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in lamp spacings
+STRIP_SIDES = 3  # one-sided strips per piece of the path, facing 120 degrees apart
+STRIP_WIDTH = 1e-3  # a strip's width over its length
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 
 
@@ -197,7 +200,10 @@ def _new_lamp(scene, name, text, kind="POINT"):
         return obj
     light.energy = 4.0 * math.pi  # 1 W/sr: the shader's Emission carries the intensity
     light.color = (1.0, 1.0, 1.0)
-    light.shadow_soft_size = 0.0
+    if kind == "AREA":  # a strip along a piece of the path: write() sets its length and width
+        light.shape = "RECTANGLE"
+    else:
+        light.shadow_soft_size = 0.0
     with warnings.catch_warnings():  # 5.x: use_nodes is deprecated (always on)
         warnings.simplefilter("ignore", DeprecationWarning)
         light.use_nodes = True
@@ -214,6 +220,8 @@ def _new_lamp(scene, name, text, kind="POINT"):
     output.location = (300.0, 0.0)
     tree.links.new(node.outputs["Emission"], output.inputs["Surface"])
     obj = bpy.data.objects.new(name, light)
+    obj.rotation_mode = "QUATERNION"
+    obj.visible_camera = False  # a strip is no surface the camera sees
     scene.collection.objects.link(obj)
     return obj
 
@@ -267,11 +275,13 @@ def _lamps_for(scene, light_name, count, text, kind="POINT"):
 def _stored_times(scene, light_name):
     """The stand-ins' times of the last placement (their shaders' inputs), or None."""
     objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
-    if not objects or any(obj is None or obj.data.type != "POINT" for obj in objects):
+    if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
         return None
-    return np.array(
-        [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["lamp_time"].default_value for obj in objects], float
-    )
+    inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
+    times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]
+    if objects[0].data.type == "AREA":  # STRIP_SIDES strips per piece: the pieces' starts and the last end
+        times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+    return np.array(times, float)
 
 
 def _positions(scene, snap, light, values, reception_time, times):
@@ -313,39 +323,98 @@ def write(
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
         else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
             positions = _positions(scene, snap, light, values, reception_time, times)
-        last = len(times) - 1
-        for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
-            before, after = max(index - 1, 0), min(index + 1, last)
-            inputs = {
-                key: values[key]
-                for key in (
-                    "camera_position",
-                    "light_beta",
-                    "spot_axis",
-                    "spot_cos_half_angle",
-                    "spot_smooth",
-                    "temperature",
-                    "luminance",
-                    "wavelength_0",
-                    "wavelength_1",
-                    "wavelength_2",
-                    "spectral_scale",
-                    "basis_weights",
-                )
-            }
-            inputs["spectral"] = int(values["spectral"])
-            inputs["lambert"] = int(values["lambert"])
-            inputs.update(
-                lamp_time=float(times[index]),
-                previous_time=float(times[before]),
-                previous_position=tuple(positions[before]),
-                next_time=float(times[after]),
-                next_position=tuple(positions[after]),
+        shared = {
+            key: values[key]
+            for key in (
+                "camera_position",
+                "light_beta",
+                "spot_axis",
+                "spot_cos_half_angle",
+                "spot_smooth",
+                "temperature",
+                "luminance",
+                "wavelength_0",
+                "wavelength_1",
+                "wavelength_2",
+                "spectral_scale",
+                "basis_weights",
             )
-            _set(obj, "location", tuple(float(v) for v in positions[index]))
-            node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
-            for key, value in inputs.items():
-                _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
+        }
+        shared["spectral"] = int(values["spectral"])
+        shared["lambert"] = int(values["lambert"])
+        if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
+            _write_points(scene, light, text, shared, times, positions)
+        else:
+            _write_strips(scene, light, text, shared, times, positions, np.asarray(values["camera_position"], float))
+
+
+def _write_inputs(obj, inputs):
+    node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
+    for key, value in inputs.items():
+        _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
+
+
+def _write_points(scene, light, text, shared, times, positions):
+    """One point lamp at each time, lighting the points whose retarded times lie next to it."""
+    last = len(times) - 1
+    for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
+        before, after = max(index - 1, 0), min(index + 1, last)
+        inputs = dict(
+            shared,
+            strip=0,
+            lamp_time=float(times[index]),
+            previous_time=float(times[before]),
+            previous_position=tuple(positions[before]),
+            next_time=float(times[after]),
+            next_position=tuple(positions[after]),
+        )
+        _set(obj, "location", tuple(float(v) for v in positions[index]))
+        _write_inputs(obj, inputs)
+
+
+def _write_strips(scene, light, text, shared, times, positions, camera_position):
+    """Two strips (thin area lights facing either way) along each piece between the times: each
+    point gets its light, and its shadow rays, from the positions within KERNEL of the spacing around
+    its retarded time."""
+    pieces = len(times) - 1
+    width = KERNEL  # in units of the piece's duration
+    for index, obj in enumerate(_lamps_for(scene, light.name, STRIP_SIDES * pieces, text, "AREA")):
+        piece, side = divmod(index, STRIP_SIDES)
+        start, end = positions[piece], positions[piece + 1]
+        along = end - start
+        length = float(np.linalg.norm(along))
+        axis = along / max(length, 1e-30)
+        first = camera_position - 0.5 * (start + end)
+        first = first - (first @ axis) * axis
+        if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
+            first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
+        first /= np.linalg.norm(first)
+        angle = 2.0 * math.pi * side / STRIP_SIDES  # Rodrigues: the first normal turned about the axis
+        normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
+        rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
+        after = min(piece + 2, pieces)
+        inputs = dict(
+            shared,
+            strip=1,
+            lamp_position=tuple(start),
+            lamp_time=float(times[piece]),
+            previous_time=float(times[max(piece - 1, 0)]),
+            previous_position=tuple(positions[max(piece - 1, 0)]),
+            next_time=float(times[piece + 1]),
+            next_position=tuple(end),
+            after_time=float(times[after]),
+            after_position=tuple(positions[after]),
+            path_start=float(times[0]),
+            path_end=float(times[-1]),
+            kernel_width=width,
+            strip_normal=tuple(normal),
+            strip_length=length,
+        )
+        _set(obj, "location", tuple(float(v) for v in 0.5 * (start + end)))
+        _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
+        _set(obj.data, "size", max(length, 1e-6))
+        _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
+        _write_inputs(obj, inputs)
 
 
 def sun_in_scene_frame(axis: npt.ArrayLike, beta: npt.ArrayLike) -> tuple[FloatArray, float]:

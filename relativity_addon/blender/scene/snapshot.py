@@ -106,6 +106,8 @@ class Snapshot:
     stereo: bool = False
     # objects moving with the camera (``scene/cockpit.py``), rendered at rest by ``camera/cockpit.py``
     cockpit: tuple[str, ...] = ()
+    # moving lights' stand-ins: strips along the path (CONTINUOUS) or point lamps (BLENDED)
+    moving_light_shadows: str = "BLENDED"
 
     @property
     def time(self) -> float:
@@ -518,4 +520,5 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         projection=lens.projection(scene, camera),
         stereo=lens.stereo_eyes(scene),
         cockpit=cockpit.object_names(scene),
+        moving_light_shadows=settings.moving_light_shadows,
     )

@@ -202,6 +202,7 @@ class RELATIVITY_PT_effects(_RelativityPanel, Panel):
         if settings.exposure_mode == "COMPENSATED" and snap is not None:
             column.label(text=f"Exposure x{snap.exposure:.4g} ({math.log2(snap.exposure):+.2f} stops)")
         if settings.method == "CAMERA":
+            layout.prop(settings, "moving_light_shadows", text="Moving Shadows")
             column = layout.column(heading="Spectral")
             column.prop(settings, "spectral_passes")
             column.operator("relativity.render_spectral", icon="RENDER_STILL")

@@ -308,6 +308,29 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
         max=40000.0,
         update=_settings_changed,
     )
+    moving_light_shadows: EnumProperty(
+        name="Moving-Light Shadows",
+        description="How lights with a velocity cast shadows behind the exact camera (docs/moving-lights.md)",
+        items=(
+            (
+                "BLENDED",
+                "Blended Lamps",
+                "Point lamps on the light's path, each point's shadow blended from the two around its retarded "
+                "position: sharp, but stepped where the retarded position changes fast across a shadow",
+                0,
+            ),
+            (
+                "CONTINUOUS",
+                "Continuous",
+                "Thin strips along the light's path: each point's shadow rays go to the path around its own "
+                "retarded position, so shadow edges follow the retarded shadow without steps, softened over "
+                "one lamp spacing; noisier (about twice the samples for the same noise)",
+                1,
+            ),
+        ),
+        default="BLENDED",
+        update=_settings_changed,
+    )
     spectral_passes: IntProperty(
         name="Spectral Passes",
         description="Colour passes of Render Spectral (three wavelengths each): "
