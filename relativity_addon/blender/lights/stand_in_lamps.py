@@ -373,9 +373,9 @@ def _write_points(scene, light, text, shared, times, positions):
 
 
 def _write_strips(scene, light, text, shared, times, positions, camera_position):
-    """Two strips (thin area lights facing either way) along each piece between the times: each
-    point gets its light, and its shadow rays, from the positions within KERNEL of the spacing around
-    its retarded time."""
+    """STRIP_SIDES one-sided strips (thin area lights facing 120 degrees apart about the path) along
+    each piece between the times: each point gets its light, and its shadow rays, from the path
+    within KERNEL / 2 of the piece's duration around its own retarded time (the shader's box)."""
     pieces = len(times) - 1
     width = KERNEL  # in units of the piece's duration
     for index, obj in enumerate(_lamps_for(scene, light.name, STRIP_SIDES * pieces, text, "AREA")):

@@ -14,7 +14,6 @@ and its scatter about a smooth curve (a cubic in the row) bound the edge's posit
 """
 
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -27,7 +26,7 @@ BETA = np.array([0.7, 0.0, 0.0])  # fast
 LAMP = np.array([3.0, 0.0, 1.0])  # where Blender draws it (1 above the floor)
 BAR_CENTRE = np.array([-1.5, 0.0, 0.25])  # close to the floor
 BAR_HALF = (0.3, 1.0)  # across the motion
-SAMPLES = int(os.environ.get("RELATIVITY_SHADOW_SAMPLES", "128"))
+SAMPLES = 128  # 64 passes too (measured: edges 0.25 px off on average, scatter rms 0.33 px)
 RESOLUTION = (160, 120)
 
 
@@ -148,6 +147,9 @@ def _render_and_measure(bpy, tmp_path, shadows):
     finally:
         floor.LAMP = saved
         floor._effect().remove(bpy.context.scene)
+        left = [obj.name for obj in bpy.data.objects if obj.name.startswith("Relativity Lamp")]
+        assert not left, f"Remove left stand-ins: {left}"
+        assert not [light.name for light in bpy.data.lights if light.name.startswith("Relativity Lamp")]
 
 
 def test_harsh_shadow_edges_follow_the_retarded_shadow(relativity_addon, factory_blender, tmp_path):
