@@ -324,7 +324,8 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
                 "Continuous",
                 "Thin strips along the light's path: each point's shadow rays go to the path around its own "
                 "retarded position, so shadow edges follow the retarded shadow without steps, softened over "
-                "one lamp spacing; noisier (about twice the samples for the same noise)",
+                "half a lamp spacing; much noisier (measured: 3.7x the noise of Blended Lamps at the same samples, "
+                "1.5x the render time)",
                 1,
             ),
         ),
