@@ -140,9 +140,18 @@ def _render_and_measure(bpy, tmp_path, shadows):
         image = floor._render(bpy, scene, tmp_path / f"{shadows}.exr")[..., 1]
         assert np.all(np.isfinite(image)) and image.min() >= 0.0
         points = floor._floor_points(bpy, scene, camera)
-        lit, _source, _ = floor._expected_radiance(points, BETA)
+        lit, source, _ = floor._expected_radiance(points, BETA)
         seen = _blocked(np.broadcast_to(floor.CAMERA, points.shape), points)  # pixels showing the bar
         model = floor.ch.pinhole_model(bpy, scene, camera)
+        # the light away from the shadow: eq. 19 (the mean over the bright floor, 3 px clear of the shadow)
+        shadowed = _blocked(source, points)
+        near = shadowed | seen
+        for shift in range(-3, 4):
+            near = near | np.roll(shadowed | seen, shift, axis=0) | np.roll(shadowed | seen, shift, axis=1)
+        clear = ~near & (lit > 0.2 * lit.max())
+        brightness = image[clear].mean() / lit[clear].mean()
+        print(f"{shadows}: the bright floor away from the shadow at {brightness:.4f} of eq. 19")
+        assert abs(brightness - 1.0) < 0.03
         return measure(image, lit, seen, model, f"{shadows}, {SAMPLES} samples")
     finally:
         floor.LAMP = saved
