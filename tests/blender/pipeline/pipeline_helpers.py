@@ -62,6 +62,15 @@ def save_blend(bpy, path):
     return Path(path)
 
 
+def moving_camera_blend(bpy, path, last_frame):
+    """A saved file: the camera keyframed from the origin along -Z over frames 1 to ``last_frame``
+    (each frame sees the emissive sphere from elsewhere), 32x32."""
+    scene, camera, _ = new_scene(bpy, resolution=(32, 32))
+    scene.frame_start, scene.frame_end = 1, last_frame
+    keyframe_camera_path(camera, [(1, (0.0, 0.0, 0.0)), (last_frame, (0.3, 0.15, -1.5))])
+    return save_blend(bpy, path)
+
+
 def _env():
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
