@@ -328,9 +328,10 @@ def _follow(copy_data, light, own=frozenset()):
 def write(scene: Scene, snap: Snapshot) -> int:
     """Bring the copies up to date with the snapshot (rebuilt when the lamps or moving objects
     changed, else only their colours and settings written). Nothing without moving objects or
-    off the Apparent Geometry path."""
+    off the Apparent Geometry path. With Doppler colour and searchlight both off the copies stay,
+    with no factor of ``D``: the aberrated direction (and the rest normals) are geometry."""
     pairs = []
-    if snap.method == "GEOMETRY" and (snap.use_doppler or snap.use_searchlight):
+    if snap.method == "GEOMETRY":
         lit_by = lamps(scene)
         found = movers(scene, snap) if lit_by else []  # no lamps: nothing to place
         pairs = [(lamp, mover) for lamp in lit_by for mover in found]
