@@ -24,9 +24,9 @@ panel's frame. Then ``albedo / pi`` and eq. 14 (``D_c^4``) to the camera. A seco
 snapshot, is what Cycles is asked to render: the sphere frozen where the camera sees it, its
 scene-frame radiance, received on the rest normal at rest; the render must match it.
 
-Blender's indirect clamp (10) is switched off: approaching, the sphere's light toward the panel is
-``D_s^4`` = 3x its rest-frame radiance, and the clamp cut the panel's bounce light to 0.48 of the
-snapshot's (the add-on scales the clamps for the exact camera only, ``camera/clamping.py``).
+Blender's indirect clamp (10) is switched off in the model tests: approaching, the sphere's light
+toward the panel is ``D_s^4`` = 3x its rest-frame radiance; ``camera/clamping.py`` scales the
+clamps for it, which the last test checks.
 """
 
 import importlib
@@ -102,7 +102,7 @@ def _scene(bpy, beta_sphere, beta_panel):
     scene.cycles.max_bounces = 1  # the sphere's light on the panel: one bounce
     scene.cycles.diffuse_bounces = 1
     scene.cycles.seed = 7
-    scene.cycles.sample_clamp_indirect = 0.0  # Blender's 10 cuts the sphere's brightened bounce
+    scene.cycles.sample_clamp_indirect = 0.0  # the model tests: no clamp at all
     white = ch.diffuse_material(bpy, "White", (ALBEDO, ALBEDO, ALBEDO))
     sphere = ch.add_sphere(bpy, scene, tuple(_origin_now(SPHERE_SEEN, beta_sphere)), 1.0, white, "Sphere", 96, 48)
     mesh = bpy.data.meshes.new("Panel")
@@ -366,3 +366,30 @@ def test_bounce_between_moving_objects(
     assert ratios["physics"] == pytest.approx(physics, abs=0.04)
     assert ratios["receiver at rest"] == pytest.approx(receiver_at_rest, abs=0.05)
     assert ratios["snapshot"] == pytest.approx(1.0, abs=0.05)
+
+
+def _clamped_share(bpy, tmp_path, beta):
+    """The panel's bounce light with Blender's default indirect clamp (10) over the same with the
+    clamp off (inner panel pixels); Remove gives the user's clamp back."""
+    means = {}
+    for clamp in (0.0, 10.0):
+        scene, rotation = _scene(bpy, beta, -beta)
+        scene.cycles.sample_clamp_indirect = clamp
+        effect = _module("pipeline.effect")
+        effect.apply(scene)
+        image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"clamp{clamp:g}.exr"))
+        effect.remove(scene)
+        assert scene.cycles.sample_clamp_indirect == pytest.approx(clamp)
+        means[clamp] = float(image[_inner(_seen_panel(rotation, beta, -beta)[0])].mean())
+    return means[10.0] / means[0.0]
+
+
+def test_default_clamp_keeps_the_brightened_bounce(relativity_addon, factory_blender, tmp_path):
+    """A clamp set for the scene at rest (Blender's default indirect 10) cuts the light a moving
+    object's searchlight brightens no more than it cuts the scene at rest: approaching at 0.5c, the
+    sphere sends the panel up to ``D_s^4`` = 3x its rest-frame light, and an unscaled clamp cut the
+    panel's bounce to 0.48 of the unclamped one."""
+    at_rest = _clamped_share(factory_blender, tmp_path, np.zeros(3))
+    moving = _clamped_share(factory_blender, tmp_path, np.array([EACH, 0.0, 0.0]))
+    print(f"panel bounce, clamp 10 over clamp off: at rest {at_rest:.4f}, approaching at 0.5c {moving:.4f}")
+    assert moving == pytest.approx(at_rest, abs=0.03)
