@@ -51,8 +51,10 @@ def _brightest(speed, power):
 def write(scene: Scene, snap: Snapshot) -> None:
     """Scale the clamps for the snapshot (only writing what changed: a write triggers a sync)."""
     cycles = getattr(scene, "cycles", None)
+    if cycles is None or (KEY not in scene and not any(getattr(cycles, name) for name in CLAMPS)):
+        return  # no clamp to scale (the speeds are not even read)
     scale = factor(scene, snap)
-    if cycles is None or (KEY not in scene and scale == 1.0):
+    if KEY not in scene and scale == 1.0:
         return
     if KEY not in scene:
         scene[KEY] = {name: getattr(cycles, name) for name in CLAMPS} | {
