@@ -266,7 +266,11 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     assert bpy.ops.relativity.render_spectral.poll()
     with pytest.raises(RuntimeError, match="temperature grid"):
         bpy.ops.relativity.render_spectral()
+    # without the blackbody (set where the user sets it: before Set Up, which links the fast
+    # mode's correction into a grid blackbody's intensity)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     fire.node_tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
+    _set_up(bpy, scene)
     spectral_render.check(scene)  # accepted
 
     mixed = dh.volume_material(bpy, "Mixed", Density=0.0, Blackbody_Intensity=1.0, Temperature=2000.0)
