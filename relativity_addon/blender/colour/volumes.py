@@ -70,11 +70,13 @@ import bpy
 
 from ..common import names
 from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
-from ..scene import sources
+from ..scene import grouped_colours, sources
 from . import materials, spectral_nodes
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Scene
+    from collections.abc import Iterator
+
+    from bpy.types import Material, NodeTree, Scene
 
 GROUP = names.VOLUME_BLACKBODY_GROUP
 NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX
@@ -359,14 +361,9 @@ def attach_colours(material: Material) -> bool:
     if any(record["group_node"].startswith(COLOUR_PREFIX) for record in records):
         return False
     tree = material.node_tree
-    targets = [
-        (node, node.inputs[name], emitted)
-        for node in list(tree.nodes)
-        for kind, inputs in VOLUME_COLOURS
-        if node.bl_idname == kind
-        for name, emitted in inputs
-    ]
-    if not targets:
+    targets = _volume_colour_inputs(tree.nodes)
+    grouped = [(inner, _volume_colour_inputs([node])) for _group, inner, node in grouped_volume_nodes(tree)]
+    if not targets and not grouped:
         return False
     group_tree = ensure_group(
         spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION
@@ -376,7 +373,44 @@ def attach_colours(material: Material) -> bool:
         record["object_temperature"] = records[0]["object_temperature"] if records else 0.0
         records.append(record)
     material[materials.ATTACHED_KEY] = records
+    # inside node groups: once in the group's tree (shared by every material using it), recorded
+    # on the tree like the surfaces' grouped colours (grouped_colours.py), which detach_all undoes
+    for inner, inner_targets in grouped:
+        inner_records = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])]
+        for target, socket, emitted in inner_targets:
+            if socket.is_linked and socket.links[0].from_node.name.startswith(COLOUR_PREFIX):
+                continue  # put in for another material already
+            inner_records.append(
+                materials.insert_colour_group(inner, group_tree, COLOUR_PREFIX, target, socket, emitted)[1]
+            )
+        inner[materials.ATTACHED_KEY] = inner_records
     return True
+
+
+def _volume_colour_inputs(nodes):
+    """``(node, input, is_emitted)`` of every volume colour (:data:`VOLUME_COLOURS`) of ``nodes``."""
+    return [
+        (node, node.inputs[name], emitted)
+        for node in list(nodes)
+        for kind, inputs in VOLUME_COLOURS
+        if node.bl_idname == kind
+        for name, emitted in inputs
+    ]
+
+
+def grouped_volume_nodes(
+    tree: NodeTree, seen: tuple[str, ...] = ()
+) -> Iterator[tuple[bpy.types.Node, NodeTree, bpy.types.Node]]:
+    """``(group node, its tree, volume node)`` for every volume node (:data:`VOLUME_KINDS`) inside
+    the user's node groups used in ``tree``, at any depth."""
+    for group in grouped_colours.user_groups(tree):
+        inner = group.node_tree
+        if inner.name in seen:
+            continue
+        for node in list(inner.nodes):
+            if node.bl_idname in VOLUME_KINDS:
+                yield group, inner, node
+        yield from grouped_volume_nodes(inner, (*seen, inner.name))
 
 
 def attach_scene(scene: Scene) -> None:
@@ -387,6 +421,32 @@ def attach_scene(scene: Scene) -> None:
     for material, _temperature in materials.scene_materials(scene):
         attach(material, grids=material in grids)
         attach_colours(material)
+
+
+def _grouped_problem(material, on_grids):
+    """Why the passes cannot carry a volume node inside one of ``material``'s node groups, or None:
+    a Volume Coefficients node, a Principled Volume blackbody (its correction and its spectrum live in
+    the material's own tree), a colour grid, an emission colour fed from outside the group (which
+    may be a blackbody the group cannot see)."""
+    for group, inner, node in grouped_volume_nodes(material.node_tree):
+        where = f"{node.name!r} inside the node group {inner.name!r} ({group.name!r}) in material {material.name!r}"
+        if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
+            return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
+        if node.bl_idname != "ShaderNodeVolumePrincipled":
+            continue
+        if _emits_blackbody(node):
+            return (
+                f"Spectral colour cannot make the blackbody of {where} spectral: a Principled Volume "
+                "blackbody must be in the material's own node tree"
+            )
+        if on_grids and node.inputs["Color Attribute"].default_value:
+            return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
+        strength = sources.constant_value(node.inputs["Emission Strength"])
+        if grouped_colours.group_input(node.inputs["Emission Color"]) is not None and strength != 0.0:
+            return (
+                f"Spectral colour cannot make the emission of {where} spectral: its colour comes from outside the group"
+            )
+    return None
 
 
 def _emits_blackbody(node):
@@ -405,12 +465,9 @@ def spectral_problem(scene: Scene) -> str | None:
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
             continue
-        grouped = sources.grouped_node(material.node_tree, VOLUME_KINDS)
+        grouped = _grouped_problem(material, material in grids)
         if grouped is not None:
-            return (
-                f"Spectral colour cannot make the volume shaders inside the node group {grouped[0].name!r} "
-                f"in material {material.name!r} spectral"
-            )
+            return grouped
         correctable = _correctable(material)
         corrected = correctable[1].node if correctable is not None else None
         for node in material.node_tree.nodes:
@@ -442,8 +499,8 @@ def spectral_problem(scene: Scene) -> str | None:
 
 
 def warnings(scene: Scene) -> list[str]:
-    """One line per Principled Volume blackbody on an object with temperature grids that the
-    correction cannot handle (it keeps the RGB matrix's colour shift)."""
+    """One line per Principled Volume blackbody the correction cannot handle (it keeps the RGB
+    matrix's colour shift): on an object with temperature grids, or inside a node group."""
     lines = []
     for material, name in grid_materials(scene).items():
         if material.node_tree is None or _correctable(material) is not None:
@@ -461,4 +518,22 @@ def warnings(scene: Scene) -> list[str]:
                     "the Volume output)"
                 )
                 break
+    for material, _temperature in materials.scene_materials(scene):
+        grouped = (
+            next(
+                (
+                    (inner, node)
+                    for _group, inner, node in grouped_volume_nodes(material.node_tree)
+                    if node.bl_idname == "ShaderNodeVolumePrincipled" and _emits_blackbody(node)
+                ),
+                None,
+            )
+            if material.node_tree is not None
+            else None
+        )
+        if grouped is not None:
+            lines.append(
+                f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
+                f"{grouped[0].name!r} keeps the RGB colour shift (shifted to D T only in the material's own tree)"
+            )
     return lines

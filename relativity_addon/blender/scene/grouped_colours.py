@@ -50,7 +50,7 @@ def user_groups(tree: NodeTree) -> list[Node]:
     ]
 
 
-def _group_input(socket):
+def group_input(socket: NodeSocket) -> str | None:
     """Identifier of the Group Input colour output feeding input ``socket`` through reroutes, or None."""
     for _step in range(256):
         link = sources.live_link(socket)
@@ -89,7 +89,7 @@ def pass_throughs(group_tree: NodeTree, seen: tuple[str, ...] = ()) -> dict[str,
         return {}
     kinds = {}
     for _node, socket, is_emission in targets(group_tree, (*seen, group_tree.name)):
-        identifier = _group_input(socket)
+        identifier = group_input(socket)
         if identifier is not None:
             kinds.setdefault(identifier, set()).add(is_emission)
     return {identifier: next(iter(found)) for identifier, found in kinds.items() if len(found) == 1}
@@ -109,7 +109,7 @@ def attach_groups(
             records = [
                 insert(group_tree, target, socket, is_emission)
                 for target, socket, is_emission in list(targets(group_tree))
-                if passed.get(_group_input(socket)) != is_emission
+                if passed.get(group_input(socket) or "") != is_emission
             ]
             group_tree[KEY] = records
         attach_groups(group_tree, insert, (*seen, group_tree.name))
