@@ -38,6 +38,8 @@ MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world mat
 # --- Doppler colour: materials --------------------------------------------------------------
 MATERIAL_ATTACHED_KEY = "relativity_doppler_nodes"  # on materials and worlds: inserted nodes
 MATERIAL_NODE_PREFIX = "Relativity Doppler"
+# Object attribute (an RNA path) read inside shared node groups: the object's blackbody temperature
+OBJECT_TEMPERATURE_PATH = "relativity.temperature"
 SETTINGS_GROUP = "Relativity Settings"
 DOPPLER_FACTOR_GROUP = "Relativity Doppler Factor"
 GAMUT_MAP_GROUP = "Relativity Gamut Map"
