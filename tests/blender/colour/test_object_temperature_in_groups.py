@@ -6,6 +6,7 @@ other is not. Observer at 0.5c toward them (exact camera, fast mode). The marked
 as colour-science's blackbody at ``D T`` with luminance ``Y(D T) / Y(T)`` times its rest luminance
 (Weiskopf et al. 1999 eq. 14, docs/physics.md), ``D`` from each pixel's viewing direction; the
 other, sharing the group, keeps the RGB path (white seen at ``D``, far from a 3000 K blackbody).
+The spectral mode (3 passes) must see the marked wall the same way.
 """
 
 import math
@@ -90,6 +91,15 @@ def test_object_temperature_reaches_an_emission_inside_a_shared_group(relativity
     assert delta_e < 1.0
     assert ratio == pytest.approx(1.0, abs=0.02)
     assert plain > 5.0  # the object without a temperature keeps the RGB path through the same group
+
+    # the spectral passes: the same colour group gives the marked wall its Planck spectrum
+    pixels, _info = dh.addon_module(relativity_addon, "pipeline.spectral_render").render(scene, 3)
+    spectral = pixels[::-1, :, :3].astype(float)
+    xyz = _xyz(spectral, MARKED).mean(axis=0)
+    delta_e, ratio = dh.delta_e_2000_normalised(xyz, expected), xyz[1] / expected[1]
+    print(f"spectral mode: Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
+    assert delta_e < 1.0
+    assert ratio == pytest.approx(1.0, abs=0.02)
 
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in group.links) == group_links
