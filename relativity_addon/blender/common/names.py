@@ -38,8 +38,9 @@ MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world mat
 # --- Doppler colour: materials --------------------------------------------------------------
 MATERIAL_ATTACHED_KEY = "relativity_doppler_nodes"  # on materials and worlds: inserted nodes
 MATERIAL_NODE_PREFIX = "Relativity Doppler"
-# Object attribute (an RNA path) read inside shared node groups: the object's blackbody temperature
-OBJECT_TEMPERATURE_PATH = "relativity.temperature"
+# custom property on objects with a blackbody temperature while Doppler colour is applied, read by
+# an Object Attribute node inside shared node groups (a plain property: the file renders alone)
+OBJECT_TEMPERATURE_PROPERTY = "relativity_blackbody_temperature"
 SETTINGS_GROUP = "Relativity Settings"
 DOPPLER_FACTOR_GROUP = "Relativity Doppler Factor"
 GAMUT_MAP_GROUP = "Relativity Gamut Map"

@@ -19,8 +19,11 @@ shifted on the mesh path). A node group is shared by every material and group th
 An object's blackbody temperature (``Object.relativity.temperature``) reaches the colours of its
 materials' own nodes and their pass-throughs as a constant (``materials.attach``); an emission
 colour inside a shared group reads it per object instead (:func:`read_object_temperature`: an
-Object Attribute node on the RNA path ``relativity.temperature``, 0 where the object has none), so
-every object using the group gets its own.
+Object Attribute node on the custom property ``names.OBJECT_TEMPERATURE_PROPERTY``, which the colour
+stage writes on the objects while it is applied, ``doppler_colour``; 0 where the object has none),
+so every object using the group gets its own. A plain custom property, not the RNA path
+``relativity.temperature``: the Attribute node reads that only where the add-on is registered, and
+a file must render the same without it (measured: the RNA path gave the RGB path there, Delta E 26.8).
 """
 
 from __future__ import annotations
@@ -128,7 +131,7 @@ def read_object_temperature(tree: NodeTree, colour_node: Node) -> list[dict[str,
         return []
     attribute = tree.nodes.new("ShaderNodeAttribute")
     attribute.attribute_type = "OBJECT"
-    attribute.attribute_name = names.OBJECT_TEMPERATURE_PATH
+    attribute.attribute_name = names.OBJECT_TEMPERATURE_PROPERTY
     is_blackbody = tree.nodes.new("ShaderNodeMath")
     is_blackbody.operation = "GREATER_THAN"
     is_blackbody.inputs[1].default_value = 0.0

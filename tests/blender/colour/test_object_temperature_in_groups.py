@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import colour_helpers as dh
+from colour_helpers import ch
 
 TEMPERATURE = 3000.0
 RESOLUTION = (64, 48)
@@ -59,6 +60,8 @@ def _xyz(image, window):
 
 def test_object_temperature_reaches_an_emission_inside_a_shared_group(relativity_addon, tmp_path):
     bpy = __import__("bpy")
+    from relativity_addon.blender.common import names
+
     scene, camera, group = _scene(bpy)
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
     y_rest = _xyz(rest, MARKED)[:, 1]
@@ -91,6 +94,11 @@ def test_object_temperature_reaches_an_emission_inside_a_shared_group(relativity
     assert delta_e < 1.0
     assert ratio == pytest.approx(1.0, abs=0.02)
     assert plain > 5.0  # the object without a temperature keeps the RGB path through the same group
+    # the file renders the same where the add-on is not installed (a render farm worker)
+    elsewhere = dh.render_without_addon(bpy, ch.save_blend(bpy, tmp_path / "grouped.blend"), tmp_path / "plain.exr")
+    away = dh.delta_e_2000_normalised(_xyz(elsewhere, MARKED).mean(axis=0), xyz)
+    print(f"without the add-on: Delta E {away:.4f} from the render with it")
+    assert away < 0.01
 
     # the spectral passes: the same colour group gives the marked wall its Planck spectrum
     pixels, _info = dh.addon_module(relativity_addon, "pipeline.spectral_render").render(scene, 3)
@@ -102,5 +110,6 @@ def test_object_temperature_reaches_an_emission_inside_a_shared_group(relativity
     assert ratio == pytest.approx(1.0, abs=0.02)
 
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert not any(names.OBJECT_TEMPERATURE_PROPERTY in obj for obj in scene.objects)
     assert sorted((link.from_node.name, link.to_node.name) for link in group.links) == group_links
     assert len(group.nodes) == group_nodes
