@@ -13,6 +13,7 @@ emitter, the volume does the exact shift itself and marks its pixels done:
   to 2e-4), where ``X`` is what the materials' Doppler colour group makes of a blackbody colour
   ``E``: the blackbody at ``D T`` with ``E``'s luminance times ``Y(D T) / Y(T)``, divided by the
   camera's ``D^4``. ``X - E`` may be negative per channel; Cycles adds volume emission as it is.
+  (With a temperature grid ``X`` follows the bolometric rule and replaces ``E``: see below.)
   Other rays (the volume lighting the scene) carry ``E``, the scene-frame light;
 - **boundary**: a Transparent BSDF on the volume's surface (the material had none) writes the
   ``relativity_colour_done`` AOV where a camera ray enters the volume (front faces), so the
