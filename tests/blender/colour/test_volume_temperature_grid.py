@@ -74,8 +74,12 @@ def _xyz(image, window):
     return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3))
 
 
-def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path):
+@pytest.mark.parametrize("searchlight", [True, False], ids=["searchlight", "rest_brightness"])
+def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path, searchlight):
+    """With the searchlight off (Doppler only, Rest Brightness) the power is 0: ``D^0``, the rest
+    luminance with the colour of ``D T``."""
     bpy = __import__("bpy")
+    power = 4 if searchlight else 0
     scene, camera, material = grid_scene(bpy, tmp_path)
     rest = dh.render(bpy, scene, tmp_path / "rest.exr")
     y_rest = {}
@@ -93,6 +97,7 @@ def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp
     scene.relativity.method = "CAMERA"
     scene.relativity.beta = BETA
     scene.relativity.speed_of_light = 1.0
+    scene.relativity.use_searchlight = searchlight
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     moving = dh.render(bpy, scene, tmp_path / "moving.exr")
     assert np.all(np.isfinite(moving))
@@ -108,8 +113,10 @@ def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp
         d = doppler[window].ravel()
         expected_colour = np.mean([dh.blackbody_xyz_colour_science(f * temperature) for f in d], axis=0)
         delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
-        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**4)
-        print(f"{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^4 Y_rest path {ratio:.4f}")
+        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**power)
+        print(
+            f"{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^{power} Y_rest {ratio:.4f}"
+        )
         if not (delta_e < 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
             failures.append(name)
     assert not failures
