@@ -38,6 +38,9 @@ MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world mat
 # --- Doppler colour: materials --------------------------------------------------------------
 MATERIAL_ATTACHED_KEY = "relativity_doppler_nodes"  # on materials and worlds: inserted nodes
 MATERIAL_NODE_PREFIX = "Relativity Doppler"
+# custom property on objects with a blackbody temperature while Doppler colour is applied, read by
+# an Object Attribute node inside shared node groups (a plain property: the file renders alone)
+OBJECT_TEMPERATURE_PROPERTY = "relativity_blackbody_temperature"
 SETTINGS_GROUP = "Relativity Settings"
 DOPPLER_FACTOR_GROUP = "Relativity Doppler Factor"
 GAMUT_MAP_GROUP = "Relativity Gamut Map"
@@ -46,8 +49,8 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 6  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
-# 5: volumes in spectral passes; 6: the coverage AOV
+SHADER_GROUPS_VERSION = 7  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+# 5: volumes in spectral passes; 6: the coverage AOV; 7: temperature grids in the volume group
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
