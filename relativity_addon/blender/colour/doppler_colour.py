@@ -66,6 +66,8 @@ def _write_object_temperatures(scene):
     shared node groups read (``grouped_colours.read_object_temperature``); written only where it
     changed (a write is a depsgraph update)."""
     for obj in scene.objects:
+        if obj.library is not None:
+            continue  # linked from another file: not editable here (its groups keep the RGB path)
         temperature = float(obj.relativity.temperature)
         if temperature > 0.0 and obj.get(names.OBJECT_TEMPERATURE_PROPERTY) != temperature:
             obj[names.OBJECT_TEMPERATURE_PROPERTY] = temperature
@@ -87,7 +89,7 @@ def remove(scene: Scene) -> None:
     compositing.remove_colour_stage(scene)
     materials.detach_all()
     for obj in scene.objects:
-        if names.OBJECT_TEMPERATURE_PROPERTY in obj:
+        if obj.library is None and names.OBJECT_TEMPERATURE_PROPERTY in obj:
             del obj[names.OBJECT_TEMPERATURE_PROPERTY]
     for world in bpy.data.worlds:
         world_sampling.release(world)
