@@ -369,9 +369,4 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     ]
     if snap.stereo:
         found.append("Objects moving with the camera are not laid over a stereo render yet (one eye's view)")
-    if snap.velocity_source == "CAMERA_ANIMATION" and compat.has_compositor_node_groups():
-        found.append(
-            "Objects moving with the camera, velocity from the camera's keyframes: Render Animation crashed "
-            "Blender 5.2; render the frames one by one (F12 at each frame, or the batch script) (docs/cockpit.md)"
-        )
     return found

@@ -32,7 +32,7 @@ from ...physics import spectral_render
 from ...physics.lorentz import aberrate, camera_to_scene_direction
 from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
 from ..colour import materials
-from ..common import names
+from ..common import busy, names
 from ..scene import animation, lens, sources
 
 if TYPE_CHECKING:
@@ -306,7 +306,10 @@ def write(
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
-        times = None if depsgraph is not None else _stored_times(scene, light.name)
+        # placed anew only outside a render: between Render Animation's frames (frame_change_post)
+        # new stand-ins crashed Blender 5.2's render of the next frame (docs/cockpit.md)
+        placing = depsgraph is not None and not busy.rendering()
+        times = None if placing else _stored_times(scene, light.name)
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
