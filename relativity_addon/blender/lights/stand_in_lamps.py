@@ -306,14 +306,18 @@ def write(
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
-        # placed anew only outside a render: between Render Animation's frames (frame_change_post)
-        # new stand-ins crashed Blender 5.2's render of the next frame (docs/cockpit.md)
-        placing = depsgraph is not None and not busy.rendering()
-        times = None if placing else _stored_times(scene, light.name)
+        stored = _stored_times(scene, light.name)
+        times = None if depsgraph is not None else stored
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+            if busy.rendering() and stored is not None and len(stored) != len(times):
+                # as many as there are: stand-ins made and deleted between Render Animation's
+                # frames (frame_change_post) crashed Blender 5.2's render of the next frame
+                ends = np.linspace(0.0, 1.0, len(times))
+                times = np.interp(np.linspace(0.0, 1.0, len(stored)), ends, times)
+                positions = _positions(scene, snap, light, values, reception_time, times)
         else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
             positions = _positions(scene, snap, light, values, reception_time, times)
         last = len(times) - 1
