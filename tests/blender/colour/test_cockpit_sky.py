@@ -165,3 +165,77 @@ def test_sky_lights_the_cockpit_beamed(relativity_addon, factory_blender, tmp_pa
     assert not [w for w in bpy.data.worlds if w.name.startswith("Relativity")]
     assert not [g for g in bpy.data.node_groups if g.name.startswith("Relativity Cockpit Sky")]
     assert len(plates) == 3
+
+
+MIRROR_DEG = 60.0  # the mirror sends the camera's central ray 60 degrees from the motion (-Z) to +X
+
+
+def _gradient_sky(bpy, scene):
+    """A sky brighter toward +X: a linear gradient of the direction's x (Texture Coordinate's
+    Generated, which the cockpit's sky must read in the scene-frame direction), tinted."""
+    tree = scene.world.node_tree
+    coordinates = tree.nodes.new("ShaderNodeTexCoord")
+    gradient = tree.nodes.new("ShaderNodeTexGradient")
+    tint = tree.nodes.new("ShaderNodeMix")
+    tint.data_type = "RGBA"
+    tint.blend_type = "MULTIPLY"
+    tint.inputs["Factor"].default_value = 1.0
+    tint.inputs[7].default_value = (1.0, 0.8, 0.5, 1.0)
+    tree.links.new(coordinates.outputs["Generated"], gradient.inputs["Vector"])
+    tree.links.new(gradient.outputs["Color"], tint.inputs[6])
+    tree.links.new(tint.outputs[2], tree.nodes["Background"].inputs["Color"])
+    tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+
+
+def test_mirror_in_the_cockpit_shows_the_sky_the_camera_sees(relativity_addon, factory_blender, tmp_path):
+    """A mirror moving with the camera at 0.9c (Doppler colour and searchlight on) sends the central
+    ray 60 degrees from the motion; what it shows there is the sky the moving camera photographs when
+    it looks that way (the exact camera turned 60 degrees, same velocity): the same aberrated
+    direction of a sky that varies (without aberration it would read the gradient at x = 0.87
+    instead of 0.69), the same Doppler colour and searchlight."""
+    bpy = factory_blender
+    scene, camera = ch.new_scene(bpy, resolution=(32, 32), samples=16)
+    camera.data.lens = 100.0
+    _gradient_sky(bpy, scene)
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = (0.0, 0.0, -SPEED)
+    scene.relativity.use_doppler = True
+    scene.relativity.use_searchlight = True
+    angle = math.radians(MIRROR_DEG)
+    reflected = np.array([math.sin(angle), 0.0, -math.cos(angle)])
+    camera.rotation_euler = (0.0, -angle, 0.0)  # looks along the reflected ray
+    bpy.context.view_layer.update()
+    assert np.allclose(-np.array(camera.matrix_world.col[2][:3]), reflected, atol=1e-6)
+    _effect().apply(scene)
+    turned = ch.render_exr(bpy, scene, tmp_path / "turned.exr")
+    _effect().remove(scene)
+    camera.rotation_euler = (0.0, 0.0, 0.0)
+    normal = reflected - np.array([0.0, 0.0, -1.0])
+    normal /= np.linalg.norm(normal)
+    mirror_material = bpy.data.materials.new("Mirror")
+    tree = ch.compat.material_node_tree(mirror_material)
+    tree.nodes.clear()
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    glossy.inputs["Roughness"].default_value = 0.0
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(glossy.outputs[0], output.inputs["Surface"])
+    mesh = bpy.data.meshes.new("Mirror")
+    mesh.from_pydata([(-0.4, -0.4, 0.0), (0.4, -0.4, 0.0), (0.4, 0.4, 0.0), (-0.4, 0.4, 0.0)], [], [(0, 1, 2, 3)])
+    mesh.materials.append(mirror_material)
+    mirror = bpy.data.objects.new("Mirror", mesh)
+    scene.collection.objects.link(mirror)
+    mirror.parent = camera
+    mirror.location = (0.0, 0.0, -1.0)
+    mirror.rotation_euler = (0.0, math.atan2(normal[0], normal[2]), 0.0)
+    mirror.relativity["moves_with_camera"] = True
+    bpy.context.view_layer.update()
+    _effect().apply(scene)
+    reflection = ch.render_exr(bpy, scene, tmp_path / "mirror.exr")
+    centre = (slice(12, 20), slice(12, 20))
+    seen, shown = turned[centre].reshape(-1, 3).mean(axis=0), reflection[centre].reshape(-1, 3).mean(axis=0)
+    print(
+        f"sky seen looking {MIRROR_DEG:g} deg from the motion {np.round(seen, 4)}; in the mirror {np.round(shown, 4)}"
+    )
+    assert seen.max() > 0.05
+    assert np.allclose(shown, seen, rtol=0.03)
