@@ -137,3 +137,6 @@ COCKPIT_SKY_PREFIX = "Relativity Cockpit Sky"  # the world "<prefix> <scene>", i
 COCKPIT_SKY_GROUP = "Relativity Cockpit Sky"  # shader group: camera-frame direction -> scene direction, ln D
 COCKPIT_SKY_COLOUR_GROUP = "Relativity Cockpit Sky Colour"  # shader group: a colour as the moving camera sees it
 COCKPIT_SKY_GROUPS_VERSION = 1
+# The scene's lamps on the cockpit (lights/cockpit_lamps.py): their copies in the cockpit scene
+COCKPIT_LAMPS_KEY = "relativity_cockpit_lamps"  # on the scene: {lamp name: its copy's name}
+COCKPIT_LAMP_PREFIX = "Relativity Cockpit Lamp"  # the copies (objects and lights): "<prefix> <lamp>"

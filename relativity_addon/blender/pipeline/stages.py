@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..camera import clamping, cockpit
 from ..colour import cockpit_sky, doppler_colour, light_groups, volumes, world_doppler
-from ..lights import lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..lights import cockpit_lamps, lamps_on_moving_objects, lamps_seen_directly, moving_lights
 from . import metadata
 
 if TYPE_CHECKING:
@@ -142,5 +142,12 @@ STAGES: tuple[Stage, ...] = (
         apply=cockpit_sky.apply,
         write=lambda scene, snap, sync: cockpit_sky.write(scene, snap, structural=sync.depsgraph is None),
         remove=cockpit_sky.remove,
+    ),
+    Stage(
+        "the scene's lamps on the cockpit",
+        cockpit_lamps,
+        apply=cockpit_lamps.apply,
+        write=lambda scene, snap, sync: cockpit_lamps.write(scene, snap, structural=sync.depsgraph is None),
+        remove=cockpit_lamps.remove,
     ),
 )
