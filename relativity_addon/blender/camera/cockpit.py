@@ -18,9 +18,10 @@ visibility for "camera rays not yet transformed", so the two parts are rendered 
   transparent parts unchanged.
 
 What is approximated (docs/cockpit.md): the cockpit is lit by the lights moving with the camera,
-its own emission and the sky as the moving camera sees it (``colour/cockpit_sky.py`` gives this
-scene its world); the scene's lamps and bounced light do not reach it, it casts no shadow on the
-scene and the two do not see each other in reflections. Remove deletes the scene,
+its own emission, the sky as the moving camera sees it (``colour/cockpit_sky.py`` gives this scene
+its world) and the scene's lamps at rest (``lights/cockpit_lamps.py``, one ``D`` per lamp); moving
+lamps and the light bounced off the scene do not reach it, it casts no shadow on the scene and the
+two do not see each other in reflections. Remove deletes the scene,
 the copies and the nodes and gives back the user's ``hide_render`` and compositor exactly.
 """
 
@@ -372,8 +373,8 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if not snap.cockpit:
         return []
     found = [
-        f"Objects moving with the camera ({len(snap.cockpit)}): lit by the lights moving with the camera and the "
-        "sky; the scene's lamps, its bounced light, shadows and reflections between them are left out (docs/cockpit.md)"
+        f"Objects moving with the camera ({len(snap.cockpit)}): lit by the sky and the lamps at rest (one D per "
+        "lamp); moving lamps, light and shadows from the scene's objects and reflections are left out (docs/cockpit.md)"
     ]
     if snap.stereo and scene.render.views_format != "STEREO_3D":
         found.append("Objects moving with the camera: a Multi-View render's own views are not rendered at rest")
