@@ -277,9 +277,11 @@ FIGURES = [
         "beamed. It is lit by its lamp and by the sky as the moving camera receives it (aberrated, "
         "`D^4`-beamed, Doppler-shifted; `colour/cockpit_sky.py`): the frame faces backward, where the sky "
         "is dim. Through the window the street is the relativistic photograph (aberration, Doppler colour, "
-        "searchlight), the lamp lighting it as a moving light. The street's sun lights the cockpit too, "
-        "from behind (its aberrated direction, eq. 18's D^2; `lights/cockpit_lamps.py`); the glowing "
-        "street lamps are meshes, whose light does not reach the cockpit (left out, docs/cockpit.md).",
+        "searchlight), the lamp lighting it as a moving light. The street's sun, behind and above the "
+        "camera in the street, shines on the cockpit from ahead in its frame (aberration: its light, 40 "
+        "degrees from straight behind, arrives 116 degrees from it; eq. 18, `lights/cockpit_lamps.py`), so "
+        "it lights the frame's far side, out of view. The glowing street lamps are meshes, whose light "
+        "does not reach the cockpit (left out, docs/cockpit.md).",
         STREET.replace("0.8c", "0.9c").replace(
             "Doppler colour off (the paper's grey-scale street: total radiance, eq. 15)",
             "Doppler colour and searchlight on",
