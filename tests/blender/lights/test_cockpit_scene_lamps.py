@@ -78,3 +78,45 @@ def test_scene_lamp_lights_the_cockpit_by_eq_18(relativity_addon, factory_blende
     _effect().remove(scene)
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity")]
     assert not [light for light in bpy.data.lights if light.name.startswith("Relativity")]
+
+
+def test_remove_gives_the_file_back_with_sky_and_lamps(relativity_addon, factory_blender, tmp_path):
+    """A cockpit under a textured sky with a point lamp and a sun at rest, Doppler colour on: Set Up
+    (the sky's copy, the lamps' copies, the colour stage in the world), a sync, Remove: the file as
+    it was (``scene_dump``)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "pipeline"))
+    import scene_dump
+
+    bpy = factory_blender
+    scene, camera = ch.new_scene(bpy, resolution=(32, 24), samples=4)
+    tree = scene.world.node_tree
+    gradient = tree.nodes.new("ShaderNodeTexGradient")
+    tree.links.new(gradient.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    mesh = bpy.data.meshes.new("Plate")
+    mesh.from_pydata([(-0.1, -0.1, 0.0), (0.1, -0.1, 0.0), (0.1, 0.1, 0.0), (-0.1, 0.1, 0.0)], [], [(0, 1, 2, 3)])
+    plate = bpy.data.objects.new("Plate", mesh)
+    scene.collection.objects.link(plate)
+    plate.parent = camera
+    plate.location = tuple(PLATE)
+    plate.relativity.moves_with_camera = True
+    for kind, location in (("POINT", LAMP), ("SUN", (0.0, 5.0, 5.0))):
+        lamp = bpy.data.objects.new(kind.title(), bpy.data.lights.new(kind.title(), kind))
+        lamp.location = tuple(location)
+        scene.collection.objects.link(lamp)
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = tuple(BETA)
+    scene.relativity.use_doppler = True
+    bpy.context.view_layer.update()
+    before = scene_dump.dump(bpy)
+    _effect().apply(scene)
+    _effect().sync(scene)
+    rest_scene = bpy.data.scenes[f"Relativity Cockpit {scene.name}"]
+    assert rest_scene.world is not None and rest_scene.world != scene.world
+    assert sorted(obj.data.type for obj in rest_scene.objects if obj.type == "LIGHT") == ["POINT", "SUN"]
+    _effect().remove(scene)
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, "\n".join(lines[:20])
