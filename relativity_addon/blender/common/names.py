@@ -134,3 +134,12 @@ COCKPIT_PREFIX = "Relativity Cockpit"  # the cockpit scene "<prefix> <scene>", i
 COCKPIT_KEY = "relativity_cockpit"  # on the scene: what the stage added and changed
 COCKPIT_HIDDEN_KEY = "relativity_cockpit_hidden"  # on an object moving with the camera: the user's hide_render
 COCKPIT_COPY_KEY = "relativity_cockpit_copy"  # on a copy in the cockpit scene: the original object's name
+# The cockpit's sky (colour/cockpit_sky.py): a copy of the scene's world as the moving camera sees it
+COCKPIT_SKY_KEY = "relativity_cockpit_sky"  # on the scene: the sky world's name and the world it copies
+COCKPIT_SKY_PREFIX = "Relativity Cockpit Sky"  # the world "<prefix> <scene>", its nodes
+COCKPIT_SKY_GROUP = "Relativity Cockpit Sky"  # shader group: camera-frame direction -> scene direction, ln D
+COCKPIT_SKY_COLOUR_GROUP = "Relativity Cockpit Sky Colour"  # shader group: a colour as the moving camera sees it
+COCKPIT_SKY_GROUPS_VERSION = 1
+# The scene's lamps on the cockpit (lights/cockpit_lamps.py): their copies in the cockpit scene
+COCKPIT_LAMPS_KEY = "relativity_cockpit_lamps"  # on the scene: {lamp name: its copy's name}
+COCKPIT_LAMP_PREFIX = "Relativity Cockpit Lamp"  # the copies (objects and lights): "<prefix> <lamp>"

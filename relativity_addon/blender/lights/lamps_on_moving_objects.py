@@ -361,7 +361,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
         if stand_ins is None:
             copy = copies[(lamp.name, mover.name, "0")]
             doppler_factor, turned = placement(matrix, lamp.data.type, mover)
-            _write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
+            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
             continue
         offsets, dopplers = stand_ins
         _write_stand_ins(
@@ -376,7 +376,10 @@ def write(scene: Scene, snap: Snapshot) -> int:
     return len(layout)
 
 
-def _write_copy(copy, lamp, colour, matrix, power_factor=None):
+def write_copy(
+    copy: Object, lamp: Object, colour: tuple[float, ...], matrix: FloatArray, power_factor: float | None = None
+) -> None:
+    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its energy)."""
     _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
     if power_factor is not None:
         _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
@@ -407,7 +410,7 @@ def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
         moved[:3, 3] += offsets[index] * beta / speed
         # without the tree (EEVEE) the copies share the lamp's light at the centre: (t / r)^2 / n each
         share = (max(float(np.linalg.norm(centre - moved[:3, 3])), 1e-9) / lamp_distance) ** 2 / len(copies)
-        _write_copy(copy, lamp, base, moved, share)
+        write_copy(copy, lamp, base, moved, share)
         values = {
             "Offset": float(offsets[index]),
             "Previous": float(offsets[index - 1]) if index > 0 else float(offsets[index]) - far,
