@@ -1,0 +1,164 @@
+"""Bake for Render Anywhere on Apparent Geometry (issue 28, part 2): a baked file renders the add-on's
+frames without it.
+
+A 2 m box keyframed to cross the view at 0.8c (slow light: c = 10 m/s, so its retarded times are some
+six frames back), lit by a lamp at rest, seen by a camera at rest (the final render is the
+scene-frame meshes) or by a camera flying towards it at 0.6-0.9c (the final render is the exact
+camera behind the meshes at their scene-frame retarded positions). The add-on renders frames 1-3
+itself; then the file is baked, saved and rendered as an animation in a fresh process where the
+add-on is neither enabled nor installed and the file's scripts are disabled. Each frame must equal
+the add-on's own render (same seed) to well below the render noise, measured as the difference
+the seed alone makes; the same file not baked, rendered the same way, must not (the control).
+"""
+
+import importlib
+
+import numpy as np
+import pytest
+import scene_dump
+
+from blender_support import ADDON_MODULE
+from pipeline_helpers import ch, render_plain_animation
+
+FRAMES = (1, 2, 3)
+FPS = 8.0  # one metre per frame at 0.8c: the box crosses a good part of the view in two frames
+C = 10.0  # m/s
+BOX_BETA = 0.8
+
+
+def _effect():
+    return importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+
+
+def _mesh(bpy, scene, name, vertices, faces, material):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(vertices, [], faces)
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def _cube(bpy, scene, name, half, material):
+    vertices = [(x * half, y * half, z * half) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return _mesh(bpy, scene, name, vertices, faces, material)
+
+
+def _linear_keys(obj, path, keys):
+    for frame, value in keys:
+        setattr(obj, path, value)
+        obj.keyframe_insert(path, frame=frame)
+    for fcurve in ch.compat.action_fcurves(obj.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+
+
+def build_moving_box(bpy, fly):
+    """Camera at 1.6 m looking along +Y (at rest, or speeds 0.6c, 0.75c, 0.9c over the frame steps),
+    floor, wall 14 m ahead, a 2 m box 8 m ahead keyframed along +X at 0.8c from frame -30 to 20
+    (linear), a point lamp at rest, a grey world."""
+    scene, camera = ch.new_scene(bpy, resolution=(64, 48), samples=32, location=(0.0, 0.0, 1.6))
+    camera.rotation_euler = (1.5707963, 0.0, 0.0)
+    camera.data.lens = 20.0
+    scene.render.fps, scene.render.fps_base = int(FPS), 1.0
+    scene.cycles.seed = 7
+    scene.cycles.use_animated_seed = False
+    world_tree = ch.compat.world_node_tree(scene.world)
+    background = next(node for node in world_tree.nodes if node.type == "BACKGROUND")
+    background.inputs["Color"].default_value = (0.2, 0.25, 0.3, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    grey = ch.diffuse_material(bpy, "Floor", (0.5, 0.5, 0.5))
+    _mesh(bpy, scene, "Floor", [(-20, -5, 0), (20, -5, 0), (20, 40, 0), (-20, 40, 0)], [(0, 1, 2, 3)], grey)
+    _mesh(bpy, scene, "Wall", [(-20, 14, 0), (20, 14, 0), (20, 14, 3), (-20, 14, 3)], [(0, 1, 2, 3)], grey)
+    box = _cube(bpy, scene, "Box", 1.0, ch.diffuse_material(bpy, "Red", (0.8, 0.1, 0.1)))
+    step = BOX_BETA * C / FPS  # metres per frame
+    # x = (frame + 6) step: seen near the middle of the view at frames 1-3, about 6.5 frames later
+    _linear_keys(box, "location", [(-30, (-24 * step, 8.0, 1.0)), (20, (26 * step, 8.0, 1.0))])
+    box.relativity.enabled = True
+    box.relativity.motion = "ANIMATION"
+    light = bpy.data.lights.new("Lamp", "POINT")
+    light.energy = 800.0
+    lamp = bpy.data.objects.new("Lamp", light)
+    lamp.location = (-1.0, 6.0, 2.5)
+    scene.collection.objects.link(lamp)
+    settings = scene.relativity
+    settings.speed_of_light = C
+    settings.method = "GEOMETRY"
+    if fly:
+        y, path = 0.0, [(1, (0.0, 0.0, 1.6))]
+        for frame, speed in ((2, 0.6), (3, 0.75), (4, 0.9)):
+            y += speed * C / FPS
+            path.append((frame, (0.0, y, 1.6)))
+        _linear_keys(camera, "location", path)
+        settings.velocity_source = "CAMERA_ANIMATION"
+    scene.frame_start, scene.frame_end = FRAMES[0], FRAMES[-1]
+    scene.frame_set(FRAMES[0])
+    return scene
+
+
+@pytest.mark.parametrize("fly", [False, True], ids=["box-at-0.8c", "flythrough-with-box"])
+def test_baked_apparent_geometry_renders_the_same_frames_without_the_add_on(
+    relativity_addon, factory_blender, tmp_path, fly
+):
+    bpy = factory_blender
+    scene = build_moving_box(bpy, fly)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    own = []
+    for frame in FRAMES:
+        scene.frame_set(frame)
+        own.append(ch.render_exr(bpy, scene, tmp_path / f"own_{frame}.exr"))
+    scene.cycles.seed = 8  # the render noise: the same frame with another seed
+    noise = float(np.abs(ch.render_exr(bpy, scene, tmp_path / "own_seed8.exr") - own[-1]).mean())
+    scene.cycles.seed = 7
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "unbaked.blend"), check_existing=False, copy=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
+    assert bpy.ops.relativity.bake_render_anywhere(frame_start=FRAMES[0], frame_end=FRAMES[-1]) == {"FINISHED"}
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
+    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
+    differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
+    unbaked = render_plain_animation(tmp_path / "unbaked.blend", tmp_path, FRAMES, "unbaked")
+    stale = [float(np.abs(ch.read_exr(bpy, u) - o).mean()) for u, o in zip(unbaked, own, strict=True)]
+    moving = float(np.abs(own[-1] - own[0]).mean())
+    print(
+        f"fly={fly}: mean |baked - add-on| per frame {differences}, not baked {stale}, seed noise {noise:.4g}, "
+        f"frame 3 - frame 1 {moving:.4g}"
+    )
+    assert moving > 2.0 * noise, "the frames differ (the box moves)"
+    assert stale[0] > noise, "without the bake the first frame is wrong (the control)"
+    assert max(differences) < 0.1 * noise, f"baked frames differ from the add-on's: {differences} (noise {noise:.4g})"
+
+
+@pytest.mark.parametrize("fly", [False, True], ids=["box-at-0.8c", "flythrough-with-box"])
+def test_remove_takes_the_geometry_bake_out(relativity_addon, factory_blender, tmp_path, fly):
+    """Set Up, bake, Remove: the file is the one before Set Up (no played-back mesh, collection,
+    modifier, node group or exact camera of the bake left)."""
+    bpy = factory_blender
+    scene = build_moving_box(bpy, fly)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "box.blend"), check_existing=False)
+    before = scene_dump.dump(bpy)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert bpy.ops.relativity.bake_render_anywhere() == {"FINISHED"}
+    box = scene.objects["Box"]
+    assert any(m.type == "NODES" and m.node_group.name == "Relativity Baked Geometry" for m in box.modifiers)
+    assert (scene.camera.data.type == "CUSTOM") == fly  # the exact camera of the final render, kept
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
+
+
+def test_moving_lights_without_osl_are_refused(relativity_addon, factory_blender, monkeypatch):
+    """A moving light on Apparent Geometry is an OSL script node in the materials: in a Blender
+    without OSL the bake is refused in one line naming that, and nothing is added."""
+    bpy = factory_blender
+    scene = build_moving_box(bpy, fly=False)
+    lamp = scene.objects["Lamp"]
+    lamp.relativity.enabled = True
+    lamp.relativity.motion = "CONSTANT"
+    lamp.relativity.beta = (0.3, 0.0, 0.0)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    osl = importlib.import_module(f"{ADDON_MODULE}.blender.common.osl")
+    monkeypatch.setattr(osl, "unavailable_reason", lambda: "This Blender build has no OSL (Open Shading Language)")
+    with pytest.raises(_effect().RelativityError, match="moving lights are OSL script nodes"):
+        _effect().bake_for_render_anywhere(scene, 1, 3)
+    assert "relativity_render_anywhere" not in scene.keys()
