@@ -14,6 +14,8 @@ light is refused (not baked yet).
 """
 
 import importlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -184,3 +186,24 @@ def test_moving_lights_without_osl_are_refused(relativity_addon, factory_blender
     with pytest.raises(_effect().RelativityError, match="moving lights are OSL script nodes"):
         _effect().bake_for_render_anywhere(scene, 1, 3)
     assert "relativity_render_anywhere" not in scene.keys()
+
+
+def test_render_script_bakes_apparent_geometry_that_renders_without_the_add_on(
+    relativity_addon, factory_blender, tmp_path
+):
+    """``render.py box.blend --frames 1-3 --bake-to baked.blend`` on the fly-through (a file never set
+    up): plain Blender renders the frames ``render.py --frames 1-3 --out`` renders with the add-on."""
+    bpy = factory_blender
+    build_moving_box(bpy, fly=True)
+    blend = ch.save_blend(bpy, tmp_path / "box.blend")
+    options = ("--frames=1-3", "--seed=7", "--samples=16")
+    command = [sys.executable, str(ch.RENDER_SCRIPT), str(blend), f"--bake-to={tmp_path / 'baked.blend'}", *options]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "baked frames 1-3" in result.stdout and "meshes played back by frame" in result.stdout, result.stdout[-2000:]
+    ch.run_render_script(blend, tmp_path / "own.exr", *options, timeout=600)
+    own = [ch.read_exr(bpy, tmp_path / f"own_{frame:04d}.exr") for frame in FRAMES]
+    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
+    differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
+    print(f"mean |baked - render.py| per frame {differences}")
+    assert max(differences) < 1e-3 * float(np.mean([o.mean() for o in own])), differences
