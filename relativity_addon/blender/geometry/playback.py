@@ -76,18 +76,27 @@ def _frame_name(obj_name: str, index: int) -> str:
     return f"{names.PLAYBACK_PREFIX} {index:06d} {obj_name}"
 
 
-def capture(obj: Object, depsgraph: Depsgraph, index: int) -> Mesh:
+def capture(obj: Object, depsgraph: Depsgraph, index: int, previous: Mesh | None = None) -> Mesh:
     """The evaluated mesh of ``obj`` in ``depsgraph`` as a new mesh datablock (every attribute and
-    material kept), named for frame ``index`` of the bake."""
+    material kept), named for frame ``index`` of the bake; ``previous`` (the last frame's) instead
+    when it is the same in every value and material (a mesh at rest behind the exact camera): the
+    frames then share it."""
     evaluated = obj.evaluated_get(depsgraph)
     mesh = bpy.data.meshes.new_from_object(evaluated, preserve_all_data_layers=True, depsgraph=depsgraph)
+    if (
+        previous is not None
+        and list(mesh.materials) == list(previous.materials)
+        and mesh.unit_test_compare(mesh=previous, threshold=0.0) == "Same"  # Blender's own comparison
+    ):
+        bpy.data.meshes.remove(mesh)
+        return previous
     mesh.name = _frame_name(obj.name, index)
     return mesh
 
 
 def install(obj: Object, meshes: list[Mesh], first_frame: int) -> dict[str, Any]:
-    """Play ``meshes`` (one per frame from ``first_frame``) on ``obj``; returns the record
-    :func:`remove` takes."""
+    """Play ``meshes`` (one per frame from ``first_frame``, a mesh repeated where frames share it)
+    on ``obj``; returns the record :func:`remove` takes."""
     collection = bpy.data.collections.new(f"{names.PLAYBACK_PREFIX} {obj.name}")
     frames = []
     for index, mesh in enumerate(meshes):
@@ -110,7 +119,7 @@ def install(obj: Object, meshes: list[Mesh], first_frame: int) -> dict[str, Any]
         "modifier": playback.name,
         "collection": collection.name,
         "frames": frames,
-        "meshes": [mesh.name for mesh in meshes],
+        "meshes": list(dict.fromkeys(mesh.name for mesh in meshes)),
         "shown": shown,
     }
 

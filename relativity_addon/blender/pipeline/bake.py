@@ -320,7 +320,7 @@ def _step(scene, frames, sync_for_render, meshes):
             with busy.computing():
                 depsgraph = bpy.context.evaluated_depsgraph_get()
                 for obj, captured in meshes.items():
-                    captured.append(playback.capture(obj, depsgraph, index))
+                    captured.append(playback.capture(obj, depsgraph, index, captured[-1] if captured else None))
     return states, images
 
 
@@ -349,7 +349,7 @@ def bake(
     try:
         states, images = _step(scene, frames, sync_for_render, meshes)
     except RelativityError:
-        playback.discard_meshes([mesh.name for captured in meshes.values() for mesh in captured])
+        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
         scene.frame_set(start)
         raise
     keys = set(states[0])
@@ -371,7 +371,7 @@ def bake(
         except RelativityError as error:
             problem = str(error)
     if problem is not None:  # refused before anything is added
-        playback.discard_meshes([mesh.name for captured in meshes.values() for mesh in captured])
+        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
         scene.frame_set(start)
         raise RelativityError(problem)
     record: dict[str, Any] = {
@@ -412,7 +412,7 @@ def bake(
         "frames": len(frames),
         "fcurves": len(record["fcurves"]),
         "sequences": len(record["sequences"]),
-        "meshes": sum(map(len, meshes.values())),
+        "meshes": sum(len(set(captured)) for captured in meshes.values()),
         # what it renders with: the exact camera (OSL), OSL script nodes of moving lights
         "needs_osl": int(exact_final_render or not geometry or bool(scene.cycles.shading_system)),
     }
