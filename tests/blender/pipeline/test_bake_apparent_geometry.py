@@ -155,6 +155,10 @@ def test_baked_apparent_geometry_renders_the_same_frames_without_the_add_on(
     scene.frame_set(FRAMES[1])
     reopened = float(np.abs(ch.render_exr(bpy, scene, tmp_path / "reopened.exr") - own[1]).mean())
     assert reopened < 0.1 * noise, f"the baked file rendered with the add-on differs: {reopened} (noise {noise:.4g})"
+    scene.frame_set(FRAMES[0])
+    assert (scene.camera.data.type == "CUSTOM") == fly, (
+        "the bake's exact camera stays after a render and a frame change"
+    )
     assert max(differences) < 0.1 * noise, f"baked frames differ from the add-on's: {differences} (noise {noise:.4g})"
 
 
