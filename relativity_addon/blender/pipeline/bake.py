@@ -23,6 +23,7 @@ the played-back meshes and the final render's exact camera.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -422,7 +423,13 @@ def holds_geometry(scene: Scene) -> bool:
     """Whether the scene's bake plays Apparent Geometry back (the add-on then leaves the file as
     baked: the handlers write nothing until Remove or the next bake)."""
     stored = scene.get(names.BAKE_RECORD_KEY)
-    return isinstance(stored, str) and bool(json.loads(stored).get("geometry"))
+    return isinstance(stored, str) and _plays_geometry(stored)
+
+
+@functools.lru_cache(maxsize=16)
+def _plays_geometry(stored: str) -> bool:
+    """Parsed once per record, not at every sync (every handler asks)."""
+    return bool(json.loads(stored).get("geometry"))
 
 
 def baked_frames(scene: Scene) -> tuple[int, int] | None:
