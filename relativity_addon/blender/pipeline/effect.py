@@ -183,12 +183,16 @@ def _bake_geometry(scene, first, last, exact):
     """Apparent Geometry baked as its final render makes it: with ``exact``, behind the exact camera
     (:func:`begin_final_render`; the meshes at their scene-frame retarded positions), which stays
     for the bake; else the boosted meshes. Every applied mesh is captured at each frame."""
-    if exact:
-        begin_final_render(scene)
+
+    def frame_sync():
+        if exact:  # as F12 at this frame: the preview decides the tessellation the final render keeps
+            end_final_render(scene)
+            sync(scene)
+            begin_final_render(scene)
+        return sync(scene, before_render=True)
+
     try:
-        counts = bake.bake(
-            scene, first, last, lambda: sync(scene, before_render=True), modifier.applied_objects(scene), exact
-        )
+        counts = bake.bake(scene, first, last, frame_sync, modifier.applied_objects(scene), exact)
     except BaseException:
         if exact:
             end_final_render(scene)
