@@ -59,8 +59,9 @@ def refusal(scene: Scene, method: str, exact_final_render: bool = True, moving_l
     if scene.camera is None:
         return "Cannot bake: the scene has no active camera"
     if method == "GEOMETRY" and exact_final_render and moving_lights:
-        # measured: frame 1 of a fly-through with a lamp at 0.3c differed by the seed noise, and
-        # the moving light's stand-ins on the meshes came and went between frames
+        # measured: the moving light's stand-in lamps are made anew for each final render (the next
+        # frame's get other names, "... Moving Lamp 7.003") and their stand-ins on the meshes come
+        # and go, which keyframes cannot play; baked from one set-up, frame 1 differed by the noise
         return (
             "Cannot bake Apparent Geometry behind the exact camera with moving lights yet: their "
             "stand-in lamps change from frame to frame; set Final Render to Boosted Meshes or bake without them"
