@@ -127,6 +127,12 @@ BAKE_ACTION_PREFIX = "Relativity Bake"  # actions the bake made for datablocks t
 BAKE_IMAGE_SUFFIX = " (baked)"  # the image sequence standing for a per-frame image
 BAKE_SCRATCH_IMAGE = "Relativity Bake Scratch"  # writes the sequence's files, removed at once
 BAKE_FOLDER_SUFFIX = "_relativity_bake"  # the folder beside the .blend holding the sequences
+# Apparent Geometry baked (geometry/playback.py): each frame's evaluated mesh, played back by frame
+PLAYBACK_GROUP = "Relativity Baked Geometry"  # geometry-nodes group: the frame's mesh of a collection
+PLAYBACK_GROUP_VERSION_KEY = "relativity_playback_version"
+PLAYBACK_GROUP_VERSION = 1
+PLAYBACK_MODIFIER = "Relativity Baked Geometry"  # the modifier playing it, after the apparent geometry's
+PLAYBACK_PREFIX = "Relativity Baked"  # "<prefix> <object>": the collection; "<prefix> NNNNNN <object>": a frame
 
 # Objects moving with the camera (camera/cockpit.py): a scene of their copies rendered at rest and
 # laid over the relativistic render in the compositor.
