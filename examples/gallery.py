@@ -66,6 +66,7 @@ FIGURES = {
     "gray_fig11a_stereo_rest": (gs.stereo_portrait, ("REST",), 0.0),
     "gray_fig11b_stereo_moving": (gs.stereo_portrait, ("MOVING",), 0.0),
     "gray_fig11c_stereo_lorentz_window": (gs.stereo_portrait, ("WINDOW",), 0.0),
+    "cockpit_street_flythrough": (gs.street_cockpit, (), -3.0),
 }
 
 

@@ -267,6 +267,27 @@ FIGURES = [
         "t_S): the anaglyph equals the anaglyph at rest (a), pupils' parallax included.",
         "As Fig. 9(c), stereo as (a).",
     ),
+    (
+        "cockpit_street_flythrough",
+        "A fly-through frame from a cockpit (issue 28; Gray et al. appendix A)",
+        "The street of Figs. 4-7 entered at 0.9c from a cockpit that moves with the camera (docs/cockpit.md): "
+        "an opaque frame with an open window and a glowing instrument strip, parented to the camera and "
+        "marked *Moves With Camera*, with a lamp moving with it. The cockpit is photographed as at rest "
+        "(Blender's render of it, laid over the relativistic one): not aberrated, not Doppler-shifted, not "
+        "beamed. It is lit by its lamp and by the sky as the moving camera receives it (aberrated, "
+        "`D^4`-beamed, Doppler-shifted; `colour/cockpit_sky.py`): the frame faces backward, where the sky "
+        "is dim. Through the window the street is the relativistic photograph (aberration, Doppler colour, "
+        "searchlight), the lamp lighting it as a moving light. The street's sun, behind and above the "
+        "camera in the street, shines on the cockpit from ahead in its frame (aberration: its light, 40 "
+        "degrees from straight behind, arrives 116 degrees from it; eq. 18, `lights/cockpit_lamps.py`), so "
+        "it lights the frame's far side, out of view. The glowing street lamps are meshes, whose light "
+        "does not reach the cockpit (left out, docs/cockpit.md).",
+        STREET.replace("0.8c", "0.9c").replace(
+            "Doppler colour off (the paper's grey-scale street: total radiance, eq. 15)",
+            "Doppler colour and searchlight on",
+        )
+        + "; exposure -3 stops.",
+    ),
 ]
 
 PENDING = """## Pending

@@ -156,6 +156,61 @@ def street(scene, effect):
     return {"camera": camera, "beta_local": (0.0, 0.0, -STREET_SPEED if moving else 0.0)}
 
 
+COCKPIT_SPEED = 0.9
+
+
+def _cockpit_frame(scene, camera, material, depth=0.3, outer=(0.6, 0.45), window=(0.24, 0.15)):
+    """A flat frame ``depth`` in front of the camera, wider than the 16 mm view there, with an open
+    window (half-sizes ``outer`` and ``window``, the window raised a little), parented to the camera."""
+    (ox, oy), (ix, iy) = outer, window
+    lift = 0.03
+    verts = [(-ox, -oy, 0), (ox, -oy, 0), (ox, oy, 0), (-ox, oy, 0)]
+    verts += [(-ix, lift - iy, 0), (ix, lift - iy, 0), (ix, lift + iy, 0), (-ix, lift + iy, 0)]
+    mesh = bpy.data.meshes.new("Cockpit frame")
+    mesh.from_pydata(verts, [], [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)])
+    mesh.materials.append(material)
+    frame = bpy.data.objects.new("Cockpit frame", mesh)
+    scene.collection.objects.link(frame)
+    frame.parent = camera
+    frame.location = (0.0, 0.0, -depth)
+    return frame
+
+
+def street_cockpit(scene):
+    """A fly-through frame: the street (Figs. 4-7) entered at 0.9c from a cockpit that moves with
+    the camera (issue 28; docs/cockpit.md): an opaque frame with an open window and a glowing
+    instrument strip, lit by a lamp that moves with the camera and by the sky as the moving camera
+    sees it. The street is seen through the window with aberration, Doppler colour and searchlight;
+    the cockpit as at rest."""
+    context = street(scene, "SEARCHLIGHT")
+    camera = context["camera"]
+    hull = principled_material("Cockpit hull", (0.35, 0.36, 0.4), 0.6)
+    frame = _cockpit_frame(scene, camera, hull)
+    strip = emission("Instrument strip", (0.1, 1.0, 0.35), 3.0)
+    mesh = bpy.data.meshes.new("Instruments")
+    mesh.from_pydata(
+        [(-0.16, -0.15, 0.0), (0.16, -0.15, 0.0), (0.16, -0.13, 0.0), (-0.16, -0.13, 0.0)], [], [(0, 1, 2, 3)]
+    )
+    mesh.materials.append(strip)
+    instruments = bpy.data.objects.new("Instruments", mesh)
+    scene.collection.objects.link(instruments)
+    instruments.parent = camera
+    instruments.location = (0.0, 0.0, -0.299)  # on the frame, just in front of it
+    light = bpy.data.lights.new("Cockpit lamp", "POINT")
+    light.energy = 2.0
+    light.shadow_soft_size = 0.02
+    lamp = bpy.data.objects.new("Cockpit lamp", light)
+    scene.collection.objects.link(lamp)
+    lamp.parent = camera
+    lamp.location = (0.0, 0.2, -0.12)
+    for obj in (frame, instruments, lamp):
+        obj.relativity.moves_with_camera = True
+    rotation = camera.matrix_world.to_quaternion()
+    scene.relativity.beta = tuple(rotation @ Vector((0.0, 0.0, -COCKPIT_SPEED)))
+    scene.relativity.use_doppler = True
+    return {**context, "beta_local": (0.0, 0.0, -COCKPIT_SPEED)}
+
+
 # --- Weiskopf et al. (1999): the Sun (Figs. 8, 9) ------------------------------------------------
 
 SUN_APPARENT_DEG = (-36.0, -18.0, 0.0, 18.0, 36.0)  # where the moving observer sees the five Suns

@@ -3,9 +3,10 @@
 // Flamenco 3 job type: render a file baked for render anywhere (the Relativity panel's "Bake for
 // Render Anywhere", or `render.py FILE --frames A-B --bake-to BAKED.blend`) with plain Blender, one
 // task per chunk of frames. The workers need neither the add-on nor Python scripts: the baked file
-// plays back everything the add-on's handlers would compute per frame (keyframes, and the world's
-// per-frame image sequence in the folder BAKED_relativity_bake/ beside the file, which must travel
-// with it). The exact camera is an OSL shader: the workers' Blender must have OSL (Cycles on the CPU).
+// plays back everything the add-on's handlers would compute per frame (keyframes, Apparent
+// Geometry's meshes per frame inside the file, and the world's per-frame image sequence in the
+// folder BAKED_relativity_bake/ beside the file, which must travel with it). The exact camera is
+// an OSL shader: for it the workers' Blender must have OSL (Cycles on the CPU).
 // Install: copy this file into the "scripts" folder next to the Flamenco Manager executable and
 // restart the Manager (docs/farm.md).
 //

@@ -1,8 +1,9 @@
 """``render.py --bake-to BAKED.blend``: set the file up, bake the frames for rendering anywhere, save.
 
 The bake (``blender/pipeline/bake.py``, through ``effect.bake_for_render_anywhere``) writes what the
-add-on's handlers compute per frame into keyframes and image sequences, so that plain Blender renders
-the saved file's frames with no add-on and scripts disabled (``blender -b BAKED.blend -a``).
+add-on's handlers compute per frame into keyframes, image sequences and (Apparent Geometry) meshes
+played back by frame, so that plain Blender renders the saved file's frames with no add-on and
+scripts disabled (``blender -b BAKED.blend -a``).
 """
 
 from __future__ import annotations
@@ -59,7 +60,8 @@ def bake(
     bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False)
     log(
         f"render.py: baked frames {first}-{last} ({counts['fcurves']} animated values, {counts['sequences']} "
-        f"image sequences) into {path}: it renders without the add-on (blender -b {path} -a)",
+        f"image sequences, {counts.get('meshes', 0)} meshes played back by frame) into {path}: it renders "
+        f"without the add-on (blender -b {path} -a)",
         flush=True,
     )
     return path

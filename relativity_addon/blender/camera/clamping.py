@@ -1,11 +1,18 @@
-"""Cycles' sample clamping, scaled by the searchlight while the exact camera renders.
+"""Cycles' sample clamping, scaled by the searchlight.
 
 The exact camera multiplies a camera ray's throughput by ``D^4`` before Cycles clamps a sample's
 contribution (Render Properties > Light Paths > Clamping), so a clamp meant for the scene at rest
 cuts the searchlight's brightening (found by the gallery: the street's centre 4.5 % too dark at 0.8c
-with Blender's default indirect clamp of 10). While the effect is applied, each non-zero clamp is
-the user's value times the brightest ``D^4`` in any direction, ``(gamma (1 + beta))^4``; a value the
-user types meanwhile becomes the user's value; removing the effect gives the user's values back.
+with Blender's default indirect clamp of 10). Moving objects and lights brighten what they send the
+same way (``D^4`` of the source, on either path): a moving sphere's light bounced onto a panel
+came out 0.49 of what Cycles was asked to render at 0.5c with that clamp
+(tests/blender/lights/test_interreflection.py). While the effect is applied, each non-zero clamp
+is the user's value times the brightest ``D^4`` in any direction, ``(gamma (1 + beta))^4`` of the
+observer, times ``(gamma (1 + beta))^6`` of the fastest object or light with its own velocity
+(``moving_objects.fastest_speed``; the relative factor of two frames is at most the product, and
+a lamp's light on a moving object gains eq. 18's ``D^2`` before the object's ``D^4``); a
+value the user types meanwhile becomes the user's value; removing the effect gives the user's
+values back.
 """
 
 from __future__ import annotations
@@ -14,6 +21,7 @@ import math
 from typing import TYPE_CHECKING
 
 from ..common import names
+from ..scene import moving_objects
 
 if TYPE_CHECKING:
     from bpy.types import Scene
@@ -24,17 +32,29 @@ KEY = names.CLAMP_SAVED_KEY
 CLAMPS = ("sample_clamp_direct", "sample_clamp_indirect")
 
 
-def factor(snap: Snapshot) -> float:
-    if not (snap.exact_camera and snap.use_searchlight and snap.speed > 0.0):
+def factor(scene: Scene, snap: Snapshot) -> float:
+    """The brightest gain the searchlight gives a sample: the observer's ``D^4`` times the fastest
+    source's ``D^6`` (1 without the searchlight or motion)."""
+    if not snap.use_searchlight or snap.use_time_of_flight:
         return 1.0
-    return (snap.gamma * (1.0 + snap.speed)) ** 4
+    observer = snap.speed if snap.method == "GEOMETRY" or snap.exact_camera else 0.0
+    lights = [math.hypot(*light.beta) for light in snap.moving_lights]
+    source = max([moving_objects.fastest_speed(scene), *lights])
+    return _brightest(observer, 4) * _brightest(min(source, 1.0 - 1e-9), 6)
+
+
+def _brightest(speed, power):
+    """``(gamma (1 + beta))^power``: the largest ``D^power`` at ``speed``."""
+    return ((1.0 + speed) / (1.0 - speed)) ** (power / 2.0)
 
 
 def write(scene: Scene, snap: Snapshot) -> None:
     """Scale the clamps for the snapshot (only writing what changed: a write triggers a sync)."""
     cycles = getattr(scene, "cycles", None)
-    scale = factor(snap)
-    if cycles is None or (KEY not in scene and scale == 1.0):
+    if cycles is None or (KEY not in scene and not any(getattr(cycles, name) for name in CLAMPS)):
+        return  # no clamp to scale (the speeds are not even read)
+    scale = factor(scene, snap)
+    if KEY not in scene and scale == 1.0:
         return
     if KEY not in scene:
         scene[KEY] = {name: getattr(cycles, name) for name in CLAMPS} | {

@@ -17,9 +17,11 @@ visibility for "camera rays not yet transformed", so the two parts are rendered 
   the cockpit occludes exactly where it does at rest, and the scene is seen through its open or
   transparent parts unchanged.
 
-What is approximated (docs/cockpit.md): the cockpit is lit by the lights moving with the camera
-(and its own emission) only; the scene's lamps, sky and bounced light do not reach it, it casts no
-shadow on the scene and the two do not see each other in reflections. Remove deletes the scene,
+What is approximated (docs/cockpit.md): the cockpit is lit by the lights moving with the camera,
+its own emission, the sky as the moving camera sees it (``colour/cockpit_sky.py`` gives this scene
+its world) and the scene's lamps at rest (``lights/cockpit_lamps.py``, one ``D`` per lamp); moving
+lamps and the light bounced off the scene do not reach it, it casts no shadow on the scene and the
+two do not see each other in reflections. Remove deletes the scene,
 the copies and the nodes and gives back the user's ``hide_render`` and compositor exactly.
 """
 
@@ -57,6 +59,8 @@ RENDER_SETTINGS = (
     "border_max_y",
     "fps",
     "fps_base",
+    "use_multiview",  # a stereo pair: the cockpit is rendered for each eye, and each view composited
+    "views_format",
 )
 # the OSL camera's settings stay the user's (the exact camera's text must not gain a user here)
 CAMERA_SKIPPED = ("name", "type", "custom_mode", "custom_shader", "custom_filepath", "custom_bytecode")
@@ -112,6 +116,7 @@ def _write_camera(rest_camera, camera):
     data = rest_camera.data
     _copy_values(camera.data, data, None, skip=CAMERA_SKIPPED)
     _copy_values(camera.data.dof, data.dof, None)
+    _copy_values(camera.data.stereo, data.stereo, None)  # the eyes (Blender's stereo pair)
     rest_type = _rest_type(camera.data)
     if data.type != rest_type:
         data.type = rest_type
@@ -126,6 +131,10 @@ def _write_camera(rest_camera, camera):
 def _write_render(scene, cockpit):
     _copy_values(scene.render, cockpit.render, RENDER_SETTINGS)
     _copy_values(scene.cycles, cockpit.cycles, None, skip=CYCLES_SKIPPED)
+    for view in scene.render.views:  # Stereo 3D's left and right (every scene has them)
+        rest_view = cockpit.render.views.get(view.name)
+        if rest_view is not None and rest_view.use != view.use:
+            rest_view.use = view.use
     clamps = scene.get(names.CLAMP_SAVED_KEY)  # the user's clamps, not the searchlight's (clamping.py)
     for name in ("sample_clamp_direct", "sample_clamp_indirect"):
         value = clamps[name] if clamps is not None and name in clamps else getattr(scene.cycles, name)
@@ -364,14 +373,9 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if not snap.cockpit:
         return []
     found = [
-        f"Objects moving with the camera ({len(snap.cockpit)}): lit only by the lights moving with the camera; the "
-        "scene's light, shadows and reflections between them and the scene are left out (docs/cockpit.md)"
+        f"Objects moving with the camera ({len(snap.cockpit)}): lit by the sky and the lamps at rest (one D per "
+        "lamp); moving lamps, light and shadows from the scene's objects and reflections are left out (docs/cockpit.md)"
     ]
-    if snap.stereo:
-        found.append("Objects moving with the camera are not laid over a stereo render yet (one eye's view)")
-    if snap.velocity_source == "CAMERA_ANIMATION" and compat.has_compositor_node_groups():
-        found.append(
-            "Objects moving with the camera, velocity from the camera's keyframes: Render Animation crashed "
-            "Blender 5.2; render the frames one by one (F12 at each frame, or the batch script) (docs/cockpit.md)"
-        )
+    if snap.stereo and scene.render.views_format != "STEREO_3D":
+        found.append("Objects moving with the camera: a Multi-View render's own views are not rendered at rest")
     return found

@@ -46,6 +46,7 @@ def write(scene: Scene, snap: Snapshot, attach_new_materials: bool = False) -> N
     if attach_new_materials:
         _attach(scene, snap)
     materials.write_settings(snap)
+    _write_object_temperatures(scene)
     if snap.colour.camera_path:
         world_colour.write(scene.world)  # the world's colour groups only where they change the colour
     compositing.write_colour_stage(scene, snap)
@@ -58,6 +59,20 @@ def _attach(scene, snap):
     materials.attach_scene(scene, camera_path=snap.colour.camera_path)
     if snap.colour.camera_path:
         volumes.attach_scene(scene)
+
+
+def _write_object_temperatures(scene):
+    """Each object's blackbody temperature as a custom property, which the colour groups inside
+    shared node groups read (``grouped_colours.read_object_temperature``); written only where it
+    changed (a write is a depsgraph update)."""
+    for obj in scene.objects:
+        if obj.library is not None:
+            continue  # linked from another file: not editable here (its groups keep the RGB path)
+        temperature = float(obj.relativity.temperature)
+        if temperature > 0.0 and obj.get(names.OBJECT_TEMPERATURE_PROPERTY) != temperature:
+            obj[names.OBJECT_TEMPERATURE_PROPERTY] = temperature
+        elif temperature <= 0.0 and names.OBJECT_TEMPERATURE_PROPERTY in obj:
+            del obj[names.OBJECT_TEMPERATURE_PROPERTY]
 
 
 def remove_camera_stage(scene: Scene) -> None:
@@ -73,6 +88,9 @@ def remove(scene: Scene) -> None:
     groups and lookup tables once no scene uses them."""
     compositing.remove_colour_stage(scene)
     materials.detach_all()
+    for obj in scene.objects:
+        if obj.library is None and names.OBJECT_TEMPERATURE_PROPERTY in obj:
+            del obj[names.OBJECT_TEMPERATURE_PROPERTY]
     for world in bpy.data.worlds:
         world_sampling.release(world)
     if not any(compositor_applied(other) for other in bpy.data.scenes):

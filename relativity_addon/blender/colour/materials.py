@@ -402,12 +402,12 @@ def attach(material: Material | None, temperature: float | None = None) -> bool:
     for record in records:
         record["object_temperature"] = object_temperature  # what attach_scene compares to re-attach
     material[ATTACHED_KEY] = records
-    grouped_colours.attach_groups(
-        tree,
-        lambda inner, target, socket, is_emission: insert_colour_group(
-            inner, group, NODE_PREFIX, target, socket, is_emission
-        )[1],
-    )
+
+    def insert(inner, target, socket, is_emission):  # inside a shared group: the object's own temperature
+        node, record = insert_colour_group(inner, group, NODE_PREFIX, target, socket, is_emission)
+        return [record, *(grouped_colours.read_object_temperature(inner, node) if is_emission else ())]
+
+    grouped_colours.attach_groups(tree, insert)
     return True
 
 

@@ -13,6 +13,7 @@ emitter, the volume does the exact shift itself and marks its pixels done:
   to 2e-4), where ``X`` is what the materials' Doppler colour group makes of a blackbody colour
   ``E``: the blackbody at ``D T`` with ``E``'s luminance times ``Y(D T) / Y(T)``, divided by the
   camera's ``D^4``. ``X - E`` may be negative per channel; Cycles adds volume emission as it is.
+  (With a temperature grid ``X`` follows the bolometric rule and replaces ``E``: see below.)
   Other rays (the volume lighting the scene) carry ``E``, the scene-frame light;
 - **boundary**: a Transparent BSDF on the volume's surface (the material had none) writes the
   ``relativity_colour_done`` AOV where a camera ray enters the volume (front faces), so the
@@ -42,11 +43,23 @@ refused in one line (:func:`spectral_problem`).
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
 Blackbody Intensity and a constant or linked Temperature (a node field is followed per point).
-Not covered: a temperature grid (``Temperature Attribute``, e.g. a fire simulation: the added
-emission uses the Temperature input only; following the grid blows up the grid's cool edges,
-docs/spectral-model.md; refused by the spectral mode, whose passes cannot give a grid a spectrum), a
-Principled Volume behind a Mix or Add shader or with a surface shader (also refused by the spectral
-mode when it emits a blackbody), and Apparent Geometry's boosted meshes.
+
+**Temperature grids** (a Volume object or fluid domain whose Temperature Attribute names a grid,
+e.g. a fire simulation; :func:`grid_materials`): Cycles' ``T`` is the Temperature input times
+``max(grid, 0)``, which an Attribute node reading the grid gives the group. Such gas is shifted by
+the **bolometric rule**: Cycles' emission ``sigma T^4`` times a unit-luminance blackbody colour is
+read as a blackbody of total ``sigma T^4``, seen at ``D T`` with total ``sigma (D T)^4``, i.e.
+Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; the visible rule's
+``Y(D T) / Y(T)`` explodes in the cool gas where every grid fades to 0 K (docs/spectral-model.md,
+"Temperature grids"). For camera rays Cycles' own blackbody is switched off and the group emits
+the shifted light alone (Blender 5.2's Principled Volume reads a grid otherwise than an Attribute
+node, so ``X - E`` would leave the difference unshifted). A Volume object renders no surface
+closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
+there too (measured: with the link to it cut the compositor shifts those pixels again). The
+spectral mode still refuses grids: no scene-frame spectrum that keeps Cycles' rest luminance
+``sigma T^4`` is shifted by ``D^4`` at every ``T``. Not covered: a Principled Volume behind a Mix
+or Add shader or with a surface shader (also refused by the spectral mode when it emits a
+blackbody; on an object with grids a panel warning names it), and Apparent Geometry's boosted meshes.
 """
 
 from __future__ import annotations
@@ -58,11 +71,13 @@ import bpy
 
 from ..common import names
 from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
-from ..scene import sources
+from ..scene import grouped_colours, sources
 from . import materials, spectral_nodes
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Scene
+    from collections.abc import Iterator
+
+    from bpy.types import Material, NodeTree, Scene
 
 GROUP = names.VOLUME_BLACKBODY_GROUP
 NODE_PREFIX = names.VOLUME_BLACKBODY_NODE_PREFIX
@@ -88,13 +103,19 @@ def volume_blackbody_group() -> Group:
     spectral pass)."""
     nodes = {
         "settings": group_node(materials.SETTINGS),
+        # Cycles' T: the Temperature input times max(grid, 0) where the object has the grid
+        # (an Attribute node's Fac and Alpha; Grid Alpha 0: no grid, T is the input)
+        "grid_clamped": fmath("MAXIMUM", "group.Grid", 0.0),
+        "grid_minus_one": fmath("SUBTRACT", "grid_clamped", 1.0),
+        "grid_factor": fmath("MULTIPLY_ADD", "group.Grid Alpha", "grid_minus_one", 1.0),
+        "temperature": fmath("MULTIPLY", "group.Temperature", "grid_factor"),
         # the volume's own emission: tint sigma mix(1, T^4, intensity) B(T)
-        "t4": fmath("POWER", "group.Temperature", 4.0),
+        "t4": fmath("POWER", "temperature", 4.0),
         "t4m1": fmath("SUBTRACT", "t4", 1.0),
         "mixed": fmath("MULTIPLY_ADD", "group.Intensity", "t4m1", 1.0),
         "sigma": fmath("MULTIPLY", "mixed", SIGMA),
         "strength": fmath("MULTIPLY", "sigma", "group.Tint"),
-        "planck": Node("ShaderNodeBlackbody", {"Temperature": "group.Temperature"}),
+        "planck": Node("ShaderNodeBlackbody", {"Temperature": "temperature"}),
         "rest": vmath("SCALE", "planck.Color", scale="strength"),
         # ln D = ln(1 - beta_o . k) - ln(1 - beta_o^2) / 2: the observer's factor only (a volume at
         # rest; the materials' factor group also reads the emitter's velocity attribute, which a
@@ -111,7 +132,7 @@ def volume_blackbody_group() -> Group:
         "ln_d": fmath("MULTIPLY_ADD", "ln_go2", -0.5, "ln_num"),
         # what a blackbody emitter of that colour emits for camera rays (as the materials' Doppler
         # colour group): the blackbody at D T with the rest luminance times exp(E)
-        "shift": group_node(materials.BLACKBODY_SHIFT, {"Temperature": "group.Temperature", "Log Doppler": "ln_d"}),
+        "shift": group_node(materials.BLACKBODY_SHIFT, {"Temperature": "temperature", "Log Doppler": "ln_d"}),
         "luminance": vmath("DOT_PRODUCT", "rest", materials.LUMINANCE_WEIGHTS),
         "shifted": vmath("SCALE", "shift.Color", scale="luminance.Value"),
         "base": Node(
@@ -122,24 +143,58 @@ def volume_blackbody_group() -> Group:
         "log_gain": fmath("MULTIPLY_ADD", "shift.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
         "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
         "gain": fmath("EXPONENT", "safe_log_gain"),
-        "emitter": vmath("SCALE", "base.Result", scale="gain"),
-        "difference": vmath("SUBTRACT", "emitter", "rest"),
+        "visible_emitter": vmath("SCALE", "base.Result", scale="gain"),
+        # the bolometric rule (temperature grids): Cycles' own emission at D T, times D^(p - 4)
+        # over the camera's D^p_cam: log gain (4 SS + p - p_cam - 4 Use Doppler) ln D
+        "d": fmath("EXPONENT", "ln_d"),
+        "undoppled": fmath("SUBTRACT", 1.0, "settings.Use Doppler"),
+        "d_used": fmath("MULTIPLY_ADD", "d", "settings.Use Doppler", "undoppled"),
+        "dt": fmath("MULTIPLY", "temperature", "d_used"),
+        "dt4": fmath("POWER", "dt", 4.0),
+        "dt4m1": fmath("SUBTRACT", "dt4", 1.0),
+        "dt_mixed": fmath("MULTIPLY_ADD", "group.Intensity", "dt4m1", 1.0),
+        "dt_sigma": fmath("MULTIPLY", "dt_mixed", SIGMA),
+        "dt_strength": fmath("MULTIPLY", "dt_sigma", "group.Tint"),
+        "dt_planck": Node("ShaderNodeBlackbody", {"Temperature": "dt"}),
+        "bolometric_base": vmath("SCALE", "dt_planck.Color", scale="dt_strength"),
+        "ss4": fmath("MULTIPLY", "settings.Spectral Searchlight", 4.0),
+        "bolometric_power": fmath("ADD", "ss4", "power"),
+        "bolometric_exponent": fmath("MULTIPLY_ADD", "settings.Use Doppler", -4.0, "bolometric_power"),
+        "bolometric_log": fmath("MULTIPLY", "bolometric_exponent", "ln_d"),
+        "bolometric_safe": fmath("MINIMUM", "bolometric_log", materials.EXP_LIMIT),
+        "bolometric_gain": fmath("EXPONENT", "bolometric_safe"),
+        "bolometric_emitter": vmath("SCALE", "bolometric_base", scale="bolometric_gain"),
+        "emitter": Node(
+            "ShaderNodeMix",
+            {"Factor": "group.Bolometric", 4: "visible_emitter", 5: "bolometric_emitter"},
+            {"data_type": "VECTOR"},
+        ),
         # only camera rays on the exact camera's path, never in a spectral pass
         "light_path": Node("ShaderNodeLightPath"),
         "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
         "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
         "switch": fmath("MULTIPLY", "camera_ray", "fast"),
+        # X - E added to Cycles' own E (which the group's E matches to 2e-4 for a constant or
+        # node-driven T); with a grid (Bolometric 1) Cycles' E is switched off for camera rays and
+        # X emitted alone: Blender 5.2 reads a grid in the Principled Volume otherwise than an
+        # Attribute node does (sigma T^4 2.4-2.9 % apart), and the difference would leak unshifted
+        "rest_kept": fmath("SUBTRACT", 1.0, "group.Bolometric"),
+        "rest_taken": vmath("SCALE", "rest", scale="rest_kept"),
+        "difference": vmath("SUBTRACT", "emitter.Result", "rest_taken"),
         "fast_out": vmath("SCALE", "difference", scale="switch"),
         # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
         # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
         # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
         "spectral": group_node(
             spectral_nodes.SPECTRAL_COLOUR,
-            {"Color": "rest", "Temperature": "group.Temperature", "Is Blackbody": 1.0, "Is Emission": 1.0},
+            {"Color": "rest", "Temperature": "temperature", "Is Blackbody": 1.0, "Is Emission": 1.0},
         ),
         "spectral_out": vmath("SCALE", "spectral", scale="settings.Spectral Pass"),
         "out": vmath("ADD", "fast_out", "spectral_out"),
-        "intensity": fmath("MULTIPLY", "group.Intensity", "fast"),
+        # Cycles' own blackbody off in a spectral pass, and for camera rays with a grid (above)
+        "switched_off": fmath("MULTIPLY", "switch", "group.Bolometric"),
+        "kept": fmath("SUBTRACT", "fast", "switched_off"),
+        "intensity": fmath("MULTIPLY", "group.Intensity", "kept"),
         # the boundary where a camera ray enters the volume
         "front": fmath("SUBTRACT", 1.0, "geometry.Backfacing"),
         "done": fmath("MULTIPLY", "switch", "front"),
@@ -151,6 +206,9 @@ def volume_blackbody_group() -> Group:
             ("Temperature", "NodeSocketFloat", 1000.0),
             ("Intensity", "NodeSocketFloat", 1.0),
             ("Tint", "NodeSocketFloat", 1.0),
+            ("Grid", "NodeSocketFloat", 1.0),  # the temperature grid's value (an Attribute node's Fac)
+            ("Grid Alpha", "NodeSocketFloat", 0.0),  # 1 where the object has that grid
+            ("Bolometric", "NodeSocketFloat", 0.0),  # 1: Cycles' own emission at D T (temperature grids)
         ),
         (
             ("Color", "NodeSocketColor", "out"),
@@ -185,9 +243,14 @@ def _correctable(material):
     return output, source, blackbody, intensity
 
 
-def attach(material: Material) -> bool:
+def attach(material: Material, grids: bool = False) -> bool:
     """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
-    (after ``materials.attach``, whose records restore it on detach). Returns whether it did."""
+    (after ``materials.attach``, whose records restore it on detach). Returns whether it did.
+
+    ``grids``: the material is on an object that may carry a temperature grid (:func:`grid_materials`);
+    where its Temperature Attribute names one, an Attribute node reads it, so that the group
+    follows Cycles' ``T`` = Temperature x max(grid, 0), and the group shifts by the bolometric rule
+    (Cycles' own emission at ``D T``: finite where the grid fades to 0 K, docs/spectral-model.md)."""
     if not materials.is_attached(material):
         return False
     records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
@@ -209,6 +272,17 @@ def attach(material: Material) -> bool:
         tree.links.new(blackbody.temperature, group.inputs["Temperature"])
     group.inputs["Intensity"].default_value = intensity
     group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+    created = [group]
+    grid_name = node.inputs["Temperature Attribute"].default_value if grids else ""
+    if grid_name:
+        attribute = tree.nodes.new("ShaderNodeAttribute")
+        attribute.name = attribute.label = f"{NODE_PREFIX} Grid {node.name}"
+        attribute.attribute_type = "GEOMETRY"
+        attribute.attribute_name = grid_name
+        tree.links.new(attribute.outputs["Fac"], group.inputs["Grid"])
+        tree.links.new(attribute.outputs["Alpha"], group.inputs["Grid Alpha"])
+        group.inputs["Bolometric"].default_value = 1.0
+        created.append(attribute)
     tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
@@ -230,9 +304,10 @@ def attach(material: Material) -> bool:
     log_doppler = tree.nodes.get(f"{materials.NODE_PREFIX} AOV")
     if log_doppler is not None:
         log_doppler.mute = True
-    for created in (group, emission, add, boundary, done):
-        created.location = (output.location.x - 200.0, output.location.y - 300.0)
-        created.hide = True
+    created += [emission, add, boundary, done]
+    for new_node in created:
+        new_node.location = (output.location.x - 200.0, output.location.y - 300.0)
+        new_node.hide = True
     blank = {
         "target": "",
         "socket": "",
@@ -240,11 +315,8 @@ def attach(material: Material) -> bool:
         "source_socket": "",
         "object_temperature": records[0]["object_temperature"] if records else 0.0,
     }
+    records += [{**blank, "group_node": new_node.name} for new_node in created if new_node is not add]
     records += [
-        {**blank, "group_node": group.name},
-        {**blank, "group_node": emission.name},
-        {**blank, "group_node": boundary.name},
-        {**blank, "group_node": done.name},
         {
             **blank,
             "group_node": add.name,
@@ -267,10 +339,10 @@ def _reads_grids(obj):
 
 
 def grid_materials(scene: Scene) -> dict[Material, str]:
-    """``{material: object name}`` of the materials on objects with temperature grids: their
-    emission is ``Temperature x grid``, which the correction does not follow (a grid fades to 0 K
-    at its edges, where Y(D T) / Y(T) of Cycles' sigma T^4 glow explodes: docs/spectral-model.md),
-    so they keep the RGB matrix and a warning."""
+    """``{material: object name}`` of the materials on objects that may carry temperature grids:
+    their emission is ``Temperature x grid``, which :func:`attach` reads with an Attribute node and
+    shifts by the bolometric rule (a grid fades to 0 K at its edges, where ``Y(D T) / Y(T)`` of
+    Cycles' ``sigma T^4`` glow explodes: docs/spectral-model.md)."""
     found = {}
     for obj in scene.objects:
         if _reads_grids(obj):
@@ -290,14 +362,9 @@ def attach_colours(material: Material) -> bool:
     if any(record["group_node"].startswith(COLOUR_PREFIX) for record in records):
         return False
     tree = material.node_tree
-    targets = [
-        (node, node.inputs[name], emitted)
-        for node in list(tree.nodes)
-        for kind, inputs in VOLUME_COLOURS
-        if node.bl_idname == kind
-        for name, emitted in inputs
-    ]
-    if not targets:
+    targets = _volume_colour_inputs(tree.nodes)
+    grouped = [(inner, _volume_colour_inputs([node])) for _group, inner, node in grouped_volume_nodes(tree)]
+    if not targets and not grouped:
         return False
     group_tree = ensure_group(
         spectral_nodes.volume_colour_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION
@@ -307,18 +374,80 @@ def attach_colours(material: Material) -> bool:
         record["object_temperature"] = records[0]["object_temperature"] if records else 0.0
         records.append(record)
     material[materials.ATTACHED_KEY] = records
+    # inside node groups: once in the group's tree (shared by every material using it), recorded
+    # on the tree like the surfaces' grouped colours (grouped_colours.py), which detach_all undoes
+    for inner, inner_targets in grouped:
+        inner_records = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])]
+        for target, socket, emitted in inner_targets:
+            if socket.is_linked and socket.links[0].from_node.name.startswith(COLOUR_PREFIX):
+                continue  # put in for another material already
+            inner_records.append(
+                materials.insert_colour_group(inner, group_tree, COLOUR_PREFIX, target, socket, emitted)[1]
+            )
+        inner[materials.ATTACHED_KEY] = inner_records
     return True
+
+
+def _volume_colour_inputs(nodes):
+    """``(node, input, is_emitted)`` of every volume colour (:data:`VOLUME_COLOURS`) of ``nodes``."""
+    return [
+        (node, node.inputs[name], emitted)
+        for node in list(nodes)
+        for kind, inputs in VOLUME_COLOURS
+        if node.bl_idname == kind
+        for name, emitted in inputs
+    ]
+
+
+def grouped_volume_nodes(
+    tree: NodeTree, seen: tuple[str, ...] = ()
+) -> Iterator[tuple[bpy.types.Node, NodeTree, bpy.types.Node]]:
+    """``(group node, its tree, volume node)`` for every volume node (:data:`VOLUME_KINDS`) inside
+    the user's node groups used in ``tree``, at any depth."""
+    for group in grouped_colours.user_groups(tree):
+        inner = group.node_tree
+        if inner.name in seen:
+            continue
+        for node in list(inner.nodes):
+            if node.bl_idname in VOLUME_KINDS:
+                yield group, inner, node
+        yield from grouped_volume_nodes(inner, (*seen, inner.name))
 
 
 def attach_scene(scene: Scene) -> None:
     """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
     except those on objects with temperature grids (:func:`grid_materials`); every volume colour
     made spectral for the spectral passes (:func:`attach_colours`)."""
-    skipped = grid_materials(scene)
+    grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
-        if material not in skipped:
-            attach(material)
+        attach(material, grids=material in grids)
         attach_colours(material)
+
+
+def _grouped_problem(material, on_grids):
+    """Why the passes cannot carry a volume node inside one of ``material``'s node groups, or None:
+    a Volume Coefficients node, a Principled Volume blackbody (its correction and its spectrum live in
+    the material's own tree), a colour grid, an emission colour fed from outside the group (which
+    may be a blackbody the group cannot see)."""
+    for group, inner, node in grouped_volume_nodes(material.node_tree):
+        where = f"{node.name!r} inside the node group {inner.name!r} ({group.name!r}) in material {material.name!r}"
+        if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
+            return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
+        if node.bl_idname != "ShaderNodeVolumePrincipled":
+            continue
+        if _emits_blackbody(node):
+            return (
+                f"Spectral colour cannot make the blackbody of {where} spectral: a Principled Volume "
+                "blackbody must be in the material's own node tree"
+            )
+        if on_grids and node.inputs["Color Attribute"].default_value:
+            return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
+        strength = sources.constant_value(node.inputs["Emission Strength"])
+        if grouped_colours.group_input(node.inputs["Emission Color"]) is not None and strength != 0.0:
+            return (
+                f"Spectral colour cannot make the emission of {where} spectral: its colour comes from outside the group"
+            )
+    return None
 
 
 def _emits_blackbody(node):
@@ -337,12 +466,9 @@ def spectral_problem(scene: Scene) -> str | None:
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
             continue
-        grouped = sources.grouped_node(material.node_tree, VOLUME_KINDS)
+        grouped = _grouped_problem(material, material in grids)
         if grouped is not None:
-            return (
-                f"Spectral colour cannot make the volume shaders inside the node group {grouped[0].name!r} "
-                f"in material {material.name!r} spectral"
-            )
+            return grouped
         correctable = _correctable(material)
         corrected = correctable[1].node if correctable is not None else None
         for node in material.node_tree.nodes:
@@ -374,13 +500,41 @@ def spectral_problem(scene: Scene) -> str | None:
 
 
 def warnings(scene: Scene) -> list[str]:
-    """One line per Principled Volume blackbody on an object with temperature grids."""
+    """One line per Principled Volume blackbody the correction cannot handle (it keeps the RGB
+    matrix's colour shift): on an object with temperature grids, or inside a node group."""
     lines = []
     for material, name in grid_materials(scene).items():
-        node = _volume_output(material.node_tree)[1] if material.node_tree is not None else None
-        if node is not None and sources.volume_blackbody(node.node) is not None:
+        if material.node_tree is None or _correctable(material) is not None:
+            continue
+        for node in material.node_tree.nodes:
+            if (
+                node.bl_idname == "ShaderNodeVolumePrincipled"
+                and node.outputs[0].is_linked
+                and _emits_blackbody(node)
+                and material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None
+            ):
+                lines.append(
+                    f"Volume {name!r} ({material.name!r}): its blackbody keeps the RGB colour shift (the "
+                    "correction needs a grey tint, a constant intensity and the Principled Volume alone on "
+                    "the Volume output)"
+                )
+                break
+    for material, _temperature in materials.scene_materials(scene):
+        grouped = (
+            next(
+                (
+                    (inner, node)
+                    for _group, inner, node in grouped_volume_nodes(material.node_tree)
+                    if node.bl_idname == "ShaderNodeVolumePrincipled" and _emits_blackbody(node)
+                ),
+                None,
+            )
+            if material.node_tree is not None
+            else None
+        )
+        if grouped is not None:
             lines.append(
-                f"Volume {name!r} ({material.name!r}) may read a temperature grid: its blackbody "
-                "keeps the RGB colour shift (grids are not shifted to D T)"
+                f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
+                f"{grouped[0].name!r} keeps the RGB colour shift (shifted to D T only in the material's own tree)"
             )
     return lines

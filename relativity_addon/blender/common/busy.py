@@ -8,6 +8,8 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
+import bpy
+
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
@@ -26,3 +28,23 @@ def computing() -> Iterator[None]:
 
 def is_computing() -> bool:
     return _depth > 0
+
+
+_render = {"running": False}
+
+
+def render_started() -> None:
+    """``render_init``: a render (F12, Render Animation) runs until :func:`render_ended`."""
+    _render["running"] = True
+
+
+def render_ended() -> None:
+    """``render_complete`` / ``render_cancel``."""
+    _render["running"] = False
+
+
+def rendering() -> bool:
+    """Whether a render runs: handlers then run between its frames, and data made or deleted there
+    is freed under the render (Blender 5.2 crashed, docs/cockpit.md). ``is_job_running`` alone is
+    False in a blocking render (background mode, the ``bpy`` module)."""
+    return _render["running"] or bool(getattr(bpy.app, "is_job_running")("RENDER"))  # noqa: B009

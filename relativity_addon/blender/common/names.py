@@ -38,6 +38,9 @@ MOTION_BAKE_KEY = "relativity_motion_bake"  # on the cache mesh: baked world mat
 # --- Doppler colour: materials --------------------------------------------------------------
 MATERIAL_ATTACHED_KEY = "relativity_doppler_nodes"  # on materials and worlds: inserted nodes
 MATERIAL_NODE_PREFIX = "Relativity Doppler"
+# custom property on objects with a blackbody temperature while Doppler colour is applied, read by
+# an Object Attribute node inside shared node groups (a plain property: the file renders alone)
+OBJECT_TEMPERATURE_PROPERTY = "relativity_blackbody_temperature"
 SETTINGS_GROUP = "Relativity Settings"
 DOPPLER_FACTOR_GROUP = "Relativity Doppler Factor"
 GAMUT_MAP_GROUP = "Relativity Gamut Map"
@@ -46,8 +49,8 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 6  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
-# 5: volumes in spectral passes; 6: the coverage AOV
+SHADER_GROUPS_VERSION = 7  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+# 5: volumes in spectral passes; 6: the coverage AOV; 7: temperature grids in the volume group
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
@@ -124,6 +127,12 @@ BAKE_ACTION_PREFIX = "Relativity Bake"  # actions the bake made for datablocks t
 BAKE_IMAGE_SUFFIX = " (baked)"  # the image sequence standing for a per-frame image
 BAKE_SCRATCH_IMAGE = "Relativity Bake Scratch"  # writes the sequence's files, removed at once
 BAKE_FOLDER_SUFFIX = "_relativity_bake"  # the folder beside the .blend holding the sequences
+# Apparent Geometry baked (geometry/playback.py): each frame's evaluated mesh, played back by frame
+PLAYBACK_GROUP = "Relativity Baked Geometry"  # geometry-nodes group: the frame's mesh of a collection
+PLAYBACK_GROUP_VERSION_KEY = "relativity_playback_version"
+PLAYBACK_GROUP_VERSION = 1
+PLAYBACK_MODIFIER = "Relativity Baked Geometry"  # the modifier playing it, after the apparent geometry's
+PLAYBACK_PREFIX = "Relativity Baked"  # "<prefix> <object>": the collection; "<prefix> NNNNNN <object>": a frame
 
 # Objects moving with the camera (camera/cockpit.py): a scene of their copies rendered at rest and
 # laid over the relativistic render in the compositor.
@@ -131,3 +140,12 @@ COCKPIT_PREFIX = "Relativity Cockpit"  # the cockpit scene "<prefix> <scene>", i
 COCKPIT_KEY = "relativity_cockpit"  # on the scene: what the stage added and changed
 COCKPIT_HIDDEN_KEY = "relativity_cockpit_hidden"  # on an object moving with the camera: the user's hide_render
 COCKPIT_COPY_KEY = "relativity_cockpit_copy"  # on a copy in the cockpit scene: the original object's name
+# The cockpit's sky (colour/cockpit_sky.py): a copy of the scene's world as the moving camera sees it
+COCKPIT_SKY_KEY = "relativity_cockpit_sky"  # on the scene: the sky world's name and the world it copies
+COCKPIT_SKY_PREFIX = "Relativity Cockpit Sky"  # the world "<prefix> <scene>", its nodes
+COCKPIT_SKY_GROUP = "Relativity Cockpit Sky"  # shader group: camera-frame direction -> scene direction, ln D
+COCKPIT_SKY_COLOUR_GROUP = "Relativity Cockpit Sky Colour"  # shader group: a colour as the moving camera sees it
+COCKPIT_SKY_GROUPS_VERSION = 1
+# The scene's lamps on the cockpit (lights/cockpit_lamps.py): their copies in the cockpit scene
+COCKPIT_LAMPS_KEY = "relativity_cockpit_lamps"  # on the scene: {lamp name: its copy's name}
+COCKPIT_LAMP_PREFIX = "Relativity Cockpit Lamp"  # the copies (objects and lights): "<prefix> <lamp>"

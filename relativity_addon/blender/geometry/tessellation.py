@@ -24,11 +24,10 @@ import zlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
-import bpy
 import numpy as np
 
 from ...physics import tessellation
-from ..common import compat, names
+from ..common import busy, compat, names
 from ..common.nodes import interface_identifier
 from . import modifier, motion
 
@@ -102,11 +101,6 @@ def render_size(scene: Scene) -> tuple[float, float]:
     return max(1.0, render.resolution_x * scale), max(1.0, render.resolution_y * scale)
 
 
-def _rendering():
-    """Whether a render job runs (its handlers must not evaluate the depsgraph again)."""
-    return bool(getattr(bpy.app, "is_job_running")("RENDER"))  # noqa: B009 - the stubs say it returns None
-
-
 def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decision | None:
     """The subdivision of ``obj`` for the snapshot (None: keep the last one). Raises ValueError
     from the physics core (superluminal motion), as the update does."""
@@ -114,7 +108,7 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     if not settings.use_adaptive_tessellation or settings.tessellation == 0:
         return Decision(int(settings.tessellation))
     uniform = Decision(min(int(settings.tessellation), UNMEASURED_LEVELS))
-    if snap.exact_camera or _rendering():
+    if snap.exact_camera or busy.rendering():  # a render's handlers must not evaluate the depsgraph again
         return None
     mesh = cast("Mesh", obj.data)
     if (

@@ -328,9 +328,10 @@ def _follow(copy_data, light, own=frozenset()):
 def write(scene: Scene, snap: Snapshot) -> int:
     """Bring the copies up to date with the snapshot (rebuilt when the lamps or moving objects
     changed, else only their colours and settings written). Nothing without moving objects or
-    off the Apparent Geometry path."""
+    off the Apparent Geometry path. With Doppler colour and searchlight both off the copies stay,
+    with no factor of ``D``: the aberrated direction (and the rest normals) are geometry."""
     pairs = []
-    if snap.method == "GEOMETRY" and (snap.use_doppler or snap.use_searchlight):
+    if snap.method == "GEOMETRY":
         lit_by = lamps(scene)
         found = movers(scene, snap) if lit_by else []  # no lamps: nothing to place
         pairs = [(lamp, mover) for lamp in lit_by for mover in found]
@@ -360,7 +361,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
         if stand_ins is None:
             copy = copies[(lamp.name, mover.name, "0")]
             doppler_factor, turned = placement(matrix, lamp.data.type, mover)
-            _write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
+            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
             continue
         offsets, dopplers = stand_ins
         _write_stand_ins(
@@ -375,7 +376,10 @@ def write(scene: Scene, snap: Snapshot) -> int:
     return len(layout)
 
 
-def _write_copy(copy, lamp, colour, matrix, power_factor=None):
+def write_copy(
+    copy: Object, lamp: Object, colour: tuple[float, ...], matrix: FloatArray, power_factor: float | None = None
+) -> None:
+    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its energy)."""
     _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
     if power_factor is not None:
         _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
@@ -406,7 +410,7 @@ def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
         moved[:3, 3] += offsets[index] * beta / speed
         # without the tree (EEVEE) the copies share the lamp's light at the centre: (t / r)^2 / n each
         share = (max(float(np.linalg.norm(centre - moved[:3, 3])), 1e-9) / lamp_distance) ** 2 / len(copies)
-        _write_copy(copy, lamp, base, moved, share)
+        write_copy(copy, lamp, base, moved, share)
         values = {
             "Offset": float(offsets[index]),
             "Previous": float(offsets[index - 1]) if index > 0 else float(offsets[index]) - far,

@@ -31,8 +31,9 @@ from ...errors import RelativityError
 from ...physics import spectral_render
 from ...physics.lorentz import aberrate, camera_to_scene_direction
 from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
+from ..camera import cockpit
 from ..colour import materials
-from ..common import names
+from ..common import busy, names
 from ..scene import animation, lens, sources
 
 if TYPE_CHECKING:
@@ -316,11 +317,20 @@ def write(
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
-        times = None if depsgraph is not None else _stored_times(scene, light.name)
+        stored = _stored_times(scene, light.name)
+        times = None if depsgraph is not None else stored
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+            keep = busy.rendering() or cockpit.is_applied(scene)
+            if keep and stored is not None and len(stored) != len(times):
+                # as many as there are: stand-ins made and deleted between Render Animation's
+                # frames (frame_change_post) crashed Blender 5.2's render of the next frame, and
+                # at a frame change with the cockpit's Render Layers node (docs/cockpit.md)
+                ends = np.linspace(0.0, 1.0, len(times))
+                times = np.interp(np.linspace(0.0, 1.0, len(stored)), ends, times)
+                positions = _positions(scene, snap, light, values, reception_time, times)
         else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
             positions = _positions(scene, snap, light, values, reception_time, times)
         shared = {

@@ -11,14 +11,19 @@ one key per frame: exact at every frame). An image whose pixels change (the worl
 written per frame as OpenEXR files beside the .blend and read back as an image sequence. Then plain
 ``blender -b baked.blend -a`` renders the same frames with no add-on and with scripts disabled.
 
+Apparent Geometry is baked in its final-render configuration (``effect.bake_for_render_anywhere``
+puts it in place first: the exact camera behind it for a moving observer, else the boosted meshes):
+at each frame every moving mesh's evaluated geometry is captured, and ``geometry/playback.py``
+plays the captured meshes back by frame; the exact camera's parameters are keyframed as above.
+
 What was added is recorded on the scene (``names.BAKE_RECORD_KEY``); :func:`unbake` (from Remove)
-takes it out again: the F-curves, the actions it created, the sequence images and their files.
-Apparent Geometry is not baked yet: its meshes and its exact-camera final render are the
-handlers' own (refused with the reason).
+takes it out again: the F-curves, the actions it created, the sequence images and their files,
+the played-back meshes and the final render's exact camera.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -30,10 +35,15 @@ import bpy
 import numpy as np
 
 from ...errors import RelativityError
-from ..common import compat, names, osl
+from ..camera import exact_camera
+from ..colour import doppler_colour
+from ..common import busy, compat, names, osl
+from ..geometry import playback
 
 if TYPE_CHECKING:
-    from bpy.types import Scene
+    from collections.abc import Sequence
+
+    from bpy.types import Object, Scene
 
 COLLECTIONS = ("objects", "cameras", "lights", "materials", "worlds", "node_groups", "scenes")
 _EMBEDDED = ("node_tree",)  # a material's, world's or light's tree (and 4.5's scene compositor)
@@ -41,18 +51,29 @@ _NUMERIC = {"FLOAT", "INT", "BOOLEAN"}
 Key = tuple[str, str, str, str, int]  # (collection, ID name, embedded tree or "", data path, index)
 
 
-def refusal(scene: Scene, method: str) -> str | None:
-    """Why ``scene`` (set up with ``method``) cannot be baked here (one line), or None."""
-    if method == "GEOMETRY":
-        return (
-            "Bake for Render Anywhere bakes the exact camera only: Apparent Geometry's meshes and its "
-            "final render still need the add-on"
-        )
-    reason = osl.unavailable_reason()
-    if reason is not None:
-        return f"Cannot bake the exact camera: it is an OSL shader and {reason[0].lower()}{reason[1:]}"
+def refusal(scene: Scene, method: str, exact_final_render: bool = True, moving_lights: bool = False) -> str | None:
+    """Why ``scene`` (set up with ``method``; on Apparent Geometry, ``exact_final_render``: its final
+    render is the exact camera; ``moving_lights``: it has lights with their own velocity) cannot be
+    baked here (one line), or None. What is baked must render where it is baked: an OSL camera or
+    OSL material nodes (moving lights on Apparent Geometry) need a Blender with OSL."""
     if scene.camera is None:
         return "Cannot bake: the scene has no active camera"
+    if method == "GEOMETRY" and exact_final_render and moving_lights:
+        # measured: the moving light's stand-in lamps are made anew for each final render (the next
+        # frame's get other names, "... Moving Lamp 7.003") and their stand-ins on the meshes come
+        # and go, which keyframes cannot play; baked from one set-up, frame 1 differed by the noise
+        return (
+            "Cannot bake Apparent Geometry behind the exact camera with moving lights yet: their "
+            "stand-in lamps change from frame to frame; set Final Render to Boosted Meshes or bake without them"
+        )
+    reason = osl.unavailable_reason()
+    if reason is None:
+        return None
+    reason = f"{reason[0].lower()}{reason[1:]}"
+    if method == "CAMERA" or exact_final_render:
+        return f"Cannot bake the exact camera: it is an OSL shader and {reason}"
+    if scene.cycles.shading_system:
+        return f"Cannot bake: the moving lights are OSL script nodes in the materials and {reason}"
     return None
 
 
@@ -282,32 +303,62 @@ def _all_trees():
             yield tree
 
 
-def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], object]) -> dict[str, int]:
-    """Step frames ``first`` .. ``last``, calling ``sync_for_render`` at each (the sync a render
-    runs), and keyframe what changes. Returns counts: frames, F-curves, image sequences.
-    RelativityError (one line) if the frames differ in what they hold (stand-in lamps added or
-    removed) or a frame's sync is refused."""
-    if last < first:
-        raise RelativityError(f"Bake: last frame {last} before first frame {first}")
-    unbake(scene)
-    frames = list(range(first, last + 1))
+def _step(scene, frames, sync_for_render, meshes):
+    """The frames' recorded states and the add-on's images' pixels; the evaluated mesh of every
+    object of ``meshes`` (object -> list, filled) captured at each frame."""
     states, images = [], {}
-    start = scene.frame_current
-    for frame in frames:
+    for index, frame in enumerate(frames):
         scene.frame_set(frame)
         if sync_for_render() is None:
-            scene.frame_set(start)
             raise RelativityError(f"Cannot bake frame {frame}: the relativistic render is refused there")
         states.append(record_frame())
         for image in _add_on_images():
             pixels = _image_pixels(image)
             if pixels is not None:
                 images.setdefault(image.name, []).append(pixels)
+        if meshes:
+            # the meshes the sync wrote, evaluated; the handlers this evaluation fires write nothing
+            # more (a render reads the state its render_pre sync left)
+            with busy.computing():
+                depsgraph = bpy.context.evaluated_depsgraph_get()
+                for obj, captured in meshes.items():
+                    captured.append(playback.capture(obj, depsgraph, index, captured[-1] if captured else None))
+    return states, images
+
+
+def bake(
+    scene: Scene,
+    first: int,
+    last: int,
+    sync_for_render: Callable[[], object],
+    geometry: Sequence[Object] = (),
+    exact_final_render: bool = False,
+) -> dict[str, int]:
+    """Step frames ``first`` .. ``last``, calling ``sync_for_render`` at each (the sync a render
+    runs), and keyframe what changes; capture the evaluated meshes of ``geometry`` (Apparent
+    Geometry's moving meshes) at each frame and play them back (``geometry/playback.py``);
+    ``exact_final_render``: the scene's camera holds the final render's exact camera, which the
+    bake keeps (and :func:`unbake` removes). Returns counts: frames, F-curves, image sequences,
+    meshes, and ``needs_osl`` (1 where what was baked renders only in a Blender with OSL).
+    RelativityError (one line) if the frames differ in what they hold (stand-in lamps added or
+    removed) or a frame's sync is refused."""
+    if last < first:
+        raise RelativityError(f"Bake: last frame {last} before first frame {first}")
+    unbake(scene)
+    frames = list(range(first, last + 1))
+    start = scene.frame_current
+    meshes: dict[Object, list] = {obj: [] for obj in geometry}
+    try:
+        states, images = _step(scene, frames, sync_for_render, meshes)
+    except RelativityError:
+        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
+        scene.frame_set(start)
+        raise
     keys = set(states[0])
+    problem = None
     if any(set(state) != keys for state in states[1:]):
         differ = sorted({key[1] for state in states[1:] for key in keys ^ set(state)})
-        scene.frame_set(start)
-        raise RelativityError(
+        problem = (
             f"Cannot bake frames {first}-{last}: the add-on's datablocks change within them "
             f"({', '.join(differ[:3])}); bake shorter ranges"
         )
@@ -316,10 +367,23 @@ def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], obje
         for name, per_frame in images.items()
         if len(per_frame) == len(frames) and any(not np.array_equal(per_frame[0], p) for p in per_frame[1:])
     ]
-    if changing_images and not bpy.data.filepath:
+    if problem is None and changing_images and not bpy.data.filepath:
+        try:
+            _sequence_folder(scene)
+        except RelativityError as error:
+            problem = str(error)
+    if problem is not None:  # refused before anything is added
+        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
         scene.frame_set(start)
-        _sequence_folder(scene)  # refused before anything is added: the file must be saved
-    record: dict[str, Any] = {"frames": [first, last], "fcurves": [], "actions": [], "sequences": []}
+        raise RelativityError(problem)
+    record: dict[str, Any] = {
+        "frames": [first, last],
+        "fcurves": [],
+        "actions": [],
+        "sequences": [],
+        "geometry": [],
+        "exact_camera": exact_final_render,
+    }
     grouped: dict[tuple[str, str, str], list[tuple[str, int]]] = {}
     for key in sorted(keys):
         values = [state[key] for state in states]
@@ -328,6 +392,10 @@ def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], obje
     try:  # whatever was added is recorded, also when a step fails: Remove takes it out
         for owner_key, paths in grouped.items():
             block = _owner(*owner_key)
+            if block is None:
+                raise RelativityError(
+                    f"Cannot bake frames {first}-{last}: {owner_key[1]!r} was removed while baking; bake shorter ranges"
+                )
             animated = _animated_paths(block)
             for path, index in paths:
                 if (path, max(index, 0)) in animated:
@@ -337,10 +405,32 @@ def bake(scene: Scene, first: int, last: int, sync_for_render: Callable[[], obje
                 record["fcurves"].append([*owner_key, path, index])
         for name in changing_images:
             record["sequences"].append(_write_sequence(scene, bpy.data.images[name], frames, images[name]))
+        for obj, captured in meshes.items():
+            record["geometry"].append(playback.install(obj, captured, first))
     finally:
         scene[names.BAKE_RECORD_KEY] = json.dumps(record)
     scene.frame_set(start)
-    return {"frames": len(frames), "fcurves": len(record["fcurves"]), "sequences": len(record["sequences"])}
+    return {
+        "frames": len(frames),
+        "fcurves": len(record["fcurves"]),
+        "sequences": len(record["sequences"]),
+        "meshes": sum(len(set(captured)) for captured in meshes.values()),
+        # what it renders with: the exact camera (OSL), OSL script nodes of moving lights
+        "needs_osl": int(exact_final_render or not geometry or bool(scene.cycles.shading_system)),
+    }
+
+
+def holds_geometry(scene: Scene) -> bool:
+    """Whether the scene's bake plays Apparent Geometry back (the add-on then leaves the file as
+    baked: the handlers write nothing until Remove or the next bake)."""
+    stored = scene.get(names.BAKE_RECORD_KEY)
+    return isinstance(stored, str) and _plays_geometry(stored)
+
+
+@functools.lru_cache(maxsize=16)
+def _plays_geometry(stored: str) -> bool:
+    """Parsed once per record, not at every sync (every handler asks)."""
+    return bool(json.loads(stored).get("geometry"))
 
 
 def baked_frames(scene: Scene) -> tuple[int, int] | None:
@@ -396,6 +486,13 @@ def unbake(scene: Scene) -> int:
         for folder in folders:
             if os.path.isdir(folder) and not os.listdir(folder):
                 os.rmdir(folder)
+    for geometry_record in record.get("geometry", []):
+        playback.remove(geometry_record)
+    if record.get("exact_camera"):  # the Apparent Geometry final render's camera, kept for the bake
+        camera_data = scene.camera.data if scene.camera is not None else None
+        if isinstance(camera_data, bpy.types.Camera) and exact_camera.is_render_only(camera_data):
+            exact_camera.remove_data(camera_data)
+        doppler_colour.remove_camera_stage(scene)
     del scene[names.BAKE_RECORD_KEY]
     return removed
 

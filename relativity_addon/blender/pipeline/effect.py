@@ -156,20 +156,48 @@ def remove(scene: Scene) -> int:
 
 
 def bake_for_render_anywhere(scene: Scene, first: int, last: int) -> dict[str, int]:
-    """Bake frames ``first`` .. ``last`` of the set-up scene into keyframes and image sequences
-    that render without the add-on (``bake.py``). RelativityError (one line) where that cannot
-    be done: nothing set up, Apparent Geometry, no OSL in this Blender, a frame refused."""
+    """Bake frames ``first`` .. ``last`` of the set-up scene into keyframes, image sequences and
+    (Apparent Geometry) meshes played back by frame, in the final render's configuration, so that
+    they render without the add-on (``bake.py``). RelativityError (one line) where that cannot be
+    done: nothing set up, no OSL in this Blender for what needs it, a frame refused."""
     method = applied_method(scene)
     if method is None:
         raise RelativityError("Nothing to bake: press Set Up Relativistic Render first")
-    problem = bake.refusal(scene, method)
+    bake.unbake(scene)  # a bake's own camera and meshes first out: every frame is computed again
+    snap = snapshot.read(scene)
+    exact = method == "GEOMETRY" and final_render_problem(scene, snap) is None
+    problem = bake.refusal(scene, method, exact, bool(snap.moving_lights))
     if problem is not None:
         raise RelativityError(problem)
-    snap = snapshot.read(scene)
     if snap.velocity_source == "CAMERA_ANIMATION":
         snapshot.check_animation_speed(scene, first, last)
-    counts = bake.bake(scene, first, last, lambda: sync(scene, before_render=True))
+    if method == "CAMERA":
+        counts = bake.bake(scene, first, last, lambda: sync(scene, before_render=True))
+    else:
+        counts = _bake_geometry(scene, first, last, exact)
     _record(scene, snapshot.read(scene))
+    return counts
+
+
+def _bake_geometry(scene, first, last, exact):
+    """Apparent Geometry baked as its final render makes it: with ``exact``, behind the exact camera
+    (:func:`begin_final_render`; the meshes at their scene-frame retarded positions), which stays
+    for the bake; else the boosted meshes. Every applied mesh is captured at each frame."""
+
+    def frame_sync():
+        if exact:  # as F12 at this frame: the preview decides the tessellation the final render keeps
+            end_final_render(scene)
+            sync(scene)
+            begin_final_render(scene)
+        return sync(scene, before_render=True)
+
+    try:
+        counts = bake.bake(scene, first, last, frame_sync, modifier.applied_objects(scene), exact)
+    except BaseException:
+        if exact:
+            end_final_render(scene)
+        raise
+    snapshot.end_final_render(scene)  # the mark only: the camera and its colour stage are the bake's now
     return counts
 
 
@@ -196,6 +224,8 @@ def begin_final_render(scene: Scene) -> bool:
     the scene frame, so lamps, shadows and the world light them where they are
     (``snapshot.begin_final_render``). :func:`end_final_render` goes back to the boosted-mesh
     preview. Returns whether the exact camera is used; RelativityError (one line) after undoing."""
+    if bake.holds_geometry(scene):
+        return False  # baked: the bake's exact camera (if any) is in place, the meshes are played back
     if applied_method(scene) != "GEOMETRY" or snapshot.in_final_render(scene):
         return snapshot.in_final_render(scene)
     problem = final_render_problem(scene, snapshot.read(scene))
@@ -222,6 +252,8 @@ def end_final_render(scene: Scene) -> None:
     """After the render (``render_complete``, ``render_cancel``): back to the boosted-mesh preview;
     the meshes follow at the next depsgraph update or frame change (a handler of the render thread
     must not evaluate the depsgraph)."""
+    if bake.holds_geometry(scene):
+        return
     was_exact = snapshot.in_final_render(scene)
     snapshot.end_final_render(scene)
     camera_object = scene.camera
@@ -267,6 +299,8 @@ def sync(
         apparent_meshes.note_updates(depsgraph)  # also while computing: what Blender evaluated again
     if busy.is_computing():
         return None
+    if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
+        return last_snapshot(scene)
     apparent_meshes.unlink_caches()  # brought into a collection by Append
     method = applied_method(scene)
     if not snapshot.in_final_render(scene):

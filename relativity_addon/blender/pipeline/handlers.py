@@ -24,6 +24,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..camera import exact_camera
+from ..common import busy
 from . import effect, render_notice
 
 if TYPE_CHECKING:
@@ -84,6 +85,7 @@ def _tell_if_refused(scene):
 
 @persistent
 def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
+    busy.render_started()
     try:
         effect.begin_final_render(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
@@ -92,6 +94,7 @@ def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
 
 @persistent
 def render_end(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
+    busy.render_ended()
     try:
         effect.end_final_render(scene)
     except Exception as error:  # noqa: BLE001

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..camera import clamping, cockpit
-from ..colour import doppler_colour, light_groups, volumes, world_doppler
-from ..lights import lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..colour import cockpit_sky, doppler_colour, light_groups, volumes, world_doppler
+from ..lights import cockpit_lamps, lamps_on_moving_objects, lamps_seen_directly, moving_lights
 from . import metadata
 
 if TYPE_CHECKING:
@@ -135,5 +135,19 @@ STAGES: tuple[Stage, ...] = (
         write=lambda scene, snap, sync: cockpit.write(scene, snap, structural=sync.depsgraph is None),
         remove=cockpit.remove,
         warnings=cockpit.warnings,
+    ),
+    Stage(
+        "the cockpit's sky",
+        cockpit_sky,
+        apply=cockpit_sky.apply,
+        write=lambda scene, snap, sync: cockpit_sky.write(scene, snap, structural=sync.depsgraph is None),
+        remove=cockpit_sky.remove,
+    ),
+    Stage(
+        "the scene's lamps on the cockpit",
+        cockpit_lamps,
+        apply=cockpit_lamps.apply,
+        write=lambda scene, snap, sync: cockpit_lamps.write(scene, snap, structural=sync.depsgraph is None),
+        remove=cockpit_lamps.remove,
     ),
 )

@@ -17,7 +17,13 @@ shifted on the mesh path). A node group is shared by every material and group th
   a BSDF colour inside is no pass-through (one colour group cannot be both).
 
 An object's blackbody temperature (``Object.relativity.temperature``) reaches the colours of its
-materials' own nodes and their pass-throughs, not colours computed inside a shared group.
+materials' own nodes and their pass-throughs as a constant (``materials.attach``); an emission
+colour inside a shared group reads it per object instead (:func:`read_object_temperature`: an
+Object Attribute node on the custom property ``names.OBJECT_TEMPERATURE_PROPERTY``, which the colour
+stage writes on the objects while it is applied, ``doppler_colour``; 0 where the object has none),
+so every object using the group gets its own. A plain custom property, not the RNA path
+``relativity.temperature``: the Attribute node reads that only where the add-on is registered, and
+a file must render the same without it (measured: the RNA path gave the RGB path there, Delta E 26.8).
 """
 
 from __future__ import annotations
@@ -50,7 +56,7 @@ def user_groups(tree: NodeTree) -> list[Node]:
     ]
 
 
-def _group_input(socket):
+def group_input(socket: NodeSocket) -> str | None:
     """Identifier of the Group Input colour output feeding input ``socket`` through reroutes, or None."""
     for _step in range(256):
         link = sources.live_link(socket)
@@ -89,17 +95,17 @@ def pass_throughs(group_tree: NodeTree, seen: tuple[str, ...] = ()) -> dict[str,
         return {}
     kinds = {}
     for _node, socket, is_emission in targets(group_tree, (*seen, group_tree.name)):
-        identifier = _group_input(socket)
+        identifier = group_input(socket)
         if identifier is not None:
             kinds.setdefault(identifier, set()).add(is_emission)
     return {identifier: next(iter(found)) for identifier, found in kinds.items() if len(found) == 1}
 
 
 def attach_groups(
-    tree: NodeTree, insert: Callable[[NodeTree, Node, NodeSocket, bool], object], seen: tuple[str, ...] = ()
+    tree: NodeTree, insert: Callable[[NodeTree, Node, NodeSocket, bool], list], seen: tuple[str, ...] = ()
 ) -> None:
     """Colour groups into every user group used in ``tree`` (at any depth) not yet attached:
-    ``insert(tree, node, socket, is_emission)`` puts one in and returns its record."""
+    ``insert(tree, node, socket, is_emission)`` puts one in and returns its records."""
     for node in user_groups(tree):
         group_tree = node.node_tree
         if group_tree.name in seen:
@@ -107,12 +113,41 @@ def attach_groups(
         if KEY not in group_tree:
             passed = pass_throughs(group_tree)
             records = [
-                insert(group_tree, target, socket, is_emission)
+                record
                 for target, socket, is_emission in list(targets(group_tree))
-                if passed.get(_group_input(socket)) != is_emission
+                if passed.get(group_input(socket) or "") != is_emission
+                for record in insert(group_tree, target, socket, is_emission)
             ]
             group_tree[KEY] = records
         attach_groups(group_tree, insert, (*seen, group_tree.name))
+
+
+def read_object_temperature(tree: NodeTree, colour_node: Node) -> list[dict[str, str]]:
+    """Feed colour group ``colour_node`` (inside a shared group's ``tree``) the rendered object's
+    blackbody temperature: Is Blackbody where it is above 0, Temperature its value (at least
+    100 K, so that the unused blackbody branch stays finite); nothing for a colour already
+    recognised as a blackbody. Returns the records that remove the nodes it added."""
+    if colour_node.inputs["Is Blackbody"].default_value or colour_node.inputs["Is Blackbody"].is_linked:
+        return []
+    attribute = tree.nodes.new("ShaderNodeAttribute")
+    attribute.attribute_type = "OBJECT"
+    attribute.attribute_name = names.OBJECT_TEMPERATURE_PROPERTY
+    is_blackbody = tree.nodes.new("ShaderNodeMath")
+    is_blackbody.operation = "GREATER_THAN"
+    is_blackbody.inputs[1].default_value = 0.0
+    temperature = tree.nodes.new("ShaderNodeMath")
+    temperature.operation = "MAXIMUM"
+    temperature.inputs[1].default_value = 100.0
+    tree.links.new(attribute.outputs["Fac"], is_blackbody.inputs[0])
+    tree.links.new(attribute.outputs["Fac"], temperature.inputs[0])
+    tree.links.new(is_blackbody.outputs[0], colour_node.inputs["Is Blackbody"])
+    tree.links.new(temperature.outputs[0], colour_node.inputs["Temperature"])
+    records = []
+    for role, node in (("Attribute", attribute), ("Is Blackbody", is_blackbody), ("Temperature", temperature)):
+        node.name = node.label = f"{colour_node.name} Object Temperature {role}"
+        node.location, node.hide = (colour_node.location.x - 200.0, colour_node.location.y - 40.0), True
+        records.append({"group_node": node.name, "target": "", "socket": "", "source_node": "", "source_socket": ""})
+    return records
 
 
 def detach_all(detach_records: Callable[..., object]) -> None:

@@ -126,6 +126,51 @@ def check_object_velocities(scene: Scene, method: str) -> None:
         raise RelativityError("; ".join(problems))
 
 
+# Quarter frames: the keyframed speeds that bound the sample clamps (``fastest_speed``).
+_SPEED_STEP_FRAMES = 0.25
+_SPEED_SAMPLES = 4096
+_keyframed_speeds: dict[str, tuple[tuple, float]] = {}
+
+
+def fastest_speed(scene: Scene) -> float:
+    """The largest speed ``|beta|`` among the scene's objects with their own velocity (meshes and
+    lights): Constant Velocity's setting; with Animation the fastest its keyframes move it over
+    the scene's frame range (every quarter frame; kept while its keyframes are the same). Below 1:
+    what reaches the speed of light is refused elsewhere."""
+    fastest = 0.0
+    for obj in scene.objects:
+        if not has_own_velocity(obj):
+            continue
+        settings = obj.relativity
+        if settings.motion == "CONSTANT":
+            speed = float(np.linalg.norm(np.asarray(tuple(settings.beta), dtype=np.float64)))
+        else:
+            speed = _keyframed_speed(obj, scene)
+        fastest = max(fastest, speed)
+    return min(fastest, 1.0 - 1e-9)
+
+
+def _keyframed_speed(obj, scene):
+    c = float(scene.relativity.speed_of_light)
+    fps = animation.frames_per_second(scene)
+    key = (animation.keyframes_signature(obj), scene.frame_start, scene.frame_end, fps, c)
+    known = _keyframed_speeds.get(obj.name)
+    if key[0] is not None and known is not None and known[0] == key:
+        return known[1]
+    count = min(int((scene.frame_end - scene.frame_start) / _SPEED_STEP_FRAMES) + 2, _SPEED_SAMPLES)
+    frames = np.linspace(scene.frame_start - _SPEED_STEP_FRAMES, scene.frame_end, count)
+    try:
+        positions = animation.world_matrices(obj, frames)[:, :3, 3]
+    except RelativityError:  # a motion its keyframes do not give: refused where it is drawn
+        return 0.0
+    if c <= 0.0 or len(frames) < 2:
+        return 0.0
+    steps = np.linalg.norm(np.diff(positions, axis=0), axis=-1) / (np.diff(frames) / fps)
+    speed = float(np.max(steps)) / c
+    _keyframed_speeds[obj.name] = (key, speed)
+    return speed
+
+
 # Frames of the scene's range (fractions of it) at which a Static mesh's keyframed place is compared.
 _RANGE_SAMPLES = (0.0, 0.25, 0.5, 0.75, 1.0)
 

@@ -334,14 +334,15 @@ def moving_lights(
             found += _emitter_light(scene, obj, frame, depsgraph)
             continue
         if obj.type == "LIGHT" and cockpit.moves_with_camera(obj) and not light_render_hidden(obj):
-            # uniform at the camera's velocity at the frame, also when that comes from its keyframes
-            # (the keyframed path crashed Blender 5.2 at frame changes with the cockpit's layer)
-            motion = "CONSTANT"
+            # with the camera: its keyframed path when the velocity comes from the camera's keyframes
+            # (an accelerating camera's lamp), else uniform at the camera's velocity
+            animated = scene.relativity.velocity_source == "CAMERA_ANIMATION"
+            motion = "ANIMATION" if animated else "CONSTANT"
             if not any(observer):
                 continue  # at rest with the camera at rest: Blender's own light
         elif obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
             continue
-        if cockpit.moves_with_camera(obj):
+        if cockpit.moves_with_camera(obj) and motion == "CONSTANT":
             beta = tuple(observer)
         else:
             beta = obj.relativity.beta if motion == "CONSTANT" else _keyframe_beta(scene, obj, frame)

@@ -168,8 +168,9 @@ class RELATIVITY_OT_render_spectral(Operator):
 
 
 class RELATIVITY_OT_bake_render_anywhere(Operator):
-    """Write what the add-on computes per frame into keyframes and image sequences, so that the
-    file renders these frames without the add-on (plain Blender, scripts disabled)"""
+    """Write what the add-on computes per frame into keyframes, image sequences and (Apparent
+    Geometry) meshes played back by frame, so that the file renders these frames without the
+    add-on (plain Blender, scripts disabled)"""
 
     bl_idname = "relativity.bake_render_anywhere"
     bl_label = "Bake for Render Anywhere"
@@ -201,10 +202,12 @@ class RELATIVITY_OT_bake_render_anywhere(Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         images = f", {counts['sequences']} image sequence(s) beside the file" if counts["sequences"] else ""
+        meshes = f", {counts['meshes']} meshes played back by frame" if counts.get("meshes") else ""
+        where = " in a Blender with OSL (Cycles on the CPU: OSL shaders)" if counts.get("needs_osl", 1) else ""
         self.report(
             {"INFO"},
-            f"Baked frames {first}-{last}: {counts['fcurves']} animated values{images}; the file renders "
-            "them without the add-on, in a Blender with OSL (Cycles on the CPU: the exact camera is an OSL shader)",
+            f"Baked frames {first}-{last}: {counts['fcurves']} animated values{images}{meshes}; the file renders "
+            f"them without the add-on{where}",
         )
         return {"FINISHED"}
 

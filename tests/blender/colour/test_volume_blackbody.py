@@ -98,10 +98,12 @@ def test_principled_volume_blackbody_is_seen_at_d_t(relativity_addon, tmp_path):
     assert len(material.node_tree.nodes) == 2
 
 
-def test_volumes_with_temperature_grids_are_left_to_the_rgb_shift_with_a_warning(relativity_addon):
-    """A Volume object (OpenVDB grids) multiplies its Temperature by a temperature grid, which the
-    correction does not follow: its material gets no correction nodes, the scene's warnings name
-    it, and the mesh gas beside it is still corrected."""
+def test_volumes_with_temperature_grids_read_the_grid_and_only_uncorrectable_ones_warn(relativity_addon):
+    """A Volume object (OpenVDB grids) multiplies its Temperature by a temperature grid: its
+    material gets the correction with an Attribute node reading the grid its Temperature Attribute
+    names, shifted by the bolometric rule (test_volume_temperature_grid.py measures it). A copy
+    with a surface shader of its own cannot be corrected: it keeps the RGB shift, and the scene's
+    warnings name it."""
     bpy = __import__("bpy")
     from relativity_addon.blender.colour import volumes
     from relativity_addon.blender.pipeline import effect
@@ -109,9 +111,14 @@ def test_volumes_with_temperature_grids_are_left_to_the_rgb_shift_with_a_warning
     scene, _camera, material = _scene(bpy)
     grid_material = material.copy()
     grid_material.name = "Fire"
-    volume_object = bpy.data.objects.new("Smoke", bpy.data.volumes.new("Smoke"))
-    volume_object.data.materials.append(grid_material)
-    scene.collection.objects.link(volume_object)
+    surfaced = material.copy()
+    surfaced.name = "Sooty"
+    tree = surfaced.node_tree
+    tree.links.new(tree.nodes.new("ShaderNodeBsdfDiffuse").outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    for name, mat in (("Smoke", grid_material), ("Soot", surfaced)):
+        volume_object = bpy.data.objects.new(name, bpy.data.volumes.new(name))
+        volume_object.data.materials.append(mat)
+        scene.collection.objects.link(volume_object)
     scene.relativity.method = "CAMERA"
     scene.relativity.beta = BETA
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
@@ -119,8 +126,14 @@ def test_volumes_with_temperature_grids_are_left_to_the_rgb_shift_with_a_warning
     def corrected(mat):
         return any(node.name.startswith(volumes.NODE_PREFIX) for node in mat.node_tree.nodes)
 
-    assert corrected(material) and not corrected(grid_material)
-    (warning,) = [line for line in effect.scene_warnings(scene) if "temperature grid" in line]
-    assert "'Smoke'" in warning and "'Fire'" in warning
+    assert corrected(material) and corrected(grid_material) and not corrected(surfaced)
+    readers = [node for node in grid_material.node_tree.nodes if node.bl_idname == "ShaderNodeAttribute"]
+    assert [(node.attribute_type, node.attribute_name) for node in readers] == [("GEOMETRY", "temperature")]
+    group = grid_material.node_tree.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
+    assert group.inputs["Bolometric"].default_value == 1.0 and group.inputs["Grid"].is_linked
+    assert not any(node.bl_idname == "ShaderNodeAttribute" for node in material.node_tree.nodes)  # a mesh: no grid
+    (warning,) = [line for line in effect.scene_warnings(scene) if "RGB colour shift" in line]
+    assert "'Soot'" in warning and "'Sooty'" in warning
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
-    assert not corrected(material)
+    assert not corrected(material) and not corrected(grid_material)
+    assert len(grid_material.node_tree.nodes) == 2

@@ -160,6 +160,33 @@ def _slab_scene(bpy, scattering):
     return scene, camera
 
 
+def _into_group(bpy, material, name, colour_from_outside=None):
+    """Move the volume node ``name`` of ``material`` into a new node group (its Volume output in
+    place of the node's); ``colour_from_outside``: that input comes from the group node's own
+    Color input (a pass-through), set there."""
+    tree = material.node_tree
+    node = tree.nodes[name]
+    group = bpy.data.node_groups.new(f"{name} Group", "ShaderNodeTree")
+    group.interface.new_socket(name="Volume", in_out="OUTPUT", socket_type="NodeSocketShader")
+    inner = group.nodes.new(node.bl_idname)
+    for socket in node.inputs:
+        if hasattr(socket, "default_value") and socket.enabled:
+            inner.inputs[socket.identifier].default_value = socket.default_value
+    outputs = group.nodes.new("NodeGroupOutput")
+    group.links.new(inner.outputs[0], outputs.inputs[0])
+    user = tree.nodes.new("ShaderNodeGroup")
+    user.node_tree = group
+    if colour_from_outside is not None:
+        group.interface.new_socket(name="Color", in_out="INPUT", socket_type="NodeSocketColor")
+        inputs = group.nodes.new("NodeGroupInput")
+        group.links.new(inputs.outputs[0], inner.inputs[colour_from_outside])
+        user.inputs["Color"].default_value = node.inputs[colour_from_outside].default_value
+    for link in list(node.outputs[0].links):
+        tree.links.new(user.outputs[0], link.to_socket)
+    tree.nodes.remove(node)
+    return group
+
+
 def _through(wall, glow, extinction, length):
     """Radiance leaving a slab of ``length`` with this extinction and emission per metre ``glow``,
     the wall's ``wall`` behind it: ``wall T + glow (1 - T) / sigma``, ``T = exp(-sigma length)``."""
@@ -177,15 +204,21 @@ def _extinction(colour, scattering):
     return {"left": principled, "right": other}
 
 
-@pytest.mark.parametrize("scattering", [False, True])
-def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_path, scattering):
+@pytest.mark.parametrize(("scattering", "grouped"), [(False, False), (True, False), (False, True)])
+def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_path, scattering, grouped):
     """The wall's up-sampled spectrum times Beer-Lambert's transmittance per wavelength, shifted:
     ``D^5 S(lambda D) exp(-sigma_t(lambda D) l)``, ``l`` the slab's thickness over the pixel's
-    scene-frame ``|k_z|``."""
+    scene-frame ``|k_z|``. ``grouped``: the volume shaders inside node groups (the Principled
+    Volume's colours set inside its group, the Volume Absorption's Color fed from the group node)."""
     bpy = __import__("bpy")
     scene, camera = _slab_scene(bpy, scattering)
     thickness = SLAB[1] - SLAB[0]
     trees = [bpy.data.materials[name].node_tree for name in ("Principled", "Other")]
+    if grouped:
+        trees += [
+            _into_group(bpy, bpy.data.materials["Principled"], "Principled Volume"),
+            _into_group(bpy, bpy.data.materials["Other"], "Volume Absorption", colour_from_outside="Color"),
+        ]
 
     def state():
         return [
@@ -266,7 +299,11 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     assert bpy.ops.relativity.render_spectral.poll()
     with pytest.raises(RuntimeError, match="temperature grid"):
         bpy.ops.relativity.render_spectral()
+    # without the blackbody (set where the user sets it: before Set Up, which links the fast
+    # mode's correction into a grid blackbody's intensity)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     fire.node_tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
+    _set_up(bpy, scene)
     spectral_render.check(scene)  # accepted
 
     mixed = dh.volume_material(bpy, "Mixed", Density=0.0, Blackbody_Intensity=1.0, Temperature=2000.0)
@@ -279,10 +316,21 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
     tree.nodes["Principled Volume"].inputs["Blackbody Intensity"].default_value = 0.0
 
     inner = bpy.data.node_groups.new("Smoke Shader", "ShaderNodeTree")
-    inner.nodes.new("ShaderNodeVolumeAbsorption")
+    inner.nodes.new("ShaderNodeVolumeAbsorption")  # carried (test_emitter_seen_through_volumes_in_spectral_mode)
     grouped = tree.nodes.new("ShaderNodeGroup")
     grouped.node_tree = inner
-    assert "volume shaders inside the node group" in refusal()
+    spectral_render.check(scene)
+    flame = inner.nodes.new("ShaderNodeVolumePrincipled")
+    flame.inputs["Blackbody Intensity"].default_value = 1.0
+    message = refusal()
+    assert "blackbody of 'Principled Volume' inside the node group 'Smoke Shader'" in message, message
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")
+    effect.sync(scene)
+    (warning,) = [line for line in effect.scene_warnings(scene) if "inside the node group" in line]
+    assert "'Mixed'" in warning and "'Smoke Shader'" in warning and "RGB colour shift" in warning
+    inner.nodes.remove(flame)
+    inner.nodes.new("ShaderNodeVolumeCoefficients")
+    assert "inside the node group 'Smoke Shader'" in refusal() and "RGB coefficients" in refusal()
     tree.nodes.remove(grouped)
 
     world_tree = scene.world.node_tree

@@ -203,3 +203,31 @@ def keyframe_linear(obj, path, index, points):
     fcurve.extrapolation = "LINEAR"
     fcurve.update()
     return fcurve
+
+
+def coloured_emission(bpy, name, colour):
+    material = ch.emission_material(bpy, name)
+    material.node_tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
+    return material
+
+
+def clock_face(bpy, scene, radius):
+    """A linked object "Clock" with Apparent Geometry on: a red dot at its origin (the centre) and
+    a green dot at (``radius``, 0, 0) (the hand's tip)."""
+    import bmesh
+
+    mesh = bpy.data.meshes.new("Clock")
+    bm = bmesh.new()
+    for index, offset in enumerate(((0.0, 0.0, 0.0), (radius, 0.0, 0.0))):
+        created = bmesh.ops.create_uvsphere(bm, u_segments=16, v_segments=8, radius=0.09)
+        bmesh.ops.translate(bm, vec=offset, verts=created["verts"])
+        for face in {f for v in created["verts"] for f in v.link_faces}:
+            face.material_index = index
+    bm.to_mesh(mesh)
+    bm.free()
+    mesh.materials.append(coloured_emission(bpy, "Centre", (1.0, 0.0, 0.0)))
+    mesh.materials.append(coloured_emission(bpy, "Tip", (0.0, 1.0, 0.0)))
+    clock = bpy.data.objects.new("Clock", mesh)
+    scene.collection.objects.link(clock)
+    clock.relativity.enabled = True
+    return clock

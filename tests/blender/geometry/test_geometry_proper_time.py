@@ -27,30 +27,10 @@ FRAME = 48  # t_o = 2 s
 DISTANCE = 8.0
 
 
-def _emission(bpy, name, colour):
-    material = ch.emission_material(bpy, name)
-    material.node_tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
-    return material
-
-
 def _clock(bpy, scene, location, beta):
     """One object: a red dot at its origin (the centre) and a green dot at (RADIUS, 0, 0) (the hand's
     tip), turning about its local Z at OMEGA rad/s by linear rotation keys."""
-    import bmesh
-
-    mesh = bpy.data.meshes.new("Clock")
-    bm = bmesh.new()
-    for index, offset in enumerate(((0.0, 0.0, 0.0), (RADIUS, 0.0, 0.0))):
-        created = bmesh.ops.create_uvsphere(bm, u_segments=16, v_segments=8, radius=0.09)
-        bmesh.ops.translate(bm, vec=offset, verts=created["verts"])
-        for face in {f for v in created["verts"] for f in v.link_faces}:
-            face.material_index = index
-    bm.to_mesh(mesh)
-    bm.free()
-    mesh.materials.append(_emission(bpy, "Centre", (1.0, 0.0, 0.0)))
-    mesh.materials.append(_emission(bpy, "Tip", (0.0, 1.0, 0.0)))
-    clock = bpy.data.objects.new("Clock", mesh)
-    scene.collection.objects.link(clock)
+    clock = gh.clock_face(bpy, scene, RADIUS)
     clock.location = location
     for frame in (0, 240):
         clock.rotation_euler = (0.0, 0.0, OMEGA * frame / FPS)
@@ -58,7 +38,6 @@ def _clock(bpy, scene, location, beta):
     for fcurve in ch.compat.action_fcurves(clock.animation_data):
         for point in fcurve.keyframe_points:
             point.interpolation = "LINEAR"
-    clock.relativity.enabled = True
     clock.relativity.motion = "CONSTANT"
     clock.relativity.beta = beta
     return clock

@@ -39,12 +39,6 @@ def _hyperbolic(t):
     return C * C / ACCELERATION * (np.sqrt(1.0 + at * at) - 1.0)
 
 
-def _emission(bpy, name, colour):
-    material = ch.emission_material(bpy, name)
-    material.node_tree.nodes["Emission"].inputs["Color"].default_value = (*colour, 1.0)
-    return material
-
-
 def _linear(obj):
     for fcurve in ch.compat.action_fcurves(obj.animation_data):
         for point in fcurve.keyframe_points:
@@ -53,22 +47,7 @@ def _linear(obj):
 
 def _face(bpy, scene):
     """A red dot at the origin (the centre) and a green dot at (RADIUS, 0, 0) (the tip), tessellation 0."""
-    import bmesh
-
-    mesh = bpy.data.meshes.new("Clock")
-    bm = bmesh.new()
-    for index, offset in enumerate(((0.0, 0.0, 0.0), (RADIUS, 0.0, 0.0))):
-        created = bmesh.ops.create_uvsphere(bm, u_segments=16, v_segments=8, radius=0.09)
-        bmesh.ops.translate(bm, vec=offset, verts=created["verts"])
-        for face in {f for v in created["verts"] for f in v.link_faces}:
-            face.material_index = index
-    bm.to_mesh(mesh)
-    bm.free()
-    mesh.materials.append(_emission(bpy, "Centre", (1.0, 0.0, 0.0)))
-    mesh.materials.append(_emission(bpy, "Tip", (0.0, 1.0, 0.0)))
-    clock = bpy.data.objects.new("Clock", mesh)
-    scene.collection.objects.link(clock)
-    clock.relativity.enabled = True
+    clock = gh.clock_face(bpy, scene, RADIUS)
     clock.relativity.tessellation = 0
     return clock
 

@@ -62,6 +62,15 @@ def save_blend(bpy, path):
     return Path(path)
 
 
+def moving_camera_blend(bpy, path, last_frame):
+    """A saved file: the camera keyframed from the origin along -Z over frames 1 to ``last_frame``
+    (each frame sees the emissive sphere from elsewhere), 32x32."""
+    scene, camera, _ = new_scene(bpy, resolution=(32, 32))
+    scene.frame_start, scene.frame_end = 1, last_frame
+    keyframe_camera_path(camera, [(1, (0.0, 0.0, 0.0)), (last_frame, (0.3, 0.15, -1.5))])
+    return save_blend(bpy, path)
+
+
 def _env():
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
@@ -102,3 +111,27 @@ def centroid(intensity):
     total = intensity.sum()
     rows, columns = np.mgrid[0 : intensity.shape[0], 0 : intensity.shape[1]]
     return np.array([((columns + 0.5) * intensity).sum() / total, ((rows + 0.5) * intensity).sum() / total])
+
+
+def render_plain_animation(blend, out_dir, frames, name="plain"):
+    """``blender -b blend -a`` in a fresh process: no add-on, no colour-science, scripts disabled.
+    Returns the paths of ``frames`` (the file's frame range) as OpenEXR files in ``out_dir``."""
+    worker = (
+        "import os, sys\n"
+        "sys.modules['colour'] = None\n"
+        "import bpy\n"
+        "bpy.context.preferences.filepaths.use_scripts_auto_execute = False\n"
+        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, use_scripts=False)\n"
+        "scene = bpy.context.scene\n"
+        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
+        "assert not bpy.app.handlers.frame_change_pre and not bpy.app.handlers.render_pre, 'handlers installed'\n"
+        f"scene.render.filepath = {str(out_dir / (name + '_####'))!r}\n"
+        "scene.render.use_file_extension = True\n"
+        "scene.render.image_settings.file_format = 'OPEN_EXR'\n"
+        "scene.render.image_settings.color_depth = '32'\n"
+        "bpy.ops.render.render(animation=True)\n"
+        "sys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"  # bpy 4.5 can hang in exit()
+    )
+    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return [out_dir / f"{name}_{frame:04d}.exr" for frame in frames]

@@ -19,7 +19,7 @@ import pytest
 import scene_dump
 
 from blender_support import ADDON_MODULE
-from pipeline_helpers import ch
+from pipeline_helpers import ch, render_plain_animation
 
 FRAMES = (1, 2, 3)
 FPS = 24.0
@@ -90,29 +90,6 @@ def build_flythrough(bpy):
     return scene
 
 
-def render_plain_animation(blend, out_dir, name="plain"):
-    """``blender -b blend -a`` in a fresh process: no add-on, no colour-science, scripts disabled."""
-    worker = (
-        "import os, sys\n"
-        "sys.modules['colour'] = None\n"
-        "import bpy\n"
-        "bpy.context.preferences.filepaths.use_scripts_auto_execute = False\n"
-        f"bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, use_scripts=False)\n"
-        "scene = bpy.context.scene\n"
-        "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
-        "assert not bpy.app.handlers.frame_change_pre and not bpy.app.handlers.render_pre, 'handlers installed'\n"
-        f"scene.render.filepath = {str(out_dir / (name + '_####'))!r}\n"
-        "scene.render.use_file_extension = True\n"
-        "scene.render.image_settings.file_format = 'OPEN_EXR'\n"
-        "scene.render.image_settings.color_depth = '32'\n"
-        "bpy.ops.render.render(animation=True)\n"
-        "sys.stdout.flush()\nsys.stderr.flush()\nos._exit(0)\n"  # bpy 4.5 can hang in exit()
-    )
-    result = subprocess.run([sys.executable, "-c", worker], capture_output=True, text=True, timeout=600)
-    assert result.returncode == 0, result.stderr[-2000:]
-    return [out_dir / f"{name}_{frame:04d}.exr" for frame in FRAMES]
-
-
 def test_baked_flythrough_renders_the_same_frames_without_the_add_on(relativity_addon, factory_blender, tmp_path):
     bpy = factory_blender
     scene = build_flythrough(bpy)
@@ -128,10 +105,12 @@ def test_baked_flythrough_renders_the_same_frames_without_the_add_on(relativity_
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
     assert bpy.ops.relativity.bake_render_anywhere(frame_start=FRAMES[0], frame_end=FRAMES[-1]) == {"FINISHED"}
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
-    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path)]
+    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
     differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
     # the control: the same file not baked, rendered the same way, plays frame 3's state only
-    unbaked = [ch.read_exr(bpy, p) for p in render_plain_animation(tmp_path / "unbaked.blend", tmp_path, "unbaked")]
+    unbaked = [
+        ch.read_exr(bpy, p) for p in render_plain_animation(tmp_path / "unbaked.blend", tmp_path, FRAMES, "unbaked")
+    ]
     stale = [float(np.abs(u - o).mean()) for u, o in zip(unbaked, own, strict=True)]
     moving = float(np.abs(own[-1] - own[0]).mean())
     print(
@@ -161,22 +140,16 @@ def test_remove_takes_the_bake_out(relativity_addon, factory_blender, tmp_path):
     assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
 
 
-@pytest.mark.parametrize("method", ["CAMERA", "GEOMETRY"])
-def test_bake_refused_with_the_reason(relativity_addon, factory_blender, monkeypatch, method):
-    """No OSL in this Blender: the exact camera cannot be baked (it is an OSL shader); Apparent
-    Geometry is refused as not baked yet. One line, nothing added."""
+def test_bake_refused_with_the_reason(relativity_addon, factory_blender, monkeypatch):
+    """No OSL in this Blender: the exact camera cannot be baked (it is an OSL shader). One line,
+    nothing added. (Apparent Geometry: test_bake_apparent_geometry.py.)"""
     bpy = factory_blender
     scene = build_flythrough(bpy)
     effect = _effect()
     osl = importlib.import_module(f"{ADDON_MODULE}.blender.common.osl")
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
-    if method == "CAMERA":
-        monkeypatch.setattr(osl, "unavailable_reason", lambda: "This Blender build has no OSL (Open Shading Language)")
-        expected = "OSL"
-    else:
-        monkeypatch.setattr(effect, "applied_method", lambda _scene: "GEOMETRY")
-        expected = "Apparent Geometry"
-    with pytest.raises(effect.RelativityError, match=expected):
+    monkeypatch.setattr(osl, "unavailable_reason", lambda: "This Blender build has no OSL (Open Shading Language)")
+    with pytest.raises(effect.RelativityError, match="OSL"):
         effect.bake_for_render_anywhere(scene, 1, 3)
     assert "relativity_render_anywhere" not in scene.keys()
 
@@ -196,7 +169,7 @@ def test_render_script_bakes_a_file_that_renders_its_frames_without_the_add_on(
     assert "baked frames 1-3" in result.stdout, result.stdout[-2000:]
     ch.run_render_script(blend, tmp_path / "own.exr", *options, timeout=600)
     own = [ch.read_exr(bpy, tmp_path / f"own_{frame:04d}.exr") for frame in FRAMES]
-    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path)]
+    plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
     differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
     print(f"mean |baked - render.py| per frame {differences}")
     assert max(differences) < 1e-3 * float(np.mean([o.mean() for o in own])), differences

@@ -22,12 +22,8 @@ DONE = re.compile(r"render\.py: frame (\d+) done in [\d.]+ s \(task [\d.]+ s\) o
 
 @pytest.fixture
 def moving_blend(factory_blender, tmp_path):
-    """Camera keyframed along -Z (each frame sees the sphere from elsewhere), emissive sphere."""
-    bpy = factory_blender
-    scene, camera, _ = wh.new_scene(bpy, resolution=(32, 32))
-    scene.frame_start, scene.frame_end = 1, 8
-    wh.keyframe_camera_path(camera, [(1, (0.0, 0.0, 0.0)), (8, (0.3, 0.15, -1.5))])
-    return wh.save_blend(bpy, tmp_path / "moving.blend")
+    """Camera keyframed along -Z over frames 1-8, emissive sphere."""
+    return wh.moving_camera_blend(factory_blender, tmp_path / "moving.blend", 8)
 
 
 def _done(stdout):

@@ -53,9 +53,9 @@ def test_gallery_figure_names_ignore_blender_log_lines(tmp_path):
     """The names are those of the figures in docs/gallery, whatever Blender prints besides."""
     names = _figure_names([sys.executable, "-c", NOISY_PYTHON], tmp_path)
     in_docs = [path.stem for path in (wh.REPO_ROOT / "docs" / "gallery").glob("*.png") if path.stem != "contact_sheet"]
-    assert len(in_docs) == 26
+    assert len(in_docs) == 27
     assert sorted(names) == sorted(in_docs)
-    assert all(re.fullmatch(r"(weiskopf|gray)_[a-z0-9_]+", name) for name in names), names
+    assert all(re.fullmatch(r"(weiskopf|gray|cockpit)_[a-z0-9_]+", name) for name in names), names
 
 
 def _y(temperature):
@@ -111,7 +111,7 @@ def test_contact_sheet_labels_every_panel(factory_blender, tmp_path):
 
 def test_gallery_renders_every_figure(factory_blender, tmp_path):
     names = _figure_names([sys.executable], tmp_path)
-    assert len(names) == 26
+    assert len(names) == 27
     result = subprocess.run(
         [sys.executable, str(GALLERY_SCRIPT), f"--out={tmp_path}", "--size=64x48", "--samples=2"],
         capture_output=True,

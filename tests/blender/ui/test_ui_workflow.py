@@ -407,3 +407,36 @@ def test_clamping_follows_the_searchlight(relativity_addon, factory_blender):
     scene.relativity.beta = (0.0, 0.0, -0.8)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert (scene.cycles.sample_clamp_direct, scene.cycles.sample_clamp_indirect) == (2.0, 10.0)
+
+
+def test_clamping_follows_moving_objects(relativity_addon, factory_blender):
+    """Apparent Geometry, camera at rest, a mesh keyframed at 0.5c (linear keys): each clamp is the
+    user's times ``(gamma (1 + beta))^6`` = 27 (eq. 18's D^2 on a lamp's light, then the object's
+    D^4); at Constant Velocity 0.6c, 64; nothing moving: the user's."""
+    bpy = factory_blender
+    scene, camera, sphere = wh.new_scene(bpy)
+    scene.relativity.method = "GEOMETRY"
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    scene.cycles.sample_clamp_indirect = 10.0
+    scene.frame_start, scene.frame_end = 1, 24
+    fps = scene.render.fps / scene.render.fps_base
+    speed = 0.5 * scene.relativity.speed_of_light  # units per second
+    for frame in (1, 24):
+        sphere.location = (speed * (frame - 1) / fps, 0.0, -5.0)
+        sphere.keyframe_insert("location", index=0, frame=frame)
+    for fcurve in compat.action_fcurves(sphere.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    sphere.relativity.enabled = True
+    sphere.relativity.motion = "ANIMATION"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    assert scene.cycles.sample_clamp_indirect == pytest.approx(270.0, rel=1e-3)
+    sphere.relativity.motion = "CONSTANT"
+    sphere.relativity.beta = (0.6, 0.0, 0.0)
+    scene.frame_set(scene.frame_current)
+    assert scene.cycles.sample_clamp_indirect == pytest.approx(640.0, rel=1e-3)
+    sphere.relativity.motion = "STATIC"
+    scene.frame_set(scene.frame_current)
+    assert scene.cycles.sample_clamp_indirect == pytest.approx(10.0, rel=1e-5)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert scene.cycles.sample_clamp_indirect == 10.0

@@ -1,0 +1,126 @@
+"""A Volume object whose blackbody reads a temperature grid is seen at ``D T`` per point (fast mode).
+
+A VDB written with Blender's bundled ``openvdb`` module: a ``temperature`` grid of 2.5 where
+x < 0 and 4.0 where x > 0 over a 6 x 4 x 2 m slab, read by a Principled Volume (density 0,
+Blackbody Intensity 1, Temperature 1000 K, Temperature Attribute ``temperature``): Cycles emits
+``sigma T^4`` times a unit-luminance blackbody colour at ``T`` = 2500 K and 4000 K, fading to 0 K
+at the grid's edges. Observer moving toward it at 0.5c. The rule (docs/spectral-model.md,
+"Temperature grids"): a blackbody whose total is ``sigma T^4`` is seen as one at ``D T`` with
+total ``sigma (D T)^4``, so each half must be seen as colour-science's blackbody at ``D T`` and
+its luminance must change by ``D^4`` (Weiskopf et al. 1999 eq. 15, docs/physics.md) times the
+slab's path-length change under aberration, ``D`` from each pixel's viewing direction.
+"""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_volume_blackbody import _slab_path_ratio
+
+import colour_helpers as dh
+
+RESOLUTION = (64, 48)
+BETA = (0.0, 0.0, -0.5)
+BASE_TEMPERATURE = 1000.0
+HALVES = {"cool": (2.5, (slice(20, 28), slice(18, 26))), "hot": (4.0, (slice(20, 28), slice(38, 46)))}
+VOXEL = 0.1  # m
+
+
+def _openvdb(bpy):
+    """Blender's bundled ``openvdb`` module (the wheel ships it outside ``sys.path``)."""
+    version = ".".join(bpy.app.version_string.split(".")[:2])
+    python = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    folder = Path(bpy.__file__).parent / version / "python" / "lib" / python / "site-packages"
+    if str(folder) not in sys.path:
+        sys.path.append(str(folder))
+    import openvdb
+
+    return openvdb
+
+
+def write_two_temperature_vdb(bpy, path):
+    """A ``temperature`` grid over x in [-3, 3], y in [-2, 2], z in [-6, -4] (voxel centres):
+    2.5 for x < 0, 4.0 for x > 0."""
+    openvdb = _openvdb(bpy)
+    counts = (61, 41, 21)
+    values = np.empty(counts, dtype=np.float32)
+    x = -3.0 + VOXEL * np.arange(counts[0])
+    values[...] = np.where(x < -1e-6, HALVES["cool"][0], HALVES["hot"][0])[:, None, None]
+    values[np.abs(x) < 1e-6] = 0.5 * (HALVES["cool"][0] + HALVES["hot"][0])
+    grid = openvdb.FloatGrid()
+    grid.name = "temperature"
+    grid.transform = openvdb.createLinearTransform(voxelSize=VOXEL)
+    grid.copyFromArray(values, ijk=(-30, -20, -60))
+    openvdb.write(str(path), grids=[grid])
+
+
+def grid_scene(bpy, tmp_path, samples=16):
+    scene, camera = dh.emitter_scene(bpy, samples=samples, resolution=RESOLUTION)
+    path = tmp_path / "temperature.vdb"
+    write_two_temperature_vdb(bpy, path)
+    material = dh.volume_material(bpy, "Fire", Density=0.0, Blackbody_Intensity=1.0, Temperature=BASE_TEMPERATURE)
+    material.node_tree.nodes["Principled Volume"].inputs["Temperature Attribute"].default_value = "temperature"
+    volume = bpy.data.volumes.new("Fire")
+    volume.filepath = str(path)
+    volume.materials.append(material)
+    obj = bpy.data.objects.new("Fire", volume)
+    scene.collection.objects.link(obj)
+    return scene, camera, material
+
+
+def _xyz(image, window):
+    return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3))
+
+
+@pytest.mark.parametrize("searchlight", [True, False], ids=["searchlight", "rest_brightness"])
+def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path, searchlight):
+    """With the searchlight off (Doppler only, Rest Brightness) the power is 0: ``D^0``, the rest
+    luminance with the colour of ``D T``."""
+    bpy = __import__("bpy")
+    power = 4 if searchlight else 0
+    scene, camera, material = grid_scene(bpy, tmp_path)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {}
+    for name, (grid, window) in HALVES.items():
+        xyz = _xyz(rest, window)
+        y_rest[name] = xyz[:, 1]
+        assert y_rest[name].min() > 0.05, name
+        # the setup: Cycles' rest colour is the blackbody at Temperature x grid
+        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), dh.blackbody_xyz_colour_science(grid * BASE_TEMPERATURE))
+        print(f"{name} at rest: Y {y_rest[name].mean():.3f}, Delta E to {grid * BASE_TEMPERATURE:.0f} K {delta_e:.3f}")
+        assert delta_e < 1.0, name
+    links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
+    nodes_before = len(material.node_tree.nodes)
+
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    scene.relativity.use_searchlight = searchlight
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving))
+
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+    path = _slab_path_ratio(bpy, scene, camera)
+    failures = []
+    for name, (grid, window) in HALVES.items():
+        temperature = grid * BASE_TEMPERATURE
+        xyz = _xyz(moving, window)
+        d = doppler[window].ravel()
+        expected_colour = np.mean([dh.blackbody_xyz_colour_science(f * temperature) for f in d], axis=0)
+        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
+        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**power)
+        print(
+            f"{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^{power} Y_rest {ratio:.4f}"
+        )
+        if not (delta_e < 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
+            failures.append(name)
+    assert not failures
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
+    assert len(material.node_tree.nodes) == nodes_before
