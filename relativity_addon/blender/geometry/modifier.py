@@ -5,6 +5,10 @@ the tessellated rest positions in the point attribute ``relativity_rest``, then 
 sampled by index from a cache mesh object, but only when the point counts match (so a stale cache
 never scrambles the mesh); it also copies the cache's ``relativity_beta`` (each point's velocity
 relative to the observer) for the Doppler shaders. ``geometry.update_object`` fills the cache.
+For the closed-form motions (``motion.closed_form``: Static, Constant Velocity without an animation
+of its own) the modifier computes the apparent positions itself (``Closed Form`` on, the inputs of
+``motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
+step sets a few inputs and needs no cache and no pass over the vertices in Python.
 
 The cache object is not linked into any scene; the modifier holds its only user, so it is saved
 with the .blend and a render farm worker needs nothing else. Motion and deformation bakes are
@@ -19,12 +23,82 @@ import bpy
 import numpy as np
 
 from ..common import compat, names
-from ..common.nodes import Group, Links, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
+from ..common.nodes import (
+    Group,
+    Links,
+    Literal,
+    Node,
+    ensure_group,
+    fmath,
+    interface_identifier,
+    remove_unused_groups,
+    vmath,
+)
 
 if TYPE_CHECKING:
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
 
     from ...physics.arrays import FloatArray
+
+
+# The closed form's inputs (object space in, object space out; every vector folded in float64 by
+# ``motion.closed_form_inputs``): the point at the observer's time relative to the observer is
+# ``r = Scene X * x + Scene Y * y + Scene Z * z + Scene Offset`` (scene units), its light-travel
+# distance ``s = c tau`` solves ``|r - s w| = s`` (``w``: Velocity, fraction of c;
+# ``Inverse Gamma Squared = 1 - w.w``) in closed form, and the apparent position in object space
+# is affine in the rest position and ``s``: ``Local X * x + Local Y * y + Local Z * z + Local Offset
+# + s * Delay Direction``.
+CLOSED_FORM_INPUTS = (
+    "Scene X",
+    "Scene Y",
+    "Scene Z",
+    "Scene Offset",
+    "Velocity",
+    "Local X",
+    "Local Y",
+    "Local Z",
+    "Local Offset",
+    "Delay Direction",
+    "Seen Velocity",
+)
+
+
+def _multiply_add(a: str, b: str, c: str) -> Node:
+    return Node("ShaderNodeVectorMath", {0: a, 1: b, 2: c}, {"operation": "MULTIPLY_ADD"})
+
+
+def _closed_form_nodes() -> dict[str, Node]:
+    """The apparent positions of the rest positions (``position`` after ``store_rest``) for uniform
+    motion (docs/physics.md, "Light-travel time": the closed form of physics/retarded.py in units of
+    c, in whichever of its two equal forms avoids cancellation). Output: ``apparent.Vector``."""
+    return {
+        "rest_split": Node("ShaderNodeSeparateXYZ", {"Vector": "position.Position"}),
+        "scene_x": _multiply_add("rest_split.X", "group.Scene X", "group.Scene Offset"),
+        "scene_y": _multiply_add("rest_split.Y", "group.Scene Y", "scene_x.Vector"),
+        "scene_r": _multiply_add("rest_split.Z", "group.Scene Z", "scene_y.Vector"),
+        "along": vmath("DOT_PRODUCT", "scene_r.Vector", "group.Velocity"),
+        "distance2": vmath("DOT_PRODUCT", "scene_r.Vector", "scene_r.Vector"),
+        "along2": fmath("MULTIPLY", "along.Value", "along.Value"),
+        "discriminant": fmath("MULTIPLY_ADD", "group.Inverse Gamma Squared", "distance2.Value", "along2"),
+        "root": fmath("SQRT", "discriminant"),
+        # moving away from the observer (r.w > 0): q / (root + r.w); else (root - r.w) / (1 - w.w)
+        "root_plus": fmath("ADD", "root", "along.Value"),
+        "delay_away": fmath("DIVIDE", "distance2.Value", "root_plus"),
+        "root_minus": fmath("SUBTRACT", "root", "along.Value"),
+        "delay_towards": fmath("DIVIDE", "root_minus", "group.Inverse Gamma Squared"),
+        "away": Node(
+            "FunctionNodeCompare", {"A": "along.Value", "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+        ),
+        "delay": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "away.Result", "False": "delay_towards", "True": "delay_away"},
+            {"input_type": "FLOAT"},
+        ),
+        "local_x": _multiply_add("rest_split.X", "group.Local X", "group.Local Offset"),
+        "local_y": _multiply_add("rest_split.Y", "group.Local Y", "local_x.Vector"),
+        "local_z": _multiply_add("rest_split.Z", "group.Local Z", "local_y.Vector"),
+        "apparent": _multiply_add("delay.Output", "group.Delay Direction", "local_z.Vector"),
+    }
 
 
 def _subdivision_nodes() -> dict[str, Node]:
@@ -149,9 +223,7 @@ def _seam_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
         ),
         "snap": Node("FunctionNodeBooleanMath", {0: "on_ring.Result", 1: "has_ring.Result"}, {"operation": "AND"}),
-        "snap_moved": Node(
-            "FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "counts_match.Result"}, {"operation": "AND"}
-        ),
+        "snap_moved": Node("FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "moved.Boolean"}, {"operation": "AND"}),
         "seen": Node(
             "GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
         ),
@@ -224,21 +296,32 @@ def node_group_spec() -> Group:
             },
             store,
         ),
+        **_closed_form_nodes(),
+        # the closed form, or the cache's positions when they fit
+        "moved": Node(
+            "FunctionNodeBooleanMath", {0: "counts_match.Result", 1: "group.Closed Form"}, {"operation": "OR"}
+        ),
+        "seen_position": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "group.Closed Form", "False": "sample_position.Value", "True": "apparent.Vector"},
+            {"input_type": "VECTOR"},
+        ),
+        "seen_beta": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "group.Closed Form", "False": "sample_beta.Value", "True": "group.Seen Velocity"},
+            {"input_type": "VECTOR"},
+        ),
         "set_position": Node(
             "GeometryNodeSetPosition",
-            {
-                "Geometry": "store_rest.Geometry",
-                "Selection": "counts_match.Result",
-                "Position": "sample_position.Value",
-            },
+            {"Geometry": "store_rest.Geometry", "Selection": "moved.Boolean", "Position": "seen_position.Output"},
         ),
         "store_beta": Node(
             "GeometryNodeStoreNamedAttribute",
             {
                 "Geometry": "set_position.Geometry",
-                "Selection": "counts_match.Result",
+                "Selection": "moved.Boolean",
                 "Name": Literal(names.BETA_ATTRIBUTE),
-                "Value": "sample_beta.Value",
+                "Value": "seen_beta.Output",
             },
             store,
         ),
@@ -253,6 +336,9 @@ def node_group_spec() -> Group:
             ("Cache", "NodeSocketObject", None),
             ("Face Codes", "NodeSocketInt", {"min_value": 0, "default_value": 0}),
             ("Weld Distance", "NodeSocketFloat", {"min_value": 0.0, "default_value": 0.0}),
+            ("Closed Form", "NodeSocketBool", {"default_value": False}),
+            *((name, "NodeSocketVector", None) for name in CLOSED_FORM_INPUTS),
+            ("Inverse Gamma Squared", "NodeSocketFloat", {"default_value": 1.0}),
         ),
         (("Geometry", "NodeSocketGeometry", "unmarked.Geometry"),),
         nodes,
@@ -332,6 +418,33 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     if modifier.show_viewport != enabled or modifier.show_render != enabled:
         modifier.show_viewport = modifier.show_render = enabled
     return modifier, cache
+
+
+def set_closed_form(mod: Modifier, inputs: dict[str, tuple[float, ...] | float] | None) -> bool:
+    """Switch the modifier's closed form on with ``inputs`` (by interface name), or off (None: the
+    cache's positions). Returns whether any input changed (the object must then be evaluated
+    again). Values equal after rounding to the sockets' float32 are left as they are."""
+    group = mod.node_group
+    wanted: dict[str, object] = {"Closed Form": inputs is not None, **(inputs or {})}
+    changed = False
+    for name, value in wanted.items():
+        identifier = interface_identifier(group, name)
+        current = compat.modifier_input(mod, identifier)
+        if isinstance(value, bool):
+            same = current is not None and bool(current) == value
+        else:
+            new = np.asarray(value, dtype=np.float32)
+            same = current is not None and np.array_equal(np.asarray(current, dtype=np.float32), new)
+            value = float(new) if new.ndim == 0 else tuple(map(float, new))
+        if not same:
+            compat.set_modifier_input(mod, identifier, value)
+            changed = True
+    return changed
+
+
+def closed_form_on(mod: Modifier) -> bool:
+    """Whether the modifier computes the apparent positions itself (the closed form)."""
+    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Closed Form")))
 
 
 def _shared_with_another_object(obj, cache):
