@@ -132,7 +132,7 @@ def closed_form(obj: Object, scene: Scene) -> bool:
 
 
 def closed_form_inputs(obj: Object, obj_eval: Object, snap: Snapshot) -> dict[str, tuple[float, ...] | float]:
-    """The modifier's closed-form inputs (``modifier.CLOSED_FORM_INPUTS``) for a closed-form object:
+    """The modifier's closed-form inputs (``node_group.CLOSED_FORM_INPUTS``) for a closed-form object:
     the relations of :func:`apparent_world_positions` (uniform motion through where Blender draws the
     object at the observer's time, the rest shape contracted along ``beta``; the retarded emission
     event boosted into the observer's frame, docs/physics.md) folded into affine maps of the rest
