@@ -92,6 +92,14 @@ def _remember(obj_eval, fingerprint):
     _known_rest[obj_eval.name] = (_evaluated_key(obj_eval), fingerprint, _reads[0])
 
 
+def _note_unread(obj_eval):
+    """Note an object whose rest shape the update does not read (a new read number, no fingerprint)
+    unless it is noted already since Blender last evaluated its geometry."""
+    known = _known_rest.get(obj_eval.name)
+    if known is None or known[0] != _evaluated_key(obj_eval):
+        _remember(obj_eval, None)
+
+
 def _rest_fingerprint(obj_eval):
     """The object's rest fingerprint, read only when its geometry was evaluated since the last read."""
     known = _known_rest.get(obj_eval.name)
@@ -119,8 +127,11 @@ def object_signature(
     (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
-    if fingerprint is None and depsgraph is not None and _reads_rest(obj, bpy.data.scenes.get(snap.scene)):
-        fingerprint = _rest_fingerprint(evaluated)
+    if fingerprint is None and depsgraph is not None:
+        if _reads_rest(obj, bpy.data.scenes.get(snap.scene)):
+            fingerprint = _rest_fingerprint(evaluated)
+        else:  # nothing to read: only noted, so that geometry_key stays while Blender does not evaluate it again
+            _note_unread(evaluated)
     parts = [
         snap.frame,
         snap.speed_of_light,
