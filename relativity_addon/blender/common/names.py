@@ -21,6 +21,7 @@ GEOMETRY_GROUP_VERSION = 3  # 2: adaptive tessellation (face codes at the end of
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)
+EDGES_SHORT_ATTRIBUTE = "relativity_edges_short"  # per face, by the modifier: every edge's image within the tolerance
 SEEN_ATTRIBUTE = "relativity_seen"  # apparent positions of the faces across the seam, inside the modifier
 TESSELLATION_KEY = "relativity_tessellation"  # on the cache mesh: the face codes' level, count and CRC-32
 TESSELLATION_WARNING_KEY = "relativity_tessellation_warning"  # on the cache mesh: edges still too bent

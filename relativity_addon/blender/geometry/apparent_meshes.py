@@ -127,11 +127,20 @@ def object_signature(
     (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
-    if fingerprint is None and depsgraph is not None:
-        if _reads_rest(obj, bpy.data.scenes.get(snap.scene)):
-            fingerprint = _rest_fingerprint(evaluated)
-        else:  # nothing to read: only noted, so that geometry_key stays while Blender does not evaluate it again
+    verdict = None
+    if depsgraph is not None:
+        scene = bpy.data.scenes.get(snap.scene)
+        closed = scene is not None and motion.closed_form(obj, scene)
+        measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
+        verdict = tessellation.edges_short(evaluated) if closed and measured else None
+        if fingerprint is not None:
+            pass
+        elif closed and (not measured or verdict):
+            # the modifier computes the positions from the rest shape, and no decision reads it:
+            # only noted, so that geometry_key stays while Blender does not evaluate it again
             _note_unread(evaluated)
+        else:
+            fingerprint = _rest_fingerprint(evaluated)
     parts = [
         snap.frame,
         snap.speed_of_light,
@@ -155,18 +164,9 @@ def object_signature(
         relativity.use_proper_time,
         len(obj.data.vertices),
         fingerprint,
+        verdict,
     ]
     return repr(parts)
-
-
-def _reads_rest(obj: Object, scene: Scene | None) -> bool:
-    """Whether the update reads the object's rest shape: not for a closed-form object (the modifier
-    computes its positions from the rest positions at each evaluation) whose tessellation measures
-    no edges."""
-    if scene is None or not motion.closed_form(obj, scene):
-        return True
-    settings = obj.relativity
-    return bool(settings.use_adaptive_tessellation and settings.tessellation > 0)
 
 
 def _render_size(snap: Snapshot) -> tuple[float, float] | None:
@@ -179,16 +179,24 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    closed = motion.closed_form(obj, scene)
+    measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if closed else None
     try:
-        decision = tessellation.decide(scene, obj, obj.evaluated_get(depsgraph), snap)
+        if measure is not None and tessellation.edges_short(obj_eval):
+            # the modifier found every edge's image short at its last evaluation and left the mesh
+            # whole; it checks again at the next (a longer edge shows in the signature: decided then)
+            decision: tessellation.Decision | None = tessellation.Decision(0, warning="")
+        else:
+            decision = tessellation.decide(scene, obj, obj_eval, snap)
         if decision is not None and tessellation.apply(obj, mod, cache, decision):
             depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
-    if motion.closed_form(obj, scene):
-        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes)
-    changed = modifier.set_closed_form(mod, None)
+    if closed:
+        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
+    changed = modifier.set_closed_form(mod, None) | modifier.set_inputs(mod, {"Measure Edges": False})
     if changed:  # the rest positions are stored before the closed form: they are current
         obj.update_tag()
     rest32 = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
@@ -214,7 +222,7 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     return len(local)
 
 
-def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes):
+def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure):
     """:func:`update_object` of a closed-form object (``motion.closed_form``): the modifier
     computes the positions and the velocity attribute; this sets its inputs (a few vectors), and
     reads and writes no vertex. The farthest seen depth comes from the evaluated bounds
@@ -225,6 +233,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes):
     except ValueError as error:  # the physics core's checks
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     changed = modifier.set_closed_form(mod, inputs)
+    changed |= modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
     points = 0 if codes is None else len(codes)
     if len(cache.data.vertices) != points:  # positions of an update on the cache's path
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)

@@ -111,8 +111,13 @@ def set_closed_form(mod: Modifier, inputs: dict[str, tuple[float, ...] | float] 
     """Switch the modifier's closed form on with ``inputs`` (by interface name), or off (None: the
     cache's positions). Returns whether any input changed (the object must then be evaluated
     again). Values equal after rounding to the sockets' float32 are left as they are."""
+    return set_inputs(mod, {"Closed Form": inputs is not None, **(inputs or {})})
+
+
+def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
+    """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
+    whether any did."""
     group = mod.node_group
-    wanted: dict[str, object] = {"Closed Form": inputs is not None, **(inputs or {})}
     changed = False
     for name, value in wanted.items():
         identifier = interface_identifier(group, name)

@@ -68,6 +68,88 @@ def _closed_form_nodes() -> dict[str, Node]:
     }
 
 
+# Adaptive tessellation's shortcut for the closed form (tessellation.edge_measure_inputs): the
+# camera's view of object-space points, ``Camera X * x + Camera Y * y + Camera Z * z + Camera
+# Offset`` (camera space, looking down -Z), and its pixels, ``(view / depth - Window Low) * Pixel Scale``
+# (render resolution; the z component is then the same for every point).
+EDGE_MEASURE_INPUTS = ("Camera X", "Camera Y", "Camera Z", "Camera Offset", "Pixel Scale", "Window Low")
+
+
+def _edge_verdict_nodes() -> dict[str, Node]:
+    """Whether every edge of the incoming mesh has an image (between the images of its ends'
+    apparent positions, the closed form's) no longer than ``Tolerance`` pixels, both ends in front
+    of the camera: then no edge needs subdividing (physics/tessellation.edge_levels measures no
+    such edge) and the mesh is left whole. Output: ``edges_short.Boolean`` (only with ``Measure
+    Edges`` and the closed form on)."""
+    vector = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
+    return {
+        "view_split": Node("ShaderNodeSeparateXYZ", {"Vector": "apparent.Vector"}),
+        "view_x": _multiply_add("view_split.X", "group.Camera X", "group.Camera Offset"),
+        "view_y": _multiply_add("view_split.Y", "group.Camera Y", "view_x.Vector"),
+        "view": _multiply_add("view_split.Z", "group.Camera Z", "view_y.Vector"),
+        "view_parts": Node("ShaderNodeSeparateXYZ", {"Vector": "view.Vector"}),
+        "depth": fmath("MULTIPLY", "view_parts.Z", -1.0),
+        "in_front": Node(
+            "FunctionNodeCompare", {"A": "depth", "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+        ),
+        "inverse_depth": fmath("DIVIDE", 1.0, "depth"),
+        "on_plane": vmath("SCALE", "view.Vector", scale="inverse_depth"),
+        "from_corner": vmath("SUBTRACT", "on_plane.Vector", "group.Window Low"),
+        "pixels": vmath("MULTIPLY", "from_corner.Vector", "group.Pixel Scale"),
+        "edge_ends": Node("GeometryNodeInputMeshEdgeVertices"),
+        "pixels_1": Node(
+            "GeometryNodeFieldAtIndex", {"Index": "edge_ends.Vertex Index 1", "Value": "pixels.Vector"}, vector
+        ),
+        "pixels_2": Node(
+            "GeometryNodeFieldAtIndex", {"Index": "edge_ends.Vertex Index 2", "Value": "pixels.Vector"}, vector
+        ),
+        "front_1": Node(
+            "GeometryNodeFieldAtIndex",
+            {"Index": "edge_ends.Vertex Index 1", "Value": "in_front.Result"},
+            {"data_type": "BOOLEAN", "domain": "POINT"},
+        ),
+        "front_2": Node(
+            "GeometryNodeFieldAtIndex",
+            {"Index": "edge_ends.Vertex Index 2", "Value": "in_front.Result"},
+            {"data_type": "BOOLEAN", "domain": "POINT"},
+        ),
+        "image_length": vmath("DISTANCE", "pixels_1.Value", "pixels_2.Value"),
+        "short": Node(
+            "FunctionNodeCompare",
+            {"A": "image_length.Value", "B": "group.Tolerance"},
+            {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
+        ),
+        "both_front": Node("FunctionNodeBooleanMath", {0: "front_1.Value", 1: "front_2.Value"}, {"operation": "AND"}),
+        "edge_fine": Node(
+            "FunctionNodeBooleanMath", {0: "short.Result", 1: "both_front.Boolean"}, {"operation": "AND"}
+        ),
+        "edge_fine_value": Node(
+            "GeometryNodeSwitch", {"Switch": "edge_fine.Boolean", "False": 0.0, "True": 1.0}, {"input_type": "FLOAT"}
+        ),
+        "edges_fine": Node(
+            "GeometryNodeAttributeStatistic",
+            {"Geometry": "group.Geometry", "Attribute": "edge_fine_value.Output"},
+            {"data_type": "FLOAT", "domain": "EDGE"},
+        ),
+        "all_fine": Node(
+            "FunctionNodeCompare",
+            {"A": "edges_fine.Min", "B": 0.5},
+            {"data_type": "FLOAT", "operation": "GREATER_THAN"},
+        ),
+        "measured": Node(
+            "FunctionNodeBooleanMath", {0: "group.Measure Edges", 1: "group.Closed Form"}, {"operation": "AND"}
+        ),
+        "edges_short": Node(
+            "FunctionNodeBooleanMath", {0: "measured.Boolean", 1: "all_fine.Result"}, {"operation": "AND"}
+        ),
+        "whole_or_subdivided": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "edges_short.Boolean", "False": "subdivided.Output", "True": "group.Geometry"},
+            {"input_type": "GEOMETRY"},
+        ),
+    }
+
+
 def _subdivision_nodes() -> dict[str, Node]:
     """The subdivision: every face at Tessellation levels (``Face Codes`` 0, or not this mesh's face
     count), else only the faces whose code, read from the last ``Face Codes`` points of the cache
@@ -211,6 +293,16 @@ def _seam_nodes() -> dict[str, Node]:
         "unmarked": Node(
             "GeometryNodeRemoveAttribute", {"Geometry": "seamless.Output", "Name": Literal(names.FACE_CODE_ATTRIBUTE)}
         ),
+        # the edges' verdict, read back by tessellation.edges_short (one value per face)
+        "store_verdict": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {
+                "Geometry": "unmarked.Geometry",
+                "Name": Literal(names.EDGES_SHORT_ATTRIBUTE),
+                "Value": "edges_short.Boolean",
+            },
+            {"data_type": "BOOLEAN", "domain": "FACE"},
+        ),
     }
 
 
@@ -222,10 +314,11 @@ def node_group_spec() -> Group:
         "cache_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "cache_info.Geometry"}, mesh_size),
         **_subdivision_nodes(),
         "position": Node("GeometryNodeInputPosition"),
+        **_edge_verdict_nodes(),
         "store_rest": Node(
             "GeometryNodeStoreNamedAttribute",
             {
-                "Geometry": "subdivided.Output",
+                "Geometry": "whole_or_subdivided.Output",
                 "Name": Literal(names.REST_ATTRIBUTE),
                 "Value": "position.Position",
             },
@@ -306,7 +399,10 @@ def node_group_spec() -> Group:
             ("Closed Form", "NodeSocketBool", {"default_value": False}),
             *((name, "NodeSocketVector", None) for name in CLOSED_FORM_INPUTS),
             ("Inverse Gamma Squared", "NodeSocketFloat", {"default_value": 1.0}),
+            ("Measure Edges", "NodeSocketBool", {"default_value": False}),
+            *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
+            ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
         ),
-        (("Geometry", "NodeSocketGeometry", "unmarked.Geometry"),),
+        (("Geometry", "NodeSocketGeometry", "store_verdict.Geometry"),),
         nodes,
     )

@@ -69,22 +69,44 @@ def _count_passes(monkeypatch):
     return calls
 
 
-@pytest.mark.parametrize("levels", [0, 1])
-def test_velocity_change_and_frame_step_run_no_per_vertex_python(relativity_addon, monkeypatch, levels):
+def _grid_mesh(bpy, name, side, width):
+    """A flat ``side`` x ``side`` vertex grid of quads, ``width`` wide: edges far shorter than a pixel."""
+    u = np.linspace(-width / 2.0, width / 2.0, side)
+    vertices = [(x, y, 0.0) for y in u for x in u]
+    faces = [
+        (i + side * j, i + 1 + side * j, i + 1 + side * (j + 1), i + side * (j + 1))
+        for j in range(side - 1)
+        for i in range(side - 1)
+    ]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(vertices, [], faces)
+    mesh.update()
+    return mesh
+
+
+# (levels, adaptive): none; one level on every face; the default adaptive tessellation on a grid whose
+# edges' images stay far below the tolerance (the modifier's own check leaves it whole)
+CASES = [(0, False), (1, False), (4, True)]
+
+
+@pytest.mark.parametrize(("levels", "adaptive"), CASES)
+def test_velocity_change_and_frame_step_run_no_per_vertex_python(relativity_addon, monkeypatch, levels, adaptive):
     import bpy
 
     scene, camera = gh.slow_light_scene(bpy, C, FPS)
     scene.relativity.beta = OBSERVER
-    obj = _link(bpy, scene, "Mover", _cube_mesh(bpy, "Mover", 0.3))
+    mesh = _grid_mesh(bpy, "Mover", 40, 0.6) if adaptive else _cube_mesh(bpy, "Mover", 0.3)
+    obj = _link(bpy, scene, "Mover", mesh)
     obj.location = (0.8, -0.4, -5.0)
     obj.rotation_euler = (0.3, -0.5, 0.9)
     obj.scale = (1.0, 1.6, 0.7)
     obj.relativity.motion = "CONSTANT"
     obj.relativity.beta = (0.5, 0.2, 0.0)
-    obj.relativity.use_adaptive_tessellation = False
+    obj.relativity.use_adaptive_tessellation = adaptive
     obj.relativity.tessellation = levels
     scene.frame_set(12)
     gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()  # the viewport's redraw after Set Up
     calls = _count_passes(monkeypatch)
 
     obj.relativity.beta = (-0.3, 0.4, 0.1)  # as the panel does: the update callback runs
@@ -95,7 +117,7 @@ def test_velocity_change_and_frame_step_run_no_per_vertex_python(relativity_addo
 
     obj_eval = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
     rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
-    assert len(rest) == (8 if levels == 0 else 26), len(rest)
+    assert len(rest) == len(mesh.vertices) if levels != 1 else 26, len(rest)
     x_o = np.array(camera.matrix_world.translation)
     expected, velocity = _seen(rest, np.array(obj_eval.matrix_world), (-0.3, 0.4, 0.1), x_o, OBSERVER)
     for positions, beta in ((changed, beta_changed), (stepped, beta_stepped)):
