@@ -79,9 +79,8 @@ def _edge_verdict_nodes() -> dict[str, Node]:
     """Whether every edge of the incoming mesh has an image (between the images of its ends'
     apparent positions, the closed form's) no longer than ``Tolerance`` pixels, both ends in front
     of the camera: then no edge needs subdividing (physics/tessellation.edge_levels measures no
-    such edge) and the mesh is left whole. Output: ``edges_short.Boolean`` (only with ``Measure
+    such edge) and the mesh is left whole. Output: ``edges_short.Output`` (only with ``Measure
     Edges`` and the closed form on)."""
-    vector = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
     return {
         "view_split": Node("ShaderNodeSeparateXYZ", {"Vector": "apparent.Vector"}),
         "view_x": _multiply_add("view_split.X", "group.Camera X", "group.Camera Offset"),
@@ -96,39 +95,29 @@ def _edge_verdict_nodes() -> dict[str, Node]:
         "on_plane": vmath("SCALE", "view.Vector", scale="inverse_depth"),
         "from_corner": vmath("SUBTRACT", "on_plane.Vector", "group.Window Low"),
         "pixels": vmath("MULTIPLY", "from_corner.Vector", "group.Pixel Scale"),
+        # each point put at its pixels, or far off the picture's plane when behind the camera: an
+        # edge with one end there is long; with both, like an edge the camera cannot see, it is
+        # left as it is (as physics/tessellation.edge_levels does)
+        "behind": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "in_front.Result", "False": (0.0, 0.0, 1e10), "True": (0.0, 0.0, 0.0)},
+            {"input_type": "VECTOR"},
+        ),
+        "image_point": vmath("ADD", "pixels.Vector", "behind.Output"),
+        "at_pixels": Node("GeometryNodeSetPosition", {"Geometry": "group.Geometry", "Position": "image_point.Vector"}),
         "edge_ends": Node("GeometryNodeInputMeshEdgeVertices"),
-        "pixels_1": Node(
-            "GeometryNodeFieldAtIndex", {"Index": "edge_ends.Vertex Index 1", "Value": "pixels.Vector"}, vector
-        ),
-        "pixels_2": Node(
-            "GeometryNodeFieldAtIndex", {"Index": "edge_ends.Vertex Index 2", "Value": "pixels.Vector"}, vector
-        ),
-        "front_1": Node(
-            "GeometryNodeFieldAtIndex",
-            {"Index": "edge_ends.Vertex Index 1", "Value": "in_front.Result"},
-            {"data_type": "BOOLEAN", "domain": "POINT"},
-        ),
-        "front_2": Node(
-            "GeometryNodeFieldAtIndex",
-            {"Index": "edge_ends.Vertex Index 2", "Value": "in_front.Result"},
-            {"data_type": "BOOLEAN", "domain": "POINT"},
-        ),
-        "image_length": vmath("DISTANCE", "pixels_1.Value", "pixels_2.Value"),
+        "image_length": vmath("DISTANCE", "edge_ends.Position 1", "edge_ends.Position 2"),
         "short": Node(
             "FunctionNodeCompare",
             {"A": "image_length.Value", "B": "group.Tolerance"},
             {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
         ),
-        "both_front": Node("FunctionNodeBooleanMath", {0: "front_1.Value", 1: "front_2.Value"}, {"operation": "AND"}),
-        "edge_fine": Node(
-            "FunctionNodeBooleanMath", {0: "short.Result", 1: "both_front.Boolean"}, {"operation": "AND"}
-        ),
         "edge_fine_value": Node(
-            "GeometryNodeSwitch", {"Switch": "edge_fine.Boolean", "False": 0.0, "True": 1.0}, {"input_type": "FLOAT"}
+            "GeometryNodeSwitch", {"Switch": "short.Result", "False": 0.0, "True": 1.0}, {"input_type": "FLOAT"}
         ),
         "edges_fine": Node(
             "GeometryNodeAttributeStatistic",
-            {"Geometry": "group.Geometry", "Attribute": "edge_fine_value.Output"},
+            {"Geometry": "at_pixels.Geometry", "Attribute": "edge_fine_value.Output"},
             {"data_type": "FLOAT", "domain": "EDGE"},
         ),
         "all_fine": Node(
@@ -139,12 +128,15 @@ def _edge_verdict_nodes() -> dict[str, Node]:
         "measured": Node(
             "FunctionNodeBooleanMath", {0: "group.Measure Edges", 1: "group.Closed Form"}, {"operation": "AND"}
         ),
+        # a Switch asks for the check only when it is on (Boolean Math would always compute it)
         "edges_short": Node(
-            "FunctionNodeBooleanMath", {0: "measured.Boolean", 1: "all_fine.Result"}, {"operation": "AND"}
+            "GeometryNodeSwitch",
+            {"Switch": "measured.Boolean", "False": False, "True": "all_fine.Result"},
+            {"input_type": "BOOLEAN"},
         ),
         "whole_or_subdivided": Node(
             "GeometryNodeSwitch",
-            {"Switch": "edges_short.Boolean", "False": "subdivided.Output", "True": "group.Geometry"},
+            {"Switch": "edges_short.Output", "False": "subdivided.Output", "True": "group.Geometry"},
             {"input_type": "GEOMETRY"},
         ),
     }
@@ -299,7 +291,7 @@ def _seam_nodes() -> dict[str, Node]:
             {
                 "Geometry": "unmarked.Geometry",
                 "Name": Literal(names.EDGES_SHORT_ATTRIBUTE),
-                "Value": "edges_short.Boolean",
+                "Value": "edges_short.Output",
             },
             {"data_type": "BOOLEAN", "domain": "FACE"},
         ),
