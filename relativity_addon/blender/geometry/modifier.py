@@ -117,10 +117,14 @@ def set_closed_form(mod: Modifier, inputs: dict[str, tuple[float, ...] | float] 
 def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
     """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
     whether any did."""
-    group = mod.node_group
+    identifiers = {
+        item.name: item.identifier
+        for item in mod.node_group.interface.items_tree
+        if item.item_type == "SOCKET" and item.in_out == "INPUT"
+    }
     changed = False
     for name, value in wanted.items():
-        identifier = interface_identifier(group, name)
+        identifier = identifiers[name]
         current = compat.modifier_input(mod, identifier)
         if isinstance(value, bool):
             same = current is not None and bool(current) == value

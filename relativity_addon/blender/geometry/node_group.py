@@ -79,10 +79,19 @@ def _edge_verdict_nodes() -> dict[str, Node]:
     """Whether every edge of the incoming mesh has an image (between the images of its ends'
     apparent positions, the closed form's) no longer than ``Tolerance`` pixels, both ends in front
     of the camera: then no edge needs subdividing (physics/tessellation.edge_levels measures no
-    such edge) and the mesh is left whole. Output: ``edges_short.Output`` (only with ``Measure
-    Edges`` and the closed form on)."""
+    such edge) and the mesh is left whole (``whole_seen``, the closed form on the incoming mesh).
+    Output: ``edges_short.Output`` (only with ``Measure Edges`` and the closed form on)."""
     return {
-        "view_split": Node("ShaderNodeSeparateXYZ", {"Vector": "apparent.Vector"}),
+        # the incoming mesh moved by the closed form, once: the output when it stays whole
+        "whole_rest": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "group.Geometry", "Name": Literal(names.REST_ATTRIBUTE), "Value": "position.Position"},
+            {"data_type": "FLOAT_VECTOR", "domain": "POINT"},
+        ),
+        "whole_seen": Node(
+            "GeometryNodeSetPosition", {"Geometry": "whole_rest.Geometry", "Position": "apparent.Vector"}
+        ),
+        "view_split": Node("ShaderNodeSeparateXYZ", {"Vector": "position.Position"}),
         "view_x": _multiply_add("view_split.X", "group.Camera X", "group.Camera Offset"),
         "view_y": _multiply_add("view_split.Y", "group.Camera Y", "view_x.Vector"),
         "view": _multiply_add("view_split.Z", "group.Camera Z", "view_y.Vector"),
@@ -104,7 +113,9 @@ def _edge_verdict_nodes() -> dict[str, Node]:
             {"input_type": "VECTOR"},
         ),
         "image_point": vmath("ADD", "pixels.Vector", "behind.Output"),
-        "at_pixels": Node("GeometryNodeSetPosition", {"Geometry": "group.Geometry", "Position": "image_point.Vector"}),
+        "at_pixels": Node(
+            "GeometryNodeSetPosition", {"Geometry": "whole_seen.Geometry", "Position": "image_point.Vector"}
+        ),
         "edge_ends": Node("GeometryNodeInputMeshEdgeVertices"),
         "image_length": vmath("DISTANCE", "edge_ends.Position 1", "edge_ends.Position 2"),
         "short": Node(
@@ -133,11 +144,6 @@ def _edge_verdict_nodes() -> dict[str, Node]:
             "GeometryNodeSwitch",
             {"Switch": "measured.Boolean", "False": False, "True": "all_fine.Result"},
             {"input_type": "BOOLEAN"},
-        ),
-        "whole_or_subdivided": Node(
-            "GeometryNodeSwitch",
-            {"Switch": "edges_short.Output", "False": "subdivided.Output", "True": "group.Geometry"},
-            {"input_type": "GEOMETRY"},
         ),
     }
 
@@ -264,7 +270,7 @@ def _seam_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
         ),
         "snap": Node("FunctionNodeBooleanMath", {0: "on_ring.Result", 1: "has_ring.Result"}, {"operation": "AND"}),
-        "snap_moved": Node("FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "moved.Boolean"}, {"operation": "AND"}),
+        "snap_moved": Node("FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "moved.Output"}, {"operation": "AND"}),
         "seen": Node(
             "GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
         ),
@@ -310,7 +316,7 @@ def node_group_spec() -> Group:
         "store_rest": Node(
             "GeometryNodeStoreNamedAttribute",
             {
-                "Geometry": "whole_or_subdivided.Output",
+                "Geometry": "subdivided.Output",
                 "Name": Literal(names.REST_ATTRIBUTE),
                 "Value": "position.Position",
             },
@@ -350,8 +356,11 @@ def node_group_spec() -> Group:
         ),
         **_closed_form_nodes(),
         # the closed form, or the cache's positions when they fit
+        # Switches, not Boolean Math: only what the chosen side needs is computed
         "moved": Node(
-            "FunctionNodeBooleanMath", {0: "counts_match.Result", 1: "group.Closed Form"}, {"operation": "OR"}
+            "GeometryNodeSwitch",
+            {"Switch": "group.Closed Form", "False": "counts_match.Result", "True": True},
+            {"input_type": "BOOLEAN"},
         ),
         "seen_position": Node(
             "GeometryNodeSwitch",
@@ -365,13 +374,18 @@ def node_group_spec() -> Group:
         ),
         "set_position": Node(
             "GeometryNodeSetPosition",
-            {"Geometry": "store_rest.Geometry", "Selection": "moved.Boolean", "Position": "seen_position.Output"},
+            {"Geometry": "store_rest.Geometry", "Selection": "moved.Output", "Position": "seen_position.Output"},
+        ),
+        "seen_geometry": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "edges_short.Output", "False": "set_position.Geometry", "True": "whole_seen.Geometry"},
+            {"input_type": "GEOMETRY"},
         ),
         "store_beta": Node(
             "GeometryNodeStoreNamedAttribute",
             {
-                "Geometry": "set_position.Geometry",
-                "Selection": "moved.Boolean",
+                "Geometry": "seen_geometry.Output",
+                "Selection": "moved.Output",
                 "Name": Literal(names.BETA_ATTRIBUTE),
                 "Value": "seen_beta.Output",
             },
