@@ -32,8 +32,30 @@ if TYPE_CHECKING:
     from ...physics.arrays import FloatArray
 
 
+# Inputs whose values the modifiers keep across a rebuild of the group (an older version's file):
+# the rest the next update sets again.
+KEPT_INPUTS = ("Cache", "Tessellation", "Face Codes", "Weld Distance")
+
+
 def ensure_node_group() -> NodeTree:
-    return ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    """The node group, rebuilt when a file holds another version of it. The rebuilt interface's
+    sockets get new identifiers, so the modifiers' values (the cache, where the bakes live) are
+    read by name before and set again after."""
+    tree = bpy.data.node_groups.get(names.GEOMETRY_GROUP)
+    kept = []
+    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) != names.GEOMETRY_GROUP_VERSION:
+        old = {item.name: item.identifier for item in tree.interface.items_tree if item.item_type == "SOCKET"}
+        for obj in bpy.data.objects:
+            for mod in obj.modifiers:
+                if mod.type == "NODES" and mod.node_group == tree:
+                    values = {name: compat.modifier_input(mod, old[name]) for name in KEPT_INPUTS if name in old}
+                    kept.append((mod, values))
+    group = ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    for mod, values in kept:
+        for name, value in values.items():
+            if value is not None:
+                compat.set_modifier_input(mod, interface_identifier(group, name), value)
+    return group
 
 
 def find_modifier(obj: Object) -> Modifier | None:
