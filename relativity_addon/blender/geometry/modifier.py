@@ -55,6 +55,9 @@ def ensure_node_group() -> NodeTree:
         for name, value in values.items():
             if value is not None:
                 compat.set_modifier_input(mod, interface_identifier(group, name), value)
+        cache = values.get("Cache")
+        if cache is not None and cache.data is not None and names.SIGNATURE_KEY in cache.data:
+            del cache.data[names.SIGNATURE_KEY]  # the next sync sets the new inputs
     return group
 
 
