@@ -183,12 +183,7 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     closed = motion.closed_form(obj, scene)
     measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if closed else None
     try:
-        verdict = tessellation.edges_short(obj_eval) if measure is not None else None
-        if measure is not None and verdict is None:  # no check yet (Set Up): the modifier checks first
-            depsgraph = _check_first(obj, obj_eval, snap, mod, cache, measure)
-            obj_eval = obj.evaluated_get(depsgraph)
-            verdict = tessellation.edges_short(obj_eval)
-        if measure is not None and verdict:
+        if measure is not None and tessellation.edges_short(obj_eval):
             # the modifier found every edge's image short at its last evaluation and left the mesh
             # whole; it checks again at the next (a longer edge shows in the signature: decided then)
             decision: tessellation.Decision | None = tessellation.Decision(0, warning="")
@@ -225,17 +220,6 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
-
-
-def _check_first(obj, obj_eval, snap, mod, cache, measure):
-    """Let the modifier check the edges before any measure in Python: the mesh left whole, the
-    closed form and the check's inputs set, the object evaluated. Returns the evaluated depsgraph."""
-    changed = tessellation.apply(obj, mod, cache, tessellation.Decision(0, warning=""))
-    changed |= modifier.set_closed_form(mod, motion.closed_form_inputs(obj, obj_eval, snap))
-    changed |= modifier.set_inputs(mod, {"Measure Edges": True, **measure})
-    if changed:
-        obj.update_tag()
-    return bpy.context.evaluated_depsgraph_get()
 
 
 def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure):
