@@ -92,6 +92,14 @@ def _remember(obj_eval, fingerprint):
     _known_rest[obj_eval.name] = (_evaluated_key(obj_eval), fingerprint, _reads[0])
 
 
+def _note_unread(obj_eval):
+    """Note an object whose rest shape the update does not read (a new read number, no fingerprint)
+    unless it is noted already since Blender last evaluated its geometry."""
+    known = _known_rest.get(obj_eval.name)
+    if known is None or known[0] != _evaluated_key(obj_eval):
+        _remember(obj_eval, None)
+
+
 def _rest_fingerprint(obj_eval):
     """The object's rest fingerprint, read only when its geometry was evaluated since the last read."""
     known = _known_rest.get(obj_eval.name)
@@ -119,8 +127,20 @@ def object_signature(
     (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
-    if fingerprint is None and depsgraph is not None:
-        fingerprint = _rest_fingerprint(evaluated)
+    verdict = None
+    if depsgraph is not None:
+        scene = bpy.data.scenes.get(snap.scene)
+        closed = scene is not None and motion.closed_form(obj, scene)
+        measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
+        verdict = tessellation.edges_short(evaluated) if closed and measured else None
+        if fingerprint is not None:
+            pass
+        elif closed and (not measured or verdict):
+            # the modifier computes the positions from the rest shape, and no decision reads it:
+            # only noted, so that geometry_key stays while Blender does not evaluate it again
+            _note_unread(evaluated)
+        else:
+            fingerprint = _rest_fingerprint(evaluated)
     parts = [
         snap.frame,
         snap.speed_of_light,
@@ -144,6 +164,7 @@ def object_signature(
         relativity.use_proper_time,
         len(obj.data.vertices),
         fingerprint,
+        verdict,
     ]
     return repr(parts)
 
@@ -158,13 +179,26 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
     mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    closed = motion.closed_form(obj, scene)
+    measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if closed else None
     try:
-        decision = tessellation.decide(scene, obj, obj.evaluated_get(depsgraph), snap)
+        if measure is not None and tessellation.edges_short(obj_eval):
+            # the modifier found every edge's image short at its last evaluation and left the mesh
+            # whole; it checks again at the next (a longer edge shows in the signature: decided then)
+            decision: tessellation.Decision | None = tessellation.Decision(0, warning="")
+        else:
+            decision = tessellation.decide(scene, obj, obj_eval, snap)
         if decision is not None and tessellation.apply(obj, mod, cache, decision):
             depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
+    if closed:
+        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
+    changed = modifier.set_closed_form(mod, None) | modifier.set_inputs(mod, {"Measure Edges": False})
+    if changed:  # the rest positions are stored before the closed form: they are current
+        obj.update_tag()
     rest32 = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
     if rest32 is None:
         raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
@@ -186,6 +220,31 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
+
+
+def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure):
+    """:func:`update_object` of a closed-form object (``motion.closed_form``): the modifier
+    computes the positions and the velocity attribute; this sets its inputs (a few vectors), and
+    reads and writes no vertex. The farthest seen depth comes from the evaluated bounds
+    (:func:`clip_end_warnings`)."""
+    obj_eval = obj.evaluated_get(depsgraph)
+    try:
+        inputs = motion.closed_form_inputs(obj, obj_eval, snap)
+    except ValueError as error:  # the physics core's checks
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    changed = modifier.set_closed_form(mod, inputs)
+    changed |= modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    points = 0 if codes is None else len(codes)
+    if len(cache.data.vertices) != points:  # positions of an update on the cache's path
+        modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
+        changed = True
+    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+    for key in (names.ERROR_KEY, names.WARNING_KEY):
+        if key in cache.data:
+            del cache.data[key]
+    if changed:
+        obj.update_tag()
+    return len(obj_eval.data.vertices)
 
 
 def _apparent_local(scene, obj, obj_eval, rest32, snap, computed=None):
@@ -446,17 +505,34 @@ def _round_up(value):
     return math.ceil(value / step - 1e-9) * step
 
 
-def clip_end_warnings(scene: Scene, snap: Snapshot) -> list[str]:
+def bounds_depth(snap: Snapshot, obj_eval: Object) -> float:
+    """The largest depth along the view axis (scene units) of the corners of the evaluated mesh's
+    bounds (the apparent positions of a closed-form object), 0 when none is ahead: at least the
+    farthest vertex's depth (a bound: the corners need not lie in the camera's view)."""
+    corners = np.array([tuple(corner) for corner in obj_eval.bound_box], dtype=np.float64)
+    world = motion.to_world(motion.matrix_array(obj_eval.matrix_world), corners)
+    depth = -(snap.world_to_camera @ (world - snap.camera_position).T)[2]
+    return float(max(depth.max(initial=0.0), 0.0))
+
+
+def clip_end_warnings(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None) -> list[str]:
     """One line when the boosted meshes reach beyond the camera's Clip End (they are cut off in the
-    viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs."""
+    viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs.
+    A closed-form object's depth is its evaluated bounds' (:func:`bounds_depth`), taken from a
+    handler's evaluated ``depsgraph`` and kept for the syncs without one."""
     camera = scene.objects.get(snap.camera)
     if snap.exact_camera or camera is None or camera.type != "CAMERA":
         return []
     depths = []
     for obj in applied_objects(scene):
         data = modifier.cache_data(obj)
-        if data is not None:
-            depths.append((float(data.get(names.DEPTH_KEY, 0.0)), obj.name))
+        if data is None:
+            continue
+        if depsgraph is not None and modifier.closed_form_on(modifier.find_modifier(obj)):
+            depth = bounds_depth(snap, obj.evaluated_get(depsgraph))
+            if data.get(names.DEPTH_KEY) != depth:
+                data[names.DEPTH_KEY] = depth
+        depths.append((float(data.get(names.DEPTH_KEY, 0.0)), obj.name))
     depth, name = max(depths, default=(0.0, ""))
     if depth <= camera.data.clip_end:
         return []

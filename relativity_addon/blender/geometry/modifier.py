@@ -1,10 +1,14 @@
 """The apparent-geometry modifier and its per-object cache.
 
-The add-on's modifier (node group ``Relativity Apparent Geometry``) subdivides the mesh, stores
+The add-on's modifier (node group ``Relativity Apparent Geometry``, ``node_group.py``) subdivides the mesh, stores
 the tessellated rest positions in the point attribute ``relativity_rest``, then sets the positions
 sampled by index from a cache mesh object, but only when the point counts match (so a stale cache
 never scrambles the mesh); it also copies the cache's ``relativity_beta`` (each point's velocity
 relative to the observer) for the Doppler shaders. ``geometry.update_object`` fills the cache.
+For the closed-form motions (``motion.closed_form``: Static, Constant Velocity without an animation
+of its own) the modifier computes the apparent positions itself (``Closed Form`` on, the inputs of
+``motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
+step sets a few inputs and needs no cache and no pass over the vertices in Python.
 
 The cache object is not linked into any scene; the modifier holds its only user, so it is saved
 with the .blend and a render farm worker needs nothing else. Motion and deformation bakes are
@@ -19,7 +23,8 @@ import bpy
 import numpy as np
 
 from ..common import compat, names
-from ..common.nodes import Group, Links, Literal, Node, ensure_group, interface_identifier, remove_unused_groups
+from ..common.nodes import ensure_group, interface_identifier, remove_unused_groups
+from .node_group import node_group_spec
 
 if TYPE_CHECKING:
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
@@ -27,240 +32,33 @@ if TYPE_CHECKING:
     from ...physics.arrays import FloatArray
 
 
-def _subdivision_nodes() -> dict[str, Node]:
-    """The subdivision: every face at Tessellation levels (``Face Codes`` 0, or not this mesh's face
-    count), else only the faces whose code, read from the last ``Face Codes`` points of the cache
-    (one per face of the incoming mesh), is 1; the two parts are welded again along their seam
-    (``Weld Distance``). Output: ``subdivided.Output``."""
-    face_code = {"data_type": "FLOAT", "domain": "FACE"}
-    return {
-        "in_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "group.Geometry"}, {"component": "MESH"}),
-        "codes_given": Node(
-            "FunctionNodeCompare", {"A": "group.Face Codes", "B": 0}, {"data_type": "INT", "operation": "GREATER_THAN"}
-        ),
-        "codes_fit": Node(
-            "FunctionNodeCompare",
-            {"A": "group.Face Codes", "B": "in_size.Face Count"},
-            {"data_type": "INT", "operation": "EQUAL"},
-        ),
-        "adaptive": Node(
-            "FunctionNodeBooleanMath", {0: "codes_given.Result", 1: "codes_fit.Result"}, {"operation": "AND"}
-        ),
-        "codes_start": Node(
-            "FunctionNodeIntegerMath", {0: "cache_size.Point Count", 1: "group.Face Codes"}, {"operation": "SUBTRACT"}
-        ),
-        "face_index": Node("GeometryNodeInputIndex"),
-        "code_index": Node(
-            "FunctionNodeIntegerMath", {0: "codes_start.Value", 1: "face_index.Index"}, {"operation": "ADD"}
-        ),
-        "cache_code": Node(
-            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
-        ),
-        "sample_code": Node(
-            "GeometryNodeSampleIndex",
-            {"Geometry": "cache_info.Geometry", "Value": "cache_code.Attribute", "Index": "code_index.Value"},
-            {"data_type": "FLOAT", "domain": "POINT"},
-        ),
-        "store_code": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {"Geometry": "group.Geometry", "Name": Literal(names.FACE_CODE_ATTRIBUTE), "Value": "sample_code.Value"},
-            face_code,
-        ),
-        "code": Node(
-            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.FACE_CODE_ATTRIBUTE)}, {"data_type": "FLOAT"}
-        ),
-        "is_subdivided": Node(
-            "FunctionNodeCompare",
-            {"A": "code.Attribute", "B": 1.0, "Epsilon": 0.25},
-            {"data_type": "FLOAT", "operation": "EQUAL"},
-        ),
-        "separate": Node(
-            "GeometryNodeSeparateGeometry",
-            {"Geometry": "store_code.Geometry", "Selection": "is_subdivided.Result"},
-            {"domain": "FACE"},
-        ),
-        "subdivide_part": Node(
-            "GeometryNodeSubdivideMesh", {"Mesh": "separate.Selection", "Level": "group.Tessellation"}
-        ),
-        "join": Node("GeometryNodeJoinGeometry", {"Geometry": Links(("separate.Inverted", "subdivide_part.Mesh"))}),
-        # points of the faces on either side of the seam (codes 1 and 2; a code read on the points is
-        # the mean of their faces'), where the two parts' copies of a vertex are welded again
-        "seam_point": Node(
-            "FunctionNodeCompare",
-            {"A": "code.Attribute", "B": 0.05},
-            {"data_type": "FLOAT", "operation": "GREATER_THAN"},
-        ),
-        "weld": Node(
-            "GeometryNodeMergeByDistance",
-            # mode All, the default on both lines (a property in 4.5, a menu socket in 5.2)
-            {"Geometry": "join.Geometry", "Selection": "seam_point.Result", "Distance": "group.Weld Distance"},
-        ),
-        "subdivide_all": Node("GeometryNodeSubdivideMesh", {"Mesh": "group.Geometry", "Level": "group.Tessellation"}),
-        "subdivided": Node(
-            "GeometryNodeSwitch",
-            {"Switch": "adaptive.Boolean", "False": "subdivide_all.Mesh", "True": "weld.Geometry"},
-            {"input_type": "GEOMETRY"},
-        ),
-    }
-
-
-def _seam_nodes() -> dict[str, Node]:
-    """Points of the subdivided faces on the seam's edges (which the faces of code 2 across the seam
-    do not have) are put on those faces' straight edges, so the surface has no crack: each takes the
-    apparent position interpolated on the code-2 faces at its rest position. Input: ``store_beta``;
-    output: ``unmarked.Geometry``."""
-    vector = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
-    return {
-        "is_ring": Node(
-            "FunctionNodeCompare",
-            {"A": "code.Attribute", "B": 2.0, "Epsilon": 0.25},
-            {"data_type": "FLOAT", "operation": "EQUAL"},
-        ),
-        "ring": Node(
-            "GeometryNodeSeparateGeometry",
-            {"Geometry": "store_beta.Geometry", "Selection": "is_ring.Result"},
-            {"domain": "FACE"},
-        ),
-        "store_seen": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {"Geometry": "ring.Selection", "Name": Literal(names.SEEN_ATTRIBUTE), "Value": "position.Position"},
-            vector,
-        ),
-        "rest": Node(
-            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.REST_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
-        ),
-        "ring_at_rest": Node(
-            "GeometryNodeSetPosition", {"Geometry": "store_seen.Geometry", "Position": "rest.Attribute"}
-        ),
-        "ring_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "ring.Selection"}, {"component": "MESH"}),
-        "has_ring": Node(
-            "FunctionNodeCompare",
-            {"A": "ring_size.Face Count", "B": 0},
-            {"data_type": "INT", "operation": "GREATER_THAN"},
-        ),
-        "proximity": Node(
-            "GeometryNodeProximity",
-            {0: "ring_at_rest.Geometry", "Sample Position": "rest.Attribute"},
-            {"target_element": "FACES"},
-        ),
-        "on_ring": Node(
-            "FunctionNodeCompare",
-            {"A": "proximity.Distance", "B": "group.Weld Distance"},
-            {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
-        ),
-        "snap": Node("FunctionNodeBooleanMath", {0: "on_ring.Result", 1: "has_ring.Result"}, {"operation": "AND"}),
-        "snap_moved": Node(
-            "FunctionNodeBooleanMath", {0: "snap.Boolean", 1: "counts_match.Result"}, {"operation": "AND"}
-        ),
-        "seen": Node(
-            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.SEEN_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
-        ),
-        "interpolated": Node(
-            "GeometryNodeSampleNearestSurface",
-            {"Mesh": "ring_at_rest.Geometry", "Value": "seen.Attribute", "Sample Position": "rest.Attribute"},
-            {"data_type": "FLOAT_VECTOR"},
-        ),
-        "snapped": Node(
-            "GeometryNodeSetPosition",
-            {"Geometry": "store_beta.Geometry", "Selection": "snap_moved.Boolean", "Position": "interpolated.Value"},
-        ),
-        "seamless": Node(
-            "GeometryNodeSwitch",
-            {"Switch": "adaptive.Boolean", "False": "store_beta.Geometry", "True": "snapped.Geometry"},
-            {"input_type": "GEOMETRY"},
-        ),
-        "unmarked": Node(
-            "GeometryNodeRemoveAttribute", {"Geometry": "seamless.Output", "Name": Literal(names.FACE_CODE_ATTRIBUTE)}
-        ),
-    }
-
-
-def node_group_spec() -> Group:
-    store = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
-    mesh_size = {"component": "MESH"}
-    nodes = {
-        "cache_info": Node("GeometryNodeObjectInfo", {"Object": "group.Cache"}, {"transform_space": "ORIGINAL"}),
-        "cache_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "cache_info.Geometry"}, mesh_size),
-        **_subdivision_nodes(),
-        "position": Node("GeometryNodeInputPosition"),
-        "store_rest": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {
-                "Geometry": "subdivided.Output",
-                "Name": Literal(names.REST_ATTRIBUTE),
-                "Value": "position.Position",
-            },
-            store,
-        ),
-        "mesh_size": Node("GeometryNodeAttributeDomainSize", {"Geometry": "store_rest.Geometry"}, mesh_size),
-        # the cache holds a position per point, then the face codes
-        "cache_points": Node(
-            "FunctionNodeIntegerMath", {0: "cache_size.Point Count", 1: "group.Face Codes"}, {"operation": "SUBTRACT"}
-        ),
-        "counts_match": Node(
-            "FunctionNodeCompare",
-            {"A": "cache_points.Value", "B": "mesh_size.Point Count"},
-            {"data_type": "INT", "operation": "EQUAL"},
-        ),
-        "index": Node("GeometryNodeInputIndex"),
-        "sample_position": Node(
-            "GeometryNodeSampleIndex",
-            {
-                "Geometry": "cache_info.Geometry",
-                "Value": "position.Position",
-                "Index": "index.Index",
-            },
-            store,
-        ),
-        "cache_beta": Node(
-            "GeometryNodeInputNamedAttribute", {"Name": Literal(names.BETA_ATTRIBUTE)}, {"data_type": "FLOAT_VECTOR"}
-        ),
-        "sample_beta": Node(
-            "GeometryNodeSampleIndex",
-            {
-                "Geometry": "cache_info.Geometry",
-                "Value": "cache_beta.Attribute",
-                "Index": "index.Index",
-            },
-            store,
-        ),
-        "set_position": Node(
-            "GeometryNodeSetPosition",
-            {
-                "Geometry": "store_rest.Geometry",
-                "Selection": "counts_match.Result",
-                "Position": "sample_position.Value",
-            },
-        ),
-        "store_beta": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {
-                "Geometry": "set_position.Geometry",
-                "Selection": "counts_match.Result",
-                "Name": Literal(names.BETA_ATTRIBUTE),
-                "Value": "sample_beta.Value",
-            },
-            store,
-        ),
-        **_seam_nodes(),
-    }
-    return Group(
-        names.GEOMETRY_GROUP,
-        "GeometryNodeTree",
-        (
-            ("Geometry", "NodeSocketGeometry", None),
-            ("Tessellation", "NodeSocketInt", {"min_value": 0, "max_value": 6, "default_value": 1}),
-            ("Cache", "NodeSocketObject", None),
-            ("Face Codes", "NodeSocketInt", {"min_value": 0, "default_value": 0}),
-            ("Weld Distance", "NodeSocketFloat", {"min_value": 0.0, "default_value": 0.0}),
-        ),
-        (("Geometry", "NodeSocketGeometry", "unmarked.Geometry"),),
-        nodes,
-    )
+# Inputs whose values the modifiers keep across a rebuild of the group (an older version's file):
+# the rest the next update sets again.
+KEPT_INPUTS = ("Cache", "Tessellation", "Face Codes", "Weld Distance")
 
 
 def ensure_node_group() -> NodeTree:
-    return ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    """The node group, rebuilt when a file holds another version of it. The rebuilt interface's
+    sockets get new identifiers, so the modifiers' values (the cache, where the bakes live) are
+    read by name before and set again after."""
+    tree = bpy.data.node_groups.get(names.GEOMETRY_GROUP)
+    kept = []
+    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) != names.GEOMETRY_GROUP_VERSION:
+        old = {item.name: item.identifier for item in tree.interface.items_tree if item.item_type == "SOCKET"}
+        for obj in bpy.data.objects:
+            for mod in obj.modifiers:
+                if mod.type == "NODES" and mod.node_group == tree:
+                    values = {name: compat.modifier_input(mod, old[name]) for name in KEPT_INPUTS if name in old}
+                    kept.append((mod, values))
+    group = ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    for mod, values in kept:
+        for name, value in values.items():
+            if value is not None:
+                compat.set_modifier_input(mod, interface_identifier(group, name), value)
+        cache = values.get("Cache")
+        if cache is not None and cache.data is not None and names.SIGNATURE_KEY in cache.data:
+            del cache.data[names.SIGNATURE_KEY]  # the next sync sets the new inputs
+    return group
 
 
 def find_modifier(obj: Object) -> Modifier | None:
@@ -332,6 +130,42 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     if modifier.show_viewport != enabled or modifier.show_render != enabled:
         modifier.show_viewport = modifier.show_render = enabled
     return modifier, cache
+
+
+def set_closed_form(mod: Modifier, inputs: dict[str, tuple[float, ...] | float] | None) -> bool:
+    """Switch the modifier's closed form on with ``inputs`` (by interface name), or off (None: the
+    cache's positions). Returns whether any input changed (the object must then be evaluated
+    again). Values equal after rounding to the sockets' float32 are left as they are."""
+    return set_inputs(mod, {"Closed Form": inputs is not None, **(inputs or {})})
+
+
+def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
+    """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
+    whether any did."""
+    identifiers = {
+        item.name: item.identifier
+        for item in mod.node_group.interface.items_tree
+        if item.item_type == "SOCKET" and item.in_out == "INPUT"
+    }
+    changed = False
+    for name, value in wanted.items():
+        identifier = identifiers[name]
+        current = compat.modifier_input(mod, identifier)
+        if isinstance(value, bool):
+            same = current is not None and bool(current) == value
+        else:
+            new = np.asarray(value, dtype=np.float32)
+            same = current is not None and np.array_equal(np.asarray(current, dtype=np.float32), new)
+            value = float(new) if new.ndim == 0 else tuple(map(float, new))
+        if not same:
+            compat.set_modifier_input(mod, identifier, value)
+            changed = True
+    return changed
+
+
+def closed_form_on(mod: Modifier) -> bool:
+    """Whether the modifier computes the apparent positions itself (the closed form)."""
+    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Closed Form")))
 
 
 def _shared_with_another_object(obj, cache):

@@ -131,6 +131,52 @@ def closed_form(obj: Object, scene: Scene) -> bool:
     return motion != "ANIMATION" and not (motion == "CONSTANT" and plays_own_animation(obj, scene))
 
 
+def closed_form_inputs(obj: Object, obj_eval: Object, snap: Snapshot) -> dict[str, tuple[float, ...] | float]:
+    """The modifier's closed-form inputs (``node_group.CLOSED_FORM_INPUTS``) for a closed-form object:
+    the relations of :func:`apparent_world_positions` (uniform motion through where Blender draws the
+    object at the observer's time, the rest shape contracted along ``beta``; the retarded emission
+    event boosted into the observer's frame, docs/physics.md) folded into affine maps of the rest
+    position and the light-travel distance ``s = c tau``, in float64. Seen in units of c, the closed
+    form needs no c. Raises RelativityError for a velocity not below c."""
+    _t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
+    check_parent_motion(obj)
+    matrix = matrix_array(obj_eval.matrix_world)
+    w = np.zeros(3)
+    if obj.relativity.motion == "CONSTANT":
+        w = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
+    beta_o = np.asarray(beta_o, dtype=np.float64)
+    x_o = np.asarray(x_o, dtype=np.float64)
+    # r = A x_rest + k: the point at the observer's time, relative to the observer
+    scene = apparent.lorentz_contraction_matrix(w) @ matrix[:3, :3]
+    offset = matrix[:3, 3] - x_o
+    # the emission event (-s, e = r - s w) boosted: e' = B e + gamma s beta_o (Lorentz boost)
+    gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
+    boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
+    # object space: N (x_o + e' - t), N the inverse of the object's 3x3
+    inverse = affine_inverse(matrix)[:3, :3]
+    to_local = inverse @ boost
+    local = to_local @ scene
+    seen = apparent.velocity_seen_by_observer(w, beta_o).reshape(-1, 3)[0]
+
+    def vector(values):
+        return tuple(float(v) for v in values)
+
+    return {
+        "Scene X": vector(scene[:, 0]),
+        "Scene Y": vector(scene[:, 1]),
+        "Scene Z": vector(scene[:, 2]),
+        "Scene Offset": vector(offset),
+        "Velocity": vector(w),
+        "Inverse Gamma Squared": 1.0 - float(w @ w),
+        "Local X": vector(local[:, 0]),
+        "Local Y": vector(local[:, 1]),
+        "Local Z": vector(local[:, 2]),
+        "Local Offset": vector(to_local @ offset - inverse @ offset),
+        "Delay Direction": vector(gamma * (inverse @ beta_o) - to_local @ w),
+        "Seen Velocity": vector(seen),
+    }
+
+
 def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:
     """A one-line warning when some point of a keyframed object (Motion Animation, no bake) is seen
     as it was before its keyframes start moving it (``earliest_time``: its earliest retarded time,

@@ -161,6 +161,49 @@ def decide(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> Decis
     return Decision(level, codes, _weld_distance(rest, edges, loop_edges, subdivided, totals, level), warning)
 
 
+def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snapshot) -> dict[str, object] | None:
+    """The modifier's inputs for its edge verdict (``node_group.EDGE_MEASURE_INPUTS``, ``Tolerance``)
+    on a closed-form object, or None where :func:`decide` measures no edges or keeps the last
+    decision (the verdict is then off, and the modifier subdivides as the decision says)."""
+    settings = obj.relativity
+    if (
+        not settings.use_adaptive_tessellation
+        or settings.tessellation == 0
+        or snap.exact_camera
+        or _rendering()
+        or not _own_mesh(obj)
+        or not snap.projection
+        or snap.projection[0] != "PERSP"
+        or len(cast("Mesh", obj.data).polygons) == 0
+    ):
+        return None
+    matrix = motion.matrix_array(obj_eval.matrix_world)
+    rotation = np.asarray(snap.world_to_camera, dtype=np.float64)
+    view = rotation @ matrix[:3, :3]
+    offset = rotation @ (matrix[:3, 3] - np.asarray(snap.mesh_observer[1], dtype=np.float64))
+    left, right, bottom, top = snap.projection[1:5]
+    width, height = render_size(scene)
+    return {
+        "Camera X": tuple(view[:, 0]),
+        "Camera Y": tuple(view[:, 1]),
+        "Camera Z": tuple(view[:, 2]),
+        "Camera Offset": tuple(offset),
+        "Pixel Scale": (width / (right - left), height / (top - bottom), 1.0),
+        "Window Low": (left, bottom, 0.0),
+        "Tolerance": float(settings.tessellation_tolerance),
+    }
+
+
+def edges_short(obj_eval: Object) -> bool | None:
+    """The modifier's verdict at its last evaluation: every edge's image within the tolerance (True;
+    the mesh was then left whole), not (False), or None (not measured there)."""
+    mesh = obj_eval.data if obj_eval.type == "MESH" else None
+    attribute = mesh.attributes.get(names.EDGES_SHORT_ATTRIBUTE) if mesh is not None else None
+    if attribute is None or len(attribute.data) == 0:
+        return None
+    return bool(attribute.data[0].value)
+
+
 def _weld_distance(rest, edges, loop_edges, subdivided, totals, level):
     """Far below the shortest piece of a subdivided edge, above float32 rounding of the positions."""
     face_of_loop = np.repeat(np.arange(len(totals)), totals)

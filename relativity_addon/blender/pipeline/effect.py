@@ -325,7 +325,7 @@ def sync(
             exact_camera.invalidate(scene.camera)
         _refused(scene, error)
         return None
-    _record(scene, snap)
+    _record(scene, snap, depsgraph)
     return snap
 
 
@@ -395,7 +395,7 @@ def _refused(scene, error):
     _scene_status[scene.name] = status
 
 
-def _record(scene, snap):
+def _record(scene, snap, depsgraph=None):
     warnings = []
     if scene.render.engine == "CYCLES" and scene.cycles.device == "GPU":
         warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
@@ -414,7 +414,7 @@ def _record(scene, snap):
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
     if snap.method == "GEOMETRY":
-        warnings += apparent_meshes.clip_end_warnings(scene, snap)
+        warnings += apparent_meshes.clip_end_warnings(scene, snap, depsgraph)
         warnings += apparent_meshes.update_warnings(scene)
         warnings += instancing.instancing_warnings(scene, snap)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))

@@ -267,3 +267,25 @@ def test_an_unchanged_decision_evaluates_nothing_again(relativity_addon, factory
     depsgraph = bpy.context.evaluated_depsgraph_get()
     slower = tessellation.decide(scene, floor, floor.evaluated_get(depsgraph), snapshot.read(scene, depsgraph))
     assert slower.key() != decision.key()
+
+
+def test_box_whole_at_a_loose_tolerance_curves_after_it_tightens(relativity_addon, factory_blender, tmp_path):
+    """Constant Velocity is computed in the modifier, which also checks every edge's image against
+    the tolerance and leaves the mesh whole when all are short; the add-on then runs no measure of
+    its own. When the check finds a longer edge (here: the tolerance tightened after Set Up), the
+    sync after that evaluation decides again, and the box curves as at the defaults."""
+    bpy = factory_blender
+    scene, camera, box, origin = _box_scene(bpy)
+    rest_corners = np.array([tuple(v.co) for v in box.data.vertices])
+    box.relativity.tessellation_tolerance = 1000.0
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()  # the check's first evaluation; its sync sees every edge short
+    assert len(gh.evaluated_points(bpy, box)[0]) == 8
+
+    box.relativity.tessellation_tolerance = 0.5
+    bpy.context.evaluated_depsgraph_get()  # the check finds long edges; its sync decides again
+    vertices = len(gh.evaluated_points(bpy, box)[0])
+    assert vertices > 8, "not subdivided after the check found long edges"
+    coverage = np.clip(ch.luminance(ch.render_exr(bpy, scene, tmp_path / "tightened.exr")), 0.0, 1.0)
+    analytic, hits = _analytic_coverage(camera, rest_corners, origin)
+    assert _outline_error(coverage, analytic, hits) <= 1.0
