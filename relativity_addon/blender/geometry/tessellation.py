@@ -170,7 +170,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
         not settings.use_adaptive_tessellation
         or settings.tessellation == 0
         or snap.exact_camera
-        or _rendering()
+        or busy.rendering()
         or not _own_mesh(obj)
         or not snap.projection
         or snap.projection[0] != "PERSP"
