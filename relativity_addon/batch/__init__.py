@@ -172,6 +172,8 @@ def _set_frame(scene, frame):
     whole = math.floor(frame)
     if (scene.frame_current, scene.frame_subframe) != (whole, frame - whole):
         scene.frame_set(whole, subframe=frame - whole)
+        if addon_module("geometry.apparent_meshes").deferred():  # left by the frame change to a sync
+            addon_module("pipeline.effect").sync(scene)
 
 
 def _render_frame(bpy, scene, frame, path, relativistic, spectral_passes=None, scene_frame=None):

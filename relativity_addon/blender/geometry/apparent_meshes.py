@@ -174,8 +174,27 @@ def _render_size(snap: Snapshot) -> tuple[float, float] | None:
     return tessellation.render_size(scene) if scene is not None else None
 
 
-def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None) -> int:
-    """Recompute the cache of one object for the snapshot's frame. Raises RelativityError."""
+# Objects whose new subdivision's positions wait for a sync outside ``frame_change_post``.
+_deferred: set[str] = set()
+
+
+def deferred() -> bool:
+    """Whether some object's update waits for a sync outside a frame change (:func:`update_object`)."""
+    return bool(_deferred)
+
+
+def update_object(
+    scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None, in_frame_change: bool = False
+) -> int:
+    """Recompute the cache of one object for the snapshot's frame. Raises RelativityError.
+
+    ``in_frame_change`` (``frame_change_post``): Blender 4.5 crashed evaluating the depsgraph
+    again there after the tessellation changed (a segmentation fault at frame 10 of the street
+    fly-through), so then a closed-form object keeps the handler's depsgraph (its inputs do not
+    read the new subdivision; the next sync finds the check's new verdict) and another object's
+    positions wait for the next sync (:func:`deferred`): the handlers and the batch script sync
+    again outside the frame change."""
+    _deferred.discard(obj.name)
     mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -190,7 +209,12 @@ def update_object(scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgrap
         else:
             decision = tessellation.decide(scene, obj, obj_eval, snap)
         if decision is not None and tessellation.apply(obj, mod, cache, decision):
-            depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
+            if in_frame_change and not closed:
+                _deferred.add(obj.name)
+                cache.data[names.SIGNATURE_KEY] = ""  # computed at the next sync
+                return 0
+            if not in_frame_change:
+                depsgraph = bpy.context.evaluated_depsgraph_get()  # the new subdivision's rest positions
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
@@ -277,10 +301,17 @@ def _apparent_local(scene, obj, obj_eval, rest32, snap, computed=None):
     return local, beta_seen[0] if shared else np.concatenate(beta_seen), delay, depth
 
 
-def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, only_changed: bool = False) -> int:
+def update(
+    scene: Scene,
+    snap: Snapshot,
+    depsgraph: Depsgraph | None = None,
+    only_changed: bool = False,
+    in_frame_change: bool = False,
+) -> int:
     """Recompute every object carrying the modifier (only those whose inputs changed, with
-    ``only_changed``). A failure is recorded on the object's cache and printed, never raised:
-    the viewport keeps the last valid state. Returns the number of objects updated."""
+    ``only_changed``; ``in_frame_change``: see :func:`update_object`). A failure is recorded on
+    the object's cache and printed, never raised: the viewport keeps the last valid state.
+    Returns the number of objects updated."""
     updated = 0
     with busy.computing():
         for obj in applied_objects(scene):
@@ -294,7 +325,7 @@ def update(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None, onl
             ):
                 continue
             try:
-                update_object(scene, obj, snap, depsgraph)
+                update_object(scene, obj, snap, depsgraph, in_frame_change)
                 updated += 1
             except RelativityError as error:
                 print(f"Relativity: {error}")

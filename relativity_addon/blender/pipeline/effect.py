@@ -286,6 +286,7 @@ def sync(
     update_geometry: bool = True,
     attach_new_materials: bool = False,
     before_render: bool = False,
+    in_frame_change: bool = False,
 ) -> Snapshot | None:
     """Bring the applied render path up to date with the scene at its current frame.
 
@@ -293,7 +294,8 @@ def sync(
     which exist only after a frame change); only objects whose inputs changed (the frame among
     them) are recomputed; ``attach_new_materials`` attaches the Doppler colour to materials added
     since Set Up; ``before_render`` (``render_pre``) also writes what only a render reads (the
-    world's direction image).
+    world's direction image); ``in_frame_change`` (``frame_change_post``): the depsgraph is not
+    evaluated again (``apparent_meshes.update_object``).
     Never raises."""
     if depsgraph is not None:
         apparent_meshes.note_updates(depsgraph)  # also while computing: what Blender evaluated again
@@ -315,7 +317,7 @@ def sync(
         if method == "GEOMETRY":
             instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
         if method == "GEOMETRY" and update_geometry:
-            apparent_meshes.update(scene, snap, depsgraph, only_changed=True)
+            apparent_meshes.update(scene, snap, depsgraph, only_changed=True, in_frame_change=in_frame_change)
         if method is not None:
             update = Sync(depsgraph, attach_new_materials, before_render)
             for stage in STAGES:

@@ -25,6 +25,7 @@ from bpy.app.handlers import persistent
 
 from ..camera import exact_camera
 from ..common import busy
+from ..geometry import apparent_meshes
 from . import effect, render_notice
 
 if TYPE_CHECKING:
@@ -46,7 +47,18 @@ def frame_change_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
 
 @persistent
 def frame_change_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
-    _sync(scene, depsgraph=depsgraph)
+    _sync(scene, depsgraph=depsgraph, in_frame_change=True)
+    if apparent_meshes.deferred() and not bpy.app.background:
+        # positions of a new subdivision, computed outside the frame change (the batch script
+        # syncs after each frame change itself; timers do not run in the background)
+        name = scene.name
+        bpy.app.timers.register(lambda: _sync_later(name), first_interval=0.0)
+
+
+def _sync_later(name):
+    scene = bpy.data.scenes.get(name)
+    if scene is not None:
+        _sync(scene)
 
 
 @persistent
