@@ -19,7 +19,6 @@ the object's cache (:func:`scene_errors`) and the viewport keeps the last valid 
 
 from __future__ import annotations
 
-import math
 import zlib
 from typing import TYPE_CHECKING
 
@@ -28,8 +27,8 @@ import numpy as np
 
 from ...errors import RelativityError
 from ..common import busy, names
-from ..scene import lens, snapshot
-from . import instancing, modifier, motion, tessellation
+from ..scene import snapshot
+from . import clip_end, instancing, modifier, motion, tessellation
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
@@ -293,7 +292,7 @@ def _apparent_local(scene, obj, obj_eval, rest32, snap, computed=None):
             except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
                 raise RelativityError(f"Object {obj.name!r}: {error}") from None
         delay = max(delay, float(np.max(delays, initial=0.0)))
-        depth = max(depth, farthest_seen_depth(scene, snap, world))
+        depth = max(depth, clip_end.farthest_seen_depth(scene, snap, world))
         # On coordinate rows (3, n): numpy multiplies the transposed views without copying them.
         local[start : start + step] = (inverse[:3, :3] @ world.T + inverse[:3, 3:]).T
         beta_seen.append(beta)
@@ -508,70 +507,6 @@ def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | No
     if fraction > COARSE_EDGE_FRACTION:
         return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, {advice}"
     return None
-
-
-def farthest_seen_depth(scene: Scene, snap: Snapshot, world: npt.ArrayLike) -> float:
-    """The largest depth along the view axis (scene units) of the apparent vertices ``world``
-    (N, 3) in the boosted preview's camera view (a tenth of the view wider on each side), 0 when
-    none: how far Clip End must reach. Fast observers see what lies ahead much farther away (a
-    point at distance d ahead at gamma (1 + beta) d, docs/physics.md)."""
-    camera = scene.objects.get(snap.camera)
-    if snap.exact_camera or camera is None or len(world) == 0:
-        return 0.0
-    world = np.asarray(world, dtype=np.float64)
-    local = (snap.world_to_camera @ (world - snap.camera_position).T).T
-    depth = -local[:, 2]
-    seen = depth > 0.0
-    if camera.data.type != "ORTHO":
-        left, right, bottom, top = lens.view_window(scene, camera)
-        x, y = local[:, 0] / np.maximum(depth, 1e-30), local[:, 1] / np.maximum(depth, 1e-30)
-        margin_x, margin_y = 0.1 * (right - left), 0.1 * (top - bottom)
-        seen &= (x >= left - margin_x) & (x <= right + margin_x) & (y >= bottom - margin_y) & (y <= top + margin_y)
-    return float(depth[seen].max()) if np.any(seen) else 0.0
-
-
-def _round_up(value):
-    """``value`` rounded up to two significant digits."""
-    step = 10.0 ** (math.floor(math.log10(value)) - 1)
-    return math.ceil(value / step - 1e-9) * step
-
-
-def bounds_depth(snap: Snapshot, obj_eval: Object) -> float:
-    """The largest depth along the view axis (scene units) of the corners of the evaluated mesh's
-    bounds (the apparent positions of a closed-form object), 0 when none is ahead: at least the
-    farthest vertex's depth (a bound: the corners need not lie in the camera's view)."""
-    corners = np.array([tuple(corner) for corner in obj_eval.bound_box], dtype=np.float64)
-    world = motion.to_world(motion.matrix_array(obj_eval.matrix_world), corners)
-    depth = -(snap.world_to_camera @ (world - snap.camera_position).T)[2]
-    return float(max(depth.max(initial=0.0), 0.0))
-
-
-def clip_end_warnings(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None) -> list[str]:
-    """One line when the boosted meshes reach beyond the camera's Clip End (they are cut off in the
-    viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs.
-    A closed-form object's depth is its evaluated bounds' (:func:`bounds_depth`), taken from a
-    handler's evaluated ``depsgraph`` and kept for the syncs without one."""
-    camera = scene.objects.get(snap.camera)
-    if snap.exact_camera or camera is None or camera.type != "CAMERA":
-        return []
-    depths = []
-    for obj in applied_objects(scene):
-        data = modifier.cache_data(obj)
-        if data is None:
-            continue
-        if depsgraph is not None and modifier.closed_form_on(modifier.find_modifier(obj)):
-            depth = bounds_depth(snap, obj.evaluated_get(depsgraph))
-            if data.get(names.DEPTH_KEY) != depth:
-                data[names.DEPTH_KEY] = depth
-        depths.append((float(data.get(names.DEPTH_KEY, 0.0)), obj.name))
-    depth, name = max(depths, default=(0.0, ""))
-    if depth <= camera.data.clip_end:
-        return []
-    scale = scene.unit_settings.scale_length or 1.0
-    return [
-        f"Camera {camera.name!r}: Clip End {camera.data.clip_end * scale:.5g} m cuts off mesh {name!r}, "
-        f"seen {depth * scale:.5g} m away at this speed: set Clip End to {_round_up(depth * scale * 1.01):.5g} m"
-    ]
 
 
 def tessellation_warning(obj: Object) -> str | None:

@@ -29,7 +29,7 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, instancing, modifier, shape_keys
+from ..geometry import apparent_meshes, clip_end, instancing, modifier, shape_keys
 from ..scene import animation, moving_objects, snapshot, traveller
 from . import bake, render_notice
 from .stages import STAGES, Sync
@@ -416,7 +416,7 @@ def _record(scene, snap, depsgraph=None):
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
     warnings += apparent_meshes.scene_errors(scene)
     if snap.method == "GEOMETRY":
-        warnings += apparent_meshes.clip_end_warnings(scene, snap, depsgraph)
+        warnings += clip_end.clip_end_warnings(scene, snap, depsgraph)
         warnings += apparent_meshes.update_warnings(scene)
         warnings += instancing.instancing_warnings(scene, snap)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
