@@ -25,6 +25,9 @@ spectral Doppler matrix per pixel after the render, with no second render:
   through the table of its blackbody (``physics/illuminants.py``): a surface it lit sends a
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
+- The light of moving blackbody lights' stand-in lamps (the observed light group,
+  ``light_groups.OBSERVED``) is kept as rendered: their shader gave each surface point the light
+  the observer sees (``shaders/relativistic_moving_lamp.osl``), which no table of one temperature can.
 - With the observer at rest in every frame the stage is the identity (``D = 1``) and is muted,
   so that it costs the render nothing (``at_rest_throughout``).
 
@@ -52,6 +55,7 @@ COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
 SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
 VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
+GROUP_INPUTS = ("Lit 1", "Lit 2", "Observed")  # the inputs of light_groups.GROUPS' passes
 
 
 def _matrix_nodes(key, image_name, colour):
@@ -132,7 +136,8 @@ def compositor_group() -> Group:
         # The light of blackbody lamps (light_groups.py: one light group per temperature) is read
         # through its temperature's table, the rest of the pixel through the emitters' table.
         # (the light groups' passes denoised like the Image where Cycles' denoiser is on: _add_denoisers)
-        "lit": vmath("ADD", "group.Lit 1", "group.Lit 2"),
+        "lit_slots": vmath("ADD", "group.Lit 1", "group.Lit 2"),
+        "lit": vmath("ADD", "lit_slots", "group.Observed"),
         "rest": vmath("SUBTRACT", "group.Image", "lit"),
         "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # the passes' noise may push it below 0
     }
@@ -142,7 +147,8 @@ def compositor_group() -> Group:
     nodes.update(
         {
             "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
-            "shifted": vmath("ADD", "emit_shifted", "lit_shifted"),
+            "lit_seen": vmath("ADD", "lit_shifted", "group.Observed"),  # the observed group as rendered
+            "shifted": vmath("ADD", "emit_shifted", "lit_seen"),
             "kept": Node(
                 "ShaderNodeMix",
                 {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
@@ -166,6 +172,7 @@ def compositor_group() -> Group:
             ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
             ("Lit 1", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the light groups' passes
             ("Lit 2", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("Observed", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the observed light group's pass
             ("World Directions", "NodeSocketFloat", 0.0),  # 1: the image has the samples' ln D without AOV
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
@@ -246,9 +253,10 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
             for image in map(bpy.data.images.get, lut_images.ILLUMINANT_LUT_NAMES)
         )
     else:
-        temperatures = light_groups.assign(scene, snap.lit_groups)
+        temperatures = light_groups.assign(scene, snap.lit_groups, light_groups.stand_ins(scene, snap.observed_lights))
         for name, temperature in zip(lut_images.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
             lut_images.ensure_illuminant_lut(name, temperature)
+    observed = any(obj.lightgroup == light_groups.OBSERVED for obj in scene.objects)
     values = colour_stage_values(snap)
     held = light_groups.KEY in scene  # else the view layers have no slot groups to link
     bypass = _stage_mode["mode"] == "COLOUR" and at_rest_throughout(scene, snap)
@@ -263,7 +271,8 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
                 node.inputs[name].default_value = value
         view_layer = scene.view_layers.get(layers.layer) if layers is not None else None
         denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
-        mutes = [not denoised or not temperature for temperature in temperatures]  # muted: the pass as rendered
+        # muted: the pass as rendered
+        mutes = [not denoised or not temperature for temperature in temperatures] + [not denoised or not observed]
         if view_layer is not None and not all(mutes):
             guided.add(view_layer.name)
         records.append((record, node, layers, mutes))
@@ -339,12 +348,12 @@ def _add_denoisers(tree, layers, node):
     denoising data passes: Cycles' denoiser denoises the Image but not the light groups' passes,
     whose noise would come back with the rest of the pixel. Muted where not needed."""
     added = []
-    for slot in range(1, len(light_groups.SLOTS) + 1):
+    for slot in range(1, len(light_groups.GROUPS) + 1):
         denoiser = tree.nodes.new("CompositorNodeDenoise")
         denoiser.name = denoiser.label = f"{node.name} Denoise {slot}"
         denoiser.location = (node.location.x - 200.0, node.location.y - 150.0 * slot)
         denoiser.mute = True
-        tree.links.new(denoiser.outputs["Image"], node.inputs[f"Lit {slot}"])
+        tree.links.new(denoiser.outputs["Image"], node.inputs[GROUP_INPUTS[slot - 1]])
         _link_light_group_pass(tree, layers, denoiser, slot)
         added.append(denoiser.name)
     return added
@@ -354,7 +363,7 @@ def _link_light_group_pass(tree, layers, denoiser, slot, guides=True):
     """Link light group ``slot``'s pass into ``denoiser``, and with ``guides`` the denoising data
     passes (the Render Layers node shows a new light group's output, or the data passes switched
     on, only once it is updated; without the passes it has no such outputs)."""
-    wanted = [(f"Combined_{light_groups.SLOTS[slot - 1]}", "Image")]
+    wanted = [(f"Combined_{light_groups.GROUPS[slot - 1]}", "Image")]
     if guides:
         wanted += [("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")]
     missing = [(output, input_name) for output, input_name in wanted if not denoiser.inputs[input_name].is_linked]

@@ -9,6 +9,11 @@ Everything set is recorded on the scene (``names.LIGHT_GROUPS_KEY``) and given b
 :func:`release`: the light groups added to the view layers, and each object's and the world's
 light group, which is only ever set where it was empty. A view layer that already has light
 groups of the user's is left alone: its lamps are read in white (:func:`user_groups`).
+
+The stand-in lamps of moving blackbody lights (``Snapshot.observed_lights``) go into one more
+light group, :data:`OBSERVED`: their shader already gives the light the observer sees (each
+surface point's own ``D T`` shifted by the observer's ``D``), and the compositor keeps that pass
+as rendered.
 """
 
 from __future__ import annotations
@@ -30,11 +35,21 @@ if TYPE_CHECKING:
 
 KEY = names.LIGHT_GROUPS_KEY
 SLOTS = names.LIT_GROUPS
+OBSERVED = names.OBSERVED_LIGHT_GROUP
+GROUPS = (*SLOTS, OBSERVED)  # every light group the add-on adds, in the compositor's order
 
 
 def user_groups(scene: Scene) -> list[str]:
     """Names of the light groups of ``scene``'s view layers that are not the add-on's."""
-    return sorted({group.name for layer in scene.view_layers for group in layer.lightgroups} - set(SLOTS))
+    return illuminants.user_light_groups(scene)
+
+
+def stand_ins(scene: Scene, lights: Sequence[str]) -> list[str]:
+    """The stand-in lamps of the moving lights named ``lights`` (``lights/stand_in_lamps.py``'s record)."""
+    record = scene.get(names.MOVING_LAMPS_KEY)
+    if record is None:
+        return []
+    return [name for light in lights for name in record.get(light, ())]
 
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:
@@ -52,7 +67,7 @@ def hold(scene: Scene) -> bool:
     if KEY in scene or user_groups(scene):
         return False
     for layer in scene.view_layers:
-        for name in SLOTS:
+        for name in GROUPS:
             layer.lightgroups.add(name=name)
     scene[KEY] = {"objects": {}, "world": {}}
     return True
@@ -63,14 +78,19 @@ def _datablock(kind, name):
     return (bpy.data.objects if kind == "objects" else bpy.data.worlds).get(name)
 
 
-def assign(scene: Scene, groups: Sequence[LitGroup]) -> tuple[float, ...]:
+def observed_held(scene: Scene) -> bool:
+    """Whether the view layers hold the observed light group (not in a file set up before it)."""
+    return KEY in scene and all(layer.lightgroups.get(OBSERVED) is not None for layer in scene.view_layers)
+
+
+def assign(scene: Scene, groups: Sequence[LitGroup], observed: Sequence[str] = ()) -> tuple[float, ...]:
     """Put the lamps of ``groups`` (``illuminants.LitGroup``, one per slot) into the slots' light
-    groups and take every other lamp the add-on put there out again. Returns the temperature of
-    each slot (0: empty)."""
+    groups and the objects named ``observed`` into :data:`OBSERVED`, and take every other lamp the
+    add-on put there out again. Returns the temperature of each slot (0: empty)."""
     if KEY not in scene:
         return (0.0,) * len(SLOTS)
     record = scene[KEY]
-    wanted = {}
+    wanted = {("objects", name): OBSERVED for name in observed} if observed_held(scene) else {}
     for index, group in enumerate(groups):
         for member in group.members:
             if member != illuminants.WORLD:
@@ -107,7 +127,7 @@ def release(scene: Scene) -> bool:
             if block is not None:
                 block.lightgroup = group
     for layer in scene.view_layers:
-        for name in SLOTS:
+        for name in GROUPS:
             group = layer.lightgroups.get(name)
             if group is not None:
                 layer.lightgroups.remove(group)
