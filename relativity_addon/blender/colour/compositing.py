@@ -26,8 +26,12 @@ spectral Doppler matrix per pixel after the render, with no second render:
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
 - The light of moving blackbody lights' stand-in lamps (the observed light group,
-  ``light_groups.OBSERVED``) is kept as rendered: their shader gave each surface point the light
-  the observer sees (``shaders/relativistic_moving_lamp.osl``), which no table of one temperature can.
+  ``light_groups.OBSERVED``) is already the illuminant the observer sees: their shader gave each
+  surface point the blackbody at ``D_o D_L T`` (``shaders/relativistic_moving_lamp.osl``), which no
+  table of one temperature can. What is left is the reflectance's own shift, ``R(lambda D_o)``:
+  the pass is scaled per channel by ``r / rho``, ``rho`` the Diffuse Color pass and ``r`` its
+  colour relative to white after the emitters' table at ``D`` (``gamut_map(N(D) rho) /
+  gamut_map(N(D) 1)``, von Kries: exact for grey, 1 where there is no diffuse colour).
 - With the observer at rest in every frame the stage is the identity (``D = 1``) and is muted,
   so that it costs the render nothing (``at_rest_throughout``).
 
@@ -56,6 +60,7 @@ SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
 VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
 GROUP_INPUTS = ("Lit 1", "Lit 2", "Observed")  # the inputs of light_groups.GROUPS' passes
+REFLECTANCE_EPSILON = 1e-4  # below it a Diffuse Color channel counts as none (the factor tends to 1)
 
 
 def _matrix_nodes(key, image_name, colour):
@@ -96,6 +101,39 @@ def _matrix_nodes(key, image_name, colour):
             f"{key}_safe_log_gain": fmath("MINIMUM", f"{key}_log_gain", materials.EXP_LIMIT),
             f"{key}_gain": fmath("EXPONENT", f"{key}_safe_log_gain"),
             f"{key}_shifted": vmath("SCALE", f"{key}_base.Result", scale=f"{key}_gain"),
+        }
+    )
+    return nodes
+
+
+def _reflectance_shift_nodes():
+    """``observed_seen``: the observed light group's pass times the reflectance shift factor
+    ``(gamut_map(N(D) rho) + e) / (gamut_map(N(D) 1) rho + e)`` per channel, ``rho`` the Diffuse
+    Color pass, ``N`` the emitters' table read at the texels of the ``emit`` nodes (mixed by Use
+    Doppler: the pass as rendered without the colour shift and in the spectral passes)."""
+    nodes = {}
+    for key, colour in (("refl", "group.Diffuse Color"), ("white", (1.0, 1.0, 1.0))):
+        for row in range(3):
+            for side in "01":
+                nodes[f"{key}_row{row}_{side}_dot"] = vmath("DOT_PRODUCT", f"emit_row{row}_{side}", colour)
+            low, high = f"{key}_row{row}_0_dot.Value", f"{key}_row{row}_1_dot.Value"
+            nodes[f"{key}_step{row}"] = fmath("SUBTRACT", high, low)
+            nodes[f"{key}_dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"{key}_step{row}", low)
+        nodes[f"{key}_product"] = Node("ShaderNodeCombineXYZ", {i: f"{key}_dot{i}" for i in range(3)})
+        nodes[f"{key}_mapped"] = group_node(COMPOSITOR_GAMUT_MAP, {0: f"{key}_product"}, kind="CompositorNodeGroup")
+    eps = (REFLECTANCE_EPSILON,) * 3
+    nodes.update(
+        {
+            "refl_top": vmath("ADD", "refl_mapped", eps),
+            "white_albedo": vmath("MULTIPLY", "white_mapped", "group.Diffuse Color"),
+            "refl_bottom": vmath("ADD", "white_albedo", eps),
+            "refl_factor": vmath("DIVIDE", "refl_top", "refl_bottom"),
+            "observed_shifted": vmath("MULTIPLY", "group.Observed", "refl_factor"),
+            "observed_seen": Node(
+                "ShaderNodeMix",
+                {"Factor": "group.Use Doppler", 4: "group.Observed", 5: "observed_shifted"},
+                {"data_type": "VECTOR"},
+            ),
         }
     )
     return nodes
@@ -142,12 +180,13 @@ def compositor_group() -> Group:
         "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # the passes' noise may push it below 0
     }
     nodes.update(_matrix_nodes("emit", lut_images.DOPPLER_LUT_NAME, "other"))
+    nodes.update(_reflectance_shift_nodes())
     for slot, image_name in enumerate(lut_images.ILLUMINANT_LUT_NAMES, start=1):
         nodes.update(_matrix_nodes(f"lit{slot}", image_name, f"group.Lit {slot}"))
     nodes.update(
         {
             "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
-            "lit_seen": vmath("ADD", "lit_shifted", "group.Observed"),  # the observed group as rendered
+            "lit_seen": vmath("ADD", "lit_shifted", "observed_seen.Result"),
             "shifted": vmath("ADD", "emit_shifted", "lit_seen"),
             "kept": Node(
                 "ShaderNodeMix",
@@ -173,6 +212,7 @@ def compositor_group() -> Group:
             ("Lit 1", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the light groups' passes
             ("Lit 2", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
             ("Observed", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the observed light group's pass
+            ("Diffuse Color", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # Cycles' pass, with the observed group
             ("World Directions", "NodeSocketFloat", 0.0),  # 1: the image has the samples' ln D without AOV
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
@@ -276,7 +316,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
         if view_layer is not None and not all(mutes):
             guided.add(view_layer.name)
         records.append((record, node, layers, mutes))
-    _store_denoising_passes(scene, guided)
+    _store_passes(scene, guided, observed)
     # Denoised light groups are recombined with the Image denoised apart: the stage is then no
     # identity to the last bit even at D = 1 (max(Image - Lit, 0) + Lit), and stays on.
     bypass = bypass and not guided
@@ -293,7 +333,36 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
                 _link_light_group_pass(tree, layers, denoiser, slot, guides=not mute)
             if denoiser.mute != mute:
                 denoiser.mute = mute
+        if held and layers is not None and observed:
+            _link_diffuse_colour(tree, layers, _node)
     return True
+
+
+def _store_passes(scene, guided, observed):
+    """The denoising data passes (normal, albedo: the light groups' denoisers' guides) only on the
+    view layers in ``guided``, and the Diffuse Color pass (the observed group's reflectance shift)
+    only while the observed light group has lamps; otherwise as the user had them: Cycles writes
+    them at every camera sample's first hit, a cost of every sample where nothing reads them."""
+    saved = scene[SAVED_KEY]
+    for view_layer in scene.view_layers:
+        for key, owner, prop, needed in (
+            ("denoising_passes", view_layer.cycles, "denoising_store_passes", view_layer.name in guided),
+            ("diffuse_colour_pass", view_layer, "use_pass_diffuse_color", observed),
+        ):
+            stored = saved.get(key, {})
+            wanted = bool(stored.get(view_layer.name)) or needed
+            if view_layer.name in stored and getattr(owner, prop) != wanted:
+                setattr(owner, prop, wanted)
+
+
+def _link_diffuse_colour(tree, layers, node):
+    """Link the Diffuse Color pass into the group node (the Render Layers node shows it once updated)."""
+    socket = node.inputs.get("Diffuse Color")
+    if socket is None or socket.is_linked:
+        return
+    layers.update()
+    if "DiffCol" in layers.outputs:
+        tree.links.new(layers.outputs["DiffCol"], socket)
 
 
 def _skip_own_compositor(scene, bypass):
@@ -328,19 +397,6 @@ def at_rest_throughout(scene: Scene, snap: Snapshot) -> bool:
     paths = [curve.data_path for curve in compat.action_fcurves(animation)]
     paths += [driver.data_path for driver in animation.drivers]
     return not any(path.startswith("relativity.") for path in paths)
-
-
-def _store_denoising_passes(scene, guided):
-    """The denoising data passes (normal, albedo: the light groups' denoisers' guides) only on the
-    view layers in ``guided``, the others as the user had them: Cycles writes them at every
-    camera sample's first hit, a cost of every sample for guides that a muted denoiser ignores."""
-    stored = scene[SAVED_KEY].get("denoising_passes", {})
-    for view_layer in scene.view_layers:
-        if view_layer.name not in stored:
-            continue
-        wanted = bool(stored[view_layer.name]) or view_layer.name in guided
-        if view_layer.cycles.denoising_store_passes != wanted:
-            view_layer.cycles.denoising_store_passes = wanted
 
 
 def _add_denoisers(tree, layers, node):
@@ -410,8 +466,9 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
             saved["created_tree"] = tree.name
         light_groups.hold(scene)
         # the denoising data passes (the light groups' denoisers' guides) as the user had them,
-        # switched on where they are needed (_store_denoising_passes)
+        # switched on where they are needed (_store_passes)
         saved["denoising_passes"] = {layer.name: layer.cycles.denoising_store_passes for layer in scene.view_layers}
+        saved["diffuse_colour_pass"] = {layer.name: layer.use_pass_diffuse_color for layer in scene.view_layers}
         for view_layer in scene.view_layers:
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
@@ -481,6 +538,10 @@ def remove_colour_stage(scene: Scene) -> bool:
         view_layer = scene.view_layers.get(name)
         if view_layer is not None:
             view_layer.cycles.denoising_store_passes = stored
+    for name, stored in saved.get("diffuse_colour_pass", {}).items():
+        view_layer = scene.view_layers.get(name)
+        if view_layer is not None:
+            view_layer.use_pass_diffuse_color = stored
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:
