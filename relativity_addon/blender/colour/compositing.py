@@ -324,7 +324,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
         if node.mute != bypass:  # muted, the group passes its Image through
             node.mute = bypass
     _skip_own_compositor(scene, bypass)
-    for record, _node, layers, mutes in records:
+    for record, node, layers, mutes in records:
         for slot, (name, mute) in enumerate(zip(record.get("denoisers", ()), mutes, strict=False), 1):
             denoiser = tree.nodes.get(name)
             if denoiser is None:
@@ -334,7 +334,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
             if denoiser.mute != mute:
                 denoiser.mute = mute
         if held and layers is not None and observed:
-            _link_diffuse_colour(tree, layers, _node)
+            _link_diffuse_colour(tree, layers, node)
     return True
 
 
@@ -361,8 +361,9 @@ def _link_diffuse_colour(tree, layers, node):
     if socket is None or socket.is_linked:
         return
     layers.update()
-    if "DiffCol" in layers.outputs:
-        tree.links.new(layers.outputs["DiffCol"], socket)
+    output = compat.render_layers_diffuse_colour(layers)
+    if output is not None:
+        tree.links.new(output, socket)
 
 
 def _skip_own_compositor(scene, bypass):

@@ -11,9 +11,9 @@ light group, which is only ever set where it was empty. A view layer that alread
 groups of the user's is left alone: its lamps are read in white (:func:`user_groups`).
 
 The stand-in lamps of moving blackbody lights (``Snapshot.observed_lights``) go into one more
-light group, :data:`OBSERVED`: their shader already gives the light the observer sees (each
-surface point's own ``D T`` shifted by the observer's ``D``), and the compositor keeps that pass
-as rendered.
+light group, :data:`OBSERVED`: their shader already gives the illuminant the observer sees (each
+surface point's own ``D T`` shifted by the observer's ``D``), and the compositor adds only the
+reflectance's own shift to that pass (``compositing.py``).
 """
 
 from __future__ import annotations

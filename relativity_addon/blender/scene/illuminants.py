@@ -22,7 +22,7 @@ A light with its own velocity is hidden while applied and drawn by stand-in lamp
 gives each surface point its own ``D T`` (``lights/stand_in_lamps.py``), so no table of one
 temperature reads it. In the fast mode (not *White*) the stand-ins of a moving blackbody light go
 into the light group ``names.OBSERVED_LIGHT_GROUP`` instead, and their shader also applies the
-observer's shift (:func:`reads_observed`); the compositor keeps that group's pass as rendered.
+observer's shift (:func:`reads_observed`); the compositor adds only the reflectance's shift.
 """
 
 from __future__ import annotations
