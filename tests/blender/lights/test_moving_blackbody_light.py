@@ -186,3 +186,8 @@ def test_moving_blackbody_lamp_on_a_coloured_floor_seen_by_a_moving_observer(
     ):
         assert delta_e <= 2.5
         assert ratio == pytest.approx(1.0, abs=0.1)
+    layer = scene.view_layers[0]
+    assert layer.use_pass_diffuse_color and any(group.name == "Relativity Observed" for group in layer.lightgroups)
+    mp._effect().remove(scene)  # gives back the pass and the light groups
+    assert not layer.use_pass_diffuse_color and not layer.lightgroups
+    assert not any(obj.name.startswith("Relativity") for obj in scene.objects)
