@@ -297,6 +297,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
         for name, temperature in zip(lut_images.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
             lut_images.ensure_illuminant_lut(name, temperature)
     observed = any(obj.lightgroup == light_groups.OBSERVED for obj in scene.objects)
+    light_groups.mute_observed_branch(nodes)
     values = colour_stage_values(snap)
     held = light_groups.KEY in scene  # else the view layers have no slot groups to link
     bypass = _stage_mode["mode"] == "COLOUR" and at_rest_throughout(scene, snap)
@@ -334,7 +335,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
             if denoiser.mute != mute:
                 denoiser.mute = mute
         if held and layers is not None and observed:
-            _link_diffuse_colour(tree, layers, node)
+            light_groups.link_diffuse_colour(tree, layers, node)
     return True
 
 
@@ -353,17 +354,6 @@ def _store_passes(scene, guided, observed):
             wanted = bool(stored.get(view_layer.name)) or needed
             if view_layer.name in stored and getattr(owner, prop) != wanted:
                 setattr(owner, prop, wanted)
-
-
-def _link_diffuse_colour(tree, layers, node):
-    """Link the Diffuse Color pass into the group node (the Render Layers node shows it once updated)."""
-    socket = node.inputs.get("Diffuse Color")
-    if socket is None or socket.is_linked:
-        return
-    layers.update()
-    output = compat.render_layers_diffuse_colour(layers)
-    if output is not None:
-        tree.links.new(output, socket)
 
 
 def _skip_own_compositor(scene, bypass):

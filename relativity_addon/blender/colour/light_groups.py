@@ -22,13 +22,13 @@ from typing import TYPE_CHECKING
 
 import bpy
 
-from ..common import names
+from ..common import compat, names
 from ..scene import illuminants
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from bpy.types import Scene
+    from bpy.types import Node, NodeTree, Scene
 
     from ..scene.illuminants import LitGroup
     from ..scene.snapshot import Snapshot
@@ -133,3 +133,26 @@ def release(scene: Scene) -> bool:
                 layer.lightgroups.remove(group)
     del scene[KEY]
     return True
+
+
+def mute_observed_branch(nodes: Sequence[Node]) -> None:
+    """Mute the observed group's reflectance shift in the compositor stage's group of ``nodes``
+    unless a lamp of the file is in an observed group: the group then passes that pass through
+    and the compositor evaluates none of the branch (benchmarks/observed_group_cost.py)."""
+    in_use = any(obj.lightgroup == OBSERVED for obj in bpy.data.objects)
+    for group in {node.node_tree for node in nodes if node.node_tree is not None}:
+        branch = group.nodes.get("observed_seen")
+        if branch is not None and branch.mute == in_use:
+            branch.mute = not in_use
+
+
+def link_diffuse_colour(tree: NodeTree, layers: Node, node: Node) -> None:
+    """Link the Diffuse Color pass of ``layers`` (a Render Layers node of ``tree``, which shows the
+    pass once updated) into the compositor stage's group ``node`` (the observed group's reflectance shift)."""
+    socket = node.inputs.get("Diffuse Color")
+    if socket is None or socket.is_linked:
+        return
+    layers.update()
+    output = compat.render_layers_diffuse_colour(layers)
+    if output is not None:
+        tree.links.new(output, socket)
