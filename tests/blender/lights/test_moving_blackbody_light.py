@@ -123,8 +123,9 @@ def test_moving_blackbody_lamp_seen_by_a_moving_observer(relativity_addon, facto
     """Lamp at 0.5c, observer at 0.3c and 0.5c against it: each floor pixel is the blackbody at
     ``D_o D_L T`` (``D_L`` lamp to floor, ``D_o`` floor to observer). The spectral mode carries the
     lamp's shifted spectrum through the passes; in the fast mode the stand-in lamps' shader shifts
-    their light by the observer's ``D_o`` too and the compositor keeps it (their light group, the
-    observed one): within Delta E 1 of the blackbody and of the spectral render (issue 27: before,
+    their light by the observer's ``D_o`` too, in a light group of their own whose pass the
+    compositor shifts only by the floor's own reflectance shift (none for a grey floor): within
+    Delta E 1 of the blackbody and of the spectral render (issue 27: before,
     the compositor read that light as lit by white light, Delta E up to 18)."""
     bpy = factory_blender
     scene, camera, lamp = _scene(bpy)
