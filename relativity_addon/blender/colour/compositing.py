@@ -25,6 +25,13 @@ spectral Doppler matrix per pixel after the render, with no second render:
   through the table of its blackbody (``physics/illuminants.py``): a surface it lit sends a
   reflectance times that spectrum. The rest of the pixel goes through the emitters' table.
   Where Cycles' denoiser is on, a Denoise node per group denoises its pass like the Image.
+- The light of moving blackbody lights' stand-in lamps (the observed light group,
+  ``light_groups.OBSERVED``) is already the illuminant the observer sees: their shader gave each
+  surface point the blackbody at ``D_o D_L T`` (``shaders/relativistic_moving_lamp.osl``), which no
+  table of one temperature can. What is left is the reflectance's own shift, ``R(lambda D_o)``:
+  the pass is scaled per channel by ``r / rho``, ``rho`` the Diffuse Color pass and ``r`` its
+  colour relative to white after the emitters' table at ``D`` (``gamut_map(N(D) rho) /
+  gamut_map(N(D) 1)``, von Kries: exact for grey, 1 where there is no diffuse colour).
 - With the observer at rest in every frame the stage is the identity (``D = 1``) and is muted,
   so that it costs the render nothing (``at_rest_throughout``).
 
@@ -52,6 +59,8 @@ COMPOSITOR_GAMUT_MAP = names.COMPOSITOR_GAMUT_MAP_GROUP
 SCENE_TREE_NAME = names.COMPOSITOR_SCENE_TREE
 SAVED_KEY = names.COMPOSITOR_SAVED_KEY
 VALUE_NAMES = ("Use Doppler", "Spectral Searchlight", "Power of D", "Camera Power")
+GROUP_INPUTS = ("Lit 1", "Lit 2", "Observed")  # the inputs of light_groups.GROUPS' passes
+REFLECTANCE_EPSILON = 1e-4  # below it a Diffuse Color channel counts as none (the factor tends to 1)
 
 
 def _matrix_nodes(key, image_name, colour):
@@ -97,6 +106,39 @@ def _matrix_nodes(key, image_name, colour):
     return nodes
 
 
+def _reflectance_shift_nodes():
+    """``observed_seen``: the observed light group's pass times the reflectance shift factor
+    ``(gamut_map(N(D) rho) + e) / (gamut_map(N(D) 1) rho + e)`` per channel, ``rho`` the Diffuse
+    Color pass, ``N`` the emitters' table read at the texels of the ``emit`` nodes (mixed by Use
+    Doppler: the pass as rendered without the colour shift and in the spectral passes)."""
+    nodes = {}
+    for key, colour in (("refl", "group.Diffuse Color"), ("white", (1.0, 1.0, 1.0))):
+        for row in range(3):
+            for side in "01":
+                nodes[f"{key}_row{row}_{side}_dot"] = vmath("DOT_PRODUCT", f"emit_row{row}_{side}", colour)
+            low, high = f"{key}_row{row}_0_dot.Value", f"{key}_row{row}_1_dot.Value"
+            nodes[f"{key}_step{row}"] = fmath("SUBTRACT", high, low)
+            nodes[f"{key}_dot{row}"] = fmath("MULTIPLY_ADD", "frac", f"{key}_step{row}", low)
+        nodes[f"{key}_product"] = Node("ShaderNodeCombineXYZ", {i: f"{key}_dot{i}" for i in range(3)})
+        nodes[f"{key}_mapped"] = group_node(COMPOSITOR_GAMUT_MAP, {0: f"{key}_product"}, kind="CompositorNodeGroup")
+    eps = (REFLECTANCE_EPSILON,) * 3
+    nodes.update(
+        {
+            "refl_top": vmath("ADD", "refl_mapped", eps),
+            "white_albedo": vmath("MULTIPLY", "white_mapped", "group.Diffuse Color"),
+            "refl_bottom": vmath("ADD", "white_albedo", eps),
+            "refl_factor": vmath("DIVIDE", "refl_top", "refl_bottom"),
+            "observed_shifted": vmath("MULTIPLY", "group.Observed", "refl_factor"),
+            "observed_seen": Node(
+                "ShaderNodeMix",
+                {"Factor": "group.Use Doppler", 4: "group.Observed", 5: "observed_shifted"},
+                {"data_type": "VECTOR"},
+            ),
+        }
+    )
+    return nodes
+
+
 def compositor_group() -> Group:
     scale, offset = lut_images.texture_u_scale_offset(lut_images.DOPPLER_LOG10_RANGE)
     nodes = {
@@ -132,17 +174,20 @@ def compositor_group() -> Group:
         # The light of blackbody lamps (light_groups.py: one light group per temperature) is read
         # through its temperature's table, the rest of the pixel through the emitters' table.
         # (the light groups' passes denoised like the Image where Cycles' denoiser is on: _add_denoisers)
-        "lit": vmath("ADD", "group.Lit 1", "group.Lit 2"),
+        "lit_slots": vmath("ADD", "group.Lit 1", "group.Lit 2"),
+        "lit": vmath("ADD", "lit_slots", "group.Observed"),
         "rest": vmath("SUBTRACT", "group.Image", "lit"),
         "other": vmath("MAXIMUM", "rest", (0.0, 0.0, 0.0)),  # the passes' noise may push it below 0
     }
     nodes.update(_matrix_nodes("emit", lut_images.DOPPLER_LUT_NAME, "other"))
+    nodes.update(_reflectance_shift_nodes())
     for slot, image_name in enumerate(lut_images.ILLUMINANT_LUT_NAMES, start=1):
         nodes.update(_matrix_nodes(f"lit{slot}", image_name, f"group.Lit {slot}"))
     nodes.update(
         {
             "lit_shifted": vmath("ADD", "lit1_shifted", "lit2_shifted"),
-            "shifted": vmath("ADD", "emit_shifted", "lit_shifted"),
+            "lit_seen": vmath("ADD", "lit_shifted", "observed_seen.Result"),
+            "shifted": vmath("ADD", "emit_shifted", "lit_seen"),
             "kept": Node(
                 "ShaderNodeMix",
                 {"Factor": "group.Done", 4: "shifted", 5: "group.Image"},
@@ -166,6 +211,8 @@ def compositor_group() -> Group:
             ("Coverage", "NodeSocketFloat", 1.0),  # unlinked: every sample wrote ln D
             ("Lit 1", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the light groups' passes
             ("Lit 2", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),
+            ("Observed", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # the observed light group's pass
+            ("Diffuse Color", "NodeSocketColor", (0.0, 0.0, 0.0, 1.0)),  # Cycles' pass, with the observed group
             ("World Directions", "NodeSocketFloat", 0.0),  # 1: the image has the samples' ln D without AOV
         )
         + tuple((name, "NodeSocketFloat", 0.0) for name in VALUE_NAMES),
@@ -246,9 +293,11 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
             for image in map(bpy.data.images.get, lut_images.ILLUMINANT_LUT_NAMES)
         )
     else:
-        temperatures = light_groups.assign(scene, snap.lit_groups)
+        temperatures = light_groups.assign(scene, snap.lit_groups, light_groups.stand_ins(scene, snap.observed_lights))
         for name, temperature in zip(lut_images.ILLUMINANT_LUT_NAMES, temperatures, strict=True):
             lut_images.ensure_illuminant_lut(name, temperature)
+    observed = any(obj.lightgroup == light_groups.OBSERVED for obj in scene.objects)
+    light_groups.mute_observed_branch(nodes)
     values = colour_stage_values(snap)
     held = light_groups.KEY in scene  # else the view layers have no slot groups to link
     bypass = _stage_mode["mode"] == "COLOUR" and at_rest_throughout(scene, snap)
@@ -263,11 +312,12 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
                 node.inputs[name].default_value = value
         view_layer = scene.view_layers.get(layers.layer) if layers is not None else None
         denoised = bool(scene.cycles.use_denoising and view_layer is not None and view_layer.cycles.use_denoising)
-        mutes = [not denoised or not temperature for temperature in temperatures]  # muted: the pass as rendered
+        # muted: the pass as rendered
+        mutes = [not denoised or not temperature for temperature in temperatures] + [not denoised or not observed]
         if view_layer is not None and not all(mutes):
             guided.add(view_layer.name)
         records.append((record, node, layers, mutes))
-    _store_denoising_passes(scene, guided)
+    _store_passes(scene, guided, observed)
     # Denoised light groups are recombined with the Image denoised apart: the stage is then no
     # identity to the last bit even at D = 1 (max(Image - Lit, 0) + Lit), and stays on.
     bypass = bypass and not guided
@@ -275,7 +325,7 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
         if node.mute != bypass:  # muted, the group passes its Image through
             node.mute = bypass
     _skip_own_compositor(scene, bypass)
-    for record, _node, layers, mutes in records:
+    for record, node, layers, mutes in records:
         for slot, (name, mute) in enumerate(zip(record.get("denoisers", ()), mutes, strict=False), 1):
             denoiser = tree.nodes.get(name)
             if denoiser is None:
@@ -284,7 +334,26 @@ def write_colour_stage(scene: Scene, snap: Snapshot) -> bool:
                 _link_light_group_pass(tree, layers, denoiser, slot, guides=not mute)
             if denoiser.mute != mute:
                 denoiser.mute = mute
+        if held and layers is not None and observed:
+            light_groups.link_diffuse_colour(tree, layers, node)
     return True
+
+
+def _store_passes(scene, guided, observed):
+    """The denoising data passes (normal, albedo: the light groups' denoisers' guides) only on the
+    view layers in ``guided``, and the Diffuse Color pass (the observed group's reflectance shift)
+    only while the observed light group has lamps; otherwise as the user had them: Cycles writes
+    them at every camera sample's first hit, a cost of every sample where nothing reads them."""
+    saved = scene[SAVED_KEY]
+    for view_layer in scene.view_layers:
+        for key, owner, prop, needed in (
+            ("denoising_passes", view_layer.cycles, "denoising_store_passes", view_layer.name in guided),
+            ("diffuse_colour_pass", view_layer, "use_pass_diffuse_color", observed),
+        ):
+            stored = saved.get(key, {})
+            wanted = bool(stored.get(view_layer.name)) or needed
+            if view_layer.name in stored and getattr(owner, prop) != wanted:
+                setattr(owner, prop, wanted)
 
 
 def _skip_own_compositor(scene, bypass):
@@ -321,30 +390,17 @@ def at_rest_throughout(scene: Scene, snap: Snapshot) -> bool:
     return not any(path.startswith("relativity.") for path in paths)
 
 
-def _store_denoising_passes(scene, guided):
-    """The denoising data passes (normal, albedo: the light groups' denoisers' guides) only on the
-    view layers in ``guided``, the others as the user had them: Cycles writes them at every
-    camera sample's first hit, a cost of every sample for guides that a muted denoiser ignores."""
-    stored = scene[SAVED_KEY].get("denoising_passes", {})
-    for view_layer in scene.view_layers:
-        if view_layer.name not in stored:
-            continue
-        wanted = bool(stored[view_layer.name]) or view_layer.name in guided
-        if view_layer.cycles.denoising_store_passes != wanted:
-            view_layer.cycles.denoising_store_passes = wanted
-
-
 def _add_denoisers(tree, layers, node):
     """Per light group, a Denoise node between its pass and the stage (``node``), guided by the
     denoising data passes: Cycles' denoiser denoises the Image but not the light groups' passes,
     whose noise would come back with the rest of the pixel. Muted where not needed."""
     added = []
-    for slot in range(1, len(light_groups.SLOTS) + 1):
+    for slot in range(1, len(light_groups.GROUPS) + 1):
         denoiser = tree.nodes.new("CompositorNodeDenoise")
         denoiser.name = denoiser.label = f"{node.name} Denoise {slot}"
         denoiser.location = (node.location.x - 200.0, node.location.y - 150.0 * slot)
         denoiser.mute = True
-        tree.links.new(denoiser.outputs["Image"], node.inputs[f"Lit {slot}"])
+        tree.links.new(denoiser.outputs["Image"], node.inputs[GROUP_INPUTS[slot - 1]])
         _link_light_group_pass(tree, layers, denoiser, slot)
         added.append(denoiser.name)
     return added
@@ -354,7 +410,7 @@ def _link_light_group_pass(tree, layers, denoiser, slot, guides=True):
     """Link light group ``slot``'s pass into ``denoiser``, and with ``guides`` the denoising data
     passes (the Render Layers node shows a new light group's output, or the data passes switched
     on, only once it is updated; without the passes it has no such outputs)."""
-    wanted = [(f"Combined_{light_groups.SLOTS[slot - 1]}", "Image")]
+    wanted = [(f"Combined_{light_groups.GROUPS[slot - 1]}", "Image")]
     if guides:
         wanted += [("Denoising Normal", "Normal"), ("Denoising Albedo", "Albedo")]
     missing = [(output, input_name) for output, input_name in wanted if not denoiser.inputs[input_name].is_linked]
@@ -401,8 +457,9 @@ def apply_colour_stage(scene: Scene, snap: Snapshot) -> None:
             saved["created_tree"] = tree.name
         light_groups.hold(scene)
         # the denoising data passes (the light groups' denoisers' guides) as the user had them,
-        # switched on where they are needed (_store_denoising_passes)
+        # switched on where they are needed (_store_passes)
         saved["denoising_passes"] = {layer.name: layer.cycles.denoising_store_passes for layer in scene.view_layers}
+        saved["diffuse_colour_pass"] = {layer.name: layer.use_pass_diffuse_color for layer in scene.view_layers}
         for view_layer in scene.view_layers:
             for aov_name in (materials.DONE_AOV, materials.LOG_DOPPLER_AOV, materials.COVERAGE_AOV):
                 if aov_name not in view_layer.aovs:
@@ -472,6 +529,10 @@ def remove_colour_stage(scene: Scene) -> bool:
         view_layer = scene.view_layers.get(name)
         if view_layer is not None:
             view_layer.cycles.denoising_store_passes = stored
+    for name, stored in saved.get("diffuse_colour_pass", {}).items():
+        view_layer = scene.view_layers.get(name)
+        if view_layer is not None:
+            view_layer.use_pass_diffuse_color = stored
     for view_layer_name, aov_name in saved["added_aovs"]:
         view_layer = scene.view_layers.get(view_layer_name)
         if view_layer is not None and aov_name in view_layer.aovs:

@@ -183,6 +183,15 @@ def alpha_over_inputs(node: Node) -> tuple[NodeSocket, NodeSocket]:
     return node.inputs[1], node.inputs[2]
 
 
+def render_layers_diffuse_colour(layers: Node) -> NodeSocket | None:
+    """The Diffuse Color pass's output of a compositor Render Layers node (the pass switched on
+    and the node updated), or None: ``Diffuse Color`` in 5.x, ``DiffCol`` in 4.5."""
+    for name in ("Diffuse Color", "DiffCol"):
+        if name in layers.outputs:
+            return layers.outputs[name]
+    return None
+
+
 def map_uv_nearest() -> tuple[dict[str, str], dict[str, str]]:
     """``(inputs, props)`` for a compositor Map UV node that reads the nearest texel.
 

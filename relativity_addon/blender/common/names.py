@@ -57,9 +57,9 @@ GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor group
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------
 COMPOSITOR_GROUP = "Relativity Doppler Compositor"
 COMPOSITOR_GAMUT_MAP_GROUP = "Relativity Gamut Map (Compositor)"
-COMPOSITOR_GROUPS_VERSION = 7  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
+COMPOSITOR_GROUPS_VERSION = 8  # 4: the LUT read as two nearest texels (4.5's Map UV has no bilinear);
 # 5: ln D over the coverage AOV; 6: the samples without AOV take ln D from the world-direction image;
-# 7: the light groups' passes through their own tables
+# 7: the light groups' passes through their own tables; 8: the observed light group (its reflectance shift)
 COMPOSITOR_SCENE_TREE = "Relativity Compositing"  # created when the scene has no compositor
 COMPOSITOR_SAVED_KEY = "relativity_compositor_saved"  # on the scene: what was inserted where
 LOG_DOPPLER_AOV = "relativity_log_doppler"  # ln D at the first camera hit
@@ -77,6 +77,10 @@ BLACKBODY_LUT_IMAGE = "Relativity Blackbody LUT"
 # its pass read through its own matrix table (light_groups.py, physics/illuminants.py).
 LIT_GROUPS = ("Relativity Lit 1", "Relativity Lit 2")
 ILLUMINANT_LUT_IMAGES = ("Relativity Illuminant LUT 1", "Relativity Illuminant LUT 2")
+# The fast mode's light that the stand-in lamps of moving blackbody lights already shifted for the
+# observer (shaders/relativistic_moving_lamp.osl): a light group whose pass the compositor shifts
+# only by the reflectance's own shift (colour/compositing.py).
+OBSERVED_LIGHT_GROUP = "Relativity Observed"
 ILLUMINANT_KEY = "relativity_illuminant_k"  # on such an image: the illuminant it holds (K, 0 = white)
 LIGHT_GROUPS_KEY = "relativity_light_groups"  # on the scene: the light groups it set, to give back
 LUT_LAYOUT_KEY = "relativity_lut_layout"

@@ -32,7 +32,7 @@ from ...physics import spectral_render
 from ...physics.lorentz import aberrate, camera_to_scene_direction
 from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
 from ..camera import cockpit
-from ..colour import materials
+from ..colour import light_groups, materials
 from ..common import busy, names
 from ..scene import animation, lens, sources
 
@@ -312,6 +312,8 @@ def write(
             _delete(name)
         scene[names.MOVING_LAMPS_KEY] = record
     points = None
+    observed = light_groups.observed_held(scene)
+    colour = snap.colour
     for light in lights:
         if light.kind == "SUN":
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
@@ -352,6 +354,15 @@ def write(
         }
         shared["spectral"] = int(values["spectral"])
         shared["lambert"] = int(values["lambert"])
+        # the fast mode's observed light group (light_groups.OBSERVED): the observer's shift too
+        shared.update(
+            observer_shift=int(observed and light.name in snap.observed_lights),
+            observer_beta=tuple(float(v) for v in snap.beta),
+            use_doppler=int(colour.use_doppler),
+            spectral_searchlight=int(colour.spectral_searchlight),
+            power_of_d=float(colour.power_of_d),
+            camera_power=float(colour.camera_power),
+        )
         if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
             _write_points(scene, light, text, shared, times, positions)
         else:

@@ -17,6 +17,12 @@ groups (``light_groups.py``), whose passes the compositor reads through their ow
 - **White**: no groups: every pixel in white, as emitters (the reading before light groups).
 - **Blackbody**: every light object (not emitting meshes nor the world) as a blackbody at the
   temperature given.
+
+A light with its own velocity is hidden while applied and drawn by stand-in lamps whose shader
+gives each surface point its own ``D T`` (``lights/stand_in_lamps.py``), so no table of one
+temperature reads it. In the fast mode (not *White*) the stand-ins of a moving blackbody light go
+into the light group ``names.OBSERVED_LIGHT_GROUP`` instead, and their shader also applies the
+observer's shift (:func:`reads_observed`); the compositor adds only the reflectance's shift.
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ from ..common import names
 from . import grouped_colours, sources
 
 if TYPE_CHECKING:
+    from collections.abc import Collection
+
     from bpy.types import Scene
 
 OWN_PREFIX = "Relativity"  # the add-on's stand-in lamps, copies and lamp faces
@@ -85,20 +93,25 @@ def _world_temperature(world):
     return found.pop() if len(found) == 1 else None
 
 
-def _candidates(scene):
-    return [obj for obj in scene.objects if not obj.hide_render and not obj.name.startswith(OWN_PREFIX)]
+def _candidates(scene, moving):
+    return [
+        obj
+        for obj in scene.objects
+        if not obj.hide_render and not obj.name.startswith(OWN_PREFIX) and obj.name not in moving
+    ]
 
 
-def lit_groups(scene: Scene) -> tuple[LitGroup, ...]:
-    """The light groups of the fast mode's blackbody lamps, by *Lit By* (tuple of :class:`LitGroup`)."""
+def lit_groups(scene: Scene, moving: Collection[str] = ()) -> tuple[LitGroup, ...]:
+    """The light groups of the fast mode's blackbody lamps, by *Lit By* (tuple of :class:`LitGroup`);
+    ``moving``: the names of lights with their own velocity, drawn by stand-in lamps, left out."""
     settings = scene.relativity
     if settings.fast_illuminant == "WHITE":
         return ()
     if settings.fast_illuminant == "BLACKBODY":
-        members = tuple(sorted(obj.name for obj in _candidates(scene) if obj.type == "LIGHT"))
+        members = tuple(sorted(obj.name for obj in _candidates(scene, moving) if obj.type == "LIGHT"))
         return (LitGroup(float(settings.fast_illuminant_temperature), members),) if members else ()
     by_temperature, seen = {}, {}
-    for obj in _candidates(scene):
+    for obj in _candidates(scene, moving):
         if obj.type in ("LIGHT", "MESH", "CURVE", "SURFACE", "META", "FONT"):
             temperature = _lamp_temperature(obj, seen)
             if temperature is not None:
@@ -108,3 +121,15 @@ def lit_groups(scene: Scene) -> tuple[LitGroup, ...]:
         by_temperature.setdefault(world_temperature, []).append(WORLD)
     ranked = sorted(by_temperature.items(), key=lambda item: (-len(item[1]), item[0]))[: len(names.LIT_GROUPS)]
     return tuple(LitGroup(temperature, tuple(sorted(members))) for temperature, members in ranked)
+
+
+def user_light_groups(scene: Scene) -> list[str]:
+    """Names of the light groups of ``scene``'s view layers that are not the add-on's."""
+    own = {*names.LIT_GROUPS, names.OBSERVED_LIGHT_GROUP}
+    return sorted({group.name for layer in scene.view_layers for group in layer.lightgroups} - own)
+
+
+def reads_observed(scene: Scene) -> bool:
+    """Whether the stand-in lamps of moving blackbody lights light the observed light group (not
+    with *White*, nor where the scene has light groups of its own, whose lamps are read in white)."""
+    return scene.relativity.fast_illuminant != "WHITE" and not user_light_groups(scene)

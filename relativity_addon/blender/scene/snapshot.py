@@ -100,6 +100,9 @@ class Snapshot:
     # the fast mode's blackbody lamps by temperature (illuminants.LitGroup): their light groups'
     # passes are read through their own tables (light_groups.py)
     lit_groups: tuple = ()
+    # the moving blackbody lights whose stand-in lamps apply the observer's shift themselves, in the
+    # fast mode's observed light group (illuminants.reads_observed)
+    observed_lights: tuple[str, ...] = ()
     # the camera's image (``lens.projection``: the perspective view window or a panorama's
     # parameters) and whether it renders a stereo pair: stages take these, not the camera anew
     projection: tuple = ()
@@ -481,6 +484,7 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         engine = compat.engine_label(scene.render.engine)
         raise RelativityError(f"Render Engine is {engine}: the exact camera renders with Cycles only")
     exact_camera = settings.method == "CAMERA" or (settings.method == "GEOMETRY" and in_final_render(scene))
+    fast_colour = exact_camera and settings.use_doppler and not time_of_flight  # the compositor's colour
     if exact_camera and settings.shutter_model == "DETECTOR_PLANE":
         lens.check_detector_image(scene, camera, matrix)
     return Snapshot(
@@ -515,8 +519,11 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         lorentz_window_shutter=settings.lorentz_window_shutter,
         lorentz_window_time=float(settings.lorentz_window_time),
         use_time_of_flight=time_of_flight,
-        lit_groups=temperatures.checked_lit_groups(illuminants.lit_groups(scene))
-        if exact_camera and settings.use_doppler and not time_of_flight
+        lit_groups=temperatures.checked_lit_groups(illuminants.lit_groups(scene, {light.name for light in lights}))
+        if fast_colour
+        else (),
+        observed_lights=tuple(light.name for light in lights if light.temperature > 0.0 and light.kind != "SUN")
+        if fast_colour and illuminants.reads_observed(scene)
         else (),
         projection=lens.projection(scene, camera),
         stereo=lens.stereo_eyes(scene),

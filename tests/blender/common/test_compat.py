@@ -89,6 +89,21 @@ def test_compositor_tree(factory_blender):
     assert compat.compositor_tree(scene) == tree
 
 
+def test_render_layers_diffuse_colour(factory_blender):
+    """The Diffuse Color pass's Render Layers output, named differently in 4.5 and 5.x."""
+    bpy = factory_blender
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    tree = compat.new_compositor_tree(scene, "Compositing")
+    layers = next((node for node in tree.nodes if node.bl_idname == "CompositorNodeRLayers"), None)
+    layers = layers or tree.nodes.new("CompositorNodeRLayers")
+    assert compat.render_layers_diffuse_colour(layers) is None
+    scene.view_layers[0].use_pass_diffuse_color = True
+    layers.update()
+    output = compat.render_layers_diffuse_colour(layers)
+    assert output is not None and output.name in ("Diffuse Color", "DiffCol")
+
+
 def test_map_uv_nearest_settings_are_accepted(factory_blender):
     bpy = factory_blender
     tree = bpy.data.node_groups.new("Compat Compositing", "CompositorNodeTree")
