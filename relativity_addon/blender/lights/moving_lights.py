@@ -181,7 +181,7 @@ def blackbody_parameters(temperature: float, luminance: float) -> dict[str, Any]
         scale = luminance * constant * math.exp(-float(spectral_render.log_blackbody_luminance(temperature)))
     return {
         "temperature": float(temperature),
-        "luminance": float(luminance),
+        "light_luminance": float(luminance),  # not "luminance": OSL has a luminance()
         "spectral": wavelengths is not None and temperature > 0.0,
         **{
             f"wavelength_{index}": float(value)

@@ -344,7 +344,7 @@ def write(
                 "spot_cos_half_angle",
                 "spot_smooth",
                 "temperature",
-                "luminance",
+                "light_luminance",
                 "wavelength_0",
                 "wavelength_1",
                 "wavelength_2",
