@@ -31,7 +31,9 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 MINIMAL = "minimal OSL camera"
 
 
-def build_scene(bpy, resolution, samples):
+def empty_cycles_scene(bpy, resolution, samples):
+    """Blender's empty factory scene rendered by Cycles on the CPU at ``resolution``, ``samples``
+    samples, no denoising or adaptive sampling (what every benchmark compares)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
@@ -41,6 +43,11 @@ def build_scene(bpy, resolution, samples):
     scene.cycles.use_adaptive_sampling = False
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
+    return scene
+
+
+def build_scene(bpy, resolution, samples):
+    scene = empty_cycles_scene(bpy, resolution, samples)
     from relativity_addon.blender.common import compat
 
     scene.world = bpy.data.worlds.new("World")  # Blender's default: a constant grey Background

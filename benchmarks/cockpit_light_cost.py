@@ -23,7 +23,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from camera_overhead import load_average, timed_render_clocks  # noqa: E402
+from camera_overhead import empty_cycles_scene, load_average, timed_render_clocks  # noqa: E402
 
 LIGHT_STAGES = ("the cockpit's sky", "the scene's lamps on the cockpit")
 
@@ -31,15 +31,7 @@ LIGHT_STAGES = ("the cockpit's sky", "the scene's lamps on the cockpit")
 def build_scene(bpy, resolution, samples):
     from relativity_addon.blender.common import compat
 
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
+    scene = empty_cycles_scene(bpy, resolution, samples)
     scene.world = bpy.data.worlds.new("Sky")
     tree = compat.world_node_tree(scene.world)
     coordinates = tree.nodes.new("ShaderNodeTexCoord")

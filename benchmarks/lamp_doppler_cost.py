@@ -27,18 +27,12 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+from camera_overhead import empty_cycles_scene  # noqa: E402
+
 
 def build_scene(bpy, resolution, samples):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
+    scene = empty_cycles_scene(bpy, resolution, samples)
     scene.cycles.max_bounces = 0
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "OPEN_EXR"
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     camera.location = (0.0, -6.0, 0.0)

@@ -27,6 +27,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 
+from camera_overhead import empty_cycles_scene  # noqa: E402
+
 MODES = ("BLENDED", "CONTINUOUS")
 
 
@@ -47,15 +49,7 @@ def _quad(bpy, scene, name, centre, half, colour):
 
 
 def build_scene(bpy, resolution, samples):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
+    scene = empty_cycles_scene(bpy, resolution, samples)
     scene.view_settings.view_transform = "Standard"
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     camera.data.lens = 25.0
