@@ -26,6 +26,7 @@ from ..camera import cockpit
 from ..common import names
 from ..scene import cockpit as cockpit_reader
 from . import lamps_on_moving_objects as eq18
+from . import stand_in_lamps
 
 if TYPE_CHECKING:
     from bpy.types import Object, Scene
@@ -61,16 +62,6 @@ def centre(scene: Scene, snap: Snapshot) -> FloatArray:
     return np.mean(points, axis=0) if points else snap.camera_position
 
 
-def _delete(name):
-    obj = bpy.data.objects.get(name)
-    if obj is None:
-        return
-    light = obj.data
-    bpy.data.objects.remove(obj)
-    if light is not None and light.users == 0:
-        bpy.data.lights.remove(light)
-
-
 def write(scene: Scene, snap: Snapshot, structural: bool = True) -> None:
     """Copies of the scene's lamps in the cockpit scene, placed and coloured for the frame (made and
     deleted only when ``structural``)."""
@@ -85,7 +76,7 @@ def write(scene: Scene, snap: Snapshot, structural: bool = True) -> None:
         for name in list(record):
             copy = bpy.data.objects.get(record[name])
             if name not in wanted or copy is None or copy.type != "LIGHT" or copy.data.type != wanted[name].data.type:
-                _delete(record.pop(name))
+                stand_in_lamps.delete_lamp(record.pop(name))
         for name, lamp in wanted.items():
             if name not in record:
                 copy = bpy.data.objects.new(f"{PREFIX} {name}", lamp.data.copy())
@@ -113,5 +104,5 @@ def remove(scene: Scene) -> None:
     if KEY not in scene:
         return
     for copy_name in scene[KEY].to_dict().values():
-        _delete(copy_name)
+        stand_in_lamps.delete_lamp(copy_name)
     del scene[KEY]

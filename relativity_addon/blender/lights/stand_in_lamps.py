@@ -227,7 +227,8 @@ def _new_lamp(scene, name, text, kind="POINT"):
     return obj
 
 
-def _delete(name):
+def delete_lamp(name: str) -> None:
+    """Delete the lamp object ``name`` (if any) and its light data once nothing else uses it."""
     obj = bpy.data.objects.get(name)
     if obj is None:
         return
@@ -263,7 +264,7 @@ def _lamps_for(scene, light_name, count, text, kind="POINT"):
     existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
     if len(existing) != count or any(bpy.data.objects[name].data.type != kind for name in existing):
         for name in existing:
-            _delete(name)
+            delete_lamp(name)
         existing = [
             _new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
             for index in range(count)
@@ -309,7 +310,7 @@ def write(
     record = _record(scene)
     for stale in set(record) - {light.name for light in lights}:
         for name in record.pop(stale):
-            _delete(name)
+            delete_lamp(name)
         scene[names.MOVING_LAMPS_KEY] = record
     points = None
     observed = light_groups.observed_held(scene)
@@ -509,7 +510,7 @@ def remove(scene: Scene) -> None:
     """Delete every stand-in lamp and the shader text."""
     for names_of_light in _record(scene).values():
         for name in names_of_light:
-            _delete(name)
+            delete_lamp(name)
     if names.MOVING_LAMPS_KEY in scene:
         del scene[names.MOVING_LAMPS_KEY]
     if not any(names.MOVING_LAMPS_KEY in other for other in bpy.data.scenes):
