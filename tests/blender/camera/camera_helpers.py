@@ -344,3 +344,15 @@ def tangent_plane_axis_ratio(camera, coverage):
     covariance = (centred.T * area) @ centred / area.sum()
     eigenvalues = np.linalg.eigvalsh(covariance)
     return math.sqrt(eigenvalues[0] / eigenvalues[1]), axis
+
+
+def pixel_rays(resolution, sensor, lens):
+    """Unit scene directions of the pixel centres' rays of a pinhole camera looking along +Y, image
+    up +Z (horizontal sensor fit; ``sensor`` and ``lens`` in mm), ``(height, width, 3)``."""
+    width, height = resolution
+    scale = sensor / lens / width
+    columns = (np.arange(width) + 0.5 - width / 2.0) * scale
+    rows = (height / 2.0 - np.arange(height) - 0.5) * scale
+    x, z = np.meshgrid(columns, rows)
+    rays = np.stack([x, np.ones_like(x), z], axis=-1)
+    return rays / np.linalg.norm(rays, axis=-1, keepdims=True)

@@ -137,17 +137,6 @@ def _scene(bpy, beta_sphere, beta_panel):
     return scene, np.array(panel.matrix_world)[:3, :3]
 
 
-def _pixel_rays():
-    """Unit scene directions of the pixel centres' rays (the camera looks along +Y, image up +Z)."""
-    width, height = RESOLUTION
-    scale = SENSOR / LENS / width
-    columns = (np.arange(width) + 0.5 - width / 2.0) * scale
-    rows = (height / 2.0 - np.arange(height) - 0.5) * scale
-    x, z = np.meshgrid(columns, rows)
-    rays = np.stack([x, np.ones_like(x), z], axis=-1)
-    return rays / np.linalg.norm(rays, axis=-1, keepdims=True)
-
-
 def _sphere_hit(start, time, directions, beta):
     """Path lengths back along ``directions`` from the event (``time``, ``start``) (times in metres
     of light travel) to the sphere where it was when the light left it (NaN: no hit), and the rest
@@ -167,7 +156,7 @@ def _sphere_hit(start, time, directions, beta):
 def _panel_hits(rotation, beta):
     """Per pixel: the camera ray's path length to the panel where it was when the light left it
     (NaN: no hit)."""
-    rays = _pixel_rays()
+    rays = ch.pixel_rays(RESOLUTION, SENSOR, LENS)
     local = np.linalg.inv(_contraction(beta) @ rotation)
     start = local @ (CAMERA - _origin_now(PANEL_SEEN, beta))
     rate = (rays + beta) @ local.T  # at path s the light left at t = -s: the panel was beta s back

@@ -94,22 +94,11 @@ def _scene(bpy, kind, samples, lamp_at=LAMP, searchlight=True):
     return scene, lamp
 
 
-def _pixel_rays():
-    """Unit scene directions of the pixel centres' rays (the camera looks along +Y, image up +Z)."""
-    width, height = RESOLUTION
-    scale = SENSOR / LENS / width
-    columns = (np.arange(width) + 0.5 - width / 2.0) * scale
-    rows = (height / 2.0 - np.arange(height) - 0.5) * scale
-    x, z = np.meshgrid(columns, rows)
-    rays = np.stack([x, np.ones_like(x), z], axis=-1)
-    return rays / np.linalg.norm(rays, axis=-1, keepdims=True)
-
-
 def _seen_sphere():
     """Per pixel: the scene point where the ray meets the sphere at the time the light left it,
     and the rest-frame normal there (NaN where the ray misses)."""
     camera = np.array([0.0, -CAMERA_DISTANCE, 0.0])
-    rays = _pixel_rays()
+    rays = ch.pixel_rays(RESOLUTION, SENSOR, LENS)
     start = camera - np.array([BETA * CAMERA_DISTANCE, 0.0, 0.0])  # camera relative to the centre at t = 0
     # at path length s the light left at t = -s / c, when the centre was at c0 - v s / c:
     # rest position = stretch (start + s (n + beta)), |rest position| = 1
