@@ -48,3 +48,23 @@ def rendering() -> bool:
     is freed under the render (Blender 5.2 crashed, docs/cockpit.md). ``is_job_running`` alone is
     False in a blocking render (background mode, the ``bpy`` module)."""
     return _render["running"] or bool(getattr(bpy.app, "is_job_running")("RENDER"))  # noqa: B009
+
+
+_keeping = {"depth": 0}
+
+
+@contextmanager
+def keeping_stand_ins() -> Iterator[None]:
+    """While Bake for Render Anywhere steps its frames (``pipeline/bake.py``): the stand-in lamps of
+    moving lights and their copies on moving objects are kept under their names from frame to frame
+    (made when first needed, never deleted; those a frame does not use hidden from renders), so
+    every frame holds the same datablocks and what changes is keyframes."""
+    _keeping["depth"] += 1
+    try:
+        yield
+    finally:
+        _keeping["depth"] -= 1
+
+
+def keeps_stand_ins() -> bool:
+    return _keeping["depth"] > 0

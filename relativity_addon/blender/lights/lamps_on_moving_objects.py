@@ -37,7 +37,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import lamp_doppler
-from ..common import compat, names, nodes
+from ..common import busy, compat, names, nodes
 from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
@@ -264,7 +264,7 @@ def _collection(name, objects, state):
 
 
 def _build(scene, layout, mover_names):
-    """``layout``: (lamp, mover, number of copies) for every pair."""
+    """``layout``: (lamp, mover's name, number of copies) for every pair."""
     record = {"copies": [], "lights": [], "collections": [], "lamps": {}}
     scene[KEY] = record  # recorded first: a failure half-way is still removed
     excluded = [scene.objects[name] for name in mover_names]
@@ -274,8 +274,8 @@ def _build(scene, layout, mover_names):
         record["lamps"][lamp.name] = ""
         lamp[KEY] = True
         lamp.light_linking.receiver_collection = exclude
-    for lamp, mover, count in layout:
-        obj = scene.objects[mover.name]
+    for lamp, mover_name, count in layout:
+        obj = scene.objects[mover_name]
         receive = _collection(f"{PREFIX} {lamp.name} on {obj.name}", [obj], "INCLUDE")
         record["collections"].append(receive.name)
         for index in range(count):
@@ -346,7 +346,11 @@ def write(scene: Scene, snap: Snapshot) -> int:
         for lamp, mover, _, stand_ins in placed
         for index in range(1 if stand_ins is None else len(stand_ins[0]))
     )
-    if record is not None and sorted(_copy_pairs(record)) != layout:
+    kept = sorted(_copy_pairs(record)) if record is not None else []
+    if busy.keeps_stand_ins() and pairs and all(len(e) == 3 and scene.objects.get(e[0]) for e in kept):
+        # a bake steps frames: every copy made stays under its name, those this frame does not use hidden
+        layout = sorted(map(list, {tuple(entry) for entry in kept} | {tuple(entry) for entry in layout}))
+    if record is not None and kept != layout:
         remove(scene)
         record = None
     if not pairs:
@@ -354,9 +358,15 @@ def write(scene: Scene, snap: Snapshot) -> int:
         return 0
     rest_normals.write(scene, [scene.objects[name] for name in sorted({mover.name for _, mover in pairs})])
     if record is None:
-        counts = [(lamp, mover, 1 if stand_ins is None else len(stand_ins[0])) for lamp, mover, _, stand_ins in placed]
-        _build(scene, counts, sorted({mover.name for _, mover in pairs}))
+        counts: dict[tuple[str, str], int] = {}
+        for lamp_name, mover_name, index in layout:
+            counts[lamp_name, mover_name] = max(counts.get((lamp_name, mover_name), 0), int(index) + 1)
+        mover_names = sorted({mover for _, mover in counts})
+        _build(scene, [(scene.objects[lamp], mover, n) for (lamp, mover), n in counts.items()], mover_names)
     copies = {tuple(bpy.data.objects[name][COPY_KEY]): bpy.data.objects[name] for name in _record(scene)["copies"]}
+    used = {(lamp.name, mover.name): 1 if s is None else len(s[0]) for lamp, mover, _, s in placed}
+    for (lamp_name, mover_name, index), copy in copies.items():  # only a bake's kept copies are ever hidden
+        _set(copy, "hide_render", int(index) >= used.get((lamp_name, mover_name), 0))
     for lamp, mover, matrix, stand_ins in placed:
         if stand_ins is None:
             copy = copies[(lamp.name, mover.name, "0")]

@@ -32,7 +32,7 @@ from ...errors import RelativityError
 from ...physics import spectral_render
 from ..camera import exact_camera
 from ..colour import materials
-from ..common import names, osl
+from ..common import busy, names, osl
 from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
@@ -423,7 +423,8 @@ def write(
             scene, snap, lights, lambda light: shader_parameters(light, snap), reception_event(snap)[0], depsgraph
         )
         return None
-    stand_in_lamps.remove(scene)  # after an Apparent Geometry final render
+    # after an Apparent Geometry final render; between a bake's frames they stay for the next one
+    (stand_in_lamps.hide if busy.keeps_stand_ins() else stand_in_lamps.remove)(scene)
     group = ensure_group(light_names)
     _write_parameters(group, snap)
     if first or attach_new_materials:

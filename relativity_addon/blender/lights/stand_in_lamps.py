@@ -260,24 +260,46 @@ def _record(scene):
 
 
 def _lamps_for(scene, light_name, count, text, kind="POINT"):
+    """The light's first ``count`` lamps; while a bake steps frames (``busy.keeps_stand_ins``) the
+    others are kept, hidden from renders, and more are added under the next names when needed."""
     record = _record(scene)
     existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
-    if len(existing) != count or any(bpy.data.objects[name].data.type != kind for name in existing):
-        for name in existing:
-            delete_lamp(name)
-        existing = [
+    same_kind = all(bpy.data.objects[name].data.type == kind for name in existing)
+    kept = busy.keeps_stand_ins() and same_kind
+    if len(existing) < count or (not kept and (len(existing) != count or not same_kind)):
+        if not kept:
+            for name in existing:
+                delete_lamp(name)
+            existing = []
+        existing += [
             _new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
-            for index in range(count)
+            for index in range(len(existing), count)
         ]
         record[light_name] = existing
         scene[names.MOVING_LAMPS_KEY] = record
-    return [bpy.data.objects[name] for name in existing]
+    lamps = [bpy.data.objects[name] for name in existing]
+    for index, obj in enumerate(lamps):
+        _set(obj, "hide_render", index >= count)
+    return lamps[:count]
+
+
+def hide(scene: Scene) -> None:
+    """Hide every stand-in lamp from renders, keeping it: the preview's sync between the frames a
+    bake steps (``busy.keeps_stand_ins``), where the next frame's final render uses them again."""
+    for names_of_light in _record(scene).values():
+        for name in names_of_light:
+            obj = bpy.data.objects.get(name)
+            if obj is not None:
+                _set(obj, "hide_render", True)
 
 
 def _stored_times(scene, light_name):
     """The stand-ins' times of the last placement (their shaders' inputs), or None."""
     objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
     if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
+        return None
+    objects = [obj for obj in objects if not obj.hide_render]  # a bake's unused lamps are hidden
+    if not objects:
         return None
     inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
     times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]

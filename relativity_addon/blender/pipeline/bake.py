@@ -23,6 +23,7 @@ the played-back meshes and the final render's exact camera.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import math
@@ -51,21 +52,13 @@ _NUMERIC = {"FLOAT", "INT", "BOOLEAN"}
 Key = tuple[str, str, str, str, int]  # (collection, ID name, embedded tree or "", data path, index)
 
 
-def refusal(scene: Scene, method: str, exact_final_render: bool = True, moving_lights: bool = False) -> str | None:
+def refusal(scene: Scene, method: str, exact_final_render: bool = True) -> str | None:
     """Why ``scene`` (set up with ``method``; on Apparent Geometry, ``exact_final_render``: its final
-    render is the exact camera; ``moving_lights``: it has lights with their own velocity) cannot be
-    baked here (one line), or None. What is baked must render where it is baked: an OSL camera or
-    OSL material nodes (moving lights on Apparent Geometry) need a Blender with OSL."""
+    render is the exact camera) cannot be baked here (one line), or None. What is baked must render
+    where it is baked: an OSL camera or OSL material nodes (moving lights on Apparent Geometry) need
+    a Blender with OSL."""
     if scene.camera is None:
         return "Cannot bake: the scene has no active camera"
-    if method == "GEOMETRY" and exact_final_render and moving_lights:
-        # measured: the moving light's stand-in lamps are made anew for each final render (the next
-        # frame's get other names, "... Moving Lamp 7.003") and their stand-ins on the meshes come
-        # and go, which keyframes cannot play; baked from one set-up, frame 1 differed by the noise
-        return (
-            "Cannot bake Apparent Geometry behind the exact camera with moving lights yet: their "
-            "stand-in lamps change from frame to frame; set Final Render to Boosted Meshes or bake without them"
-        )
     reason = osl.unavailable_reason()
     if reason is None:
         return None
@@ -326,6 +319,18 @@ def _step(scene, frames, sync_for_render, meshes):
     return states, images
 
 
+def _differ(states):
+    """Whether the frames' recorded datablocks and properties differ (added or removed)."""
+    return any(set(state) != set(states[0]) for state in states[1:])
+
+
+def _discard(meshes):
+    """Delete the captured meshes and empty the lists (a bake refused, or stepped again)."""
+    playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
+    for captured in meshes.values():
+        captured.clear()
+
+
 def bake(
     scene: Scene,
     first: int,
@@ -349,14 +354,19 @@ def bake(
     start = scene.frame_current
     meshes: dict[Object, list] = {obj: [] for obj in geometry}
     try:
-        states, images = _step(scene, frames, sync_for_render, meshes)
+        # played-back geometry: the handlers leave the scene as baked, so stand-in lamps can stay
+        with busy.keeping_stand_ins() if geometry else contextlib.nullcontext():
+            states, images = _step(scene, frames, sync_for_render, meshes)
+            if geometry and _differ(states):  # stand-ins first needed at a later frame: all there now
+                _discard(meshes)
+                states, images = _step(scene, frames, sync_for_render, meshes)
     except RelativityError:
-        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
+        _discard(meshes)
         scene.frame_set(start)
         raise
     keys = set(states[0])
     problem = None
-    if any(set(state) != keys for state in states[1:]):
+    if _differ(states):
         differ = sorted({key[1] for state in states[1:] for key in keys ^ set(state)})
         problem = (
             f"Cannot bake frames {first}-{last}: the add-on's datablocks change within them "
@@ -373,7 +383,7 @@ def bake(
         except RelativityError as error:
             problem = str(error)
     if problem is not None:  # refused before anything is added
-        playback.discard_meshes(list({mesh.name for captured in meshes.values() for mesh in captured}))
+        _discard(meshes)
         scene.frame_set(start)
         raise RelativityError(problem)
     record: dict[str, Any] = {

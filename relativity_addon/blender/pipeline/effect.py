@@ -166,7 +166,7 @@ def bake_for_render_anywhere(scene: Scene, first: int, last: int) -> dict[str, i
     bake.unbake(scene)  # a bake's own camera and meshes first out: every frame is computed again
     snap = snapshot.read(scene)
     exact = method == "GEOMETRY" and final_render_problem(scene, snap) is None
-    problem = bake.refusal(scene, method, exact, bool(snap.moving_lights))
+    problem = bake.refusal(scene, method, exact)
     if problem is not None:
         raise RelativityError(problem)
     if snap.velocity_source == "CAMERA_ANIMATION":

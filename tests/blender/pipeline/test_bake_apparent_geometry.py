@@ -9,8 +9,9 @@ their scene-frame retarded positions). The add-on renders frames 1-3 itself; the
 baked, saved and rendered as an animation in a fresh process where the add-on is neither enabled
 nor installed and the file's scripts are disabled. Each frame must equal the add-on's own render
 (same seed) to well below the render noise, measured as the difference the seed alone makes; the
-same file not baked, rendered the same way, must not (the control). A fly-through with a moving
-light is refused (not baked yet).
+same file not baked, rendered the same way, must not (the control). Issue 28's acceptance case: the
+camera at 0.9c, the keyframed box and a lamp moving at 0.3c (the stand-in lamps of the exact camera's
+final render and their copies on the box, kept under stable names by the bake).
 """
 
 import importlib
@@ -59,10 +60,11 @@ def _linear_keys(obj, path, keys):
             point.interpolation = "LINEAR"
 
 
-def build_moving_box(bpy, fly, moving_light=False):
-    """Camera at 1.6 m looking along +Y (at rest, or speeds 0.6c, 0.75c, 0.9c over the frame steps),
-    floor, wall 14 m ahead, a 2 m box 8 m ahead keyframed along +X at 0.8c from frame -30 to 20
-    (linear), a point lamp at rest (and, flying, a lamp moving at 0.3c along -X), a grey world."""
+def build_moving_box(bpy, fly, moving_light=False, cruise=False):
+    """Camera at 1.6 m looking along +Y (at rest, or speeds 0.6c, 0.75c, 0.9c over the frame steps;
+    ``cruise``: 0.9c at every frame), floor, wall 14 m ahead, a 2 m box 8 m ahead keyframed along +X
+    at 0.8c from frame -30 to 20 (linear), a point lamp at rest (and a lamp moving at 0.3c along -X),
+    a grey world."""
     scene, camera = ch.new_scene(bpy, resolution=(64, 48), samples=32, location=(0.0, 0.0, 1.6))
     camera.rotation_euler = (1.5707963, 0.0, 0.0)
     camera.data.lens = 20.0
@@ -103,6 +105,9 @@ def build_moving_box(bpy, fly, moving_light=False):
         for frame, speed in ((2, 0.6), (3, 0.75), (4, 0.9)):
             y += speed * C / FPS
             path.append((frame, (0.0, y, 1.6)))
+        if cruise:  # linear keys around the frames: 0.9c at each of them
+            path = [(frame, (0.0, 0.9 * C / FPS * (frame - 1), 1.6)) for frame in (-10, 10)]
+            scene.cycles.samples = 128  # the beamed stand-in lamps' fireflies: the seed noise near the frames' change
         _linear_keys(camera, "location", path)
         settings.velocity_source = "CAMERA_ANIMATION"
         # the wall's edges subdivided in the moving camera's preview (not at rest): the bake keeps that
@@ -113,15 +118,18 @@ def build_moving_box(bpy, fly, moving_light=False):
 
 
 @pytest.mark.parametrize(
-    ("fly", "moving_light"),
-    [(False, False), (True, False), (False, True)],
-    ids=["box-at-0.8c", "flythrough-with-box", "box-and-moving-lamp"],
+    ("fly", "moving_light", "cruise"),
+    [(False, False, False), (True, False, False), (False, True, False), (True, True, True)],
+    ids=["box-at-0.8c", "flythrough-with-box", "box-and-moving-lamp", "flythrough-0.9c-box-and-moving-lamp"],
 )
 def test_baked_apparent_geometry_renders_the_same_frames_without_the_add_on(
-    relativity_addon, factory_blender, tmp_path, fly, moving_light
+    relativity_addon, factory_blender, tmp_path, fly, moving_light, cruise
 ):
+    """The last case is issue 28's acceptance: a camera at 0.9c, a keyframed moving object and a
+    moving light, behind the exact camera (the final render's default): the moving light's stand-in
+    lamps and their copies on the box are kept from frame to frame, unused ones hidden by keys."""
     bpy = factory_blender
-    scene = build_moving_box(bpy, fly, moving_light)
+    scene = build_moving_box(bpy, fly, moving_light, cruise)
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     own = []
     for frame in FRAMES:
@@ -181,12 +189,16 @@ def test_baked_apparent_geometry_renders_the_same_frames_without_the_add_on(
     assert max(differences) < 0.1 * noise, f"baked frames differ from the add-on's: {differences} (noise {noise:.4g})"
 
 
-@pytest.mark.parametrize("fly", [False, True], ids=["box-at-0.8c", "flythrough-with-box"])
-def test_remove_takes_the_geometry_bake_out(relativity_addon, factory_blender, tmp_path, fly):
+@pytest.mark.parametrize(
+    ("fly", "moving_light"),
+    [(False, False), (True, False), (True, True)],
+    ids=["box-at-0.8c", "flythrough-with-box", "flythrough-with-box-and-moving-lamp"],
+)
+def test_remove_takes_the_geometry_bake_out(relativity_addon, factory_blender, tmp_path, fly, moving_light):
     """Set Up, bake, Remove: the file is the one before Set Up (no played-back mesh, collection,
-    modifier, node group or exact camera of the bake left)."""
+    modifier, node group, exact camera, stand-in lamp or copy of one of the bake left)."""
     bpy = factory_blender
-    scene = build_moving_box(bpy, fly)
+    scene = build_moving_box(bpy, fly, moving_light)
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "box.blend"), check_existing=False)
     before = scene_dump.dump(bpy)
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
@@ -197,17 +209,6 @@ def test_remove_takes_the_geometry_bake_out(relativity_addon, factory_blender, t
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
-
-
-def test_moving_lights_behind_the_exact_camera_are_refused(relativity_addon, factory_blender):
-    """A fly-through with a moving light (the final render is the exact camera) is not baked yet:
-    refused in one line, nothing added."""
-    bpy = factory_blender
-    scene = build_moving_box(bpy, fly=True, moving_light=True)
-    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
-    with pytest.raises(_effect().RelativityError, match="with moving lights yet"):
-        _effect().bake_for_render_anywhere(scene, 1, 3)
-    assert "relativity_render_anywhere" not in scene.keys()
 
 
 def test_moving_lights_without_osl_are_refused(relativity_addon, factory_blender, monkeypatch):
