@@ -113,9 +113,12 @@ def centroid(intensity):
     return np.array([((columns + 0.5) * intensity).sum() / total, ((rows + 0.5) * intensity).sum() / total])
 
 
-def render_plain_animation(blend, out_dir, frames, name="plain"):
+def render_plain_animation(blend, out_dir, frames, name="plain", chunk=None):
     """``blender -b blend -a`` in a fresh process: no add-on, no colour-science, scripts disabled.
-    Returns the paths of ``frames`` (the file's frame range) as OpenEXR files in ``out_dir``."""
+    Returns the paths of ``frames`` (the file's frame range) as OpenEXR files in ``out_dir``.
+    ``chunk``: (first, last) rendered instead of the file's range, as a Flamenco task's
+    ``--frame-start A --frame-end B --render-anim`` (flamenco/relativistic_render_baked.js)."""
+    frame_range = "" if chunk is None else f"scene.frame_start, scene.frame_end = {chunk[0]}, {chunk[1]}\n"
     worker = (
         "import os, sys\n"
         "sys.modules['colour'] = None\n"
@@ -125,7 +128,7 @@ def render_plain_animation(blend, out_dir, frames, name="plain"):
         "scene = bpy.context.scene\n"
         "assert not hasattr(scene, 'relativity'), 'add-on unexpectedly enabled'\n"
         "assert not bpy.app.handlers.frame_change_pre and not bpy.app.handlers.render_pre, 'handlers installed'\n"
-        f"scene.render.filepath = {str(out_dir / (name + '_####'))!r}\n"
+        f"{frame_range}scene.render.filepath = {str(out_dir / (name + '_####'))!r}\n"
         "scene.render.use_file_extension = True\n"
         "scene.render.image_settings.file_format = 'OPEN_EXR'\n"
         "scene.render.image_settings.color_depth = '32'\n"
