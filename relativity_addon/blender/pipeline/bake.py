@@ -15,6 +15,9 @@ Apparent Geometry is baked in its final-render configuration (``effect.bake_for_
 puts it in place first: the exact camera behind it for a moving observer, else the boosted meshes):
 at each frame every moving mesh's evaluated geometry is captured, and ``geometry/playback.py``
 plays the captured meshes back by frame; the exact camera's parameters are keyframed as above.
+Stand-in lamps (of moving lights behind that camera, and lamps' copies on moving meshes) are kept
+under their names while the frames are stepped (``busy.keeping_stand_ins``), those a frame does not
+use hidden by a keyed ``hide_render``: every frame holds the same datablocks.
 
 What was added is recorded on the scene (``names.BAKE_RECORD_KEY``); :func:`unbake` (from Remove)
 takes it out again: the F-curves, the actions it created, the sequence images and their files,
@@ -346,7 +349,8 @@ def bake(
     bake keeps (and :func:`unbake` removes). Returns counts: frames, F-curves, image sequences,
     meshes, and ``needs_osl`` (1 where what was baked renders only in a Blender with OSL).
     RelativityError (one line) if the frames differ in what they hold (stand-in lamps added or
-    removed) or a frame's sync is refused."""
+    removed; with ``geometry`` they are kept, and the range stepped again if a later frame added
+    some) or a frame's sync is refused."""
     if last < first:
         raise RelativityError(f"Bake: last frame {last} before first frame {first}")
     unbake(scene)
