@@ -230,13 +230,15 @@ def test_moving_lights_without_osl_are_refused(relativity_addon, factory_blender
     assert "relativity_render_anywhere" not in scene.keys()
 
 
+@pytest.mark.parametrize("moving_light", [False, True], ids=["flythrough-with-box", "flythrough-0.9c-and-moving-lamp"])
 def test_render_script_bakes_apparent_geometry_that_renders_without_the_add_on(
-    relativity_addon, factory_blender, tmp_path
+    relativity_addon, factory_blender, tmp_path, moving_light
 ):
     """``render.py box.blend --frames 1-3 --bake-to baked.blend`` on the fly-through (a file never set
-    up): plain Blender renders the frames ``render.py --frames 1-3 --out`` renders with the add-on."""
+    up; with a moving lamp, at 0.9c: issue 28's case): plain Blender renders the frames ``render.py
+    --frames 1-3 --out`` renders with the add-on."""
     bpy = factory_blender
-    build_moving_box(bpy, fly=True)
+    build_moving_box(bpy, fly=True, moving_light=moving_light, cruise=moving_light)
     blend = ch.save_blend(bpy, tmp_path / "box.blend")
     options = ("--frames=1-3", "--seed=7", "--samples=16")
     command = [sys.executable, str(ch.RENDER_SCRIPT), str(blend), f"--bake-to={tmp_path / 'baked.blend'}", *options]
