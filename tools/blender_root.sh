@@ -8,7 +8,8 @@
 # script (so any change to the package list or the steps builds a new root; older roots are deleted).
 # Needs root (or sudo) and Debian's package registry; debootstrap is installed on the host if missing.
 # Inside the root: Blender, Xvfb, xdotool, x11-apps (xwd) and the Python modules that Debian's
-# Blender imports but does not pull in (numpy, cattrs, requests).
+# Blender imports but does not pull in (numpy, cattrs, requests); node, to compile the Flamenco job
+# types the way Flamenco's Manager does (tests/gui/test_flamenco_baked.py).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/relativity-addon
@@ -25,7 +26,7 @@ fi
 
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo=sudo
-PACKAGES="blender xvfb xauth xdotool x11-apps x11-utils python3-numpy python3-cattr python3-requests"
+PACKAGES="blender xvfb xauth xdotool x11-apps x11-utils python3-numpy python3-cattr python3-requests nodejs"
 mirror=${RELATIVITY_DEBIAN_MIRROR:-$(grep -hoE '^URIs: *[^ ]+/debian/?$' /etc/apt/sources.list.d/*.sources 2>/dev/null | head -n1 | sed 's/^URIs: *//')}
 mirror=${mirror:-http://deb.debian.org/debian}
 

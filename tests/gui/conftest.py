@@ -84,15 +84,32 @@ class GuiSession:
 
 
 @pytest.fixture(scope="session")
-def gui_session(tmp_path_factory):
+def debian_root():
+    """The Debian sid root with Blender (and node); skipped only when told."""
     if _skip_requested():
         pytest.skip("RELATIVITY_SKIP_GUI is set: the real-application stage was told not to run")
+    return blender_root()
+
+
+@pytest.fixture
+def root_work(debian_root):
+    """(path on the host, the same path inside the root, run) of a fresh folder in the root's /tmp,
+    removed after; ``run(script)`` runs a shell script in the root (:func:`in_root`)."""
+    name = f"relativity-test-{uuid.uuid4().hex[:8]}"
+    work = debian_root / "tmp" / name
+    work.mkdir(parents=True)
+    yield work, f"/tmp/{name}", lambda script: in_root(debian_root, script)
+    shutil.rmtree(work, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def gui_session(tmp_path_factory, debian_root):
     sys.path.insert(0, str(REPO_ROOT / "tools"))
     import build_extension
 
     zip_path, output = build_extension.build(tmp_path_factory.mktemp("gui-extension"))
     assert zip_path is not None, f"extension build failed:\n{output}"
-    root = blender_root()
+    root = debian_root
     name = f"relativity-gui-{uuid.uuid4().hex[:8]}"
     work = root / "tmp" / name
     (work / "out").mkdir(parents=True)

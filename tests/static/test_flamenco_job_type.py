@@ -9,30 +9,11 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from flamenco_harness import compile_job
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 JOB_TYPE = REPO_ROOT / "flamenco" / "relativistic_render.js"
 NODE = shutil.which("node") or shutil.which("nodejs")
-
-HARNESS = r"""
-const fs = require("fs"), vm = require("vm"), nodePath = require("path");
-const source = fs.readFileSync(process.argv[1], "utf8");
-const settings = JSON.parse(process.argv[2]);
-const tasks = [];
-const context = {
-  print: () => {},
-  path: nodePath.posix,
-  author: {
-    Task: (name, type) => ({ name, type, commands: [], addCommand(c) { this.commands.push(c); } }),
-    Command: (type, parameters) => ({ type, parameters }),
-  },
-};
-vm.createContext(context);
-vm.runInContext(source + "\nthis.JOB_TYPE = JOB_TYPE; this.compileJob = compileJob;", context);
-context.compileJob({ name: "shot", settings, addTask: (task) => tasks.push(task) });
-const keys = context.JOB_TYPE.settings.map((s) => s.key);
-process.stdout.write(JSON.stringify({ keys, tasks }));
-"""
 
 
 def test_job_type_parses_as_javascript():
@@ -71,9 +52,7 @@ def test_job_type_compiles_tasks_the_batch_script_accepts():
         "extra_args": "--seed=3  --no-searchlight",
         "blendfile": "/farm/shot.blend",
     }
-    result = subprocess.run(
-        [NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps(settings)], capture_output=True, text=True, timeout=60
-    )
+    result = compile_job([NODE], JOB_TYPE, settings)
     assert result.returncode == 0, result.stderr
     compiled = json.loads(result.stdout)
     assert set(settings) <= set(compiled["keys"])
@@ -95,12 +74,7 @@ def test_job_type_compiles_tasks_the_batch_script_accepts():
         covered += range(first, last + 1)
     assert covered == list(range(3, 13)) and len(compiled["tasks"]) == 3  # 3-6, 7-10, 11-12
 
-    bad = subprocess.run(
-        [NODE, "-e", HARNESS, str(JOB_TYPE), json.dumps({**settings, "frames": "1,5"})],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    bad = compile_job([NODE], JOB_TYPE, {**settings, "frames": "1,5"})
     assert bad.returncode != 0 and "frames must be FIRST-LAST" in bad.stderr
 
 
@@ -127,9 +101,7 @@ def test_baked_job_type_renders_with_plain_blender_and_scripts_disabled():
         "file_format": "exr",
         "blendfile": "/farm/shot_baked.blend",
     }
-    result = subprocess.run(
-        [NODE, "-e", HARNESS, str(BAKED_JOB_TYPE), json.dumps(settings)], capture_output=True, text=True, timeout=60
-    )
+    result = compile_job([NODE], BAKED_JOB_TYPE, settings)
     assert result.returncode == 0, result.stderr
     compiled = json.loads(result.stdout)
     assert set(settings) <= set(compiled["keys"])
