@@ -55,11 +55,12 @@ Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; t
 the shifted light alone (Blender 5.2's Principled Volume reads a grid otherwise than an Attribute
 node, so ``X - E`` would leave the difference unshifted). A Volume object renders no surface
 closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
-there too (measured: with the link to it cut the compositor shifts those pixels again). The
-spectral mode still refuses grids: no scene-frame spectrum that keeps Cycles' rest luminance
-``sigma T^4`` is shifted by ``D^4`` at every ``T``. Not covered: a Principled Volume behind a Mix
-or Add shader or with a surface shader (also refused by the spectral mode when it emits a
-blackbody; on an object with grids a panel warning names it), and Apparent Geometry's boosted meshes.
+there too (measured: with the link to it cut the compositor shifts those pixels again). In a
+spectral pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, the scene-frame spectrum whose
+shift is that rule (``D`` of the ray: it depends on the direction), other rays ``E`` up-sampled as
+an RGB emitter. Not covered: a Principled Volume behind a Mix or Add shader or with a surface
+shader (also refused by the spectral mode when it emits a blackbody; on an object with grids a
+panel warning names it), and Apparent Geometry's boosted meshes.
 """
 
 from __future__ import annotations
@@ -185,11 +186,27 @@ def volume_blackbody_group() -> Group:
         # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
         # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
         # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
+        # With a grid, camera rays: the spectrum whose shift is the bolometric rule, E's times
+        # mix(1, (D T)^4, I) / mix(1, T^4, I) Y_B(T) / Y_B(D T) (in logs); other rays: E up-sampled
+        # as an RGB emitter (no Wien tail to explode where the grid fades to 0 K)
+        "bolometric_camera": fmath("MULTIPLY", "group.Bolometric", "camera_ray"),
+        "grid_light": fmath("SUBTRACT", "group.Bolometric", "bolometric_camera"),
+        "spectral_blackbody": fmath("SUBTRACT", 1.0, "grid_light"),
         "spectral": group_node(
             spectral_nodes.SPECTRAL_COLOUR,
-            {"Color": "rest", "Temperature": "temperature", "Is Blackbody": 1.0, "Is Emission": 1.0},
+            {"Color": "rest", "Temperature": "temperature", "Is Blackbody": "spectral_blackbody", "Is Emission": 1.0},
         ),
-        "spectral_out": vmath("SCALE", "spectral", scale="settings.Spectral Pass"),
+        "safe_dt_mixed": fmath("MAXIMUM", "dt_mixed", 1e-30),
+        "safe_mixed": fmath("MAXIMUM", "mixed", 1e-30),
+        "ln_dt_mixed": fmath("LOGARITHM", "safe_dt_mixed", math.e),
+        "ln_mixed": fmath("LOGARITHM", "safe_mixed", math.e),
+        "ln_total_ratio": fmath("SUBTRACT", "ln_dt_mixed", "ln_mixed"),
+        "ln_spectral_ratio": fmath("SUBTRACT", "ln_total_ratio", "shift.Log Luminance Ratio"),
+        "spectral_log_gain": fmath("MULTIPLY", "ln_spectral_ratio", "bolometric_camera"),
+        "spectral_safe_gain": fmath("MINIMUM", "spectral_log_gain", materials.EXP_LIMIT),
+        "spectral_gain": fmath("EXPONENT", "spectral_safe_gain"),
+        "spectral_scale": fmath("MULTIPLY", "spectral_gain", "settings.Spectral Pass"),
+        "spectral_out": vmath("SCALE", "spectral", scale="spectral_scale"),
         "out": vmath("ADD", "fast_out", "spectral_out"),
         # Cycles' own blackbody off in a spectral pass, and for camera rays with a grid (above)
         "switched_off": fmath("MULTIPLY", "switch", "group.Bolometric"),
@@ -352,6 +369,16 @@ def grid_materials(scene: Scene) -> dict[Material, str]:
     return found
 
 
+def grid_blackbodies(scene: Scene) -> list[str]:
+    """Names of the materials whose volume blackbody reads a temperature grid (:func:`attach`)."""
+    return [
+        material.name
+        for material in grid_materials(scene)
+        if material.node_tree is not None
+        and any(node.name.startswith(f"{NODE_PREFIX} Grid ") for node in material.node_tree.nodes)
+    ]
+
+
 def attach_colours(material: Material) -> bool:
     """Put the volume colour group (``spectral_nodes.volume_colour_group``: unchanged outside the
     spectral passes) in front of every volume colour input of an attached ``material``
@@ -457,11 +484,9 @@ def _emits_blackbody(node):
 
 
 def spectral_problem(scene: Scene) -> str | None:
-    """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
-    that may read a temperature grid (its emission varies with the grid, which has no spectrum in
-    the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
-    would stay RGB), a Volume Coefficients node, volume shaders inside a node group (only the
-    material's own nodes get the colour group), or a world volume."""
+    """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a colour grid
+    (Color Attribute), a blackbody the correction does not handle (it would stay RGB), a Volume
+    Coefficients node, what :func:`_grouped_problem` names inside node groups, or a world volume."""
     grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
@@ -477,11 +502,6 @@ def spectral_problem(scene: Scene) -> str | None:
                 return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
             if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:
                 continue
-            if material in grids and _emits_blackbody(node):
-                return (
-                    f"Spectral colour cannot follow temperature grids: the blackbody of {where} on "
-                    f"{grids[material]!r} varies with its grid (set Blackbody Intensity to 0)"
-                )
             if material in grids and node.inputs["Color Attribute"].default_value:
                 return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
             attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None

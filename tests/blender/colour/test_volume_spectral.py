@@ -272,10 +272,11 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
 
 
 def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
-    """A blackbody on an object that may read a temperature grid (a Volume object), one behind a
-    Mix shader, volume shaders inside a node group, and a world volume: one-line RelativityError
-    before any pass, never a picture with RGB volumes; without the blackbody the grid object is
-    accepted (its density grid only scales every wavelength alike)."""
+    """A colour grid on an object that may read grids (a Volume object), a blackbody behind a Mix
+    shader, volume shaders inside a node group, and a world volume: one-line RelativityError
+    before any pass, never a picture with RGB volumes. A blackbody reading a temperature grid is
+    accepted (``test_volume_temperature_grid.py``), and so is the grid object without it (its
+    density grid only scales every wavelength alike)."""
     bpy = __import__("bpy")
     from importlib import import_module
 
@@ -293,12 +294,16 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
             spectral_render.render(scene, 2)
         return str(caught.value)
 
+    spectral_render.check(scene)  # a temperature grid: accepted (refused before)
+    principled = fire.node_tree.nodes["Principled Volume"]
+    principled.inputs["Color Attribute"].default_value = "color"
     message = refusal()
-    assert "temperature grid" in message and "'Fire'" in message and "'Smoke'" in message and "\n" not in message
+    assert "colour grids" in message and "'Fire'" in message and "\n" not in message
     # the button: enabled (its poll runs only the cheap checks), the refusal reported when pressed
     assert bpy.ops.relativity.render_spectral.poll()
-    with pytest.raises(RuntimeError, match="temperature grid"):
+    with pytest.raises(RuntimeError, match="colour grids"):
         bpy.ops.relativity.render_spectral()
+    principled.inputs["Color Attribute"].default_value = ""
     # without the blackbody (set where the user sets it: before Set Up, which links the fast
     # mode's correction into a grid blackbody's intensity)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
