@@ -369,13 +369,13 @@ def grid_materials(scene: Scene) -> dict[Material, str]:
     return found
 
 
-def grid_blackbodies(scene: Scene) -> list[str]:
-    """Names of the materials whose volume blackbody reads a temperature grid (:func:`attach`)."""
+def blackbody_materials(scene: Scene) -> list[str]:
+    """Names of the materials of ``scene`` with a volume blackbody the correction handles (:func:`attach`)."""
     return [
         material.name
-        for material in grid_materials(scene)
+        for material, _temperature in materials.scene_materials(scene)
         if material.node_tree is not None
-        and any(node.name.startswith(f"{NODE_PREFIX} Grid ") for node in material.node_tree.nodes)
+        and any(node.name.startswith(f"{NODE_PREFIX} Add ") for node in material.node_tree.nodes)
     ]
 
 

@@ -191,9 +191,10 @@ def render(
             wavelengths = spectral_render.sample_wavelengths(d_min, d_max, passes)
             compositing.set_stage_mode("PASS_THROUGH")
             scene.render.use_persistent_data = True  # the passes differ in colours only: keep the scene's BVH
-            if volumes.grid_blackbodies(scene):
-                # 5.x's null scattering renders grid gas at some wavelengths black (measured: the pass
-                # at 1127-1357 nm) and the others 3-8 % apart; ray marching, 4.5's only method, does not
+            if volumes.blackbody_materials(scene):
+                # 5.x's null scattering renders heterogeneous blackbody gas wrongly in the passes (a
+                # grid: the 1127-1357 nm pass black; a node field: 3.4 % dim); ray marching, 4.5's only
+                # method, matches 4.5 (docs/spectral-model.md, "Temperature grids in the spectral mode")
                 compat.set_volume_ray_marching(scene, True)
             samples = []
             for index in range(passes):
