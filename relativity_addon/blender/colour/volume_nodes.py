@@ -90,7 +90,8 @@ def volume_blackbody_group() -> Group:
         "light_path": Node("ShaderNodeLightPath"),
         "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
         "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
-        "switch": fmath("MULTIPLY", "camera_ray", "fast"),
+        "fast_camera_ray": fmath("MULTIPLY", "camera_ray", "fast"),
+        "switch": fmath("MULTIPLY", "fast_camera_ray", "group.Fast Part"),  # 0: inside a node group
         # X - E added to Cycles' own E (which the group's E matches to 2e-4 for a constant or
         # node-driven T); with a grid (Bolometric 1) Cycles' E is switched off for camera rays and
         # X emitted alone: Blender 5.2 reads a grid in the Principled Volume otherwise than an
@@ -142,6 +143,7 @@ def volume_blackbody_group() -> Group:
             ("Grid", "NodeSocketFloat", 1.0),  # the temperature grid's value (an Attribute node's Fac)
             ("Grid Alpha", "NodeSocketFloat", 0.0),  # 1 where the object has that grid
             ("Bolometric", "NodeSocketFloat", 0.0),  # 1: Cycles' own emission at D T (temperature grids)
+            ("Fast Part", "NodeSocketFloat", 1.0),  # 0: the spectral passes' part only (no done mask there)
         ),
         (
             ("Color", "NodeSocketColor", "out"),

@@ -37,8 +37,10 @@ Principled Volume Color and Absorption Color and the Volume Absorption / Scatter
 as reflectances, which Cycles' per-channel formulas (``sigma_a = density max(1 - C, 0)
 max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wavelength; the
 Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
-Emission node in a volume has the materials' own group already. What cannot be made spectral is
-refused in one line (:func:`spectral_problem`).
+Emission node in a volume has the materials' own group already. A Principled Volume blackbody
+inside a node group gets the group's spectral part in the group's tree (:func:`attach_grouped`; the
+fast mode keeps its RGB shift). What cannot be made spectral is refused in one line
+(:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
@@ -230,13 +232,75 @@ def grid_materials(scene: Scene) -> dict[Material, str]:
 
 
 def blackbody_materials(scene: Scene) -> list[str]:
-    """Names of the materials of ``scene`` with a volume blackbody the correction handles (:func:`attach`)."""
+    """Names of the materials of ``scene`` with a volume blackbody the correction handles
+    (:func:`attach`, :func:`attach_grouped`)."""
     return [
         material.name
         for material, _temperature in materials.scene_materials(scene)
         if material.node_tree is not None
-        and any(node.name.startswith(f"{NODE_PREFIX} Add ") for node in material.node_tree.nodes)
+        and any(
+            node.name.startswith(f"{NODE_PREFIX} Add ")
+            for tree in (
+                material.node_tree,
+                *(inner for _group, inner, _node in grouped_volume_nodes(material.node_tree)),
+            )
+            for node in tree.nodes
+        )
     ]
+
+
+def attach_grouped(material: Material) -> bool:
+    """The spectral part of the correction for Principled Volume blackbodies inside the node groups
+    of an attached ``material``, in the group's tree (once for every material sharing it, recorded
+    on the tree like the grouped colours, which ``grouped_colours.detach_all`` undoes): in a pass
+    Cycles' RGB blackbody is off and the group emits its Planck spectrum, as in the material's own
+    tree; outside the passes the group adds nothing (``Fast Part`` 0: the done mask and boundary
+    belong to the material, so the fast mode keeps the RGB shift and names it). Returns whether it did."""
+    if not materials.is_attached(material) or material.node_tree is None:
+        return False
+    did = False
+    for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
+        blackbody = sources.volume_blackbody(node)
+        if blackbody is None:
+            continue
+        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+        if (
+            intensity is None
+            or not node.outputs[0].is_linked
+            or inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
+        ):
+            continue
+        ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
+        group = inner.nodes.new("ShaderNodeGroup")
+        group.node_tree = bpy.data.node_groups[GROUP]
+        group.name = group.label = f"{NODE_PREFIX} {node.name}"
+        if isinstance(blackbody.temperature, float):
+            group.inputs["Temperature"].default_value = blackbody.temperature
+        else:
+            inner.links.new(blackbody.temperature, group.inputs["Temperature"])
+        group.inputs["Intensity"].default_value = intensity
+        group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+        group.inputs["Fast Part"].default_value = 0.0
+        emission = inner.nodes.new("ShaderNodeEmission")
+        emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
+        add = inner.nodes.new("ShaderNodeAddShader")
+        add.name = add.label = f"{NODE_PREFIX} Add {node.name}"
+        targets = [link.to_socket for link in node.outputs[0].links]
+        inner.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+        inner.links.new(group.outputs["Color"], emission.inputs["Color"])
+        inner.links.new(node.outputs[0], add.inputs[0])
+        inner.links.new(emission.outputs[0], add.inputs[1])
+        blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
+        records = [{**blank, "group_node": new.name} for new in (group, emission)]
+        for target in targets:
+            inner.links.new(add.outputs[0], target)
+            relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}
+            records.append({**relink, "group_node": add.name, "source_socket": node.outputs[0].identifier})
+        for new in (group, emission, add):
+            new.location, new.hide = (node.location.x + 200.0, node.location.y - 200.0), True
+        inner[materials.ATTACHED_KEY] = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])] + records
+        did = True
+    return did
 
 
 def attach_colours(material: Material) -> bool:
@@ -304,11 +368,13 @@ def grouped_volume_nodes(
 def attach_scene(scene: Scene) -> None:
     """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
     except those on objects with temperature grids (:func:`grid_materials`); every volume colour
-    made spectral for the spectral passes (:func:`attach_colours`)."""
+    made spectral for the spectral passes (:func:`attach_colours`), and blackbodies inside node
+    groups too (:func:`attach_grouped`)."""
     grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         attach(material, grids=material in grids)
         attach_colours(material)
+        attach_grouped(material)
 
 
 def _grouped_problem(material, on_grids):
@@ -322,10 +388,12 @@ def _grouped_problem(material, on_grids):
             return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
         if node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
-        if _emits_blackbody(node):
+        if _emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
+            return f"Spectral colour cannot follow temperature grids inside node groups: {where} reads one"
+        if _emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
             return (
-                f"Spectral colour cannot make the blackbody of {where} spectral: a Principled Volume "
-                "blackbody must be in the material's own node tree"
+                f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint and a "
+                "constant intensity (added after Set Up: set up again)"
             )
         if on_grids and node.inputs["Color Attribute"].default_value:
             return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"

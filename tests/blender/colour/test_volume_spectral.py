@@ -76,12 +76,14 @@ def _compare(label, doppler, xyz, fast_xyz, expected):
     return fast_delta_e
 
 
-def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path):
+@pytest.mark.parametrize("grouped", [False, True], ids=["own_tree", "grouped"])
+def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path, grouped):
     """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh, a blue emitter behind
     the slab's lower half: the gas and the mesh are the blackbody at ``D T`` with luminance
     ``Y(D T) / Y(T)`` times the rest luminance (times the slab's path-length change under
     aberration); through the gas the blue emitter's up-sampled spectrum, shifted, is added (the
-    fast mode's done mask keeps it at its rest colour)."""
+    fast mode's done mask keeps it at its rest colour). ``grouped``: the Principled Volume inside
+    a node group (refused before; the fast mode keeps the RGB shift there)."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
     dh.add_emitter_plane(
@@ -90,6 +92,14 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
     dh.add_emitter_plane(bpy, scene, "Behind", (-5.0, -0.5), (-3.0, -0.5), colour=BEHIND, beta=None, depth=7.0)
     gas = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
     dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), gas)
+    trees = [gas.node_tree, *([_into_group(bpy, gas, "Principled Volume")] if grouped else [])]
+
+    def state():
+        return [
+            (sorted((link.from_node.name, link.to_node.name) for link in tree.links), len(tree.nodes)) for tree in trees
+        ]
+
+    before = state()
     windows = {"volume": GAS, "volume + blue emitter": GAS_THROUGH, "mesh": RIGHT}
     _border(scene, slice(GAS[0].start, GAS_THROUGH[0].stop))
     behind_xyz = dh.linear_rec709_to_xyz(BEHIND)
@@ -123,6 +133,8 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
         measured[name] = _xyz(spectral, window)
         _compare(name, doppler[window].mean(), measured[name], _xyz(fast, window), expected)
     assert dh.delta_e_2000_normalised(measured["volume"], measured["mesh"]) < 2.0
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert state() == before
 
 
 def _slab_scene(bpy, scattering):
