@@ -483,6 +483,6 @@ def warnings(scene: Scene) -> list[str]:
         if grouped is not None:
             lines.append(
                 f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
-                f"{grouped[0].name!r} keeps the RGB colour shift (shifted to D T only in the material's own tree)"
+                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (Render Spectral shifts it to D T)"
             )
     return lines
