@@ -7,7 +7,7 @@ instead (emitting ``N(D)^-1`` of the wanted colour) is hopeless: ``M(D)`` is nea
 from ``D`` = 1 (condition number 1.3e9 at 1.7; docs/spectral-model.md). So, like a blackbody
 emitter, the volume does the exact shift itself and marks its pixels done:
 
-- **volume**: for camera rays, the group below adds ``X - E`` to the Principled Volume's own
+- **volume**: for camera rays, the group (``volume_nodes.py``) adds ``X - E`` to the Principled Volume's own
   blackbody emission ``E = tint sigma mix(1, T^4, intensity) B(T)`` (Cycles' formula,
   ``sigma = 5.670373e-14 / pi``, ``B`` the Blackbody node's colour; measured equal to Cycles' own
   to 2e-4), where ``X`` is what the materials' Doppler colour group makes of a blackbody colour
@@ -37,8 +37,10 @@ Principled Volume Color and Absorption Color and the Volume Absorption / Scatter
 as reflectances, which Cycles' per-channel formulas (``sigma_a = density max(1 - C, 0)
 max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wavelength; the
 Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
-Emission node in a volume has the materials' own group already. What cannot be made spectral is
-refused in one line (:func:`spectral_problem`).
+Emission node in a volume has the materials' own group already. A Principled Volume blackbody
+inside a node group gets the group's spectral part in the group's tree (:func:`attach_grouped`; the
+fast mode keeps its RGB shift). What cannot be made spectral is refused in one line
+(:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
@@ -55,24 +57,25 @@ Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; t
 the shifted light alone (Blender 5.2's Principled Volume reads a grid otherwise than an Attribute
 node, so ``X - E`` would leave the difference unshifted). A Volume object renders no surface
 closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
-there too (measured: with the link to it cut the compositor shifts those pixels again). The
-spectral mode still refuses grids: no scene-frame spectrum that keeps Cycles' rest luminance
-``sigma T^4`` is shifted by ``D^4`` at every ``T``. Not covered: a Principled Volume behind a Mix
-or Add shader or with a surface shader (also refused by the spectral mode when it emits a
-blackbody; on an object with grids a panel warning names it), and Apparent Geometry's boosted meshes.
+there too (measured: with the link to it cut the compositor shifts those pixels again). In a
+spectral pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, the scene-frame spectrum whose
+shift is that rule (``D`` of the ray: it depends on the direction), other rays ``E`` up-sampled as
+an RGB emitter. Not covered: a Principled Volume behind a Mix or Add shader or with a surface
+shader (also refused by the spectral mode when it emits a blackbody; on an object with grids a
+panel warning names it), and Apparent Geometry's boosted meshes.
 """
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import bpy
 
 from ..common import names
-from ..common.nodes import Group, Node, ensure_group, fmath, group_node, vmath
+from ..common.nodes import ensure_group
 from ..scene import grouped_colours, sources
 from . import materials, spectral_nodes
+from .volume_nodes import volume_blackbody_group
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -93,130 +96,6 @@ VOLUME_COLOURS = (
 )
 UNSUPPORTED_VOLUME_NODES = ("ShaderNodeVolumeCoefficients",)  # RGB coefficients: no spectrum to give them
 VOLUME_KINDS = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
-SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the Principled Volume
-
-
-def volume_blackbody_group() -> Group:
-    """``Color``: the emission to add to the volume (``X - E`` for camera rays on the exact camera's
-    path, 0 otherwise; in a spectral pass ``E``'s spectral values); ``Done``: 1 where the boundary
-    marks the pixel as shifted; ``Intensity``: the Principled Volume's Blackbody Intensity (0 in a
-    spectral pass)."""
-    nodes = {
-        "settings": group_node(materials.SETTINGS),
-        # Cycles' T: the Temperature input times max(grid, 0) where the object has the grid
-        # (an Attribute node's Fac and Alpha; Grid Alpha 0: no grid, T is the input)
-        "grid_clamped": fmath("MAXIMUM", "group.Grid", 0.0),
-        "grid_minus_one": fmath("SUBTRACT", "grid_clamped", 1.0),
-        "grid_factor": fmath("MULTIPLY_ADD", "group.Grid Alpha", "grid_minus_one", 1.0),
-        "temperature": fmath("MULTIPLY", "group.Temperature", "grid_factor"),
-        # the volume's own emission: tint sigma mix(1, T^4, intensity) B(T)
-        "t4": fmath("POWER", "temperature", 4.0),
-        "t4m1": fmath("SUBTRACT", "t4", 1.0),
-        "mixed": fmath("MULTIPLY_ADD", "group.Intensity", "t4m1", 1.0),
-        "sigma": fmath("MULTIPLY", "mixed", SIGMA),
-        "strength": fmath("MULTIPLY", "sigma", "group.Tint"),
-        "planck": Node("ShaderNodeBlackbody", {"Temperature": "temperature"}),
-        "rest": vmath("SCALE", "planck.Color", scale="strength"),
-        # ln D = ln(1 - beta_o . k) - ln(1 - beta_o^2) / 2: the observer's factor only (a volume at
-        # rest; the materials' factor group also reads the emitter's velocity attribute, which a
-        # volume shader does not read as 0 where it is missing: measured ln D != 0 at rest)
-        "geometry": Node("ShaderNodeNewGeometry"),
-        "bo_k": vmath("DOT_PRODUCT", "settings.Observer Beta", "geometry.Incoming"),
-        "bo_bo": vmath("DOT_PRODUCT", "settings.Observer Beta", "settings.Observer Beta"),
-        "ns_bo_k": fmath("SUBTRACT", 1.0, "bo_k.Value"),
-        "one_bo_k": fmath("MAXIMUM", "ns_bo_k", 1e-12),
-        "ns_bo2": fmath("SUBTRACT", 1.0, "bo_bo.Value"),
-        "one_bo2": fmath("MAXIMUM", "ns_bo2", 1e-12),
-        "ln_num": fmath("LOGARITHM", "one_bo_k", math.e),
-        "ln_go2": fmath("LOGARITHM", "one_bo2", math.e),
-        "ln_d": fmath("MULTIPLY_ADD", "ln_go2", -0.5, "ln_num"),
-        # what a blackbody emitter of that colour emits for camera rays (as the materials' Doppler
-        # colour group): the blackbody at D T with the rest luminance times exp(E)
-        "shift": group_node(materials.BLACKBODY_SHIFT, {"Temperature": "temperature", "Log Doppler": "ln_d"}),
-        "luminance": vmath("DOT_PRODUCT", "rest", materials.LUMINANCE_WEIGHTS),
-        "shifted": vmath("SCALE", "shift.Color", scale="luminance.Value"),
-        "base": Node(
-            "ShaderNodeMix", {"Factor": "settings.Use Doppler", 4: "rest", 5: "shifted"}, {"data_type": "VECTOR"}
-        ),
-        "power": fmath("SUBTRACT", "settings.Power of D", "settings.Camera Power"),
-        "power_term": fmath("MULTIPLY", "power", "ln_d"),
-        "log_gain": fmath("MULTIPLY_ADD", "shift.Log Luminance Ratio", "settings.Spectral Searchlight", "power_term"),
-        "safe_log_gain": fmath("MINIMUM", "log_gain", materials.EXP_LIMIT),
-        "gain": fmath("EXPONENT", "safe_log_gain"),
-        "visible_emitter": vmath("SCALE", "base.Result", scale="gain"),
-        # the bolometric rule (temperature grids): Cycles' own emission at D T, times D^(p - 4)
-        # over the camera's D^p_cam: log gain (4 SS + p - p_cam - 4 Use Doppler) ln D
-        "d": fmath("EXPONENT", "ln_d"),
-        "undoppled": fmath("SUBTRACT", 1.0, "settings.Use Doppler"),
-        "d_used": fmath("MULTIPLY_ADD", "d", "settings.Use Doppler", "undoppled"),
-        "dt": fmath("MULTIPLY", "temperature", "d_used"),
-        "dt4": fmath("POWER", "dt", 4.0),
-        "dt4m1": fmath("SUBTRACT", "dt4", 1.0),
-        "dt_mixed": fmath("MULTIPLY_ADD", "group.Intensity", "dt4m1", 1.0),
-        "dt_sigma": fmath("MULTIPLY", "dt_mixed", SIGMA),
-        "dt_strength": fmath("MULTIPLY", "dt_sigma", "group.Tint"),
-        "dt_planck": Node("ShaderNodeBlackbody", {"Temperature": "dt"}),
-        "bolometric_base": vmath("SCALE", "dt_planck.Color", scale="dt_strength"),
-        "ss4": fmath("MULTIPLY", "settings.Spectral Searchlight", 4.0),
-        "bolometric_power": fmath("ADD", "ss4", "power"),
-        "bolometric_exponent": fmath("MULTIPLY_ADD", "settings.Use Doppler", -4.0, "bolometric_power"),
-        "bolometric_log": fmath("MULTIPLY", "bolometric_exponent", "ln_d"),
-        "bolometric_safe": fmath("MINIMUM", "bolometric_log", materials.EXP_LIMIT),
-        "bolometric_gain": fmath("EXPONENT", "bolometric_safe"),
-        "bolometric_emitter": vmath("SCALE", "bolometric_base", scale="bolometric_gain"),
-        "emitter": Node(
-            "ShaderNodeMix",
-            {"Factor": "group.Bolometric", 4: "visible_emitter", 5: "bolometric_emitter"},
-            {"data_type": "VECTOR"},
-        ),
-        # only camera rays on the exact camera's path, never in a spectral pass
-        "light_path": Node("ShaderNodeLightPath"),
-        "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
-        "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
-        "switch": fmath("MULTIPLY", "camera_ray", "fast"),
-        # X - E added to Cycles' own E (which the group's E matches to 2e-4 for a constant or
-        # node-driven T); with a grid (Bolometric 1) Cycles' E is switched off for camera rays and
-        # X emitted alone: Blender 5.2 reads a grid in the Principled Volume otherwise than an
-        # Attribute node does (sigma T^4 2.4-2.9 % apart), and the difference would leak unshifted
-        "rest_kept": fmath("SUBTRACT", 1.0, "group.Bolometric"),
-        "rest_taken": vmath("SCALE", "rest", scale="rest_kept"),
-        "difference": vmath("SUBTRACT", "emitter.Result", "rest_taken"),
-        "fast_out": vmath("SCALE", "difference", scale="switch"),
-        # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
-        # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
-        # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
-        "spectral": group_node(
-            spectral_nodes.SPECTRAL_COLOUR,
-            {"Color": "rest", "Temperature": "temperature", "Is Blackbody": 1.0, "Is Emission": 1.0},
-        ),
-        "spectral_out": vmath("SCALE", "spectral", scale="settings.Spectral Pass"),
-        "out": vmath("ADD", "fast_out", "spectral_out"),
-        # Cycles' own blackbody off in a spectral pass, and for camera rays with a grid (above)
-        "switched_off": fmath("MULTIPLY", "switch", "group.Bolometric"),
-        "kept": fmath("SUBTRACT", "fast", "switched_off"),
-        "intensity": fmath("MULTIPLY", "group.Intensity", "kept"),
-        # the boundary where a camera ray enters the volume
-        "front": fmath("SUBTRACT", 1.0, "geometry.Backfacing"),
-        "done": fmath("MULTIPLY", "switch", "front"),
-    }
-    return Group(
-        GROUP,
-        "ShaderNodeTree",
-        (
-            ("Temperature", "NodeSocketFloat", 1000.0),
-            ("Intensity", "NodeSocketFloat", 1.0),
-            ("Tint", "NodeSocketFloat", 1.0),
-            ("Grid", "NodeSocketFloat", 1.0),  # the temperature grid's value (an Attribute node's Fac)
-            ("Grid Alpha", "NodeSocketFloat", 0.0),  # 1 where the object has that grid
-            ("Bolometric", "NodeSocketFloat", 0.0),  # 1: Cycles' own emission at D T (temperature grids)
-        ),
-        (
-            ("Color", "NodeSocketColor", "out"),
-            ("Done", "NodeSocketFloat", "done"),
-            ("Intensity", "NodeSocketFloat", "intensity"),
-        ),
-        nodes,
-    )
 
 
 def _volume_output(tree):
@@ -352,6 +231,78 @@ def grid_materials(scene: Scene) -> dict[Material, str]:
     return found
 
 
+def blackbody_materials(scene: Scene) -> list[str]:
+    """Names of the materials of ``scene`` with a volume blackbody the correction handles
+    (:func:`attach`, :func:`attach_grouped`)."""
+    return [
+        material.name
+        for material, _temperature in materials.scene_materials(scene)
+        if material.node_tree is not None
+        and any(
+            node.name.startswith(f"{NODE_PREFIX} Add ")
+            for tree in (
+                material.node_tree,
+                *(inner for _group, inner, _node in grouped_volume_nodes(material.node_tree)),
+            )
+            for node in tree.nodes
+        )
+    ]
+
+
+def attach_grouped(material: Material) -> bool:
+    """The spectral part of the correction for Principled Volume blackbodies inside the node groups
+    of an attached ``material``, in the group's tree (once for every material sharing it, recorded
+    on the tree like the grouped colours, which ``grouped_colours.detach_all`` undoes): in a pass
+    Cycles' RGB blackbody is off and the group emits its Planck spectrum, as in the material's own
+    tree; outside the passes the group adds nothing (``Fast Part`` 0: the done mask and boundary
+    belong to the material, so the fast mode keeps the RGB shift and names it). Returns whether it did."""
+    if not materials.is_attached(material) or material.node_tree is None:
+        return False
+    did = False
+    for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
+        blackbody = sources.volume_blackbody(node)
+        if blackbody is None:
+            continue
+        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+        if (
+            intensity is None
+            or not node.outputs[0].is_linked
+            or inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
+        ):
+            continue
+        ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
+        group = inner.nodes.new("ShaderNodeGroup")
+        group.node_tree = bpy.data.node_groups[GROUP]
+        group.name = group.label = f"{NODE_PREFIX} {node.name}"
+        if isinstance(blackbody.temperature, float):
+            group.inputs["Temperature"].default_value = blackbody.temperature
+        else:
+            inner.links.new(blackbody.temperature, group.inputs["Temperature"])
+        group.inputs["Intensity"].default_value = intensity
+        group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+        group.inputs["Fast Part"].default_value = 0.0
+        emission = inner.nodes.new("ShaderNodeEmission")
+        emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
+        add = inner.nodes.new("ShaderNodeAddShader")
+        add.name = add.label = f"{NODE_PREFIX} Add {node.name}"
+        targets = [link.to_socket for link in node.outputs[0].links]
+        inner.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+        inner.links.new(group.outputs["Color"], emission.inputs["Color"])
+        inner.links.new(node.outputs[0], add.inputs[0])
+        inner.links.new(emission.outputs[0], add.inputs[1])
+        blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
+        records = [{**blank, "group_node": new.name} for new in (group, emission)]
+        for target in targets:
+            inner.links.new(add.outputs[0], target)
+            relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}
+            records.append({**relink, "group_node": add.name, "source_socket": node.outputs[0].identifier})
+        for new in (group, emission, add):
+            new.location, new.hide = (node.location.x + 200.0, node.location.y - 200.0), True
+        inner[materials.ATTACHED_KEY] = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])] + records
+        did = True
+    return did
+
+
 def attach_colours(material: Material) -> bool:
     """Put the volume colour group (``spectral_nodes.volume_colour_group``: unchanged outside the
     spectral passes) in front of every volume colour input of an attached ``material``
@@ -417,11 +368,13 @@ def grouped_volume_nodes(
 def attach_scene(scene: Scene) -> None:
     """The correction for every attached material of ``scene`` with a Principled Volume blackbody,
     except those on objects with temperature grids (:func:`grid_materials`); every volume colour
-    made spectral for the spectral passes (:func:`attach_colours`)."""
+    made spectral for the spectral passes (:func:`attach_colours`), and blackbodies inside node
+    groups too (:func:`attach_grouped`)."""
     grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         attach(material, grids=material in grids)
         attach_colours(material)
+        attach_grouped(material)
 
 
 def _grouped_problem(material, on_grids):
@@ -435,10 +388,12 @@ def _grouped_problem(material, on_grids):
             return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
         if node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
-        if _emits_blackbody(node):
+        if _emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
+            return f"Spectral colour cannot follow temperature grids inside node groups: {where} reads one"
+        if _emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
             return (
-                f"Spectral colour cannot make the blackbody of {where} spectral: a Principled Volume "
-                "blackbody must be in the material's own node tree"
+                f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint and a "
+                "constant intensity (added after Set Up: set up again)"
             )
         if on_grids and node.inputs["Color Attribute"].default_value:
             return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
@@ -457,11 +412,9 @@ def _emits_blackbody(node):
 
 
 def spectral_problem(scene: Scene) -> str | None:
-    """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a blackbody
-    that may read a temperature grid (its emission varies with the grid, which has no spectrum in
-    the passes), a colour grid (Color Attribute), a blackbody the correction does not handle (it
-    would stay RGB), a Volume Coefficients node, volume shaders inside a node group (only the
-    material's own nodes get the colour group), or a world volume."""
+    """Why the spectral passes cannot carry ``scene``'s volumes (one line), or None: a colour grid
+    (Color Attribute), a blackbody the correction does not handle (it would stay RGB), a Volume
+    Coefficients node, what :func:`_grouped_problem` names inside node groups, or a world volume."""
     grids = grid_materials(scene)
     for material, _temperature in materials.scene_materials(scene):
         if material.node_tree is None:
@@ -477,11 +430,6 @@ def spectral_problem(scene: Scene) -> str | None:
                 return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
             if node.bl_idname != "ShaderNodeVolumePrincipled" or not node.outputs[0].is_linked:
                 continue
-            if material in grids and _emits_blackbody(node):
-                return (
-                    f"Spectral colour cannot follow temperature grids: the blackbody of {where} on "
-                    f"{grids[material]!r} varies with its grid (set Blackbody Intensity to 0)"
-                )
             if material in grids and node.inputs["Color Attribute"].default_value:
                 return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
             attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
@@ -535,6 +483,6 @@ def warnings(scene: Scene) -> list[str]:
         if grouped is not None:
             lines.append(
                 f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
-                f"{grouped[0].name!r} keeps the RGB colour shift (shifted to D T only in the material's own tree)"
+                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (Render Spectral shifts it to D T)"
             )
     return lines

@@ -241,3 +241,16 @@ def custom_camera_aperture_scale(focal_length: float) -> float:
     5.x samples the aperture for a unit focal length (radius ``1 / (2 f-stop)``), 4.5 in scene
     units (radius ``focal length / (2 f-stop)``). No API tells the two apart: decided by version."""
     return focal_length if bpy.app.version >= (5, 0, 0) else 1.0
+
+
+def volume_ray_marching(scene: Scene) -> bool | None:
+    """Whether Cycles renders ``scene``'s volumes by ray marching: 5.x's ``volume_biased`` (its
+    default is null scattering), None where Cycles has only ray marching (4.5)."""
+    value = getattr(scene.cycles, "volume_biased", None)
+    return None if value is None else bool(value)
+
+
+def set_volume_ray_marching(scene: Scene, value: bool | None) -> None:
+    """Set what :func:`volume_ray_marching` reads (nothing to set on 4.5, or for None)."""
+    if value is not None and hasattr(scene.cycles, "volume_biased"):
+        scene.cycles.volume_biased = value

@@ -32,7 +32,7 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import spectral_render
 from ..colour import compositing, materials, volumes, world_doppler
-from ..common import names
+from ..common import compat, names
 from ..geometry import modifier
 from ..scene import snapshot
 from . import effect
@@ -105,6 +105,7 @@ class _Saved:
         self.render = {key: getattr(render, key) for key in ("filepath", "use_file_extension", "use_persistent_data")}
         self.image = {key: getattr(settings, key) for key in ("file_format", "color_depth", "color_mode")}
         self.lights = {light.name: (tuple(light.color), light.use_temperature) for light in _scene_lights(scene)}
+        self.ray_marching = compat.volume_ray_marching(scene)
 
     def restore(self) -> None:
         scene = self.scene
@@ -112,6 +113,7 @@ class _Saved:
             setattr(scene.render, key, value)
         for key, value in self.image.items():
             setattr(scene.render.image_settings, key, value)
+        compat.set_volume_ray_marching(scene, self.ray_marching)
         for name, (colour, use_temperature) in self.lights.items():
             light = bpy.data.lights.get(name)
             if light is not None:
@@ -189,6 +191,11 @@ def render(
             wavelengths = spectral_render.sample_wavelengths(d_min, d_max, passes)
             compositing.set_stage_mode("PASS_THROUGH")
             scene.render.use_persistent_data = True  # the passes differ in colours only: keep the scene's BVH
+            if volumes.blackbody_materials(scene):
+                # 5.x's null scattering renders heterogeneous blackbody gas wrongly in the passes (a
+                # grid: the 1127-1357 nm pass black; a node field: 3.4 % dim); ray marching, 4.5's only
+                # method, matches 4.5 (docs/spectral-model.md, "Temperature grids in the spectral mode")
+                compat.set_volume_ray_marching(scene, True)
             samples = []
             for index in range(passes):
                 trio = spectral_render.pass_wavelengths(wavelengths, index)

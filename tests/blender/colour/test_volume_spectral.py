@@ -76,12 +76,14 @@ def _compare(label, doppler, xyz, fast_xyz, expected):
     return fast_delta_e
 
 
-def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path):
+@pytest.mark.parametrize("grouped", [False, True], ids=["own_tree", "grouped"])
+def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_addon, tmp_path, grouped):
     """A 3000 K slab of emitting gas (density 0) beside a 3000 K emitter mesh, a blue emitter behind
     the slab's lower half: the gas and the mesh are the blackbody at ``D T`` with luminance
     ``Y(D T) / Y(T)`` times the rest luminance (times the slab's path-length change under
     aberration); through the gas the blue emitter's up-sampled spectrum, shifted, is added (the
-    fast mode's done mask keeps it at its rest colour)."""
+    fast mode's done mask keeps it at its rest colour). ``grouped``: the Principled Volume inside
+    a node group (refused before; the fast mode keeps the RGB shift there)."""
     bpy = __import__("bpy")
     scene, camera = dh.emitter_scene(bpy, samples=8, resolution=RESOLUTION)
     dh.add_emitter_plane(
@@ -90,6 +92,14 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
     dh.add_emitter_plane(bpy, scene, "Behind", (-5.0, -0.5), (-3.0, -0.5), colour=BEHIND, beta=None, depth=7.0)
     gas = dh.volume_material(bpy, "Gas", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
     dh.add_box(bpy, scene, "Gas", (-4.0, -0.2), (-2.0, 2.0), (-6.0, -4.0), gas)
+    trees = [gas.node_tree, *([_into_group(bpy, gas, "Principled Volume")] if grouped else [])]
+
+    def state():
+        return [
+            (sorted((link.from_node.name, link.to_node.name) for link in tree.links), len(tree.nodes)) for tree in trees
+        ]
+
+    before = state()
     windows = {"volume": GAS, "volume + blue emitter": GAS_THROUGH, "mesh": RIGHT}
     _border(scene, slice(GAS[0].start, GAS_THROUGH[0].stop))
     behind_xyz = dh.linear_rec709_to_xyz(BEHIND)
@@ -123,6 +133,8 @@ def test_principled_volume_blackbody_in_spectral_mode_is_seen_at_d_t(relativity_
         measured[name] = _xyz(spectral, window)
         _compare(name, doppler[window].mean(), measured[name], _xyz(fast, window), expected)
     assert dh.delta_e_2000_normalised(measured["volume"], measured["mesh"]) < 2.0
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert state() == before
 
 
 def _slab_scene(bpy, scattering):
@@ -272,10 +284,11 @@ def test_emitter_seen_through_volumes_in_spectral_mode(relativity_addon, tmp_pat
 
 
 def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
-    """A blackbody on an object that may read a temperature grid (a Volume object), one behind a
-    Mix shader, volume shaders inside a node group, and a world volume: one-line RelativityError
-    before any pass, never a picture with RGB volumes; without the blackbody the grid object is
-    accepted (its density grid only scales every wavelength alike)."""
+    """A colour grid on an object that may read grids (a Volume object), a blackbody behind a Mix
+    shader, volume shaders inside a node group, and a world volume: one-line RelativityError
+    before any pass, never a picture with RGB volumes. A blackbody reading a temperature grid is
+    accepted (``test_volume_temperature_grid.py``), and so is the grid object without it (its
+    density grid only scales every wavelength alike)."""
     bpy = __import__("bpy")
     from importlib import import_module
 
@@ -293,12 +306,16 @@ def test_volumes_the_passes_cannot_carry_are_refused(relativity_addon):
             spectral_render.render(scene, 2)
         return str(caught.value)
 
+    spectral_render.check(scene)  # a temperature grid: accepted (refused before)
+    principled = fire.node_tree.nodes["Principled Volume"]
+    principled.inputs["Color Attribute"].default_value = "color"
     message = refusal()
-    assert "temperature grid" in message and "'Fire'" in message and "'Smoke'" in message and "\n" not in message
+    assert "colour grids" in message and "'Fire'" in message and "\n" not in message
     # the button: enabled (its poll runs only the cheap checks), the refusal reported when pressed
     assert bpy.ops.relativity.render_spectral.poll()
-    with pytest.raises(RuntimeError, match="temperature grid"):
+    with pytest.raises(RuntimeError, match="colour grids"):
         bpy.ops.relativity.render_spectral()
+    principled.inputs["Color Attribute"].default_value = ""
     # without the blackbody (set where the user sets it: before Set Up, which links the fast
     # mode's correction into a grid blackbody's intensity)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}

@@ -124,3 +124,47 @@ def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
     assert len(material.node_tree.nodes) == nodes_before
+
+
+def test_temperature_grid_in_spectral_mode_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path):
+    """The same grid in the spectral mode (3 passes, docs/spectral-model.md, "Temperature grids"):
+    camera rays see the gas's scene-frame spectrum whose shift is Cycles' own emission at ``D T``,
+    so each half must be colour-science's blackbody at ``D T`` (Delta E 2000 <= 1) with its rest
+    luminance times ``D^4`` (eq. 15) and the slab's path-length change. Refused before (the passes
+    had no rule for grids)."""
+    bpy = __import__("bpy")
+    scene, camera, material = grid_scene(bpy, tmp_path)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: _xyz(rest, window)[:, 1] for name, (_grid, window) in HALVES.items()}
+    links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
+    nodes_before = len(material.node_tree.nodes)
+
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
+    pixels, _info = spectral_render.render(scene, 3)
+    spectral = pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
+    assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
+
+    view = -dh.pixel_photon_directions(bpy, scene, camera)
+    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
+    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
+    path = _slab_path_ratio(bpy, scene, camera)
+    failures = []
+    for name, (grid, window) in HALVES.items():
+        temperature = grid * BASE_TEMPERATURE
+        xyz = _xyz(spectral, window)
+        d = doppler[window].ravel()
+        expected_colour = np.mean([dh.blackbody_xyz_colour_science(f * temperature) for f in d], axis=0)
+        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
+        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**4)
+        print(f"spectral {name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^4 Y {ratio:.4f}")
+        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
+            failures.append(name)
+    assert not failures
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
+    assert len(material.node_tree.nodes) == nodes_before

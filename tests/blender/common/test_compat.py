@@ -169,3 +169,20 @@ def test_compositor_output_and_alpha_over_inputs(factory_blender, tmp_path):
     image = bpy.data.images.load(str(tmp_path / "over.exr"))
     red, green = image.pixels[0], image.pixels[1]
     assert green > 0.9 and red < 0.1
+
+
+def test_volume_ray_marching(factory_blender):
+    """5.x chooses between null scattering (default) and ray marching; 4.5 only ray-marches."""
+    bpy = factory_blender
+    scene = bpy.context.scene
+    before = compat.volume_ray_marching(scene)
+    if hasattr(scene.cycles, "volume_biased"):
+        assert before is False
+        compat.set_volume_ray_marching(scene, True)
+        assert scene.cycles.volume_biased and compat.volume_ray_marching(scene) is True
+        compat.set_volume_ray_marching(scene, before)
+        assert not scene.cycles.volume_biased
+    else:
+        assert before is None
+        compat.set_volume_ray_marching(scene, True)  # nothing to set
+        assert compat.volume_ray_marching(scene) is None
