@@ -44,6 +44,26 @@ COORDINATOR_OPTIONS = {
     "threads",
 }
 
+# Dask's settings for a local cluster (``--workers``), whose processes share the machine with the
+# Blender processes doing the work: Dask's defaults watch a cluster several times a second, which on
+# a few cores takes CPU from the renders. A worker that dies while running a task counts against
+# the task as one failure (``allowed-failures``, set from --retries); a lost worker is seen when its
+# connection closes, not by any of these monitors.
+LOCAL_CLUSTER_SETTINGS = {
+    # The statistical profiler samples every worker's stacks every 10 ms, for a dashboard page.
+    "distributed.worker.profile.enabled": False,
+    # Event-loop health checks (default every 20 ms in the scheduler, each nanny and each worker).
+    "distributed.admin.tick.interval": "1s",
+    # CPU, memory, network and disk counters of each process (default every 500 ms), for dashboards.
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.admin.system-monitor.disk": False,
+    # Replicas of results: a task's result is a few numbers, held once.
+    "distributed.scheduler.active-memory-manager.start": False,
+    # One task per worker at a time (default 1.1: two per single-threaded worker, one waiting
+    # behind the other's frame), so the last frames go to whichever worker is free first.
+    "distributed.scheduler.worker-saturation": 1.0,
+}
+
 
 def output_pattern(out_path: str, several: bool) -> str:
     """The --out path with a run of '#' for the frame number: each task renders its frames to the
@@ -141,10 +161,7 @@ def _connect(options, log, arguments, job_name):
         client.register_plugin(plugin, name=job_name)
         return client, None
     dashboard = importlib.util.find_spec("bokeh") is not None  # Dask's dashboard needs bokeh
-    # A worker that dies while running a task counts against the task as one failure; after
-    # ``retries`` more the task is given up (KilledWorker). No statistical profiler in the workers:
-    # it samples their stacks every 10 ms for a dashboard page, while Blender does the work.
-    settings = {"distributed.scheduler.allowed-failures": options.retries, "distributed.worker.profile.enabled": False}
+    settings = {"distributed.scheduler.allowed-failures": options.retries, **LOCAL_CLUSTER_SETTINGS}
     with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=options.workers,
@@ -153,6 +170,7 @@ def _connect(options, log, arguments, job_name):
             dashboard_address=":0" if dashboard else None,
             silence_logs=logging.CRITICAL,
             plugins=(plugin,),
+            memory_limit=0,  # no memory monitors: a worker holds no data, its Blender is another process
         )
     client = Client(cluster)
     log(

@@ -4,6 +4,7 @@ Blender process is replaced and its frame rendered again; frames rendered by one
 order equal a single-process render pixel for pixel. Behaviour, read from the progress lines and
 the processes, not from times."""
 
+import json
 import os
 import re
 import signal
@@ -141,3 +142,45 @@ def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkey
     finally:
         os.close(read_fd)
         os.close(write_fd)
+
+
+CLUSTER_TIMERS = """
+import argparse, json, sys
+sys.path.insert(0, sys.argv[1])
+from relativity_addon.batch import farm
+
+def timers(server):
+    return {name: callback.callback_time for name, callback in server.periodic_callbacks.items()}
+
+options = argparse.Namespace(scheduler=None, workers=2, retries=2)
+client, cluster = farm._connect(options, lambda *a, **k: None, [sys.argv[2], "--out=" + sys.argv[3]], "job")
+try:
+    found = {
+        "scheduler": client.run_on_scheduler(lambda dask_scheduler: timers(dask_scheduler)),
+        "saturation": client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION),
+        "nannies": [timers(nanny) for nanny in cluster.workers.values()],
+        "workers": list(client.run(lambda dask_worker: timers(dask_worker)).values()),
+    }
+finally:
+    client.close()
+    cluster.close()
+print(json.dumps(found))
+"""
+
+
+def test_local_cluster_leaves_the_cores_to_blender(tmp_path):
+    """The scheduler, nannies and workers of ``--workers`` run without Dask's fast monitors, which
+    on a few cores take CPU from the renders: no timer in any of them fires more often than every
+    250 ms (Dask's own defaults: event-loop checks every 20 ms, memory checks every 100 ms), no
+    memory monitor or profiler at all; and the scheduler gives a single-threaded worker one task
+    at a time, so the last frames go to whichever worker is free first. Read from the servers of a
+    real local cluster."""
+    result = wh.run_python(CLUSTER_TIMERS, wh.REPO_ROOT, tmp_path / "absent.blend", tmp_path / "f.png")
+    assert result.returncode == 0, result.stderr[-3000:]
+    found = json.loads(result.stdout.strip().splitlines()[-1])
+    assert len(found["nannies"]) == len(found["workers"]) == 2, found
+    servers = [found["scheduler"], *found["nannies"], *found["workers"]]
+    fastest = {name: ms for server in servers for name, ms in server.items() if ms < 250}
+    assert not fastest, fastest
+    assert not any({"memory_monitor", "profile", "profile-cycle"} & set(server) for server in servers), servers
+    assert found["saturation"] == 1.0
