@@ -132,10 +132,10 @@ def _frames(options):
     raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
-def _connect(options, log, arguments, job_name):
+def _connect(options, log, arguments, job_name, setup_frame=None):
     """(client, cluster or None) for --workers or --scheduler, every worker with the job's
     Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
-    ``job_name``): a local cluster's workers start loading the file as they start, a running
+    ``job_name``, set up at ``setup_frame``): a local cluster's workers start loading the file as they start, a running
     cluster's when the plugin is registered; any worker that joins later, when it joins."""
     try:
         import dask
@@ -146,7 +146,7 @@ def _connect(options, log, arguments, job_name):
         raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
 
-    plugin = farm_worker.BlenderProcesses(arguments, job_name)
+    plugin = farm_worker.BlenderProcesses(arguments, job_name, setup_frame)
 
     if options.scheduler is not None:
         try:
@@ -283,7 +283,7 @@ def render(
     if threads is not None:
         common.append(f"--threads={threads}")
     job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
-    client, cluster = _connect(options, log, common, job_name)
+    client, cluster = _connect(options, log, common, job_name, todo[0])
     try:
         from distributed import as_completed
 
