@@ -59,6 +59,9 @@ LOCAL_CLUSTER_SETTINGS = {
     "distributed.admin.system-monitor.disk": False,
     # Replicas of results: a task's result is a few numbers, held once.
     "distributed.scheduler.active-memory-manager.start": False,
+    # Workers forked from one process that has imported Dask once (default: each worker a fresh
+    # Python importing Dask and the main script again).
+    "distributed.worker.multiprocessing-method": "forkserver",
     # One task per worker at a time (default 1.1: two per single-threaded worker, one waiting
     # behind the other's frame), so the last frames go to whichever worker is free first.
     "distributed.scheduler.worker-saturation": 1.0,
