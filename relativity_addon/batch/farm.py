@@ -138,8 +138,9 @@ def _frames(options):
 def _connect(options, log, arguments, job_name, setup_frame=None):
     """(client, cluster or None) for --workers or --scheduler, every worker with the job's
     Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
-    ``job_name``, set up at ``setup_frame``): a local cluster's workers start loading the file as they start, a running
-    cluster's when the plugin is registered; any worker that joins later, when it joins."""
+    ``job_name``, the effect applied at ``setup_frame``): a local cluster's workers start loading
+    the file as they start, a running cluster's when the plugin is registered; any worker that
+    joins later, when it joins."""
     try:
         import dask
         from distributed import Client, LocalCluster
