@@ -3,7 +3,7 @@ long-lived Blender process) against one process rendering the frames in turn on 
 side in one run.
 
     python benchmarks/farm_throughput.py [--frames 16] [--resolution 160x120] [--samples 256]
-        [--workers CORES] [--repeats 2]
+        [--workers CORES] [--repeats 2] [--compare-with OTHER_CHECKOUT]
 
 The two commands run alternately (single process, cluster, then again), so that load from other
 processes hits them alike; each is timed from launch to exit as a user sees it (the cluster's
@@ -19,10 +19,17 @@ start and every Blender start included). Printed, medians over the rounds:
   worker's first task, which waits for its Blender process to load the file);
 - the CPU time (user + system) of all the processes of each command, and their ratio: what the
   cluster costs in CPU beyond the frames (its Dask processes, a Blender start per worker), read
-  along with the wall times on a shared machine, where a session's share of the cores varies;
+  along with the wall times on a shared machine, where a session's share of the cores varies.
+  Read with psutil from every process of the command's tree every 0.1 s (a process's last tenth
+  of a second may be missed), since not every process of a cluster is waited for by its parent
+  (a forkserver's workers); for the cluster also per kind of process: the coordinator (with the
+  scheduler and the nannies), the Dask worker processes (with a forkserver), the Blender processes;
 - start: launch to the first finished frame, and the amortised overhead per frame: the cluster's
   wall time times its workers minus the frames' render times, over the frames (everything a
   frame pays besides its own render, the cluster's and the processes' starts included).
+
+``--compare-with DIR`` runs the cluster a second time in each round from another checkout (its
+``examples/render.py``, e.g. the main branch's), after this one's, under the same load.
 
 The single process renders with ``--threads`` = cores, each worker's Blender with one thread.
 Start the measurement with ``uptime`` and read the ratios: the machine may be shared.
@@ -31,12 +38,14 @@ Start the measurement with ``uptime`` and read the ratios: the machine may be sh
 import argparse
 import os
 import re
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
+
+import psutil
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RENDER_SCRIPT = os.path.join(REPO_ROOT, "examples", "render.py")
@@ -59,34 +68,94 @@ CLUSTER_FRAME = re.compile(
 )
 
 
-def _cpu_seconds():
-    """CPU time (user + system) of every finished descendant process (each one waited for)."""
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
+def _kind(process):
+    """coordinator, dask (a worker process or a forkserver) or blender, from the command line."""
+    try:
+        command = " ".join(process.cmdline())
+    except psutil.Error:
+        return "dask"
+    if "frame_server" in command:
+        return "blender"
+    if "multiprocessing" in command:
+        return "dask"
+    return "coordinator"
+
+
+def _sample_tree(root, cpu, stop):
+    """Until ``stop`` is set: the CPU seconds (user + system) of every process under ``root``
+    (pid: [kind, seconds]), read every 0.1 s into ``cpu``."""
+    while not stop.is_set():
+        try:
+            processes = [root, *root.children(recursive=True)]
+        except psutil.Error:
+            processes = []
+        for process in processes:
+            try:
+                times = process.cpu_times()
+            except psutil.Error:
+                continue
+            entry = cpu.setdefault(process.pid, [_kind(process), 0.0])
+            entry[1] = max(entry[1], times.user + times.system)
+        stop.wait(0.1)
 
 
 def run(command, cpu=None):
     """(wall seconds, stdout lines with their arrival time since launch); the CPU seconds of the
-    command's processes are appended to ``cpu``."""
-    cpu_before = _cpu_seconds()
+    command's processes per kind (coordinator, dask, blender, total) are appended to ``cpu``."""
     start = time.perf_counter()
     process = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV, cwd=REPO_ROOT
     )
+    per_process, stop = {}, threading.Event()
+    sampler = threading.Thread(target=_sample_tree, args=(psutil.Process(process.pid), per_process, stop))
+    sampler.start()
     lines = []
     for line in process.stdout:
         lines.append((time.perf_counter() - start, line.rstrip("\n")))
     errors = process.stderr.read()
     process.wait()
     wall = time.perf_counter() - start
+    stop.set()
+    sampler.join()
     if process.returncode != 0:
         sys.exit(f"farm_throughput: {' '.join(command[2:4])} failed ({process.returncode}): {errors[-1500:]}")
     if cpu is not None:
-        cpu.append(_cpu_seconds() - cpu_before)
+        kinds = {"coordinator": 0.0, "dask": 0.0, "blender": 0.0}
+        for kind, seconds in per_process.values():
+            kinds[kind] += seconds
+        cpu.append({**kinds, "total": sum(kinds.values())})
     return wall, lines
 
 
+def _cluster_round(command, options, into):
+    """One run of the cluster ``command``; its figures appended to the lists of ``into``."""
+    cpu = []
+    wall, lines = run(command, cpu)
+    into["wall"].append(wall)
+    for kind, seconds in cpu[0].items():
+        into[f"cpu_{kind}"].append(seconds)
+    tasks = [(at, m) for at, text in lines if (m := CLUSTER_FRAME.match(text))]
+    if len(tasks) != options.frames:
+        sys.exit(f"farm_throughput: {len(tasks)} frames reported by the cluster, not {options.frames}")
+    first_of = {}
+    for _, m in tasks:
+        first_of.setdefault(m.group(5), m.group(1))
+    later = [float(m.group(2)) for _, m in tasks if m.group(1) not in first_of.values()]
+    into["frame"].append(statistics.median(later or [float(m.group(2)) for _, m in tasks]))
+    overheads = [float(m.group(3)) - float(m.group(2)) for _, m in tasks]
+    into["task_overhead"].append(statistics.median(overheads))
+    into["max_overhead"].append(max(overheads))
+    into["start"].append(tasks[0][0])
+    last_worker = tasks[-1][1].group(4)
+    others_done = max((at for at, m in tasks if m.group(4) != last_worker), default=tasks[-1][0])
+    into["tail"].append(tasks[-1][0] - others_done)
+    rendering = sum(float(m.group(2)) for _, m in tasks)
+    into["amortised"].append((wall * options.workers - rendering) / options.frames)
+
+
 def measure(blend, work, options):
+    """Medians over the rounds: ``single`` (wall, cpu_total, frame) and per cluster command
+    (``cluster``, and ``other`` with --compare-with) its wall time, CPU per kind and task figures."""
     common = [
         f"--frames=1-{options.frames}",
         f"--resolution={options.resolution}",
@@ -96,52 +165,55 @@ def measure(blend, work, options):
     cores = os.cpu_count() or 1
     single = [sys.executable, RENDER_SCRIPT, blend, *common, f"--out={os.path.join(work, 'single', 'f.png')}"]
     single.append(f"--threads={cores}")
-    cluster = [
-        sys.executable,
-        RENDER_SCRIPT,
-        blend,
-        *common,
-        f"--out={os.path.join(work, 'cluster', 'f.png')}",
-        f"--workers={options.workers}",
-        "--threads=1",
-        "--no-resume",
-    ]
-    keys = (
-        "single",
-        "cluster",
-        "single_cpu",
-        "cluster_cpu",
-        "single_frame",
-        "frame",
-        "task_overhead",
-        "max_overhead",
-        "start",
-        "amortised",
-    )
-    result = {key: [] for key in keys}
+    clusters = {"cluster": RENDER_SCRIPT}
+    if options.compare_with:
+        clusters["other"] = os.path.join(os.path.abspath(options.compare_with), "examples", "render.py")
+    commands = {
+        name: [
+            sys.executable,
+            script,
+            blend,
+            *common,
+            f"--out={os.path.join(work, name, 'f.png')}",
+            f"--workers={options.workers}",
+            "--threads=1",
+            "--no-resume",
+        ]
+        for name, script in clusters.items()
+    }
+    keys = ("wall", "cpu_coordinator", "cpu_dask", "cpu_blender", "cpu_total", "frame", "task_overhead")
+    keys += ("max_overhead", "start", "tail", "amortised")
+    results = {name: {key: [] for key in keys} for name in ["single", *commands]}
     run([*single[:3], "--frames=1-1", *single[4:]])  # warm-up: file cache, bytecode, kernels
     for _ in range(options.repeats):
-        wall, lines = run(single, result["single_cpu"])
-        result["single"].append(wall)
+        cpu = []
+        wall, lines = run(single, cpu)
+        results["single"]["wall"].append(wall)
+        results["single"]["cpu_total"].append(cpu[0]["total"])
         frames = [float(m.group(2)) for _, text in lines if (m := SINGLE_FRAME.match(text))]
-        result["single_frame"].append(statistics.median(frames[1:] or frames))
-        wall, lines = run(cluster, result["cluster_cpu"])
-        result["cluster"].append(wall)
-        tasks = [(at, m) for at, text in lines if (m := CLUSTER_FRAME.match(text))]
-        if len(tasks) != options.frames:
-            sys.exit(f"farm_throughput: {len(tasks)} frames reported by the cluster, not {options.frames}")
-        first_of = {}
-        for _, m in tasks:
-            first_of.setdefault(m.group(5), m.group(1))
-        later = [float(m.group(2)) for _, m in tasks if m.group(1) not in first_of.values()]
-        result["frame"].append(statistics.median(later or [float(m.group(2)) for _, m in tasks]))
-        overheads = [float(m.group(3)) - float(m.group(2)) for _, m in tasks]
-        result["task_overhead"].append(statistics.median(overheads))
-        result["max_overhead"].append(max(overheads))
-        result["start"].append(tasks[0][0])
-        rendering = sum(float(m.group(2)) for _, m in tasks)
-        result["amortised"].append((wall * options.workers - rendering) / options.frames)
-    return {key: statistics.median(values) for key, values in result.items()}
+        results["single"]["frame"].append(statistics.median(frames[1:] or frames))
+        for name, command in commands.items():
+            _cluster_round(command, options, results[name])
+    return {
+        name: {key: statistics.median(values) for key, values in figures.items() if values}
+        for name, figures in results.items()
+    }
+
+
+def _report(name, m, single, options):
+    print(f"  {name}: {m['wall']:7.2f} s, {options.frames / m['wall']:.3f} frames/s")
+    print(f"    throughput, cluster / single process: {single['wall'] / m['wall']:.2f}")
+    print(
+        f"    CPU: {m['cpu_total']:.1f} s (coordinator with scheduler and nannies {m['cpu_coordinator']:.1f} s, "
+        f"Dask worker processes {m['cpu_dask']:.1f} s, Blender processes {m['cpu_blender']:.1f} s); "
+        f"single / cluster {single['cpu_total'] / m['cpu_total']:.2f}"
+    )
+    print(f"    a frame in a running Blender process: {m['frame']:.2f} s (worker, 1 thread)")
+    print(f"    per-task overhead (task on its worker minus the frame in Blender): median {m['task_overhead']:.3f} s,")
+    print(f"      largest {m['max_overhead']:.2f} s (a worker's first task: waits for its Blender to be set up)")
+    print(f"    launch to the first finished frame: {m['start']:.2f} s; tail (last frame after the")
+    print(f"      other workers' last): {m['tail']:.2f} s")
+    print(f"    amortised overhead per frame (cluster wall x workers - render times, / frames): {m['amortised']:.2f} s")
 
 
 def main():
@@ -151,6 +223,7 @@ def main():
     parser.add_argument("--samples", type=int, default=256)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="default: one per core")
     parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--compare-with", help="another checkout whose cluster runs too, after this one's")
     options = parser.parse_args()
 
     work = tempfile.mkdtemp(prefix="farm-throughput-")
@@ -171,21 +244,12 @@ def main():
         flush=True,
     )
     m = measure(blend, work, options)
-    print(f"  single process:  {m['single']:7.2f} s, {options.frames / m['single']:.3f} frames/s")
-    print(f"  cluster:         {m['cluster']:7.2f} s, {options.frames / m['cluster']:.3f} frames/s")
-    print(f"  throughput, cluster / single process: {m['single'] / m['cluster']:.2f}")
-    print(
-        f"  CPU time of all their processes: single {m['single_cpu']:.1f} s, cluster {m['cluster_cpu']:.1f} s; "
-        f"single / cluster {m['single_cpu'] / m['cluster_cpu']:.2f}"
-    )
-    print(
-        f"  a frame in a running Blender process: {m['frame']:.2f} s (worker, 1 thread); "
-        f"{m['single_frame']:.2f} s (single process, {os.cpu_count()} threads)"
-    )
-    print(f"  per-task overhead (task on its worker minus the frame in Blender): median {m['task_overhead']:.3f} s,")
-    print(f"    largest {m['max_overhead']:.2f} s (a worker's first task: waits for its Blender to load the file)")
-    print(f"  launch to the first finished frame: {m['start']:.2f} s")
-    print(f"  amortised overhead per frame (cluster wall x workers - render times, / frames): {m['amortised']:.2f} s")
+    single = m["single"]
+    print(f"  single process:  {single['wall']:7.2f} s, {options.frames / single['wall']:.3f} frames/s")
+    print(f"    CPU: {single['cpu_total']:.1f} s; a frame {single['frame']:.2f} s ({os.cpu_count()} threads)")
+    _report("cluster", m["cluster"], single, options)
+    if "other" in m:
+        _report(f"cluster of {options.compare_with}", m["other"], single, options)
     print(f"(load average at the end: {os.getloadavg()[0]:.2f})")
 
 

@@ -33,12 +33,14 @@ if TYPE_CHECKING:
 PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 # The process: dies with the thread that started it (Linux), then serves frames from the worker's
-# own copy of the add-on. argv: parent pid, package root, reply file descriptor, script options.
+# own copy of the add-on. argv: parent pid, package root, reply file descriptor, the frame to apply
+# the effect at ("" for the first frame asked for), script options.
 LAUNCH = """
 import os, sys
 parent = int(sys.argv.pop(1))
 root = sys.argv.pop(1)
 reply_fd = int(sys.argv.pop(1))
+setup_frame = sys.argv.pop(1)
 if sys.platform.startswith("linux"):
     import ctypes, signal
     ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
@@ -47,7 +49,7 @@ if sys.platform.startswith("linux"):
 sys.path.insert(0, root)
 from relativity_addon.batch import frame_server
 from relativity_addon.blender.common import compat
-compat.run_main(lambda: frame_server.serve(sys.argv, reply_fd))
+compat.run_main(lambda: frame_server.serve(sys.argv, reply_fd, int(setup_frame) if setup_frame else None))
 """
 
 
@@ -67,10 +69,11 @@ def _log_tail(path, lines=3):
 class BlenderProcess:
     """One Blender process serving frames; its output goes to a log file in the temp folder."""
 
-    def __init__(self, arguments: Sequence[str]) -> None:
+    def __init__(self, arguments: Sequence[str], setup_frame: int | None = None) -> None:
         read_fd, write_fd = os.pipe()
         handle, self.log_path = tempfile.mkstemp(prefix="relativity-blender-", suffix=".log")
-        command = [sys.executable, "-c", LAUNCH, str(os.getpid()), PACKAGE_ROOT, str(write_fd), *arguments]
+        setup = "" if setup_frame is None else str(setup_frame)
+        command = [sys.executable, "-c", LAUNCH, str(os.getpid()), PACKAGE_ROOT, str(write_fd), setup, *arguments]
         env = dict(os.environ)
         env.pop("PYTHONPATH", None)
         # Dask's nanny sets this for its workers (``distributed.nanny.pre-spawn-environ``); in Blender
@@ -140,10 +143,12 @@ class BlenderProcess:
 
 
 class BlenderPool:
-    """A worker's Blender processes for one job (the batch-script ``arguments`` without frames)."""
+    """A worker's Blender processes for one job (the batch-script ``arguments`` without frames),
+    each with the effect applied at ``setup_frame`` as it starts (None: at its first frame)."""
 
-    def __init__(self, arguments: Sequence[str]) -> None:
+    def __init__(self, arguments: Sequence[str], setup_frame: int | None = None) -> None:
         self.arguments = list(arguments)
+        self.setup_frame = setup_frame
         self._idle: list[BlenderProcess] = []
         self._started: list[BlenderProcess] = []
         self._lock = threading.Lock()
@@ -153,7 +158,7 @@ class BlenderPool:
         self._spawner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="relativity-blender")
 
     def _start(self) -> BlenderProcess:
-        process = self._spawner.submit(BlenderProcess, self.arguments).result()
+        process = self._spawner.submit(BlenderProcess, self.arguments, self.setup_frame).result()
         with self._lock:
             self._started.append(process)
         return process

@@ -44,6 +44,29 @@ COORDINATOR_OPTIONS = {
     "threads",
 }
 
+# Dask's settings for a local cluster (``--workers``), whose processes share the machine with the
+# Blender processes doing the work: Dask's defaults watch a cluster several times a second, which on
+# a few cores takes CPU from the renders. A worker that dies while running a task counts against
+# the task as one failure (``allowed-failures``, set from --retries); a lost worker is seen when its
+# connection closes, not by any of these monitors.
+LOCAL_CLUSTER_SETTINGS = {
+    # The statistical profiler samples every worker's stacks every 10 ms, for a dashboard page.
+    "distributed.worker.profile.enabled": False,
+    # Event-loop health checks (default every 20 ms in the scheduler, each nanny and each worker).
+    "distributed.admin.tick.interval": "1s",
+    # CPU, memory, network and disk counters of each process (default every 500 ms), for dashboards.
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.admin.system-monitor.disk": False,
+    # Replicas of results: a task's result is a few numbers, held once.
+    "distributed.scheduler.active-memory-manager.start": False,
+    # Workers forked from one process that has imported Dask once (default: each worker a fresh
+    # Python importing Dask and the main script again).
+    "distributed.worker.multiprocessing-method": "forkserver",
+    # One task per worker at a time (default 1.1: two per single-threaded worker, one waiting
+    # behind the other's frame), so the last frames go to whichever worker is free first.
+    "distributed.scheduler.worker-saturation": 1.0,
+}
+
 
 def output_pattern(out_path: str, several: bool) -> str:
     """The --out path with a run of '#' for the frame number: each task renders its frames to the
@@ -112,11 +135,12 @@ def _frames(options):
     raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
-def _connect(options, log, arguments, job_name):
+def _connect(options, log, arguments, job_name, setup_frame=None):
     """(client, cluster or None) for --workers or --scheduler, every worker with the job's
     Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
-    ``job_name``): a local cluster's workers start loading the file as they start, a running
-    cluster's when the plugin is registered; any worker that joins later, when it joins."""
+    ``job_name``, the effect applied at ``setup_frame``): a local cluster's workers start loading
+    the file as they start, a running cluster's when the plugin is registered; any worker that
+    joins later, when it joins."""
     try:
         import dask
         from distributed import Client, LocalCluster
@@ -126,7 +150,7 @@ def _connect(options, log, arguments, job_name):
         raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
 
-    plugin = farm_worker.BlenderProcesses(arguments, job_name)
+    plugin = farm_worker.BlenderProcesses(arguments, job_name, setup_frame)
 
     if options.scheduler is not None:
         try:
@@ -141,10 +165,7 @@ def _connect(options, log, arguments, job_name):
         client.register_plugin(plugin, name=job_name)
         return client, None
     dashboard = importlib.util.find_spec("bokeh") is not None  # Dask's dashboard needs bokeh
-    # A worker that dies while running a task counts against the task as one failure; after
-    # ``retries`` more the task is given up (KilledWorker). No statistical profiler in the workers:
-    # it samples their stacks every 10 ms for a dashboard page, while Blender does the work.
-    settings = {"distributed.scheduler.allowed-failures": options.retries, "distributed.worker.profile.enabled": False}
+    settings = {"distributed.scheduler.allowed-failures": options.retries, **LOCAL_CLUSTER_SETTINGS}
     with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=options.workers,
@@ -153,6 +174,7 @@ def _connect(options, log, arguments, job_name):
             dashboard_address=":0" if dashboard else None,
             silence_logs=logging.CRITICAL,
             plugins=(plugin,),
+            memory_limit=0,  # no memory monitors: a worker holds no data, its Blender is another process
         )
     client = Client(cluster)
     log(
@@ -265,7 +287,7 @@ def render(
     if threads is not None:
         common.append(f"--threads={threads}")
     job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
-    client, cluster = _connect(options, log, common, job_name)
+    client, cluster = _connect(options, log, common, job_name, todo[0])
     try:
         from distributed import as_completed
 

@@ -27,15 +27,17 @@ if TYPE_CHECKING:
 
 class BlenderProcesses(WorkerPlugin):
     """A worker's Blender processes for one job; ``arguments``: the batch-script command line
-    every frame shares (file, --out pattern, options; no frames); ``name``: the job's, unique."""
+    every frame shares (file, --out pattern, options; no frames); ``name``: the job's, unique;
+    ``setup_frame``: the frame each process applies the effect at as it starts (the job's first)."""
 
-    def __init__(self, arguments: Sequence[str], name: str) -> None:
+    def __init__(self, arguments: Sequence[str], name: str, setup_frame: int | None = None) -> None:
         self.arguments = list(arguments)
+        self.setup_frame = setup_frame
         self.name = name  # the key of ``worker.plugins`` (Dask reads the attribute)
         self.pool: BlenderPool | None = None
 
     def setup(self, worker: Worker) -> None:
-        self.pool = BlenderPool(self.arguments)
+        self.pool = BlenderPool(self.arguments, self.setup_frame)
         self.pool.prestart()
 
     def teardown(self, worker: Worker) -> None:

@@ -6,15 +6,19 @@ not a process start, an import of ``bpy``, a file load and a camera compile. Req
 lines on stdin (``{"frame": 7}``); replies are JSON lines on the file descriptor given (stdout and
 stderr stay Blender's, for its log):
 
-- ``{"ready": true, "pid": P}`` once set up, or ``{"ready": false, "reason": ...}`` and exit 1;
+- ``{"ready": true, "pid": P, "applied_at": F}`` once set up (``F``: the frame the effect was
+  applied at, or null), or ``{"ready": false, "reason": ...}`` and exit 1;
 - per request ``{"frame": N, "reason": null, "seconds": S, "pid": P}`` when the frame is
   written (partial name, renamed when whole: ``batch._render_frame``), or with the one-line
   ``reason`` it failed and ``"clean"``: whether the scene is as before the request (a refused
   speed or a refused Set Up). After an unclean failure the worker starts a fresh process.
 
-The effect is applied at the first frame asked for, with the camera's speed checked at that frame
-only; later frames check their own speed first. That is what a fresh process per frame did, and
-frames come out pixel for pixel the same in any order (``tests/blender/pipeline/test_distributed.py``).
+The effect is applied while the process starts, at the job's first frame (``setup_frame``), so a
+worker's first task does not wait for it; where it cannot be applied there (the camera at or above
+c at that frame), it is applied at the first frame asked for, with the camera's speed checked at
+that frame only. Later frames check their own speed first. That is what a fresh process per frame
+did, and frames come out pixel for pixel the same in any order, whatever frame the effect was
+applied at (``tests/blender/pipeline/test_farm_processes.py``).
 """
 
 from __future__ import annotations
@@ -68,6 +72,17 @@ class _Frames:
         except (RelativityError, snapshot.RelativityError) as error:
             raise BatchError(str(error)) from None
 
+    def set_up_at(self, frame):
+        """Apply the effect at output ``frame`` before any request; left for the first request to
+        do (and report) when it cannot be applied there. Returns the frame, or None."""
+        try:
+            scene_frame = self.batch.scene_frames_of(self.scene, self.options, [frame])[0]
+            self.batch.apply_effect(self.scene, self.options, scene_frame, scene_frame)
+        except BatchError:
+            return None
+        self.applied = True
+        return frame
+
     def render(self, frame):
         """(reason or None, clean): render output ``frame`` to its file."""
         import bpy
@@ -114,19 +129,21 @@ def _requests(fd):
         yield request
 
 
-def serve(argv: Sequence[str], reply_fd: int) -> int:
+def serve(argv: Sequence[str], reply_fd: int, setup_frame: int | None = None) -> int:
     """Set up from the batch-script command line ``argv`` (``render.py FILE.blend --out=PATTERN
-    ...``), then answer frame requests until told to stop; the exit status."""
+    ...``) with the effect applied at output frame ``setup_frame`` (None: at the first frame asked
+    for), then answer frame requests until told to stop; the exit status."""
     channel = os.fdopen(reply_fd, "w", encoding="utf-8")
     try:
         frames = _Frames(argv)
+        applied_at = None if setup_frame is None else frames.set_up_at(setup_frame)
     except BatchError as error:
         _reply(channel, ready=False, reason=str(error))
         return 1
     except Exception as error:  # noqa: BLE001 - a batch tool reports one line, never a traceback
         _reply(channel, ready=False, reason=_one_line(error))
         return 1
-    _reply(channel, ready=True, pid=os.getpid())
+    _reply(channel, ready=True, pid=os.getpid(), applied_at=applied_at)
     for request in _requests(sys.stdin.fileno()):
         frame = int(request["frame"])
         started = time.monotonic()

@@ -4,6 +4,7 @@ Blender process is replaced and its frame rendered again; frames rendered by one
 order equal a single-process render pixel for pixel. Behaviour, read from the progress lines and
 the processes, not from times."""
 
+import json
 import os
 import re
 import signal
@@ -104,12 +105,12 @@ def test_killed_blender_process_is_restarted_and_its_frame_rendered_again(moving
 
 @pytest.mark.parametrize("method", ["camera", "geometry"])
 def test_frames_in_any_order_in_one_process_equal_one_process_in_turn(method, moving_blend, tmp_path, factory_blender):
-    """One long-lived Blender process (the worker side's pool, without Dask) renders frames 4, 1,
-    3 and 2, in that order; the batch script renders 1-4 in turn in one process: equal pixel for
-    pixel, all four from the same process."""
+    """One long-lived Blender process (the worker side's pool, without Dask), set up at frame 3 as
+    it starts, renders frames 4, 1, 3 and 2, in that order; the batch script renders 1-4 in turn in
+    one process: equal pixel for pixel, all four from the same process."""
     bpy = factory_blender
     common = ["--beta=0,0,-0.5", "--samples=2", "--seed=3", "--resolution=32x32", f"--method={method}"]
-    pool = blender_pool.BlenderPool([str(moving_blend), f"--out={tmp_path / 'pool' / 'f_####.png'}", *common])
+    pool = blender_pool.BlenderPool([str(moving_blend), f"--out={tmp_path / 'pool' / 'f_####.png'}", *common], 3)
     try:
         results = pool.render([4, 1, 3, 2])
     finally:
@@ -128,6 +129,37 @@ def test_frames_in_any_order_in_one_process_equal_one_process_in_turn(method, mo
     assert not np.array_equal(images[0], images[3])
 
 
+def test_blender_process_is_set_up_before_its_first_frame_is_asked_for(factory_blender, tmp_path):
+    """A worker's Blender process applies the effect as it starts, at the job's first frame, so the
+    first task does not wait for it: ready, with the effect applied at frame 2, before any frame is
+    asked for. Where the camera is at 1.2 c at that frame (frame 3 of this camera path, as in
+    test_distributed.py), the process is ready all the same with nothing applied; frame 3 fails
+    alone with its reason and frame 2 renders in the same process."""
+    bpy = factory_blender
+    scene, camera, _ = wh.new_scene(bpy, resolution=(32, 32))
+    scene.frame_start, scene.frame_end = 1, 5
+    wh.keyframe_camera_path(camera, [(1, (0, 0, 0)), (2.5, (0, 0, -0.15)), (3.5, (0, 0, -0.65)), (5, (0, 0, -0.8))])
+    blend = wh.save_blend(bpy, tmp_path / "fast.blend")
+    common = [str(blend), f"--out={tmp_path / 'f_####.png'}", "--velocity-from-animation", "--speed-of-light=10"]
+    applied = {}
+    for setup_frame in (2, 3):
+        pool = blender_pool.BlenderPool([*common, "--samples=1", "--resolution=32x32"], setup_frame)
+        try:
+            pool.prestart()
+            process = pool._idle[0]
+            assert process.setup_failure() is None
+            applied[setup_frame] = process.setup["applied_at"]
+            if setup_frame == 3:
+                results = pool.render([3, 2])
+        finally:
+            pool.close()
+    assert applied == {2: 2, 3: None}
+    assert results[0]["reason"].startswith("Camera 'Camera' moves at 1.2 c at frame 3"), results
+    assert results[1]["reason"] is None and results[0]["pid"] == results[1]["pid"], results
+    assert sorted(os.listdir(tmp_path)) == ["f_0002.png", "fast.blend"]
+    assert frame_files.problem(tmp_path / "f_0002.png") is None
+
+
 def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkeypatch):
     """Requests that arrive together are all served (none left waiting in a read buffer until
     the idle limit), a stop request ends the loop, and so does a silent, open stdin."""
@@ -141,3 +173,45 @@ def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkey
     finally:
         os.close(read_fd)
         os.close(write_fd)
+
+
+CLUSTER_TIMERS = """
+import argparse, json, sys
+sys.path.insert(0, sys.argv[1])
+from relativity_addon.batch import farm
+
+def timers(server):
+    return {name: callback.callback_time for name, callback in server.periodic_callbacks.items()}
+
+options = argparse.Namespace(scheduler=None, workers=2, retries=2)
+client, cluster = farm._connect(options, lambda *a, **k: None, [sys.argv[2], "--out=" + sys.argv[3]], "job")
+try:
+    found = {
+        "scheduler": client.run_on_scheduler(lambda dask_scheduler: timers(dask_scheduler)),
+        "saturation": client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION),
+        "nannies": [timers(nanny) for nanny in cluster.workers.values()],
+        "workers": list(client.run(lambda dask_worker: timers(dask_worker)).values()),
+    }
+finally:
+    client.close()
+    cluster.close()
+print(json.dumps(found))
+"""
+
+
+def test_local_cluster_leaves_the_cores_to_blender(tmp_path):
+    """The scheduler, nannies and workers of ``--workers`` run without Dask's fast monitors, which
+    on a few cores take CPU from the renders: no timer in any of them fires more often than every
+    250 ms (Dask's own defaults: event-loop checks every 20 ms, memory checks every 100 ms), no
+    memory monitor or profiler at all; and the scheduler gives a single-threaded worker one task
+    at a time, so the last frames go to whichever worker is free first. Read from the servers of a
+    real local cluster."""
+    result = wh.run_python(CLUSTER_TIMERS, wh.REPO_ROOT, tmp_path / "absent.blend", tmp_path / "f.png")
+    assert result.returncode == 0, result.stderr[-3000:]
+    found = json.loads(result.stdout.strip().splitlines()[-1])
+    assert len(found["nannies"]) == len(found["workers"]) == 2, found
+    servers = [found["scheduler"], *found["nannies"], *found["workers"]]
+    fastest = {name: ms for server in servers for name, ms in server.items() if ms < 250}
+    assert not fastest, fastest
+    assert not any({"memory_monitor", "profile", "profile-cycle"} & set(server) for server in servers), servers
+    assert found["saturation"] == 1.0
