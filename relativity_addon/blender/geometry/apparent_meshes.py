@@ -132,12 +132,12 @@ def object_signature(
         closed = scene is not None and motion.closed_form(obj, scene)
         keyframed_on = not closed and keyframed.is_on(modifier.find_modifier(obj))
         measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
-        verdict = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
-        if keyframed_on:  # and whether every retarded time lay inside the modifier's intervals
-            verdict = (verdict, keyframed.window_found(evaluated))
+        short = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
+        # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals
+        verdict = (short, keyframed.window_found(evaluated)) if keyframed_on else short
         if fingerprint is not None:
             pass
-        elif (closed or keyframed_on) and (not measured or verdict):
+        elif (closed or keyframed_on) and (not measured or short):
             # the modifier computes the positions from the rest shape, and no decision reads it:
             # only noted, so that geometry_key stays while Blender does not evaluate it again
             _note_unread(evaluated)
