@@ -223,3 +223,39 @@ def test_keyframed_motion_in_the_modifier(relativity_addon, monkeypatch, levels,
     np.testing.assert_allclose(beta_stepped, beta_python, atol=2e-5)
     scene.frame_set(12)
     np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], changed, atol=2e-5)
+
+
+def test_retarded_time_outside_the_intervals_falls_back_and_widens(relativity_addon, monkeypatch):
+    """A window too narrow for the mesh (its recorded reach made tiny, as after an edit that grew the
+    mesh): the modifier finds retarded times outside its intervals and says so; the next sync puts
+    the object on the Python path for that update (the mesh where the relation puts it, its reach
+    measured again) and the next change is back in the modifier with a wider window."""
+    import bpy
+
+    keyframed = gh.addon_module("geometry.keyframed")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    obj = _keyframed_mover(bpy, scene, False, 0, True)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    data = modifier.cache_data(obj)
+    reach = data[keyframed.REACH_KEY]
+    data[keyframed.REACH_KEY] = 1e-6
+    calls = _count_passes(monkeypatch)
+
+    scene.relativity.beta = OBSERVER_CHANGED
+    bpy.context.evaluated_depsgraph_get()
+    bpy.context.evaluated_depsgraph_get()  # the sync after the evaluation that said so
+    assert calls["apparent_world_positions"] > 0
+    assert not keyframed.is_on(modifier.find_modifier(obj))
+    assert data[keyframed.REACH_KEY] == pytest.approx(reach)
+    assert data[keyframed.WIDEN_KEY] == 2.0
+    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+    expected, _velocity = _seen(obj, rest, 12 / FPS, np.array(camera.matrix_world.translation), OBSERVER_CHANGED)
+    np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
+
+    scene.frame_set(13)
+    assert keyframed.is_on(modifier.find_modifier(obj))
+    assert keyframed.window_found(obj.evaluated_get(bpy.context.evaluated_depsgraph_get())) is True
+    expected, _velocity = _seen(obj, rest, 13 / FPS, np.array(camera.matrix_world.translation), OBSERVER_CHANGED)
+    np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
