@@ -13,11 +13,12 @@ outside it (a point receding or approaching fast is seen much earlier or later t
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from .apparent import SampledRigidMotion, apparent_positions_sampled
-from .arrays import ArrayLike, FloatArray
+from .arrays import ArrayLike, BoolArray, FloatArray
 from .rest_shape import check_samples_used, contracted_rigid_samples
 from .validation import finite_array, positive_array, speed_of_light, vector_array
 
@@ -52,7 +53,10 @@ def apparent_positions_from_matrix_function(
     around ``t_o - |x_o - centroid| / c`` (the centroid's travel time) widened by ``2 reach / c``
     and two steps each side, ``reach`` being the largest distance of a point from the centroid at
     ``t_o`` (``world_matrix_now``, default ``world_matrices_at_times([t_o])[0]``). Between samples
-    the motion is a Catmull-Rom cubic (:class:`apparent.SampledRigidMotion`). When a retarded time
+    the motion is a Catmull-Rom cubic (:class:`apparent.SampledRigidMotion`); each sample is
+    contracted with the central difference of its neighbours (one sample more is read beyond each
+    end of the window), so the motion does not depend on the window: it is the one
+    :func:`motion_intervals` gives the modifier. When a retarded time
     falls outside the inner samples (not between the second and the second-last), the window is
     stretched to hold all of them with four steps to spare, and solved again, up to ``max_tries``
     windows in all.
@@ -93,7 +97,7 @@ def apparent_positions_from_matrix_function(
                 f" samples of {step:.4g} s, from {low:.4g} s to {high:.4g} s)"
             )
         times = np.arange(low_index, high_index + 1) * step
-        matrices, superluminal = contracted_rigid_samples(world_matrices_at_times(times), step, c)
+        matrices, superluminal = _contracted_window(world_matrices_at_times, low_index, high_index, step, c)
         result = apparent_positions_sampled(SampledRigidMotion(times, matrices, rest_local), t_o, x_o, c, beta_o)
         t_e = t_o - result[1]
         if t_e.size == 0 or (t_e.min() >= times[1] and t_e.max() <= times[-2]):
@@ -105,3 +109,88 @@ def apparent_positions_from_matrix_function(
         f"retarded times did not settle inside the sampled animation in {max_tries} windows "
         f"(last retarded times {t_e.min():.4g}..{t_e.max():.4g} s, window {times[1]:.4g}..{times[-2]:.4g} s)"
     )
+
+
+def _contracted_window(
+    world_matrices_at_times: MatrixFunction, first: int, last: int, step: float, c: float
+) -> tuple[FloatArray, BoolArray]:
+    """The contracted samples ``first..last`` (grid indices) and their superluminal mask: read with
+    one sample more each side, so every sample's velocity is the central difference."""
+    times = np.arange(first - 1, last + 2) * step
+    matrices, superluminal = contracted_rigid_samples(world_matrices_at_times(times), step, c)
+    return matrices[1:-1], superluminal[1:-1]
+
+
+@dataclass(frozen=True)
+class MotionIntervals:
+    """A rigid motion's Catmull-Rom pieces over the sample intervals that hold every retarded time
+    of a body (:func:`motion_intervals`): interval ``j`` runs from grid index ``first + j`` to the
+    next (times ``k step``), and on it the world position of the object-space point ``p`` is
+    ``sum_i f**i (coefficients[j, i, :, :3] @ p + coefficients[j, i, :, 3])`` minus ``x_o``
+    (``f`` in [0, 1] across the interval). ``start_distance``: ``c tau`` of the origin."""
+
+    first: int
+    coefficients: FloatArray  # (K, 4, 3, 4)
+    start_distance: float
+    fastest: float  # the origin's largest knot speed over the intervals, fraction of c
+
+
+def motion_intervals(
+    world_matrices_at_times: MatrixFunction,
+    step: float,
+    t_o: float,
+    x_o: ArrayLike,
+    c: float,
+    reach: float,
+    max_intervals: int,
+) -> MotionIntervals | None:
+    """The pieces of the motion of :func:`apparent_positions_from_matrix_function` (the same samples,
+    contraction and Catmull-Rom cubic) over the intervals where the retarded times of every point
+    within ``reach`` of the object's origin (object space: scaled by the largest singular value of
+    the matrices' 3x3) lie, seen from ``(t_o, x_o)``; None when they span more than
+    ``max_intervals`` intervals or the origin is not slower than light there.
+
+    The bound: with ``g(tau) = c tau - |O(t_o - tau) - x_o|`` (``O``: the origin), ``g' >= c - v``
+    (``v``: the origin's largest speed) and a point's ``|g| <= reach``, so its ``tau`` lies within
+    ``reach / (c - v)`` of the origin's. ``v`` is the largest knot speed of the window (the bound
+    widened by 5% and two steps for the cubic between knots; the modifier checks that every
+    retarded time it finds lies inside); the window is widened until it holds its own bound."""
+    c = speed_of_light(c)
+    step = float(positive_array(step, "step"))
+    x_o = vector_array(x_o, "x_o")
+    origin = apparent_positions_from_matrix_function(
+        world_matrices_at_times, step, np.zeros((1, 3)), t_o, x_o, np.zeros(3), c
+    )
+    tau = float(origin[1][0])
+    speed = 0.0
+    now = np.asarray(world_matrices_at_times(np.array([t_o])), dtype=np.float64)[0, :3, :3]
+    size = float(np.linalg.svd(now, compute_uv=False)[0])
+    for _ in range(8):
+        if speed >= 1.0:
+            return None
+        half = 1.05 * reach * size / (c * (1.0 - speed)) + 2.0 * step
+        first = math.floor((t_o - tau - half) / step)
+        last = math.ceil((t_o - tau + half) / step)
+        if last - first > max_intervals:
+            return None
+        # knots first - 1 .. last + 1 (every interval's Catmull-Rom neighbours)
+        knots, superluminal = _contracted_window(world_matrices_at_times, first - 1, last + 1, step, c)
+        if np.any(superluminal):
+            return None
+        origins = knots[:, :3, 3]
+        fastest = float(np.max(np.linalg.norm(origins[2:] - origins[:-2], axis=1))) / (2.0 * step * c)
+        # the cubic's weights sum to at most 1.25 in magnitude: the interpolated 3x3 stays below
+        largest = 1.25 * float(np.max(np.linalg.svd(knots[:, :3, :3], compute_uv=False)[:, 0]))
+        if fastest <= speed and largest <= size:
+            break
+        speed = max(speed, fastest + 0.1 * (1.0 - fastest))  # some room: fewer widenings
+        size = max(size, largest)
+    else:
+        return None
+    affine = knots[:, :3, :].copy()
+    affine[:, :, 3] -= x_o
+    p0, p1, p2, p3 = affine[:-3], affine[1:-2], affine[2:-1], affine[3:]
+    coefficients = np.stack(
+        [p1, 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2)], axis=1
+    )
+    return MotionIntervals(first, coefficients, c * tau, speed)

@@ -17,11 +17,16 @@ CAMERA_SAVED_STATE_KEY = "relativity_saved_state"  # on camera data while the OS
 GEOMETRY_GROUP = "Relativity Apparent Geometry"  # geometry-nodes group
 GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
 GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
-GEOMETRY_GROUP_VERSION = 3  # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form
+GEOMETRY_GROUP_VERSION = 4  # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form;
+# 4: keyframed motion in the modifier
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)
 EDGES_SHORT_ATTRIBUTE = "relativity_edges_short"  # per face, by the modifier: every edge's image within the tolerance
+# per point of the cache (its first points, one per sample interval): keyframed motion's Catmull-Rom
+# coefficients of f**0 .. f**3 as 4x4 affine maps of the rest position (geometry/keyframed.py)
+MOTION_ATTRIBUTES = tuple(f"relativity_motion_{power}" for power in range(4))
+WINDOW_OK_ATTRIBUTE = "relativity_window_ok"  # per face, by the modifier: every retarded time in its intervals
 SEEN_ATTRIBUTE = "relativity_seen"  # apparent positions of the faces across the seam, inside the modifier
 TESSELLATION_KEY = "relativity_tessellation"  # on the cache mesh: the face codes' level, count and CRC-32
 TESSELLATION_WARNING_KEY = "relativity_tessellation_warning"  # on the cache mesh: edges still too bent

@@ -41,7 +41,8 @@ class Node:
 
     A reference is ``"node"`` (first output), ``"node.Output Name"``, ``"node.2"`` (output index)
     or ``"group.Input Name"`` (the group's own input). ``props`` are node attributes; the values
-    of ``node_tree`` and ``image`` name a node group and an image.
+    of ``node_tree`` and ``image`` name a node group and an image; ``capture_items`` lists a
+    Capture Attribute's values as ``(socket type, name)``.
     """
 
     kind: str
@@ -118,6 +119,10 @@ def build_group(spec: Group) -> NodeTree:
                 value = bpy.data.node_groups[value]
             elif prop == "image":
                 value = bpy.data.images[value]
+            elif prop == "capture_items":  # Capture Attribute's values: (socket type, name)
+                for socket_type, item in value:
+                    node.capture_items.new(socket_type, item)
+                continue
             setattr(node, prop, value)
         built[name] = node
 

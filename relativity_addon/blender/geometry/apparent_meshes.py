@@ -28,7 +28,7 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import snapshot
-from . import clip_end, instancing, modifier, motion, tessellation
+from . import clip_end, instancing, keyframed, modifier, motion, tessellation
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
@@ -126,15 +126,18 @@ def object_signature(
     (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
-    verdict = None
+    verdict: object = None
     if depsgraph is not None:
         scene = bpy.data.scenes.get(snap.scene)
         closed = scene is not None and motion.closed_form(obj, scene)
+        keyframed_on = not closed and keyframed.is_on(modifier.find_modifier(obj))
         measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
-        verdict = tessellation.edges_short(evaluated) if closed and measured else None
+        short = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
+        # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals
+        verdict = (short, keyframed.window_found(evaluated)) if keyframed_on else short
         if fingerprint is not None:
             pass
-        elif closed and (not measured or verdict):
+        elif (closed or keyframed_on) and (not measured or short):
             # the modifier computes the positions from the rest shape, and no decision reads it:
             # only noted, so that geometry_key stays while Blender does not evaluate it again
             _note_unread(evaluated)
@@ -199,7 +202,8 @@ def update_object(
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
     closed = motion.closed_form(obj, scene)
-    measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if closed else None
+    in_modifier = closed or keyframed.can_show(obj, scene)
+    measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if in_modifier else None
     try:
         if measure is not None and tessellation.edges_short(obj_eval):
             # the modifier found every edge's image short at its last evaluation and left the mesh
@@ -208,7 +212,7 @@ def update_object(
         else:
             decision = tessellation.decide(scene, obj, obj_eval, snap)
         if decision is not None and tessellation.apply(obj, mod, cache, decision):
-            if in_frame_change and not closed:
+            if in_frame_change and not in_modifier:
                 _deferred.add(obj.name)
                 cache.data[names.SIGNATURE_KEY] = ""  # computed at the next sync
                 return 0
@@ -219,7 +223,16 @@ def update_object(
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
     if closed:
         return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
-    changed = modifier.set_closed_form(mod, None) | modifier.set_inputs(mod, {"Measure Edges": False})
+    obj_eval = obj.evaluated_get(depsgraph)
+    if in_modifier and keyframed.update(obj, depsgraph, snap, scene, mod, cache, codes, measure):
+        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+        for key in (names.ERROR_KEY, names.WARNING_KEY):
+            if key in cache.data:
+                del cache.data[key]
+        obj.update_tag()
+        return len(obj_eval.data.vertices)
+    changed = modifier.set_closed_form(mod, None)
+    changed |= modifier.set_inputs(mod, {"Measure Edges": False, "Keyframed": False})
     if changed:  # the rest positions are stored before the closed form: they are current
         obj.update_tag()
     rest32 = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
@@ -227,6 +240,7 @@ def update_object(
         raise RelativityError(f"Object {obj.name!r}: evaluated mesh has no {names.REST_ATTRIBUTE!r} attribute")
     obj_eval = obj.evaluated_get(depsgraph)
     fingerprint = rest_fingerprint(obj_eval, rest32.reshape(-1))
+    keyframed.note_rest(cache.data, rest32)
     _remember(obj_eval, fingerprint)
     measured = decision.vertices if decision is not None and decision.codes is None else None
     computed = measured[1:] if measured is not None and np.array_equal(measured[0], rest32) else None
@@ -256,7 +270,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
     except ValueError as error:  # the physics core's checks
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     changed = modifier.set_closed_form(mod, inputs)
-    changed |= modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    changed |= modifier.set_inputs(mod, {"Keyframed": False, "Measure Edges": measure is not None, **(measure or {})})
     points = 0 if codes is None else len(codes)
     if len(cache.data.vertices) != points:  # positions of an update on the cache's path
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)

@@ -164,8 +164,12 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
 
 
 def closed_form_on(mod: Modifier) -> bool:
-    """Whether the modifier computes the apparent positions itself (the closed form)."""
-    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Closed Form")))
+    """Whether the modifier computes the apparent positions itself (the closed form, or keyframed
+    motion: ``keyframed.py``)."""
+    group = mod.node_group
+    return any(
+        bool(compat.modifier_input(mod, interface_identifier(group, name))) for name in ("Closed Form", "Keyframed")
+    )
 
 
 def _shared_with_another_object(obj, cache):

@@ -37,7 +37,7 @@ from ..scene.snapshot import check_velocity
 from . import modifier, shape_keys
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Callable, Iterable
 
     import numpy.typing as npt
     from bpy.types import Object, Scene
@@ -221,6 +221,11 @@ def plays_own_animation(obj: Object, scene: Scene) -> bool:
     if animation.keyframe_motion_problem(obj, scene) is not None:
         return False
     return animation.has_own_animation(obj, scene) or shape_keys.has_animated_shape_keys(obj)
+
+
+def path_clock(obj: Object, fps: float, step: float, c: float) -> Callable[[npt.ArrayLike], FloatArray]:
+    """The object's proper time ``tau(t)`` along its keyframed path (:func:`_path_clock`)."""
+    return _path_clock(obj, fps, step, c)
 
 
 def _path_clock(obj, fps, step, c):

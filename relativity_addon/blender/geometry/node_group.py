@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from ..common import names
 from ..common.nodes import Group, Links, Literal, Node, fmath, vmath
+from .keyframed_nodes import KEYFRAMED_INPUTS, keyframed_nodes, window_verdict_nodes
 
 # The closed form's inputs (object space in, object space out; every vector folded in float64 by
 # ``motion.closed_form_inputs``): the point at the observer's time relative to the observer is
@@ -89,7 +90,7 @@ def _edge_verdict_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT_VECTOR", "domain": "POINT"},
         ),
         "whole_seen": Node(
-            "GeometryNodeSetPosition", {"Geometry": "whole_rest.Geometry", "Position": "apparent.Vector"}
+            "GeometryNodeSetPosition", {"Geometry": "kf_whole_geometry.Output", "Position": "kf_whole_seen.Output"}
         ),
         "view_split": Node("ShaderNodeSeparateXYZ", {"Vector": "position.Position"}),
         "view_x": _multiply_add("view_split.X", "group.Camera X", "group.Camera Offset"),
@@ -137,7 +138,7 @@ def _edge_verdict_nodes() -> dict[str, Node]:
             {"data_type": "FLOAT", "operation": "GREATER_THAN"},
         ),
         "measured": Node(
-            "FunctionNodeBooleanMath", {0: "group.Measure Edges", 1: "group.Closed Form"}, {"operation": "AND"}
+            "FunctionNodeBooleanMath", {0: "group.Measure Edges", 1: "in_modifier.Boolean"}, {"operation": "AND"}
         ),
         # a Switch asks for the check only when it is on (Boolean Math would always compute it)
         "edges_short": Node(
@@ -355,26 +356,27 @@ def node_group_spec() -> Group:
             store,
         ),
         **_closed_form_nodes(),
-        # the closed form, or the cache's positions when they fit
+        **keyframed_nodes(),
+        # the closed form, the keyframed motion, or the cache's positions when they fit
         # Switches, not Boolean Math: only what the chosen side needs is computed
         "moved": Node(
             "GeometryNodeSwitch",
-            {"Switch": "group.Closed Form", "False": "counts_match.Result", "True": True},
+            {"Switch": "in_modifier.Boolean", "False": "counts_match.Result", "True": True},
             {"input_type": "BOOLEAN"},
         ),
         "seen_position": Node(
             "GeometryNodeSwitch",
-            {"Switch": "group.Closed Form", "False": "sample_position.Value", "True": "apparent.Vector"},
+            {"Switch": "group.Closed Form", "False": "kf_seen.Output", "True": "apparent.Vector"},
             {"input_type": "VECTOR"},
         ),
         "seen_beta": Node(
             "GeometryNodeSwitch",
-            {"Switch": "group.Closed Form", "False": "sample_beta.Value", "True": "group.Seen Velocity"},
+            {"Switch": "group.Closed Form", "False": "kf_cache_beta.Output", "True": "group.Seen Velocity"},
             {"input_type": "VECTOR"},
         ),
         "set_position": Node(
             "GeometryNodeSetPosition",
-            {"Geometry": "store_rest.Geometry", "Selection": "moved.Output", "Position": "seen_position.Output"},
+            {"Geometry": "kf_geometry.Output", "Selection": "moved.Output", "Position": "seen_position.Output"},
         ),
         "seen_geometry": Node(
             "GeometryNodeSwitch",
@@ -392,6 +394,7 @@ def node_group_spec() -> Group:
             store,
         ),
         **_seam_nodes(),
+        **window_verdict_nodes("store_verdict.Geometry"),
     }
     return Group(
         names.GEOMETRY_GROUP,
@@ -408,7 +411,8 @@ def node_group_spec() -> Group:
             ("Measure Edges", "NodeSocketBool", {"default_value": False}),
             *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
             ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
+            *KEYFRAMED_INPUTS,
         ),
-        (("Geometry", "NodeSocketGeometry", "store_verdict.Geometry"),),
+        (("Geometry", "NodeSocketGeometry", "store_window.Output"),),
         nodes,
     )

@@ -1,0 +1,196 @@
+"""Keyframed rigid motion computed in the modifier (``keyframed_nodes.py``): the glue that picks the
+objects it can show, gives the modifier the few sample intervals of the object's motion that its
+retarded times need (``physics/sampling.motion_intervals``: the same samples, contraction and
+Catmull-Rom cubic as the Python path, ``motion.animated_apparent_positions``), and reads back the
+modifier's verdict that every retarded time lay inside them.
+
+A frame step or an observer change then evaluates the object's keyframes at those samples, writes
+their coefficients into the cache's first points (4x4 attributes, a few hundred at most) and sets a
+few inputs: no pass over the vertices in Python. Motion bakes, deformation bakes and animated shape
+keys stay on the Python path, as do motions whose intervals number more than MAX_INTERVALS
+(rotation and scale keys played at the proper time are in the sampled matrices, as there). The
+window's bound needs the rest points' reach from the origin: read once (Set Up), and again by every
+update on the Python path. An evaluation that found a retarded time outside the intervals (or one
+that did not converge) widens the next window; the object's update in between runs on the Python
+path (its verdict is in the object's signature).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, cast
+
+import numpy as np
+
+from ...errors import RelativityError
+from ...physics import sampling
+from ..common import compat, names
+from ..common.nodes import interface_identifier
+from ..scene import animation
+from . import modifier, motion, shape_keys
+
+if TYPE_CHECKING:
+    from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
+
+    from ...physics.arrays import FloatArray
+    from ..scene.snapshot import Snapshot
+
+# Most sample intervals the modifier is given (4 matrices each, read by Sample Index).
+MAX_INTERVALS = 1024
+# Most widenings of the window after verdicts that a retarded time lay outside it.
+MAX_WIDENING = 8.0
+REACH_KEY = "relativity_reach"  # on the cache mesh: the rest points' largest distance from the origin
+WIDEN_KEY = "relativity_widen"  # on the cache mesh: the window's factor after outside verdicts
+
+
+def can_show(obj: Object, scene: Scene) -> bool:
+    """Whether the object's motion is keyframed rigid motion the modifier can compute (Motion
+    Animation from keyframes alone, no bake, no animated shape keys; rotation and scale keys at the
+    proper time too: the sampled matrices carry the clock)."""
+    settings = obj.relativity
+    return (
+        settings.motion == "ANIMATION"
+        and not settings.use_deformation
+        and modifier.motion_bake_range(obj) is None
+        and animation.keyframe_motion_problem(obj, scene) is None
+        and not shape_keys.has_animated_shape_keys(obj)
+    )
+
+
+def _matrix_function(obj, scene, fps, step, c):
+    """The world matrices at scene times (seconds) that the Python path samples: the keyframes, with
+    the rotation and scale keys at the proper time when the object plays them there
+    (``motion.proper_time_apparent_positions``)."""
+    if obj.relativity.use_proper_time and motion.plays_own_animation(obj, scene):
+        clock = motion.path_clock(obj, fps, step, c)
+        return lambda times: animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
+    return lambda times: animation.world_matrices(obj, times * fps)
+
+
+def is_on(mod: Modifier | None) -> bool:
+    """Whether the modifier computes keyframed motion itself."""
+    if mod is None:
+        return False
+    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Keyframed")))
+
+
+def window_found(obj_eval: Object) -> bool | None:
+    """The modifier's verdict at its last evaluation: every retarded time inside its intervals (True),
+    not (False), or None (it did not compute keyframed motion there)."""
+    mesh = obj_eval.data if obj_eval.type == "MESH" else None
+    attribute = mesh.attributes.get(names.WINDOW_OK_ATTRIBUTE) if mesh is not None else None
+    if attribute is None or len(attribute.data) == 0:
+        return None
+    return bool(attribute.data[0].value)
+
+
+def note_rest(data: Mesh, rest: FloatArray) -> None:
+    """Record the rest points' reach (object space) on the cache mesh ``data``: the window's bound."""
+    reach = float(np.sqrt(np.max(np.einsum("ij,ij->i", rest, rest), initial=0.0)))
+    if data.get(REACH_KEY) != reach:
+        data[REACH_KEY] = reach
+
+
+def modifier_inputs(
+    obj: Object, obj_eval: Object, snap: Snapshot, scene: Scene, reach: float
+) -> tuple[dict[str, object], FloatArray] | None:
+    """The modifier's keyframed inputs (``keyframed_nodes.KEYFRAMED_INPUTS``) and the intervals'
+    coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event, or None when the intervals
+    would be more than MAX_INTERVALS or reach back before the keyframes start moving the object (the
+    Python path then, which warns when a point is seen there). Raises RelativityError."""
+    t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
+    c = snap.speed_of_light
+    motion.check_parent_motion(obj)
+    fps = animation.frames_per_second(scene)
+    step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    try:
+        function = _matrix_function(obj, scene, fps, step, c)
+        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS)
+    except ValueError as error:
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    held_before = animation.held_before_frame(obj)
+    if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
+        return None  # the Python path then (and its warning when a point is seen before the keys move it)
+    beta_o = np.asarray(beta_o, dtype=np.float64)
+    x_o = np.asarray(x_o, dtype=np.float64)
+    matrix = motion.matrix_array(obj_eval.matrix_world)
+    inverse = motion.affine_inverse(matrix)[:3, :3]
+    gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
+    # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
+    boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
+    emission = inverse @ boost
+
+    def vector(values):
+        return tuple(float(v) for v in values)
+
+    inputs = {
+        "Keyframed": True,
+        "Last Interval": float(len(pieces.coefficients) - 1),
+        "Grid Now": t_o / step - pieces.first,
+        "Grid Per Distance": 1.0 / (c * step),
+        "Start Distance": pieces.start_distance,
+        "Emission X": vector(emission[:, 0]),
+        "Emission Y": vector(emission[:, 1]),
+        "Emission Z": vector(emission[:, 2]),
+        "Emission Offset": vector(inverse @ (x_o - matrix[:3, 3])),
+        "Emission Delay": vector(gamma * (inverse @ beta_o)),
+        "Observer Velocity": vector(-beta_o),
+        "Observer Inverse Gamma": 1.0 / gamma,
+        "Observer Factor": gamma / (gamma + 1.0),
+    }
+    return inputs, pieces.coefficients
+
+
+def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray | None) -> None:
+    """The intervals' coefficients into the cache mesh's first points (one 4x4 attribute per power,
+    column-major as Blender stores matrices), the face codes after them."""
+    count = len(coefficients)
+    modifier.write_cache(data, np.zeros((count, 3)), np.zeros((1, 3)), face_codes)
+    total = len(data.vertices)
+    for power, name in enumerate(names.MOTION_ATTRIBUTES):
+        attribute = data.attributes.get(name)
+        if attribute is None:
+            attribute = data.attributes.new(name, "FLOAT4X4", "POINT")
+        matrices = np.zeros((total, 4, 4), dtype=np.float32)
+        matrices[:count, :3, :] = coefficients[:, power]
+        matrices[:, 3, 3] = 1.0
+        attribute.data.foreach_set("value", np.ascontiguousarray(matrices.transpose(0, 2, 1)).ravel())
+    data.update()
+
+
+def update(
+    obj: Object,
+    depsgraph: Depsgraph,
+    snap: Snapshot,
+    scene: Scene,
+    mod: Modifier,
+    cache: Object,
+    codes: FloatArray | None,
+    measure: dict[str, object] | None,
+) -> bool | None:
+    """Set the modifier's keyframed inputs and intervals for the snapshot (``measure``: the adaptive
+    check's inputs, or None). Returns whether anything changed, or None when the modifier cannot
+    compute this frame (a verdict of a retarded time outside the intervals, or
+    too many intervals: the Python path then)."""
+    data = cast("Mesh", cache.data)
+    obj_eval = obj.evaluated_get(depsgraph)
+    reach = data.get(REACH_KEY)
+    if reach is None:  # once (Set Up): the rest points' reach, the window's bound
+        rest = modifier.evaluated_rest_positions(obj, depsgraph, dtype=np.float32)
+        if rest is None:
+            return None
+        note_rest(data, rest)
+        reach = data[REACH_KEY]
+    widen = float(data.get(WIDEN_KEY, 1.0))
+    if is_on(mod) and window_found(obj_eval) is False:
+        data[WIDEN_KEY] = widen * 2.0
+        return None  # this frame on the Python path; the next tries the wider window
+    if widen > MAX_WIDENING:
+        return None
+    found = modifier_inputs(obj, obj_eval, snap, scene, float(reach) * widen)
+    if found is None:
+        return None
+    inputs, coefficients = found
+    write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
+    modifier.set_inputs(mod, {"Closed Form": False, **inputs})
+    modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    return True

@@ -1,0 +1,266 @@
+"""Keyframed rigid motion in the apparent-geometry modifier (``node_group.py`` links these nodes):
+each point's retarded time solved on the Catmull-Rom pieces of its motion that
+``geometry/keyframed.py`` writes into the cache's first points, the same motion and relation the
+Python path solves (``physics/sampling.py``; docs/physics.md, "Light-travel time").
+
+In units of scene length: a point's light-travel distance ``sigma = c tau`` puts it at grid
+coordinate ``s = Grid Now - sigma * Grid Per Distance`` (sample interval ``j = floor(s)``, clamped
+to the intervals given, ``f = s - j``), where it is at ``x = y0 + f y1 + f^2 y2 + f^3 y3`` relative
+to the observer, ``y_i`` the interval's coefficient ``i`` (a 4x4 affine map, Sample Index from the
+cache) applied to the rest position; beyond the first or last interval the end's slope continues,
+as in ``apparent.SampledRigidMotion``. Each step moves ``sigma`` to the closed form of uniform
+motion through ``x`` with the velocity there (``|r - sigma w| = sigma``, ``r = x + sigma w``: one
+step for uniform motion, quadratic convergence otherwise); ``STEPS`` of them from the origin's
+``Start Distance`` reach float32 rounding for a body turning and accelerating at 0.9c
+(``tests/blender/geometry/test_geometry_keyframed_modifier.py``). The apparent position in object
+space is affine in the emission point and ``sigma`` (``Emission X/Y/Z/Offset/Delay``: the
+observer's boost and the object's inverse matrix, folded in float64), and the velocity the
+shaders read is the point's own at its retarded time seen by the observer (relativistic addition
+of ``Observer Velocity``, which is minus the observer's).
+"""
+
+from __future__ import annotations
+
+from ..common import names
+from ..common.nodes import Literal, Node, fmath, vmath
+
+# Closed-form steps from the origin's light-travel distance (the first reads one interval for all
+# points; each other reads each point's own by Sample Index, most of the modifier's cost).
+STEPS = 3
+# A retarded time counts as found when the last step moved sigma by at most this fraction (+ 1e-6).
+RESIDUAL = 1e-4
+
+KEYFRAMED_INPUTS = (
+    ("Keyframed", "NodeSocketBool", {"default_value": False}),
+    ("Last Interval", "NodeSocketFloat", {"default_value": 0.0}),
+    ("Grid Now", "NodeSocketFloat", {"default_value": 0.0}),
+    ("Grid Per Distance", "NodeSocketFloat", {"default_value": 0.0}),
+    ("Start Distance", "NodeSocketFloat", {"default_value": 0.0}),
+    *(
+        (name, "NodeSocketVector", None)
+        for name in ("Emission X", "Emission Y", "Emission Z", "Emission Offset", "Emission Delay", "Observer Velocity")
+    ),
+    ("Observer Inverse Gamma", "NodeSocketFloat", {"default_value": 1.0}),
+    ("Observer Factor", "NodeSocketFloat", {"default_value": 0.5}),
+)
+
+
+def _multiply_add(a: object, b: object, c: object) -> Node:
+    return Node("ShaderNodeVectorMath", {0: a, 1: b, 2: c}, {"operation": "MULTIPLY_ADD"})
+
+
+def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
+    """Nodes for the motion at light-travel distance ``sigma`` (a reference or a value); returns the
+    references of the position relative to the observer, the rate per grid unit and ``s``."""
+    nodes.update(
+        {
+            f"{tag}_s": fmath("MULTIPLY_ADD", sigma, "kf_minus_kappa", "group.Grid Now"),
+            f"{tag}_floor": fmath("FLOOR", f"{tag}_s"),
+            f"{tag}_low": fmath("MAXIMUM", f"{tag}_floor", 0.0),
+            f"{tag}_j": fmath("MINIMUM", f"{tag}_low", "group.Last Interval"),
+            f"{tag}_f": fmath("SUBTRACT", f"{tag}_s", f"{tag}_j"),
+            f"{tag}_g": fmath("ADD", f"{tag}_f", 0.0, clamp=True),
+            f"{tag}_beyond": fmath("SUBTRACT", f"{tag}_f", f"{tag}_g"),
+        }
+    )
+    for power in range(4):
+        nodes[f"{tag}_m{power}"] = Node(
+            "GeometryNodeSampleIndex",
+            {"Geometry": "cache_info.Geometry", "Value": f"kf_coefficient{power}.Attribute", "Index": f"{tag}_j"},
+            {"data_type": "FLOAT4X4", "domain": "POINT"},
+        )
+        nodes[f"{tag}_y{power}"] = Node(
+            "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_m{power}.Value"}
+        )
+    g = f"{tag}_g"
+    nodes.update(
+        {
+            f"{tag}_p2": _multiply_add(f"{tag}_y3.Vector", g, f"{tag}_y2.Vector"),
+            f"{tag}_p1": _multiply_add(f"{tag}_p2.Vector", g, f"{tag}_y1.Vector"),
+            f"{tag}_p0": _multiply_add(f"{tag}_p1.Vector", g, f"{tag}_y0.Vector"),
+            f"{tag}_g3": fmath("MULTIPLY", g, 3.0),
+            f"{tag}_y2x2": vmath("ADD", f"{tag}_y2.Vector", f"{tag}_y2.Vector"),
+            f"{tag}_r1": _multiply_add(f"{tag}_y3.Vector", f"{tag}_g3", f"{tag}_y2x2.Vector"),
+            f"{tag}_rate": _multiply_add(f"{tag}_r1.Vector", g, f"{tag}_y1.Vector"),
+            f"{tag}_x": _multiply_add(f"{tag}_rate.Vector", f"{tag}_beyond", f"{tag}_p0.Vector"),
+        }
+    )
+    return f"{tag}_x.Vector", f"{tag}_rate.Vector", f"{tag}_s"
+
+
+def _step(nodes: dict[str, Node], tag: str, sigma: object, x: str, rate: str) -> str:
+    """Nodes for the next light-travel distance: uniform motion through ``x`` with its velocity
+    ``w`` (units of c) solved in closed form (in whichever form avoids cancellation)."""
+    nodes.update(
+        {
+            f"{tag}_w": vmath("SCALE", rate, scale="group.Grid Per Distance"),
+            f"{tag}_r": _multiply_add(f"{tag}_w.Vector", sigma, x),
+            f"{tag}_a": vmath("DOT_PRODUCT", f"{tag}_r.Vector", f"{tag}_w.Vector"),
+            f"{tag}_q": vmath("DOT_PRODUCT", f"{tag}_r.Vector", f"{tag}_r.Vector"),
+            f"{tag}_ww": vmath("DOT_PRODUCT", f"{tag}_w.Vector", f"{tag}_w.Vector"),
+            f"{tag}_b": fmath("SUBTRACT", 1.0, f"{tag}_ww.Value"),
+            f"{tag}_a2": fmath("MULTIPLY", f"{tag}_a.Value", f"{tag}_a.Value"),
+            f"{tag}_disc": fmath("MULTIPLY_ADD", f"{tag}_b", f"{tag}_q.Value", f"{tag}_a2"),
+            f"{tag}_root": fmath("SQRT", f"{tag}_disc"),
+            f"{tag}_plus": fmath("ADD", f"{tag}_root", f"{tag}_a.Value"),
+            f"{tag}_away": fmath("DIVIDE", f"{tag}_q.Value", f"{tag}_plus"),
+            f"{tag}_minus": fmath("SUBTRACT", f"{tag}_root", f"{tag}_a.Value"),
+            f"{tag}_towards": fmath("DIVIDE", f"{tag}_minus", f"{tag}_b"),
+            f"{tag}_receding": Node(
+                "FunctionNodeCompare",
+                {"A": f"{tag}_a.Value", "B": 0.0},
+                {"data_type": "FLOAT", "operation": "GREATER_THAN"},
+            ),
+            f"{tag}_sigma": Node(
+                "GeometryNodeSwitch",
+                {"Switch": f"{tag}_receding.Result", "False": f"{tag}_towards", "True": f"{tag}_away"},
+                {"input_type": "FLOAT"},
+            ),
+        }
+    )
+    return f"{tag}_sigma.Output"
+
+
+def keyframed_nodes() -> dict[str, Node]:
+    """The keyframed motion's fields on the rest positions (``position``), captured in one
+    evaluation on ``store_rest`` (``kf_capture``) and, for the adaptive check's whole mesh, on
+    ``whole_rest`` (``kf_capture_whole``): ``Seen`` (object space), ``Beta`` (the velocity attribute)
+    and ``Inside`` (1 where the retarded time was found inside the intervals given). Outputs for
+    ``node_group``: ``kf_geometry``, ``kf_whole_geometry``, ``kf_seen``, ``kf_beta``, ``kf_whole_seen``,
+    ``kf_whole_beta`` and ``kf_inside`` (the verdict over the output's points)."""
+    nodes: dict[str, Node] = {
+        f"kf_coefficient{power}": Node(
+            "GeometryNodeInputNamedAttribute", {"Name": Literal(name)}, {"data_type": "FLOAT4X4"}
+        )
+        for power, name in enumerate(names.MOTION_ATTRIBUTES)
+    }
+    nodes["kf_minus_kappa"] = fmath("MULTIPLY", "group.Grid Per Distance", -1.0)
+    sigma: object = "group.Start Distance"
+    for step in range(STEPS):
+        last = sigma
+        _x, rate, s = _evaluate(nodes, f"kf{step}", sigma)
+        sigma = _step(nodes, f"kf{step}", sigma, _x, rate)
+    # the emission point on the last step's uniform motion (r - sigma w): its error is the cubic's
+    # departure over the last step, far below float32 rounding once the steps converge (checked below)
+    tag = f"kf{STEPS - 1}"
+    x = "kf_x.Vector"
+    nodes.update(
+        {
+            "kf_minus_sigma": fmath("MULTIPLY", sigma, -1.0),
+            "kf_x": _multiply_add(f"{tag}_w.Vector", "kf_minus_sigma", f"{tag}_r.Vector"),
+            # the apparent position, object space: Emission (x, y, z) + Offset + sigma Delay
+            "kf_e": Node("ShaderNodeSeparateXYZ", {"Vector": x}),
+            "kf_lx": _multiply_add("kf_e.X", "group.Emission X", "group.Emission Offset"),
+            "kf_ly": _multiply_add("kf_e.Y", "group.Emission Y", "kf_lx.Vector"),
+            "kf_lz": _multiply_add("kf_e.Z", "group.Emission Z", "kf_ly.Vector"),
+            "kf_local": _multiply_add(sigma, "group.Emission Delay", "kf_lz.Vector"),
+            # u' = [u / gamma + v (1 + F v.u)] / (1 + v.u), v = Observer Velocity, F = gamma / (gamma + 1)
+            "kf_vu": vmath("DOT_PRODUCT", f"{tag}_w.Vector", "group.Observer Velocity"),
+            "kf_along": fmath("MULTIPLY_ADD", "group.Observer Factor", "kf_vu.Value", 1.0),
+            "kf_slow": vmath("SCALE", f"{tag}_w.Vector", scale="group.Observer Inverse Gamma"),
+            "kf_sum": _multiply_add("group.Observer Velocity", "kf_along", "kf_slow.Vector"),
+            "kf_denominator": fmath("ADD", "kf_vu.Value", 1.0),
+            "kf_inverse": fmath("DIVIDE", 1.0, "kf_denominator"),
+            "kf_beta_seen": vmath("SCALE", "kf_sum.Vector", scale="kf_inverse"),
+            # found: s within the intervals, and the last step small
+            "kf_s_high": fmath("ADD", "group.Last Interval", 1.0),
+            "kf_after_start": Node(
+                "FunctionNodeCompare", {"A": s, "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_EQUAL"}
+            ),
+            "kf_before_end": Node(
+                "FunctionNodeCompare", {"A": s, "B": "kf_s_high"}, {"data_type": "FLOAT", "operation": "LESS_EQUAL"}
+            ),
+            "kf_residual": fmath("SUBTRACT", sigma, last),
+            "kf_residual_size": fmath("ABSOLUTE", "kf_residual"),
+            "kf_allowed": fmath("MULTIPLY_ADD", sigma, RESIDUAL, 1e-6),
+            "kf_converged": Node(
+                "FunctionNodeCompare",
+                {"A": "kf_residual_size", "B": "kf_allowed"},
+                {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
+            ),
+            "kf_in_window": Node(
+                "FunctionNodeBooleanMath",
+                {0: "kf_after_start.Result", 1: "kf_before_end.Result"},
+                {"operation": "AND"},
+            ),
+            "kf_found": Node(
+                "FunctionNodeBooleanMath", {0: "kf_in_window.Boolean", 1: "kf_converged.Result"}, {"operation": "AND"}
+            ),
+        }
+    )
+    items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"), ("FLOAT", "Inside"))}
+    captured = {"Seen": "kf_local.Vector", "Beta": "kf_beta_seen.Vector", "Inside": "kf_found.Boolean"}
+    nodes.update(
+        {
+            "kf_capture": Node("GeometryNodeCaptureAttribute", {"Geometry": "store_rest.Geometry", **captured}, items),
+            "kf_capture_whole": Node(
+                "GeometryNodeCaptureAttribute", {"Geometry": "whole_rest.Geometry", **captured}, items
+            ),
+            # Switches on single values: only the side asked for is computed
+            "kf_geometry": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Keyframed", "False": "store_rest.Geometry", "True": "kf_capture.Geometry"},
+                {"input_type": "GEOMETRY"},
+            ),
+            "kf_whole_geometry": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Keyframed", "False": "whole_rest.Geometry", "True": "kf_capture_whole.Geometry"},
+                {"input_type": "GEOMETRY"},
+            ),
+            "kf_whole_seen": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Keyframed", "False": "apparent.Vector", "True": "kf_capture_whole.Seen"},
+                {"input_type": "VECTOR"},
+            ),
+            "kf_seen": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Keyframed", "False": "sample_position.Value", "True": "kf_capture.Seen"},
+                {"input_type": "VECTOR"},
+            ),
+            "kf_beta": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "edges_short.Output", "False": "kf_capture.Beta", "True": "kf_capture_whole.Beta"},
+                {"input_type": "VECTOR"},
+            ),
+            "kf_cache_beta": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Keyframed", "False": "sample_beta.Value", "True": "kf_beta.Output"},
+                {"input_type": "VECTOR"},
+            ),
+            "kf_inside_field": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "edges_short.Output", "False": "kf_capture.Inside", "True": "kf_capture_whole.Inside"},
+                {"input_type": "FLOAT"},
+            ),
+            "in_modifier": Node(
+                "FunctionNodeBooleanMath", {0: "group.Closed Form", 1: "group.Keyframed"}, {"operation": "OR"}
+            ),
+        }
+    )
+    return nodes
+
+
+def window_verdict_nodes(geometry: str) -> dict[str, Node]:
+    """The verdict stored on the output ``geometry`` (read by ``keyframed.window_found``): every
+    point's retarded time found inside the intervals given (only with Keyframed on). Output:
+    ``store_window.Geometry``."""
+    return {
+        "kf_inside": Node(
+            "GeometryNodeAttributeStatistic",
+            {"Geometry": geometry, "Attribute": "kf_inside_field.Output"},
+            {"data_type": "FLOAT", "domain": "POINT"},
+        ),
+        "kf_all_inside": Node(
+            "FunctionNodeCompare", {"A": "kf_inside.Min", "B": 0.5}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+        ),
+        "kf_store_window": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": geometry, "Name": Literal(names.WINDOW_OK_ATTRIBUTE), "Value": "kf_all_inside.Result"},
+            {"data_type": "BOOLEAN", "domain": "FACE"},
+        ),
+        "store_window": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "group.Keyframed", "False": geometry, "True": "kf_store_window.Geometry"},
+            {"input_type": "GEOMETRY"},
+        ),
+    }
