@@ -39,7 +39,8 @@ max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wav
 Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
 Emission node in a volume has the materials' own group already. A Principled Volume blackbody
 inside a node group gets the group's spectral part in the group's tree (:func:`attach_grouped`; the
-fast mode keeps its RGB shift). What cannot be made spectral is refused in one line
+fast part there is switched on, and the boundary put into each material using the group, by
+``grouped_volumes.py``). What cannot be made spectral is refused in one line
 (:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
@@ -98,7 +99,8 @@ UNSUPPORTED_VOLUME_NODES = ("ShaderNodeVolumeCoefficients",)  # RGB coefficients
 VOLUME_KINDS = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
 
 
-def _volume_output(tree):
+def volume_output(tree: NodeTree) -> tuple[bpy.types.Node | None, bpy.types.NodeSocket | None]:
+    """``(active Material Output, what feeds its Volume input)``, or ``(None, None)``."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
     if output is None or not output.inputs["Volume"].is_linked:
@@ -112,7 +114,7 @@ def _correctable(material):
     volume is a Principled Volume blackbody the correction handles, else None."""
     if material.node_tree is None:
         return None
-    output, source = _volume_output(material.node_tree)
+    output, source = volume_output(material.node_tree)
     if output is None or source.node.bl_idname != "ShaderNodeVolumePrincipled" or output.inputs["Surface"].is_linked:
         return None
     blackbody = sources.volume_blackbody(source.node)
@@ -254,8 +256,9 @@ def attach_grouped(material: Material) -> bool:
     of an attached ``material``, in the group's tree (once for every material sharing it, recorded
     on the tree like the grouped colours, which ``grouped_colours.detach_all`` undoes): in a pass
     Cycles' RGB blackbody is off and the group emits its Planck spectrum, as in the material's own
-    tree; outside the passes the group adds nothing (``Fast Part`` 0: the done mask and boundary
-    belong to the material, so the fast mode keeps the RGB shift and names it). Returns whether it did."""
+    tree; outside the passes it adds nothing until ``grouped_volumes.attach_scene`` switches its
+    ``Fast Part`` on (the done mask and boundary belong to each material using the group). Returns
+    whether it did."""
     if not materials.is_attached(material) or material.node_tree is None:
         return False
     did = False
@@ -388,9 +391,9 @@ def _grouped_problem(material, on_grids):
             return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
         if node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
-        if _emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
+        if emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
             return f"Spectral colour cannot follow temperature grids inside node groups: {where} reads one"
-        if _emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
+        if emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
             return (
                 f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint and a "
                 "constant intensity (added after Set Up: set up again)"
@@ -405,7 +408,7 @@ def _grouped_problem(material, on_grids):
     return None
 
 
-def _emits_blackbody(node):
+def emits_blackbody(node: bpy.types.Node) -> bool:
     """Whether a Principled Volume may add its blackbody emission (intensity linked or above the cutoff)."""
     intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
@@ -433,7 +436,7 @@ def spectral_problem(scene: Scene) -> str | None:
             if material in grids and node.inputs["Color Attribute"].default_value:
                 return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
             attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
-            if _emits_blackbody(node) and node != corrected and not attached:
+            if emits_blackbody(node) and node != corrected and not attached:
                 return (
                     f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint, a "
                     "constant intensity and the Principled Volume alone on the Volume output"
@@ -449,7 +452,8 @@ def spectral_problem(scene: Scene) -> str | None:
 
 def warnings(scene: Scene) -> list[str]:
     """One line per Principled Volume blackbody the correction cannot handle (it keeps the RGB
-    matrix's colour shift): on an object with temperature grids, or inside a node group."""
+    matrix's colour shift): on an object with temperature grids, or inside a node group whose
+    users cannot all take the boundary (``grouped_volumes.attach_scene``)."""
     lines = []
     for material, name in grid_materials(scene).items():
         if material.node_tree is None or _correctable(material) is not None:
@@ -458,7 +462,7 @@ def warnings(scene: Scene) -> list[str]:
             if (
                 node.bl_idname == "ShaderNodeVolumePrincipled"
                 and node.outputs[0].is_linked
-                and _emits_blackbody(node)
+                and emits_blackbody(node)
                 and material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None
             ):
                 lines.append(
@@ -473,12 +477,12 @@ def warnings(scene: Scene) -> list[str]:
                 (
                     (inner, node)
                     for _group, inner, node in grouped_volume_nodes(material.node_tree)
-                    if node.bl_idname == "ShaderNodeVolumePrincipled" and _emits_blackbody(node)
+                    if node.bl_idname == "ShaderNodeVolumePrincipled" and emits_blackbody(node)
                 ),
                 None,
             )
-            if material.node_tree is not None
-            else None
+            if material.node_tree is not None and material.node_tree.nodes.get(names.VOLUME_GROUPED_BOUNDARY_NODE) is None
+            else None  # with that boundary the fast mode shifts it (grouped_volumes.py)
         )
         if grouped is not None:
             lines.append(

@@ -1,0 +1,116 @@
+"""A Principled Volume blackbody inside a shared node group, fast mode (F12): seen at ``D T``.
+
+Two slabs of 3000 K gas (density 0) on two objects with two materials, both using one node group
+that holds the Principled Volume, beside a 3000 K emitter mesh; the scene at rest, the observer at
+0.5c toward it. As for the ungrouped gas (``test_volume_blackbody.py``), each must be the blackbody
+at ``D T`` with luminance ``Y(D T) / Y(T)`` times its rest luminance times the slab's path-length
+change under aberration (Weiskopf et al. 1999 eq. 14, docs/physics.md; ``D`` from each pixel's
+viewing direction; colour-science's Planck spectra). Before the fix the fast mode kept the RGB
+matrix's shift there (Delta E 27, 0.27 of the luminance). Remove gives the file back exactly.
+"""
+
+import math
+
+import numpy as np
+import pytest
+import scene_dump
+
+import colour_helpers as dh
+from colour_helpers import ch
+
+TEMPERATURE = 3000.0
+RESOLUTION = (64, 48)
+UPPER = (slice(14, 20), slice(12, 18))  # gas A (y > 0)
+LOWER = (slice(28, 34), slice(12, 18))  # gas B (y < 0)
+MESH = (slice(20, 28), slice(46, 52))
+BETA = (0.0, 0.0, -0.5)
+
+
+def _share_group(bpy, first, second):
+    """Move ``first``'s Principled Volume into a new node group and use that group in both
+    materials (``second``'s own volume node replaced by it)."""
+    node = first.node_tree.nodes["Principled Volume"]
+    group = bpy.data.node_groups.new("Gas Group", "ShaderNodeTree")
+    group.interface.new_socket(name="Volume", in_out="OUTPUT", socket_type="NodeSocketShader")
+    inner = group.nodes.new(node.bl_idname)
+    for socket in node.inputs:
+        if hasattr(socket, "default_value") and socket.enabled:
+            inner.inputs[socket.identifier].default_value = socket.default_value
+    group.links.new(inner.outputs[0], group.nodes.new("NodeGroupOutput").inputs[0])
+    for material in (first, second):
+        tree = material.node_tree
+        user = tree.nodes.new("ShaderNodeGroup")
+        user.node_tree = group
+        tree.links.new(user.outputs[0], tree.nodes["Material Output"].inputs["Volume"])
+        tree.nodes.remove(tree.nodes["Principled Volume"])
+    return group
+
+
+def _xyz(image, window):
+    return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3)).mean(axis=0)
+
+
+def _expected(doppler, y_rest):
+    """Mean XYZ of blackbodies at ``D T``, each scaled to its ``y_rest`` times ``Y(D T) / Y(T)``."""
+    y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
+    return np.mean(
+        [dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in zip(doppler, y_rest, strict=True)],
+        axis=0,
+    )
+
+
+def test_grouped_volume_blackbody_is_seen_at_d_t_in_the_fast_mode(relativity_addon, tmp_path):
+    bpy = __import__("bpy")
+    from relativity_addon.blender.pipeline import effect
+
+    scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
+    dh.add_emitter_plane(
+        bpy, scene, "Mesh", (0.3, 2.5), (-1.0, 1.0), colour=(1.0, 1.0, 1.0), beta=None, temperature=TEMPERATURE
+    )
+    gas = [
+        dh.volume_material(bpy, name, Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
+        for name in ("Gas A", "Gas B")
+    ]
+    _share_group(bpy, *gas)
+    dh.add_box(bpy, scene, "Gas A", (-4.0, -0.2), (0.1, 2.0), (-6.0, -4.0), gas[0])
+    dh.add_box(bpy, scene, "Gas B", (-4.0, -0.2), (-2.0, -0.1), (-6.0, -4.0), gas[1])
+    windows = {"gas A": UPPER, "gas B": LOWER, "mesh": MESH}
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: dh.linear_rec709_to_xyz(rest[window].reshape(-1, 3))[:, 1] for name, window in windows.items()}
+    assert min(y.min() for y in y_rest.values()) > 0.5
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    rest_path = scene.render.filepath
+    before = scene_dump.dump(bpy)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving)) and moving.min() >= 0.0
+    warnings = [line for line in effect.scene_warnings(scene) if "RGB colour shift" in line]
+
+    doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
+    rest_k = dh.pixel_photon_directions(bpy, scene, camera)
+    scene_k = np.array([ch.aberrate(k, -np.asarray(BETA)) for k in rest_k.reshape(-1, 3)]).reshape(rest_k.shape)
+    path = np.abs(rest_k[..., 2]) / np.abs(scene_k[..., 2])
+    measured = {}
+    failures = []
+    for name, window in windows.items():
+        gas_path = path[window].ravel() if name != "mesh" else 1.0
+        expected = _expected(doppler[window].ravel(), y_rest[name] * gas_path)
+        measured[name] = _xyz(moving, window)
+        delta_e = dh.delta_e_2000_normalised(measured[name], expected)
+        ratio = measured[name][1] / expected[1]
+        print(f"{name}: D {doppler[window].mean():.3f}, Delta E {delta_e:.3f}, Y / expected {ratio:.4f}")
+        if delta_e >= 1.0 or not ratio == pytest.approx(1.0, abs=0.03):
+            failures.append(name)
+    between = dh.delta_e_2000_normalised(measured["gas A"], measured["mesh"])
+    print(f"gas A against the emitter mesh: Delta E {between:.3f}; warnings {warnings}")
+    assert not failures, failures
+    assert between < 1.0
+    assert not warnings  # handled: the panel no longer names the grouped blackbody
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    scene.render.filepath = rest_path  # the test's own output file, set by the second render
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
+    assert math.isclose(y_rest["gas A"].mean(), y_rest["gas B"].mean(), rel_tol=0.05)  # the two slabs alike
