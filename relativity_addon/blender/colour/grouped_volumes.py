@@ -30,7 +30,7 @@ from ..common import names
 from . import materials, volumes
 
 if TYPE_CHECKING:
-    from bpy.types import Material, Node, NodeTree, Scene
+    from bpy.types import Material, Node, Scene
 
 PRINCIPLED = "ShaderNodeVolumePrincipled"
 BOUNDARY = names.VOLUME_GROUPED_BOUNDARY_NODE
@@ -38,7 +38,7 @@ MASK = f"{names.VOLUME_BLACKBODY_NODE_PREFIX} Grouped Mask"
 DONE = f"{names.VOLUME_BLACKBODY_NODE_PREFIX} Grouped Done"
 
 
-def _correctors(material: Material) -> list[tuple[NodeTree, Node]]:
+def _correctors(material):
     """``(group tree, volume blackbody group node)`` of every corrected grouped blackbody of ``material``."""
     found = []
     for _group, inner, node in volumes.grouped_volume_nodes(material.node_tree):
@@ -48,7 +48,7 @@ def _correctors(material: Material) -> list[tuple[NodeTree, Node]]:
     return found
 
 
-def _can_take_boundary(material: Material, on_grids: bool) -> bool:
+def _can_take_boundary(material, on_grids):
     """Whether ``material``'s own tree can mark its volume's pixels done (Surface free, Volume from
     a node group), and none of its grouped blackbodies reads a temperature grid."""
     tree = material.node_tree
@@ -94,8 +94,8 @@ def attach_scene(scene: Scene) -> None:
         if not dropped:
             break
         candidates -= dropped
-    for name, found in correctors.items():
-        for corrector in found:
+    for name, group_nodes in correctors.items():
+        for corrector in group_nodes:
             corrector.inputs["Fast Part"].default_value = 1.0 if name in on else 0.0
     for using in users.values():
         for material in using:
@@ -105,7 +105,7 @@ def attach_scene(scene: Scene) -> None:
                 _remove_boundary(material)
 
 
-def _add_boundary(material: Material) -> None:
+def _add_boundary(material):
     """The boundary of the ungrouped correction in ``material``'s own tree, recorded like its nodes
     (``materials.detach`` removes them, and with them the link to the Surface input)."""
     tree = material.node_tree
@@ -141,7 +141,7 @@ def _add_boundary(material: Material) -> None:
         log_doppler.mute = True
 
 
-def _remove_boundary(material: Material) -> None:
+def _remove_boundary(material):
     tree = material.node_tree
     if tree.nodes.get(BOUNDARY) is None:
         return

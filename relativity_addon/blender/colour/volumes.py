@@ -472,21 +472,22 @@ def warnings(scene: Scene) -> list[str]:
                 )
                 break
     for material, _temperature in materials.scene_materials(scene):
-        grouped = (
-            next(
-                (
-                    (inner, node)
-                    for _group, inner, node in grouped_volume_nodes(material.node_tree)
-                    if node.bl_idname == "ShaderNodeVolumePrincipled" and emits_blackbody(node)
-                ),
-                None,
-            )
-            if material.node_tree is not None and material.node_tree.nodes.get(names.VOLUME_GROUPED_BOUNDARY_NODE) is None
-            else None  # with that boundary the fast mode shifts it (grouped_volumes.py)
+        tree = material.node_tree
+        if tree is None or tree.nodes.get(names.VOLUME_GROUPED_BOUNDARY_NODE) is not None:
+            continue  # with that boundary the fast mode shifts it (grouped_volumes.py)
+        grouped = next(
+            (
+                (inner, node)
+                for _group, inner, node in grouped_volume_nodes(tree)
+                if node.bl_idname == "ShaderNodeVolumePrincipled" and emits_blackbody(node)
+            ),
+            None,
         )
         if grouped is not None:
             lines.append(
                 f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
-                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (Render Spectral shifts it to D T)"
+                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (it needs a grey tint and a constant "
+                "intensity, no temperature grid, and every material using the group without a surface "
+                "shader; Render Spectral shifts it to D T)"
             )
     return lines
