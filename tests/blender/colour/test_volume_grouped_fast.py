@@ -114,3 +114,42 @@ def test_grouped_volume_blackbody_is_seen_at_d_t_in_the_fast_mode(relativity_add
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
     assert math.isclose(y_rest["gas A"].mean(), y_rest["gas B"].mean(), rel_tol=0.05)  # the two slabs alike
+
+
+def test_a_user_with_a_surface_shader_keeps_the_shared_group_on_the_rgb_shift(relativity_addon):
+    """The boundary belongs to each material using the group: where one of them has a surface
+    shader of its own, none can be marked done without leaving that one's gas shifted twice, so the
+    group's fast part stays off, no material gets the boundary, and the panel names them; Set Up
+    again after the surface is gone switches it on."""
+    bpy = __import__("bpy")
+    from relativity_addon.blender.colour import grouped_volumes, volumes
+    from relativity_addon.blender.pipeline import effect
+
+    scene, _camera = dh.emitter_scene(bpy, samples=1, resolution=RESOLUTION)
+    gas = [
+        dh.volume_material(bpy, name, Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
+        for name in ("Gas A", "Gas B")
+    ]
+    group = _share_group(bpy, *gas)
+    tree = gas[1].node_tree
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    tree.links.new(diffuse.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    dh.add_box(bpy, scene, "Gas A", (-4.0, -0.2), (0.1, 2.0), (-6.0, -4.0), gas[0])
+    dh.add_box(bpy, scene, "Gas B", (-4.0, -0.2), (-2.0, -0.1), (-6.0, -4.0), gas[1])
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    corrector = group.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
+    assert corrector.inputs["Fast Part"].default_value == 0.0
+    assert not any(grouped_volumes.handled(material) for material in gas)
+    warnings = [line for line in effect.scene_warnings(scene) if "RGB colour shift" in line]
+    assert len(warnings) == 2 and all("'Gas Group'" in line for line in warnings)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+
+    tree.nodes.remove(diffuse)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    corrector = group.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
+    assert corrector.inputs["Fast Part"].default_value == 1.0
+    assert all(grouped_volumes.handled(material) for material in gas)
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert not any(node.name.startswith(volumes.NODE_PREFIX) for m in gas for node in m.node_tree.nodes)
