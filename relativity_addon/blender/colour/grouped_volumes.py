@@ -10,9 +10,9 @@ there, as a second volume blackbody group node whose ``Done`` alone is used.
 
 So the group's ``Fast Part`` is switched on (:func:`attach_scene`) where every material of the
 scene using the group can take the boundary: its active Material Output's Surface unlinked and its
-Volume fed by a node group, and no temperature grid to read (a Volume object or fluid domain with
-the Principled Volume's Temperature Attribute set: the shared group cannot read the grid for one
-user and not another; those keep the RGB shift, as the panel says). A material taking the
+Volume fed by a node group. A temperature grid is read inside the group (``volumes.attach_grouped``
+puts an Attribute node there when a user may carry grids) and the bolometric rule follows the
+grid's Alpha per point, where the ungrouped correction chooses it per material. A material taking the
 boundary must have every grouped blackbody it uses switched on, since its done mask keeps all of
 its pixels as rendered; the sets are narrowed until they agree. The same approximations as
 ungrouped gas hold (what is seen through the gas keeps its rest colour; a camera inside the gas
@@ -50,7 +50,7 @@ def _correctors(material):
 
 def _can_take_boundary(material, on_grids):
     """Whether ``material``'s own tree can mark its volume's pixels done (Surface free, Volume from
-    a node group), and none of its grouped blackbodies reads a temperature grid."""
+    a node group), and every temperature grid its grouped blackbodies read has its reader."""
     tree = material.node_tree
     output, source = volumes.volume_output(tree)
     if output is None or source.node.bl_idname != "ShaderNodeGroup":
@@ -58,10 +58,11 @@ def _can_take_boundary(material, on_grids):
     surface = output.inputs["Surface"]
     if surface.is_linked and surface.links[0].from_node.name != BOUNDARY:
         return False
-    for _group, _inner, node in volumes.grouped_volume_nodes(tree):
+    for _group, inner, node in volumes.grouped_volume_nodes(tree):
         if node.bl_idname != PRINCIPLED or not volumes.emits_blackbody(node):
             continue
-        if on_grids and node.inputs["Temperature Attribute"].default_value:
+        reads_grid = on_grids and node.inputs["Temperature Attribute"].default_value
+        if reads_grid and inner.nodes.get(f"{volumes.NODE_PREFIX} Grid {node.name}") is None:
             return False
     return True
 

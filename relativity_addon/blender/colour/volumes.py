@@ -251,7 +251,7 @@ def blackbody_materials(scene: Scene) -> list[str]:
     ]
 
 
-def attach_grouped(material: Material) -> bool:
+def attach_grouped(material: Material, grids: bool = False) -> bool:
     """The spectral part of the correction for Principled Volume blackbodies inside the node groups
     of an attached ``material``, in the group's tree (once for every material sharing it, recorded
     on the tree like the grouped colours, which ``grouped_colours.detach_all`` undoes): in a pass
@@ -267,11 +267,17 @@ def attach_grouped(material: Material) -> bool:
         if blackbody is None:
             continue
         intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
-        if (
-            intensity is None
-            or not node.outputs[0].is_linked
-            or inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
-        ):
+        if intensity is None or not node.outputs[0].is_linked:
+            continue
+        existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
+        if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
+            if existing is not None:  # put in for another material, which may not carry grids
+                reader = [
+                    {"group_node": new.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
+                    for new in _grid_reader(inner, node, existing, grids)
+                ]
+                inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
+                did = did or bool(reader)
             continue
         ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
         group = inner.nodes.new("ShaderNodeGroup")
@@ -283,7 +289,8 @@ def attach_grouped(material: Material) -> bool:
             inner.links.new(blackbody.temperature, group.inputs["Temperature"])
         group.inputs["Intensity"].default_value = intensity
         group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
-        group.inputs["Fast Part"].default_value = 0.0
+        group.inputs["Fast Part"].default_value = 0.0  # on where every user takes the boundary (grouped_volumes)
+        created = [group, *_grid_reader(inner, node, group, grids)]
         emission = inner.nodes.new("ShaderNodeEmission")
         emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
         add = inner.nodes.new("ShaderNodeAddShader")
@@ -294,16 +301,36 @@ def attach_grouped(material: Material) -> bool:
         inner.links.new(node.outputs[0], add.inputs[0])
         inner.links.new(emission.outputs[0], add.inputs[1])
         blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
-        records = [{**blank, "group_node": new.name} for new in (group, emission)]
+        records = [{**blank, "group_node": new.name} for new in (*created, emission)]
         for target in targets:
             inner.links.new(add.outputs[0], target)
             relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}
             records.append({**relink, "group_node": add.name, "source_socket": node.outputs[0].identifier})
-        for new in (group, emission, add):
+        for new in (*created, emission, add):
             new.location, new.hide = (node.location.x + 200.0, node.location.y - 200.0), True
         inner[materials.ATTACHED_KEY] = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])] + records
         did = True
     return did
+
+
+def _grid_reader(inner, node, group, grids):
+    """An Attribute node reading the temperature grid ``node`` names, feeding ``group`` (in a shared
+    group's tree ``inner``), where a user of the group may carry grids and none is there yet:
+    Cycles' ``T`` per point as in :func:`attach`, and the bolometric rule where the grid is (its
+    Alpha: a shared group follows the shading point, not its users' objects). Returns the nodes added."""
+    grid_name = node.inputs["Temperature Attribute"].default_value if grids else ""
+    name = f"{NODE_PREFIX} Grid {node.name}"
+    if not grid_name or inner.nodes.get(name) is not None:
+        return []
+    attribute = inner.nodes.new("ShaderNodeAttribute")
+    attribute.name = attribute.label = name
+    attribute.attribute_type = "GEOMETRY"
+    attribute.attribute_name = grid_name
+    inner.links.new(attribute.outputs["Fac"], group.inputs["Grid"])
+    inner.links.new(attribute.outputs["Alpha"], group.inputs["Grid Alpha"])
+    inner.links.new(attribute.outputs["Alpha"], group.inputs["Bolometric"])
+    attribute.location, attribute.hide = (node.location.x + 200.0, node.location.y - 250.0), True
+    return [attribute]
 
 
 def attach_colours(material: Material) -> bool:
@@ -377,7 +404,7 @@ def attach_scene(scene: Scene) -> None:
     for material, _temperature in materials.scene_materials(scene):
         attach(material, grids=material in grids)
         attach_colours(material)
-        attach_grouped(material)
+        attach_grouped(material, grids=material in grids)
 
 
 def _grouped_problem(material, on_grids):

@@ -138,10 +138,12 @@ def test_a_user_with_a_surface_shader_keeps_the_shared_group_on_the_rgb_shift(re
     dh.add_box(bpy, scene, "Gas B", (-4.0, -0.2), (-2.0, -0.1), (-6.0, -4.0), gas[1])
     scene.relativity.method = "CAMERA"
     scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     corrector = group.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
     assert corrector.inputs["Fast Part"].default_value == 0.0
     assert not any(grouped_volumes.handled(material) for material in gas)
+    effect.sync(scene)  # what the panel shows after any change
     warnings = [line for line in effect.scene_warnings(scene) if "RGB colour shift" in line]
     assert len(warnings) == 2 and all("'Gas Group'" in line for line in warnings)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
@@ -153,3 +155,52 @@ def test_a_user_with_a_surface_shader_keeps_the_shared_group_on_the_rgb_shift(re
     assert all(grouped_volumes.handled(material) for material in gas)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert not any(node.name.startswith(volumes.NODE_PREFIX) for m in gas for node in m.node_tree.nodes)
+
+
+def test_grouped_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path):
+    """The two-temperature VDB of ``test_volume_temperature_grid.py`` (2500 K and 4000 K halves) with
+    its Principled Volume inside a node group that a second material, on a mesh (out of view), uses
+    too: each half must be colour-science's blackbody at ``D T`` (Delta E 2000 <= 1) with its rest
+    luminance times ``D^4`` (eq. 15) and the slab's path-length change, within 5 % as ungrouped
+    (Blender 5.2 reads the grid 3 % brighter in the Principled Volume than in an Attribute node).
+    Before: the RGB shift (the group could not read the grid)."""
+    bpy = __import__("bpy")
+    import test_volume_temperature_grid as tg
+    from test_volume_blackbody import _slab_path_ratio
+
+    scene, camera, fire = tg.grid_scene(bpy, tmp_path)
+    other = dh.volume_material(bpy, "Other", Density=0.0, Blackbody_Intensity=1.0, Temperature=TEMPERATURE)
+    _share_group(bpy, fire, other)
+    dh.add_box(bpy, scene, "Behind the camera", (-1.0, 1.0), (-1.0, 1.0), (2.0, 3.0), other)
+    rest = dh.render(bpy, scene, tmp_path / "rest.exr")
+    y_rest = {name: tg._xyz(rest, window)[:, 1] for name, (_grid, window) in tg.HALVES.items()}
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+    rest_path = scene.render.filepath
+    before = scene_dump.dump(bpy)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    moving = dh.render(bpy, scene, tmp_path / "moving.exr")
+    assert np.all(np.isfinite(moving))
+
+    doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
+    path = _slab_path_ratio(bpy, scene, camera)
+    failures = []
+    for name, (grid, window) in tg.HALVES.items():
+        temperature = grid * tg.BASE_TEMPERATURE
+        xyz = tg._xyz(moving, window)
+        d = doppler[window].ravel()
+        expected_colour = np.mean([dh.blackbody_xyz_colour_science(f * temperature) for f in d], axis=0)
+        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
+        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**4)
+        print(
+            f"grouped grid {name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^4 Y {ratio:.4f}"
+        )
+        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
+            failures.append(name)
+    assert not failures
+
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    scene.render.filepath = rest_path
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, f"{len(lines)} differences after Remove:\n" + "\n".join(lines[:40])
