@@ -418,7 +418,8 @@ def _grouped_problem(material, on_grids):
             return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
         if node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
-        if emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
+        reads_grid = emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value
+        if reads_grid and inner.nodes.get(f"{NODE_PREFIX} Grid {node.name}") is None:
             return f"Spectral colour cannot follow temperature grids inside node groups: {where} reads one"
         if emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
             return (
