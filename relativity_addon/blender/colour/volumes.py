@@ -409,9 +409,9 @@ def attach_scene(scene: Scene) -> None:
 
 def _grouped_problem(material, on_grids):
     """Why the passes cannot carry a volume node inside one of ``material``'s node groups, or None:
-    a Volume Coefficients node, a Principled Volume blackbody (its correction and its spectrum live in
-    the material's own tree), a colour grid, an emission colour fed from outside the group (which
-    may be a blackbody the group cannot see)."""
+    a Volume Coefficients node, a Principled Volume blackbody without its correction in the group's
+    tree (or reading a temperature grid without the group's reader), a colour grid, an emission
+    colour fed from outside the group (which may be a blackbody the group cannot see)."""
     for group, inner, node in grouped_volume_nodes(material.node_tree):
         where = f"{node.name!r} inside the node group {inner.name!r} ({group.name!r}) in material {material.name!r}"
         if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
@@ -514,8 +514,8 @@ def warnings(scene: Scene) -> list[str]:
         if grouped is not None:
             lines.append(
                 f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
-                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (it needs a grey tint and a constant "
-                "intensity, no temperature grid, and every material using the group without a surface "
-                "shader; Render Spectral shifts it to D T)"
+                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (it needs a grey tint, a constant "
+                "intensity, and every material using the group without a surface shader, the group feeding "
+                "its Volume output; Render Spectral shifts it to D T)"
             )
     return lines
