@@ -61,7 +61,7 @@ def _expected(doppler, y_rest):
 
 def test_grouped_volume_blackbody_is_seen_at_d_t_in_the_fast_mode(relativity_addon, tmp_path):
     bpy = __import__("bpy")
-    from relativity_addon.blender.pipeline import effect
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")  # the add-on's own (bl_ext) module
 
     scene, camera = dh.emitter_scene(bpy, samples=16, resolution=RESOLUTION)
     dh.add_emitter_plane(
@@ -122,8 +122,9 @@ def test_a_user_with_a_surface_shader_keeps_the_shared_group_on_the_rgb_shift(re
     group's fast part stays off, no material gets the boundary, and the panel names them; Set Up
     again after the surface is gone switches it on."""
     bpy = __import__("bpy")
-    from relativity_addon.blender.colour import grouped_volumes, volumes
-    from relativity_addon.blender.pipeline import effect
+    grouped_volumes = dh.addon_module(relativity_addon, "colour.grouped_volumes")
+    volumes = dh.addon_module(relativity_addon, "colour.volumes")
+    effect = dh.addon_module(relativity_addon, "pipeline.effect")  # the add-on's own (bl_ext) module
 
     scene, _camera = dh.emitter_scene(bpy, samples=1, resolution=RESOLUTION)
     gas = [
