@@ -15,7 +15,7 @@ import bpy
 
 from ...errors import RelativityError
 from ..common import names
-from . import compositing, lut_images, materials, volumes, world_colour, world_sampling
+from . import compositing, grouped_volumes, lut_images, materials, volumes, world_colour, world_sampling
 from .compositing import is_applied as compositor_applied
 
 if TYPE_CHECKING:
@@ -59,6 +59,7 @@ def _attach(scene, snap):
     materials.attach_scene(scene, camera_path=snap.colour.camera_path)
     if snap.colour.camera_path:
         volumes.attach_scene(scene)
+        grouped_volumes.attach_scene(scene)
 
 
 def _write_object_temperatures(scene):

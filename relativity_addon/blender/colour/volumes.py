@@ -39,7 +39,8 @@ max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wav
 Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
 Emission node in a volume has the materials' own group already. A Principled Volume blackbody
 inside a node group gets the group's spectral part in the group's tree (:func:`attach_grouped`; the
-fast mode keeps its RGB shift). What cannot be made spectral is refused in one line
+fast part there is switched on, and the boundary put into each material using the group, by
+``grouped_volumes.py``). What cannot be made spectral is refused in one line
 (:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
@@ -98,7 +99,8 @@ UNSUPPORTED_VOLUME_NODES = ("ShaderNodeVolumeCoefficients",)  # RGB coefficients
 VOLUME_KINDS = {kind for kind, _inputs in VOLUME_COLOURS} | set(UNSUPPORTED_VOLUME_NODES)
 
 
-def _volume_output(tree):
+def volume_output(tree: NodeTree) -> tuple[bpy.types.Node | None, bpy.types.NodeSocket | None]:
+    """``(active Material Output, what feeds its Volume input)``, or ``(None, None)``."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
     if output is None or not output.inputs["Volume"].is_linked:
@@ -112,7 +114,7 @@ def _correctable(material):
     volume is a Principled Volume blackbody the correction handles, else None."""
     if material.node_tree is None:
         return None
-    output, source = _volume_output(material.node_tree)
+    output, source = volume_output(material.node_tree)
     if output is None or source.node.bl_idname != "ShaderNodeVolumePrincipled" or output.inputs["Surface"].is_linked:
         return None
     blackbody = sources.volume_blackbody(source.node)
@@ -249,13 +251,14 @@ def blackbody_materials(scene: Scene) -> list[str]:
     ]
 
 
-def attach_grouped(material: Material) -> bool:
+def attach_grouped(material: Material, grids: bool = False) -> bool:
     """The spectral part of the correction for Principled Volume blackbodies inside the node groups
     of an attached ``material``, in the group's tree (once for every material sharing it, recorded
     on the tree like the grouped colours, which ``grouped_colours.detach_all`` undoes): in a pass
     Cycles' RGB blackbody is off and the group emits its Planck spectrum, as in the material's own
-    tree; outside the passes the group adds nothing (``Fast Part`` 0: the done mask and boundary
-    belong to the material, so the fast mode keeps the RGB shift and names it). Returns whether it did."""
+    tree; outside the passes it adds nothing until ``grouped_volumes.attach_scene`` switches its
+    ``Fast Part`` on (the done mask and boundary belong to each material using the group). Returns
+    whether it did."""
     if not materials.is_attached(material) or material.node_tree is None:
         return False
     did = False
@@ -264,11 +267,17 @@ def attach_grouped(material: Material) -> bool:
         if blackbody is None:
             continue
         intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
-        if (
-            intensity is None
-            or not node.outputs[0].is_linked
-            or inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
-        ):
+        if intensity is None or not node.outputs[0].is_linked:
+            continue
+        existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
+        if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
+            if existing is not None:  # put in for another material, which may not carry grids
+                reader = [
+                    {"group_node": new.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
+                    for new in _grid_reader(inner, node, existing, grids)
+                ]
+                inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
+                did = did or bool(reader)
             continue
         ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
         group = inner.nodes.new("ShaderNodeGroup")
@@ -280,7 +289,8 @@ def attach_grouped(material: Material) -> bool:
             inner.links.new(blackbody.temperature, group.inputs["Temperature"])
         group.inputs["Intensity"].default_value = intensity
         group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
-        group.inputs["Fast Part"].default_value = 0.0
+        group.inputs["Fast Part"].default_value = 0.0  # on where every user takes the boundary (grouped_volumes)
+        created = [group, *_grid_reader(inner, node, group, grids)]
         emission = inner.nodes.new("ShaderNodeEmission")
         emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
         add = inner.nodes.new("ShaderNodeAddShader")
@@ -291,16 +301,36 @@ def attach_grouped(material: Material) -> bool:
         inner.links.new(node.outputs[0], add.inputs[0])
         inner.links.new(emission.outputs[0], add.inputs[1])
         blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
-        records = [{**blank, "group_node": new.name} for new in (group, emission)]
+        records = [{**blank, "group_node": new.name} for new in (*created, emission)]
         for target in targets:
             inner.links.new(add.outputs[0], target)
             relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}
             records.append({**relink, "group_node": add.name, "source_socket": node.outputs[0].identifier})
-        for new in (group, emission, add):
+        for new in (*created, emission, add):
             new.location, new.hide = (node.location.x + 200.0, node.location.y - 200.0), True
         inner[materials.ATTACHED_KEY] = [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])] + records
         did = True
     return did
+
+
+def _grid_reader(inner, node, group, grids):
+    """An Attribute node reading the temperature grid ``node`` names, feeding ``group`` (in a shared
+    group's tree ``inner``), where a user of the group may carry grids and none is there yet:
+    Cycles' ``T`` per point as in :func:`attach`, and the bolometric rule where the grid is (its
+    Alpha: a shared group follows the shading point, not its users' objects). Returns the nodes added."""
+    grid_name = node.inputs["Temperature Attribute"].default_value if grids else ""
+    name = f"{NODE_PREFIX} Grid {node.name}"
+    if not grid_name or inner.nodes.get(name) is not None:
+        return []
+    attribute = inner.nodes.new("ShaderNodeAttribute")
+    attribute.name = attribute.label = name
+    attribute.attribute_type = "GEOMETRY"
+    attribute.attribute_name = grid_name
+    inner.links.new(attribute.outputs["Fac"], group.inputs["Grid"])
+    inner.links.new(attribute.outputs["Alpha"], group.inputs["Grid Alpha"])
+    inner.links.new(attribute.outputs["Alpha"], group.inputs["Bolometric"])
+    attribute.location, attribute.hide = (node.location.x + 200.0, node.location.y - 250.0), True
+    return [attribute]
 
 
 def attach_colours(material: Material) -> bool:
@@ -374,23 +404,24 @@ def attach_scene(scene: Scene) -> None:
     for material, _temperature in materials.scene_materials(scene):
         attach(material, grids=material in grids)
         attach_colours(material)
-        attach_grouped(material)
+        attach_grouped(material, grids=material in grids)
 
 
 def _grouped_problem(material, on_grids):
     """Why the passes cannot carry a volume node inside one of ``material``'s node groups, or None:
-    a Volume Coefficients node, a Principled Volume blackbody (its correction and its spectrum live in
-    the material's own tree), a colour grid, an emission colour fed from outside the group (which
-    may be a blackbody the group cannot see)."""
+    a Volume Coefficients node, a Principled Volume blackbody without its correction in the group's
+    tree (or reading a temperature grid without the group's reader), a colour grid, an emission
+    colour fed from outside the group (which may be a blackbody the group cannot see)."""
     for group, inner, node in grouped_volume_nodes(material.node_tree):
         where = f"{node.name!r} inside the node group {inner.name!r} ({group.name!r}) in material {material.name!r}"
         if node.bl_idname in UNSUPPORTED_VOLUME_NODES:
             return f"Spectral colour cannot make the volume node {where} spectral (RGB coefficients)"
         if node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
-        if _emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value:
+        reads_grid = emits_blackbody(node) and on_grids and node.inputs["Temperature Attribute"].default_value
+        if reads_grid and inner.nodes.get(f"{NODE_PREFIX} Grid {node.name}") is None:
             return f"Spectral colour cannot follow temperature grids inside node groups: {where} reads one"
-        if _emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
+        if emits_blackbody(node) and inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None:
             return (
                 f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint and a "
                 "constant intensity (added after Set Up: set up again)"
@@ -405,7 +436,7 @@ def _grouped_problem(material, on_grids):
     return None
 
 
-def _emits_blackbody(node):
+def emits_blackbody(node: bpy.types.Node) -> bool:
     """Whether a Principled Volume may add its blackbody emission (intensity linked or above the cutoff)."""
     intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
     return intensity is None or intensity > sources.BLACKBODY_INTENSITY_CUTOFF
@@ -433,7 +464,7 @@ def spectral_problem(scene: Scene) -> str | None:
             if material in grids and node.inputs["Color Attribute"].default_value:
                 return f"Spectral colour cannot follow colour grids: {where} reads the Color Attribute grid"
             attached = material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None
-            if _emits_blackbody(node) and node != corrected and not attached:
+            if emits_blackbody(node) and node != corrected and not attached:
                 return (
                     f"Spectral colour cannot make the blackbody of {where} spectral: it needs a grey tint, a "
                     "constant intensity and the Principled Volume alone on the Volume output"
@@ -449,7 +480,8 @@ def spectral_problem(scene: Scene) -> str | None:
 
 def warnings(scene: Scene) -> list[str]:
     """One line per Principled Volume blackbody the correction cannot handle (it keeps the RGB
-    matrix's colour shift): on an object with temperature grids, or inside a node group."""
+    matrix's colour shift): on an object with temperature grids, or inside a node group whose
+    users cannot all take the boundary (``grouped_volumes.attach_scene``)."""
     lines = []
     for material, name in grid_materials(scene).items():
         if material.node_tree is None or _correctable(material) is not None:
@@ -458,7 +490,7 @@ def warnings(scene: Scene) -> list[str]:
             if (
                 node.bl_idname == "ShaderNodeVolumePrincipled"
                 and node.outputs[0].is_linked
-                and _emits_blackbody(node)
+                and emits_blackbody(node)
                 and material.node_tree.nodes.get(f"{NODE_PREFIX} Add {node.name}") is None
             ):
                 lines.append(
@@ -468,21 +500,22 @@ def warnings(scene: Scene) -> list[str]:
                 )
                 break
     for material, _temperature in materials.scene_materials(scene):
-        grouped = (
-            next(
-                (
-                    (inner, node)
-                    for _group, inner, node in grouped_volume_nodes(material.node_tree)
-                    if node.bl_idname == "ShaderNodeVolumePrincipled" and _emits_blackbody(node)
-                ),
-                None,
-            )
-            if material.node_tree is not None
-            else None
+        tree = material.node_tree
+        if tree is None or tree.nodes.get(names.VOLUME_GROUPED_BOUNDARY_NODE) is not None:
+            continue  # with that boundary the fast mode shifts it (grouped_volumes.py)
+        grouped = next(
+            (
+                (inner, node)
+                for _group, inner, node in grouped_volume_nodes(tree)
+                if node.bl_idname == "ShaderNodeVolumePrincipled" and emits_blackbody(node)
+            ),
+            None,
         )
         if grouped is not None:
             lines.append(
                 f"Material {material.name!r}: the blackbody of {grouped[1].name!r} inside the node group "
-                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (Render Spectral shifts it to D T)"
+                f"{grouped[0].name!r} keeps the RGB colour shift in F12 (it needs a grey tint, a constant "
+                "intensity, and every material using the group without a surface shader, the group feeding "
+                "its Volume output; Render Spectral shifts it to D T)"
             )
     return lines

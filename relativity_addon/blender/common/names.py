@@ -129,6 +129,8 @@ LAMP_FACES_KEY = "relativity_lamp_faces"  # on the scene: {light object name: fa
 LAMP_FACE_SAVED_KEY = "relativity_lamp_face_saved"  # on light objects: the user's visible_camera
 VOLUME_BLACKBODY_GROUP = "Relativity Volume Blackbody"  # shader group: camera-ray emission of a blackbody volume
 VOLUME_BLACKBODY_NODE_PREFIX = "Relativity Volume"  # nodes it inserts in a volume material
+# in a material whose volume blackbody sits in a shared node group: the boundary marking its pixels done
+VOLUME_GROUPED_BOUNDARY_NODE = "Relativity Volume Grouped Boundary"
 VOLUME_COLOUR_GROUP = "Relativity Spectral Volume Colour"  # shader group: a volume colour, spectral in the passes
 VOLUME_COLOUR_NODE_PREFIX = "Relativity Spectral Volume"  # its nodes in front of volume colour inputs
 

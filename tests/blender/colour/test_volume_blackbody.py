@@ -105,8 +105,10 @@ def test_volumes_with_temperature_grids_read_the_grid_and_only_uncorrectable_one
     with a surface shader of its own cannot be corrected: it keeps the RGB shift, and the scene's
     warnings name it."""
     bpy = __import__("bpy")
-    from relativity_addon.blender.colour import volumes
-    from relativity_addon.blender.pipeline import effect
+    volumes = dh.addon_module(relativity_addon, "colour.volumes")
+    effect = dh.addon_module(
+        relativity_addon, "pipeline.effect"
+    )  # the add-on's own (bl_ext) module, whose status the operators write
 
     scene, _camera, material = _scene(bpy)
     grid_material = material.copy()
