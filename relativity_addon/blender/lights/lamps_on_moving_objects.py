@@ -37,6 +37,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import lamp_doppler
+from ..camera import exact_camera
 from ..common import busy, compat, names, nodes
 from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
@@ -517,6 +518,12 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
         for obj in modifier.applied_objects(scene)
         if obj.relativity.motion == "ANIMATION" and obj.relativity.use_deformation
     ]
+    preview_renders = snap.speed == 0.0 or exact_camera.final_render_problem(scene, snap) is not None
+    if moving_lights.supported(snap) and not moving_lights.uses_lamps(snap) and preview_renders and movers(scene, snap):
+        found.append(
+            "Moving lights on moving objects: the render's material shader lights them as if at rest "
+            "(docs/moving-lights.md); only the exact camera's final render (a moving observer) includes their motion"
+        )
     used = light_linking_collections(scene)
     if used > MAX_LIGHT_LINKING and KEY in scene:
         found.append(
