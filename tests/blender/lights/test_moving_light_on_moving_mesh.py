@@ -261,3 +261,38 @@ def test_observer_at_rest_warns(relativity_addon, factory_blender, label, light_
     assert len(found) == 1 and "\n" not in found[0]
     scene.relativity.beta = tuple(OBSERVER)  # the exact camera's final render: no warning
     assert not [line for line in effect.scene_warnings(scene) if "Moving lights on moving objects" in line]
+
+
+def test_remove_restores_the_scene(relativity_addon, factory_blender):
+    """The pair's lamps, their collections and the stand-ins' light linking are the add-on's while
+    the final render's exact camera is set up; after the render and on Remove the file is as before."""
+    bpy = factory_blender
+    scene = _scene(bpy, np.array([BETA, 0.0, 0.0]))
+
+    def state():
+        return {
+            "objects": sorted(obj.name for obj in bpy.data.objects),
+            "lights": sorted(light.name for light in bpy.data.lights),
+            "collections": sorted(collection.name for collection in bpy.data.collections),
+            "linking": sorted(
+                (obj.name, str(obj.light_linking.receiver_collection))
+                for obj in bpy.data.objects
+                if obj.type == "LIGHT"
+            ),
+            "scene_keys": sorted(scene.keys()),
+        }
+
+    before = state()
+    effect = _module("pipeline.effect")
+    effect.apply(scene)
+    assert effect.begin_final_render(scene)
+    pairs = [obj for obj in scene.objects if obj.name.startswith("Relativity Pair") and not obj.hide_render]
+    stand_ins = [obj for obj in scene.objects if obj.name.startswith("Relativity Lamp ")]
+    assert 2 <= len(pairs) <= 6 and stand_ins
+    assert all(obj.light_linking.receiver_collection is not None for obj in pairs + stand_ins)
+    effect.end_final_render(scene)
+    effect.sync(scene)
+    assert not [obj for obj in bpy.data.objects if obj.name.startswith("Relativity Pair")]
+    assert effect.begin_final_render(scene)
+    effect.remove(scene)
+    assert state() == before
