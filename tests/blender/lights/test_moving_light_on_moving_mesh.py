@@ -296,3 +296,15 @@ def test_remove_restores_the_scene(relativity_addon, factory_blender):
     assert effect.begin_final_render(scene)
     effect.remove(scene)
     assert state() == before
+
+
+def test_exact_camera_method_refuses_the_moving_mesh(relativity_addon, factory_blender):
+    """With the exact camera's method a moving mesh is refused (README), moving light or not: the
+    case only arises on the Apparent Geometry path."""
+    scene = _scene(factory_blender, np.array([BETA, 0.0, 0.0]))
+    scene.relativity.method = "CAMERA"
+    errors = importlib.import_module(f"{ADDON_MODULE}.errors")
+    with pytest.raises(errors.RelativityError) as raised:
+        _module("pipeline.effect").apply(scene)
+    print(raised.value)
+    assert "'Sphere'" in str(raised.value) and "\n" not in str(raised.value)
