@@ -223,6 +223,8 @@ def write(scene: Scene, snap: Snapshot, movers: Sequence[Any]) -> list[str]:
             first = first or obj
             if obj.light_linking.receiver_collection != exclude:
                 obj.light_linking.receiver_collection = exclude
+        if first is None:  # its stand-ins are gone (the stage makes them again at the next sync)
+            continue
         shared = {
             socket.name: socket.default_value
             for socket in first.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs
