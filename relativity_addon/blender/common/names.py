@@ -122,6 +122,11 @@ MOVING_LAMP_PREFIX = "Relativity Lamp"  # stand-in point lamps (objects and ligh
 SUN_DOPPLER_KEY = "relativity_sun_doppler"  # on a stand-in sun's light: D of the moving sun's light
 SUN_REST_KEY = "relativity_sun_rest"  # on it too: the user's sun's colour, use_temperature, temperature
 MOVING_LAMPS_KEY = "relativity_moving_lamps"  # on the scene: {light name: [stand-in object names]}
+MOVING_PAIR_PREFIX = (
+    "Relativity Pair"  # a moving light's lamps on one moving object: "<prefix> <light> on <object> <i>"
+)
+MOVING_PAIR_KEY = "relativity_moving_pairs"  # on the scene: those lamps, their light data and collections
+MOVING_PAIR_COPY_KEY = "relativity_moving_pair"  # on such a lamp: (light name, object name, index)
 
 # --- directly visible lamps (exact camera) ----------------------------------------------------
 LAMP_FACE_PREFIX = "Relativity Lamp Face"  # emitter meshes (objects, meshes, materials): "<prefix> <light>"

@@ -37,11 +37,12 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import lamp_doppler
+from ..camera import exact_camera
 from ..common import busy, compat, names, nodes
 from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
-from . import lamp_stand_ins, moving_lights, rest_normals
+from . import lamp_stand_ins, moving_lights, moving_pairs, rest_normals, stand_in_lamps
 
 if TYPE_CHECKING:
     from bpy.types import Light, Object, Scene
@@ -91,6 +92,7 @@ def lamps(scene: Scene) -> list[Object]:
         and obj.relativity.motion == "STATIC"
         and not snapshot.light_render_hidden(obj)
         and not _skipped_lamp(obj)
+        and not moving_pairs.is_ours(scene, obj)  # a moving light's lamps: moving_pairs.py
     ]
 
 
@@ -330,11 +332,15 @@ def write(scene: Scene, snap: Snapshot) -> int:
     changed, else only their colours and settings written). Nothing without moving objects or
     off the Apparent Geometry path. With Doppler colour and searchlight both off the copies stay,
     with no factor of ``D``: the aberrated direction (and the rest normals) are geometry."""
-    pairs = []
+    pairs, moving_lit = [], []
     if snap.method == "GEOMETRY":
         lit_by = lamps(scene)
-        found = movers(scene, snap) if lit_by else []  # no lamps: nothing to place
+        moving = moving_lights.uses_lamps(snap) and bool(stand_in_lamps.stand_in_names(scene))
+        found = movers(scene, snap) if lit_by or moving else []  # no lamps: nothing to place
         pairs = [(lamp, mover) for lamp in lit_by for mover in found]
+        moving_lit = moving_pairs.write(scene, snap, found)  # moving lights on moving objects
+    else:
+        moving_pairs.remove(scene)
     record = _record(scene)
     placed = []
     for lamp, mover in pairs:
@@ -351,12 +357,15 @@ def write(scene: Scene, snap: Snapshot) -> int:
         # a bake steps frames: every copy made stays under its name, those this frame does not use hidden
         layout = sorted(map(list, {tuple(entry) for entry in kept} | {tuple(entry) for entry in layout}))
     if record is not None and kept != layout:
-        remove(scene)
+        _remove_copies(scene)
         record = None
-    if not pairs:
+    lit = sorted({mover.name for _, mover in pairs} | set(moving_lit))
+    if lit:
+        rest_normals.write(scene, [scene.objects[name] for name in lit])
+    else:
         rest_normals.remove(scene)
+    if not pairs:
         return 0
-    rest_normals.write(scene, [scene.objects[name] for name in sorted({mover.name for _, mover in pairs})])
     if record is None:
         counts: dict[tuple[str, str], int] = {}
         for lamp_name, mover_name, index in layout:
@@ -455,9 +464,14 @@ def apply(scene: Scene, snap: Snapshot) -> int:
 
 
 def remove(scene: Scene) -> int:
-    """Delete the copies, their light data and the collections; give the lamps back their own
-    (empty) light linking. Returns the number of copies removed."""
+    """Delete the copies, their light data and the collections, and the moving lights' lamps on
+    moving objects; give the lamps back their own (empty) light linking. Returns the number of
+    copies removed."""
     rest_normals.remove(scene)
+    return moving_pairs.remove(scene) + _remove_copies(scene)
+
+
+def _remove_copies(scene):
     record = _record(scene)
     if record is None:
         return 0
@@ -497,13 +511,19 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     found = [
         f"Light {obj.name!r} uses light linking: its light on moving objects is not Doppler shifted (eq. 18)"
         for obj in scene.objects
-        if obj.type == "LIGHT" and _skipped_lamp(obj) and not is_copy(obj)
+        if obj.type == "LIGHT" and _skipped_lamp(obj) and not is_copy(obj) and not moving_pairs.is_ours(scene, obj)
     ]
     found += [
         f"Object {obj.name!r} deforms: lamps light it as if it were at rest (eq. 18 not applied)"
         for obj in modifier.applied_objects(scene)
         if obj.relativity.motion == "ANIMATION" and obj.relativity.use_deformation
     ]
+    preview_renders = snap.speed == 0.0 or exact_camera.final_render_problem(scene, snap) is not None
+    if moving_lights.supported(snap) and not moving_lights.uses_lamps(snap) and preview_renders and movers(scene, snap):
+        found.append(
+            "Moving lights on moving objects: the render's material shader lights them as if at rest "
+            "(docs/moving-lights.md); only the exact camera's final render (a moving observer) includes their motion"
+        )
     used = light_linking_collections(scene)
     if used > MAX_LIGHT_LINKING and KEY in scene:
         found.append(

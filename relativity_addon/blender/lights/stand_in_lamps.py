@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Mapping, Sequence
 
     import numpy.typing as npt
-    from bpy.types import Depsgraph, Light, Scene
+    from bpy.types import Depsgraph, Light, Object, Scene
 
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import MovingLight, Snapshot
@@ -227,6 +227,16 @@ def _new_lamp(scene, name, text, kind="POINT"):
     return obj
 
 
+def new_point_lamp(scene: Scene, name: str) -> Object:
+    """A point lamp (radius 0, power 4 pi) with the moving-lamp shader, its inputs unset."""
+    return _new_lamp(scene, name, _shader_text())
+
+
+def stand_in_names(scene: Scene) -> dict[str, list[str]]:
+    """``{light name: [its stand-in lamps' object names]}`` (``names.MOVING_LAMPS_KEY``)."""
+    return _record(scene)
+
+
 def delete_lamp(name: str) -> None:
     """Delete the lamp object ``name`` (if any) and its light data once nothing else uses it."""
     obj = bpy.data.objects.get(name)
@@ -308,11 +318,14 @@ def _stored_times(scene, light_name):
     return np.array(times, float)
 
 
-def _positions(scene, snap, light, values, reception_time, times):
+def path_positions(
+    scene: Scene, snap: Snapshot, light: MovingLight, values: Mapping[str, Any], reception_time: float, times: Any
+) -> FloatArray:
     """The light's positions at the times ``c (t - t_reception)``."""
     if light.motion == "ANIMATION":
-        return _keyframe_path(scene.objects[light.name], snap, reception_time, times)
-    return np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
+        return np.asarray(_keyframe_path(scene.objects[light.name], snap, reception_time, times), dtype=np.float64)
+    path = np.array(values["light_position"], float) + np.outer(times, np.array(light.beta, float))
+    return np.asarray(path, dtype=np.float64)
 
 
 def write(
@@ -355,9 +368,9 @@ def write(
                 # at a frame change with the cockpit's Render Layers node (docs/cockpit.md)
                 ends = np.linspace(0.0, 1.0, len(times))
                 times = np.interp(np.linspace(0.0, 1.0, len(stored)), ends, times)
-                positions = _positions(scene, snap, light, values, reception_time, times)
+                positions = path_positions(scene, snap, light, values, reception_time, times)
         else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
-            positions = _positions(scene, snap, light, values, reception_time, times)
+            positions = path_positions(scene, snap, light, values, reception_time, times)
         shared = {
             key: values[key]
             for key in (
@@ -392,7 +405,8 @@ def write(
             _write_strips(scene, light, text, shared, times, positions, np.asarray(values["camera_position"], float))
 
 
-def _write_inputs(obj, inputs):
+def write_inputs(obj: Object, inputs: Mapping[str, Any]) -> None:
+    """Set the moving-lamp shader's inputs of lamp ``obj`` (only changed values)."""
     node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
     for key, value in inputs.items():
         _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
@@ -413,7 +427,7 @@ def _write_points(scene, light, text, shared, times, positions):
             next_position=tuple(positions[after]),
         )
         _set(obj, "location", tuple(float(v) for v in positions[index]))
-        _write_inputs(obj, inputs)
+        write_inputs(obj, inputs)
 
 
 def _write_strips(scene, light, text, shared, times, positions, camera_position):
@@ -458,7 +472,7 @@ def _write_strips(scene, light, text, shared, times, positions, camera_position)
         _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
         _set(obj.data, "size", max(length, 1e-6))
         _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
-        _write_inputs(obj, inputs)
+        write_inputs(obj, inputs)
 
 
 def sun_in_scene_frame(axis: npt.ArrayLike, beta: npt.ArrayLike) -> tuple[FloatArray, float]:

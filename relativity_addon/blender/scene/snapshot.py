@@ -343,7 +343,15 @@ def moving_lights(
             motion = "ANIMATION" if animated else "CONSTANT"
             if not any(observer):
                 continue  # at rest with the camera at rest: Blender's own light
-        elif obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION") or light_render_hidden(obj):
+        elif obj.type != "LIGHT" or motion not in ("CONSTANT", "ANIMATION"):
+            continue
+        if any(curve.data_path == "hide_render" for curve in compat.action_fcurves(obj.animation_data)):
+            # its F-curve would write the lamp's visibility back over the stage's hiding at each frame
+            raise RelativityError(
+                f"Light {obj.name!r} moves and its Hide in Render is keyframed: remove those keyframes "
+                "(animate its Power to switch it off)"
+            )
+        if light_render_hidden(obj):
             continue
         if cockpit.moves_with_camera(obj) and motion == "CONSTANT":
             beta = tuple(observer)

@@ -154,3 +154,26 @@ def test_keyframed_light_with_a_constraint_is_refused_in_one_line(relativity_add
     print(raised.value)
     assert "'Lamp'" in str(raised.value) and "constraints" in str(raised.value) and "\n" not in str(raised.value)
     assert _signature(bpy, scene) == before
+
+
+def test_keyframed_hide_render_on_a_moving_light_is_refused(relativity_addon, factory_blender):
+    """A moving light whose Hide in Render is keyframed: its F-curve writes the lamp's render
+    visibility back at every frame change, over the stage's hiding, so the lamp rendered as
+    Blender's lamp at its drawn position beside its stand-ins (reproduced on main: after Set Up
+    and a frame change the lamp was shown again). Set Up refuses it in one line, naming the light,
+    and leaves the scene as it was."""
+    bpy = factory_blender
+    effect = _module("pipeline.effect")
+    errors = importlib.import_module(f"{ADDON_MODULE}.errors")
+    scene, _camera, lamp = _floor_scene(bpy, method="CAMERA")
+    lamp.hide_render = False
+    lamp.keyframe_insert("hide_render", frame=1)
+    lamp.keyframe_insert("hide_render", frame=20)
+    before = _signature(bpy, scene)
+    with pytest.raises(errors.RelativityError) as raised:
+        effect.apply(scene)
+    message = str(raised.value)
+    print(message)
+    assert "\n" not in message and "'Lamp'" in message and "Hide in Render" in message
+    effect.remove(scene)
+    assert _signature(bpy, scene) == before
