@@ -12,6 +12,7 @@ Everything is vectorised over edges; the apparent map and the projection are giv
 of arrays of points, so this module knows no camera model and no motion.
 """
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -199,6 +200,12 @@ def face_levels(
     return levels, touches & (levels == 0)
 
 
+# the eight corners of a box: which of (low, high) each coordinate takes
+_CORNER_BITS = ((np.arange(8)[:, None] >> np.arange(3)) & 1).astype(bool)
+_EYE3 = np.eye(3)
+_EYE3.flags.writeable = False
+
+
 def edge_image_bound(
     rest_low: ArrayLike,
     rest_high: ArrayLike,
@@ -226,30 +233,29 @@ def edge_image_bound(
     matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
     w = np.asarray(object_beta, dtype=np.float64).reshape(3)
     beta_o = np.asarray(observer_beta, dtype=np.float64).reshape(3)
-    speed, speed_o = float(np.sqrt(w @ w)), float(np.sqrt(beta_o @ beta_o))
+    speed, speed_o = math.sqrt(float(w @ w)), math.sqrt(float(beta_o @ beta_o))
     if not (speed < 1.0 and speed_o < 1.0):
         raise ValueError("velocities must be below the speed of light")
-    gamma, gamma_o = 1.0 / np.sqrt(1.0 - speed * speed), 1.0 / np.sqrt(1.0 - speed_o * speed_o)
+    gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
     # r = A x + k: the rest point at the observer's time, relative to the observer
-    contraction = np.eye(3) - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
+    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
     a = contraction @ matrix[:3, :3]
     k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
-    corners = np.array([[(low, high)[(i >> j) & 1][j] for j in range(3)] for i in range(8)])
-    r = corners @ a.T + k
+    r = np.where(_CORNER_BITS, high, low) @ a.T + k
     # s = c tau from |r - s w| = s: convex in r, so largest at a corner of the box's image
     along = r @ w
-    s = (along + np.sqrt(along * along + (1.0 - speed * speed) * np.einsum("ij,ij->i", r, r))) / (1.0 - speed * speed)
-    s_high = float(np.max(s))
-    centre = np.mean(r, axis=0)
-    toward = centre / max(float(np.linalg.norm(centre)), 1e-300)
-    s_low = max(0.0, float(np.min(r @ toward))) / (1.0 + speed)  # |r| <= (1 + |w|) s
+    s = (along + np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=1))) / (1.0 - speed * speed)
+    s_high = float(s.max())
+    centre = r.sum(axis=0)
+    toward = centre / max(math.sqrt(float(centre @ centre)), 1e-300)
+    s_low = max(0.0, float((r @ toward).min())) / (1.0 + speed)  # |r| <= (1 + |w|) s
     # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
-    boost = np.eye(3) + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
+    boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
     h = gamma_o * beta_o - boost @ w
     forward = -np.asarray(world_to_camera, dtype=np.float64).reshape(3, 3)[2]
-    ahead, ahead_s = r @ boost.T @ forward, float(forward @ h)
+    ahead, ahead_s = r @ (boost @ forward), float(forward @ h)
     # depth f.e': concave in r when f.h <= 0 (least at a corner), else at least its linear part's least
-    depth = float(np.min(ahead + s * ahead_s)) if ahead_s <= 0.0 else float(np.min(ahead)) + s_low * ahead_s
+    depth = float((ahead + s * ahead_s).min()) if ahead_s <= 0.0 else float(ahead.min()) + s_low * ahead_s
     distance = gamma_o * (1.0 + speed_o) * s_high
     if not depth > 1e-9 * distance:
         return float("inf")
@@ -257,7 +263,6 @@ def edge_image_bound(
     width, height = resolution
     scale = max(width / (right - left), height / (top - bottom))
     # |d pixels| <= scale |v| / depth^2 |dv|;  De' = B A + h (A^T n)^T / (1 + n.w), n = e / s
-    stretch = float(np.linalg.norm(boost @ a, 2)) + float(np.linalg.norm(h)) * float(
-        np.linalg.norm(matrix[:3, :3], 2)
-    ) * gamma * (1.0 + speed)
+    norms = np.linalg.svd(np.stack((boost @ a, matrix[:3, :3])), compute_uv=False)[:, 0]
+    stretch = float(norms[0]) + math.sqrt(float(h @ h)) * float(norms[1]) * gamma * (1.0 + speed)
     return scale * distance / (depth * depth) * stretch * float(longest_edge)

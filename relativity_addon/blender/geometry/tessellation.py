@@ -203,6 +203,7 @@ PROVEN_MARGIN = 0.99
 # rest shape; forgotten when Blender evaluates the object's geometry again for a reason the add-on
 # did not announce (:func:`note_updates`).
 _rest_bounds: dict[str, tuple] = {}
+_last_bound: dict[str, tuple] = {}  # object name -> (the bound's inputs, the bound)
 _announced: set[str] = set()
 
 
@@ -231,13 +232,31 @@ def edge_image_bound(obj: Object, matrix: FloatArray, snap: Snapshot, size: tupl
     bounds = rest_bounds(obj)
     if bounds is None:
         return float("inf")
-    beta = obj.relativity.beta if obj.relativity.motion == "CONSTANT" else (0.0, 0.0, 0.0)
+    beta = tuple(obj.relativity.beta) if obj.relativity.motion == "CONSTANT" else (0.0, 0.0, 0.0)
     _t_o, x_o, beta_o = snap.mesh_observer
     window = cast("tuple[float, float, float, float]", tuple(snap.projection[1:5]))
+    # a frame step changes none of these for most objects: the last bound stands
+    key = (
+        bounds[0].tobytes(),
+        bounds[1].tobytes(),
+        bounds[2],
+        matrix.tobytes(),
+        beta,
+        tuple(x_o),
+        tuple(beta_o),
+        repr(snap.world_to_camera),
+        window,
+        size,
+    )
+    last = _last_bound.get(obj.name)
+    if last is not None and last[0] == key:
+        return last[1]
     try:
-        return tessellation.edge_image_bound(*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+        bound = tessellation.edge_image_bound(*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
     except ValueError:  # a velocity not below c: the update reports it
-        return float("inf")
+        bound = float("inf")
+    _last_bound[obj.name] = (key, bound)
+    return bound
 
 
 def announce(obj: Object) -> None:
