@@ -199,6 +199,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
 
 # The bound must clear the tolerance by this much (the modifier measures in float32).
 PROVEN_MARGIN = 0.99
+CHUNK_EDGES = 1 << 20  # edges whose lengths are computed at once
 # Object name -> (the mesh's key, rest box low, high, longest edge) of its own mesh, read once per
 # rest shape; forgotten when Blender evaluates the object's geometry again for a reason the add-on
 # did not announce (:func:`note_updates`).
@@ -220,10 +221,24 @@ def rest_bounds(obj: Object) -> tuple[FloatArray, FloatArray, float] | None:
     known = _rest_bounds.get(obj.name)
     if known is not None and known[0] == _mesh_key(mesh):
         return known[1:]
-    rest, edges = _mesh_arrays(mesh)
-    longest = float(np.max(np.linalg.norm(rest[edges[:, 1]] - rest[edges[:, 0]], axis=1), initial=0.0))
-    _rest_bounds[obj.name] = (_mesh_key(mesh), rest.min(axis=0), rest.max(axis=0), longest)
+    _rest_bounds[obj.name] = (_mesh_key(mesh), *_read_rest_bounds(mesh))
     return _rest_bounds[obj.name][1:]
+
+
+def _read_rest_bounds(mesh: Mesh) -> tuple[FloatArray, FloatArray, float]:
+    """The mesh's box (low, high) and longest edge: one read of its positions and edges."""
+    rest = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.attributes["position"].data.foreach_get("vector", rest)
+    rest = rest.reshape(-1, 3)
+    edges = np.empty(len(mesh.edges) * 2, dtype=np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    longest = 0.0
+    for start in range(0, len(edges), 2 * CHUNK_EDGES):  # bounds the float64 temporaries
+        part = edges[start : start + 2 * CHUNK_EDGES].reshape(-1, 2)
+        step = rest[part[:, 1]].astype(np.float64) - rest[part[:, 0]]  # exact: float32 ends
+        longest = max(longest, float(np.einsum("ij,ij->i", step, step).max(initial=0.0)))
+    longest = math.sqrt(longest) * (1.0 + 1e-9)
+    return rest.min(axis=0).astype(np.float64), rest.max(axis=0).astype(np.float64), longest
 
 
 def edge_image_bound(obj: Object, matrix: FloatArray, snap: Snapshot, size: tuple[float, float]) -> float:
@@ -319,6 +334,7 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
     if changed:
         modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), decision.codes)
         data[names.TESSELLATION_KEY] = decision.key()
+        announce(obj)
         obj.update_tag()
     return changed
 
