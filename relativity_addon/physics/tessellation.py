@@ -12,6 +12,7 @@ Everything is vectorised over edges; the apparent map and the projection are giv
 of arrays of points, so this module knows no camera model and no motion.
 """
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -197,3 +198,71 @@ def face_levels(
     touches = np.zeros(len(totals), dtype=bool)
     np.logical_or.at(touches, face_of_loop, subdivided_edge[loop_edges])
     return levels, touches & (levels == 0)
+
+
+# the eight corners of a box: which of (low, high) each coordinate takes
+_CORNER_BITS = ((np.arange(8)[:, None] >> np.arange(3)) & 1).astype(bool)
+_EYE3 = np.eye(3)
+_EYE3.flags.writeable = False
+
+
+def edge_image_bound(
+    rest_low: ArrayLike,
+    rest_high: ArrayLike,
+    longest_edge: float,
+    object_matrix: ArrayLike,
+    object_beta: ArrayLike,
+    observer_position: ArrayLike,
+    observer_beta: ArrayLike,
+    world_to_camera: ArrayLike,
+    window: tuple[float, float, float, float],
+    resolution: tuple[float, float],
+) -> float:
+    """An upper bound, in pixels, on the image length of every edge of a mesh in uniform motion
+    (the closed form: docs/performance.md, "A bound on the edges' images"), from its rest shape's
+    bounding box ``rest_low``/``rest_high`` and ``longest_edge`` (object space) alone: the length
+    :func:`edge_levels` compares with the tolerance, the segment between the images of the edge's
+    apparent end points seen by the pinhole of :func:`perspective_pixels` at ``observer_position``.
+    Infinite when the bound cannot show every apparent point in front of the camera.
+
+    The object is drawn with ``object_matrix`` (4, 4) at the observer's time, its rest shape
+    contracted along ``object_beta`` (fraction of c) about its origin; the observer moves with
+    ``observer_beta``; docs/physics.md, "Light-travel time" and "Lorentz boost of an event"."""
+    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
+    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
+    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
+    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
+    beta_o = np.asarray(observer_beta, dtype=np.float64).reshape(3)
+    speed, speed_o = math.sqrt(float(w @ w)), math.sqrt(float(beta_o @ beta_o))
+    if not (speed < 1.0 and speed_o < 1.0):
+        raise ValueError("velocities must be below the speed of light")
+    gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
+    # r = A x + k: the rest point at the observer's time, relative to the observer
+    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
+    a = contraction @ matrix[:3, :3]
+    k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
+    r = np.where(_CORNER_BITS, high, low) @ a.T + k
+    # s = c tau from |r - s w| = s: convex in r, so largest at a corner of the box's image
+    along = r @ w
+    s = (along + np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=1))) / (1.0 - speed * speed)
+    s_high = float(s.max())
+    centre = r.sum(axis=0)
+    toward = centre / max(math.sqrt(float(centre @ centre)), 1e-300)
+    s_low = max(0.0, float((r @ toward).min())) / (1.0 + speed)  # |r| <= (1 + |w|) s
+    # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
+    boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
+    h = gamma_o * beta_o - boost @ w
+    forward = -np.asarray(world_to_camera, dtype=np.float64).reshape(3, 3)[2]
+    ahead, ahead_s = r @ (boost @ forward), float(forward @ h)
+    # depth f.e': concave in r when f.h <= 0 (least at a corner), else at least its linear part's least
+    depth = float((ahead + s * ahead_s).min()) if ahead_s <= 0.0 else float(ahead.min()) + s_low * ahead_s
+    distance = gamma_o * (1.0 + speed_o) * s_high
+    if not depth > 1e-9 * distance:
+        return float("inf")
+    left, right, bottom, top = window
+    width, height = resolution
+    scale = max(width / (right - left), height / (top - bottom))
+    # |d pixels| <= scale |v| / depth^2 |dv|;  De' = B A + h (A^T n)^T / (1 + n.w), n = e / s
+    norms = np.linalg.svd(np.stack((boost @ a, matrix[:3, :3])), compute_uv=False)[:, 0]
+    stretch = float(norms[0]) + math.sqrt(float(h @ h)) * float(norms[1]) * gamma * (1.0 + speed)
+    return scale * distance / (depth * depth) * stretch * float(longest_edge)

@@ -73,6 +73,7 @@ _reads = [0]
 def note_updates(depsgraph: Depsgraph) -> None:
     """Forget the rest fingerprints of the objects whose geometry ``depsgraph`` evaluated again
     (called by every sync that gets a handler's depsgraph, also while the add-on computes)."""
+    tessellation.note_updates(depsgraph)
     if not _known_rest:
         return
     for update in depsgraph.updates:
@@ -205,9 +206,10 @@ def update_object(
     in_modifier = closed or keyframed.can_show(obj, scene)
     measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if in_modifier else None
     try:
-        if measure is not None and tessellation.edges_short(obj_eval):
-            # the modifier found every edge's image short at its last evaluation and left the mesh
-            # whole; it checks again at the next (a longer edge shows in the signature: decided then)
+        if measure is not None and (measure["Edges Proven Short"] or tessellation.edges_short(obj_eval)):
+            # the bound shows every edge's image short, or the modifier found them so at its last
+            # evaluation and left the mesh whole; it checks again at the next (a longer edge shows
+            # in the signature: decided then)
             decision: tessellation.Decision | None = tessellation.Decision(0, warning="")
         else:
             decision = tessellation.decide(scene, obj, obj_eval, snap)
@@ -280,6 +282,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
         if key in cache.data:
             del cache.data[key]
     if changed:
+        tessellation.announce(obj)
         obj.update_tag()
     return len(obj_eval.data.vertices)
 

@@ -81,7 +81,8 @@ def _edge_verdict_nodes() -> dict[str, Node]:
     apparent positions, the closed form's) no longer than ``Tolerance`` pixels, both ends in front
     of the camera: then no edge needs subdividing (physics/tessellation.edge_levels measures no
     such edge) and the mesh is left whole (``whole_seen``, the closed form on the incoming mesh).
-    Output: ``edges_short.Output`` (only with ``Measure Edges`` and the closed form on)."""
+    Output: ``edges_short.Output`` (only with ``Measure Edges`` and the closed form on); with ``Edges
+    Proven Short`` (a bound shows every image short) the edges are not visited."""
     return {
         # the incoming mesh moved by the closed form, once: the output when it stays whole
         "whole_rest": Node(
@@ -124,26 +125,33 @@ def _edge_verdict_nodes() -> dict[str, Node]:
             {"A": "image_length.Value", "B": "group.Tolerance"},
             {"data_type": "FLOAT", "operation": "LESS_EQUAL"},
         ),
-        "edge_fine_value": Node(
-            "GeometryNodeSwitch", {"Switch": "short.Result", "False": 0.0, "True": 1.0}, {"input_type": "FLOAT"}
+        "edge_long_value": Node(
+            "GeometryNodeSwitch", {"Switch": "short.Result", "False": 1.0, "True": 0.0}, {"input_type": "FLOAT"}
         ),
-        "edges_fine": Node(
+        # the sum of the long edges' ones: Attribute Statistic sorts every value for its Min, not for its Sum
+        "edges_long": Node(
             "GeometryNodeAttributeStatistic",
-            {"Geometry": "at_pixels.Geometry", "Attribute": "edge_fine_value.Output"},
+            {"Geometry": "at_pixels.Geometry", "Attribute": "edge_long_value.Output"},
             {"data_type": "FLOAT", "domain": "EDGE"},
         ),
         "all_fine": Node(
             "FunctionNodeCompare",
-            {"A": "edges_fine.Min", "B": 0.5},
-            {"data_type": "FLOAT", "operation": "GREATER_THAN"},
+            {"A": "edges_long.Sum", "B": 0.5},
+            {"data_type": "FLOAT", "operation": "LESS_THAN"},
         ),
         "measured": Node(
             "FunctionNodeBooleanMath", {0: "group.Measure Edges", 1: "in_modifier.Boolean"}, {"operation": "AND"}
         ),
+        # every edge short by tessellation.edge_measure_inputs' bound: no edge is visited
+        "proven_or_checked": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "group.Edges Proven Short", "False": "all_fine.Result", "True": True},
+            {"input_type": "BOOLEAN"},
+        ),
         # a Switch asks for the check only when it is on (Boolean Math would always compute it)
         "edges_short": Node(
             "GeometryNodeSwitch",
-            {"Switch": "measured.Boolean", "False": False, "True": "all_fine.Result"},
+            {"Switch": "measured.Boolean", "False": False, "True": "proven_or_checked.Output"},
             {"input_type": "BOOLEAN"},
         ),
     }
@@ -412,6 +420,7 @@ def node_group_spec() -> Group:
             *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
             ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
             *KEYFRAMED_INPUTS,
+            ("Edges Proven Short", "NodeSocketBool", {"default_value": False}),
         ),
         (("Geometry", "NodeSocketGeometry", "store_window.Output"),),
         nodes,

@@ -24,6 +24,7 @@ import zlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
+import bpy
 import numpy as np
 
 from ...physics import tessellation
@@ -32,7 +33,7 @@ from ..common.nodes import interface_identifier
 from . import modifier, motion
 
 if TYPE_CHECKING:
-    from bpy.types import Mesh, Modifier, Object, Scene
+    from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
 
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
@@ -183,6 +184,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
     offset = rotation @ (matrix[:3, 3] - np.asarray(snap.mesh_observer[1], dtype=np.float64))
     left, right, bottom, top = snap.projection[1:5]
     width, height = render_size(scene)
+    tolerance = float(settings.tessellation_tolerance)
     return {
         "Camera X": tuple(view[:, 0]),
         "Camera Y": tuple(view[:, 1]),
@@ -190,8 +192,104 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
         "Camera Offset": tuple(offset),
         "Pixel Scale": (width / (right - left), height / (top - bottom), 1.0),
         "Window Low": (left, bottom, 0.0),
-        "Tolerance": float(settings.tessellation_tolerance),
+        "Tolerance": tolerance,
+        # the bound knows uniform motion only: a keyframed object's edges are always checked
+        "Edges Proven Short": motion.closed_form(obj, scene)
+        and bool(edge_image_bound(obj, matrix, snap, (width, height)) <= PROVEN_MARGIN * tolerance),
     }
+
+
+# The bound must clear the tolerance by this much (the modifier measures in float32).
+PROVEN_MARGIN = 0.99
+CHUNK_EDGES = 1 << 20  # edges whose lengths are computed at once
+# Object name -> (the mesh's key, rest box low, high, longest edge) of its own mesh, read once per
+# rest shape; forgotten when Blender evaluates the object's geometry again for a reason the add-on
+# did not announce (:func:`note_updates`).
+_rest_bounds: dict[str, tuple] = {}
+_last_bound: dict[str, tuple] = {}  # object name -> (the bound's inputs, the bound)
+_announced: set[str] = set()
+
+
+def _mesh_key(mesh: Mesh) -> tuple:
+    return mesh.name, mesh.as_pointer(), len(mesh.vertices), len(mesh.edges)
+
+
+def rest_bounds(obj: Object) -> tuple[FloatArray, FloatArray, float] | None:
+    """The rest box (low, high) and longest edge of the object's own mesh (object space), the
+    modifier's incoming mesh, or None where that is not the mesh (edit mode, shape keys)."""
+    mesh = cast("Mesh", obj.data)
+    if mesh.is_editmode or mesh.shape_keys is not None or len(mesh.vertices) == 0:
+        return None
+    known = _rest_bounds.get(obj.name)
+    if known is not None and known[0] == _mesh_key(mesh):
+        return known[1:]
+    _rest_bounds[obj.name] = (_mesh_key(mesh), *_read_rest_bounds(mesh))
+    return _rest_bounds[obj.name][1:]
+
+
+def _read_rest_bounds(mesh: Mesh) -> tuple[FloatArray, FloatArray, float]:
+    """The mesh's box (low, high) and longest edge: one read of its positions and edges."""
+    rest = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.attributes["position"].data.foreach_get("vector", rest)
+    rest = rest.reshape(-1, 3)
+    edges = np.empty(len(mesh.edges) * 2, dtype=np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    longest = 0.0
+    for start in range(0, len(edges), 2 * CHUNK_EDGES):  # bounds the float64 temporaries
+        part = edges[start : start + 2 * CHUNK_EDGES].reshape(-1, 2)
+        step = rest[part[:, 1]].astype(np.float64) - rest[part[:, 0]]  # exact: float32 ends
+        longest = max(longest, float(np.einsum("ij,ij->i", step, step).max(initial=0.0)))
+    longest = math.sqrt(longest) * (1.0 + 1e-9)
+    return rest.min(axis=0).astype(np.float64), rest.max(axis=0).astype(np.float64), longest
+
+
+def edge_image_bound(obj: Object, matrix: FloatArray, snap: Snapshot, size: tuple[float, float]) -> float:
+    """``physics/tessellation.edge_image_bound`` of a closed-form object (pixels), inf where it
+    cannot be computed: a velocity change that it clears needs no edge visited."""
+    bounds = rest_bounds(obj)
+    if bounds is None:
+        return float("inf")
+    beta = tuple(obj.relativity.beta) if obj.relativity.motion == "CONSTANT" else (0.0, 0.0, 0.0)
+    _t_o, x_o, beta_o = snap.mesh_observer
+    window = cast("tuple[float, float, float, float]", tuple(snap.projection[1:5]))
+    # a frame step changes none of these for most objects: the last bound stands
+    key = (
+        bounds[0].tobytes(),
+        bounds[1].tobytes(),
+        bounds[2],
+        matrix.tobytes(),
+        beta,
+        tuple(x_o),
+        tuple(beta_o),
+        repr(snap.world_to_camera),
+        window,
+        size,
+    )
+    last = _last_bound.get(obj.name)
+    if last is not None and last[0] == key:
+        return last[1]
+    try:
+        bound = tessellation.edge_image_bound(*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+    except ValueError:  # a velocity not below c: the update reports it
+        bound = float("inf")
+    _last_bound[obj.name] = (key, bound)
+    return bound
+
+
+def announce(obj: Object) -> None:
+    """The next evaluation of ``obj``'s geometry is the add-on's (its settings or the modifier's
+    inputs changed): its rest shape is not read again for it."""
+    _announced.add(obj.name)
+
+
+def note_updates(depsgraph: Depsgraph) -> None:
+    """Forget the rest bounds of the objects whose geometry Blender evaluated again unannounced
+    (an edit of the mesh, or of anything else). An announcement holds for one evaluation only."""
+    for update in depsgraph.updates:
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Object):
+            if update.id.name not in _announced:
+                _rest_bounds.pop(update.id.name, None)
+    _announced.clear()
 
 
 def edges_short(obj_eval: Object) -> bool | None:
@@ -238,6 +336,7 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
     if changed:
         modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), decision.codes)
         data[names.TESSELLATION_KEY] = decision.key()
+        announce(obj)
         obj.update_tag()
     return changed
 

@@ -29,7 +29,7 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, clip_end, instancing, modifier, shape_keys
+from ..geometry import apparent_meshes, clip_end, instancing, modifier, shape_keys, tessellation
 from ..scene import animation, moving_objects, snapshot, traveller
 from . import bake, render_notice
 from .stages import STAGES, Sync
@@ -362,6 +362,7 @@ def object_changed(scene: Scene, obj: Object) -> None:
         except RelativityError as error:
             _refused(scene, error)
             return
+    tessellation.announce(obj)  # the setting's update tags the object: not an edit of its rest shape
     sync(scene, attach_new_materials=True)
 
 

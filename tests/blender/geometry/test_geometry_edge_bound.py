@@ -1,0 +1,141 @@
+"""Issue 26: a velocity change on a fine closed-form grid whose edge images the bound
+(physics/tessellation.edge_image_bound) shows short visits no edge: the add-on sets the modifier's
+``Edges Proven Short`` and runs no measure and no read of the mesh, and the modifier leaves the
+mesh whole without its per-edge check (shown by a tolerance the check would fail: the verdict
+stays, and turns when the bound's input is off). An edit of the mesh is followed (the bound's rest
+box and longest edge are read again), and a coarse box near the camera is not cleared (the check
+and the measure subdivide it; test_adaptive_tessellation.py renders its outline)."""
+
+from contextlib import contextmanager
+
+from test_geometry_closed_form import _grid_mesh
+from test_object_type_sweep import _link
+
+import geometry_helpers as gh
+from relativity_addon.blender.common import compat
+
+C = 4.0
+FPS = 24
+SIDE = 100  # 1 m wide, 5 m away at 64 x 48: edges about 0.2 px
+
+
+def _verdict(bpy, obj):
+    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    attribute = mesh.attributes.get("relativity_edges_short")
+    return None if attribute is None else bool(attribute.data[0].value), len(mesh.vertices)
+
+
+def _input(mod, name):
+    identifier = gh.addon_module("common.nodes").interface_identifier(mod.node_group, name)
+    return mod, identifier
+
+
+@contextmanager
+def _without_addon_handlers(bpy):
+    taken = []
+    for name in dir(bpy.app.handlers):
+        handlers = getattr(bpy.app.handlers, name)
+        if isinstance(handlers, list):
+            for handler in list(handlers):
+                if getattr(handler, "__module__", "").endswith("pipeline.handlers"):
+                    handlers.remove(handler)
+                    taken.append((handlers, handler))
+    try:
+        yield
+    finally:
+        for handlers, handler in taken:
+            handlers.append(handler)
+
+
+def _counted(monkeypatch, module, name, calls):
+    original = getattr(module, name)
+
+    def counted(*args, **kwargs):
+        calls[name] = calls.get(name, 0) + 1
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(module, name, counted)
+
+
+def _fine_grid(bpy):
+    scene, _camera = gh.slow_light_scene(bpy, C, FPS)
+    obj = _link(bpy, scene, "Grid", _grid_mesh(bpy, "Grid", SIDE, 1.0))
+    obj.location = (0.3, -0.2, -5.0)
+    obj.relativity.motion = "CONSTANT"
+    obj.relativity.beta = (0.5, 0.0, 0.0)
+    scene.frame_set(12)
+    return scene, obj
+
+
+def test_velocity_change_on_a_fine_grid_visits_no_edge(relativity_addon, monkeypatch):
+    import bpy
+
+    tessellation = gh.addon_module("geometry.tessellation")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, obj = _fine_grid(bpy)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    calls = {}
+    for name in ("decide", "_mesh_arrays", "_read_rest_bounds"):
+        _counted(monkeypatch, tessellation, name, calls)
+
+    for beta in ((0.52, 0.1, 0.0), (0.48, 0.0, 0.1), (0.5, 0.1, 0.0)):  # as the panel does, one after another
+        obj.relativity.beta = beta
+        verdict, vertices = _verdict(bpy, obj)
+    mod = modifier.find_modifier(obj)
+    assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
+    assert verdict is True and vertices == SIDE * SIDE
+    assert calls == {}, calls  # no measure, no read of the mesh
+
+    # the per-edge check is not run: a tolerance it would fail leaves the verdict as it is ...
+    with _without_addon_handlers(bpy):  # the add-on's syncs would set its own inputs again
+        compat.set_modifier_input(*_input(mod, "Tolerance"), 1e-6)
+        obj.update_tag()
+        assert _verdict(bpy, obj)[0] is True
+        # ... and fails it once the bound's input is off (the check runs again)
+        compat.set_modifier_input(*_input(mod, "Edges Proven Short"), False)
+        obj.update_tag()
+        assert _verdict(bpy, obj)[0] is False
+        assert compat.modifier_input(*_input(mod, "Tolerance")) < 1e-5
+
+
+def test_an_edit_of_the_mesh_is_read_again(relativity_addon, monkeypatch):
+    """The rest box and longest edge are kept while only the add-on evaluates the object; after an
+    edit (a vertex pulled far out: the grid's longest edge now long on screen) they are read again,
+    the bound no longer clears the grid and the modifier's check decides."""
+    import bpy
+
+    tessellation = gh.addon_module("geometry.tessellation")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, obj = _fine_grid(bpy)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    calls = {}
+    _counted(monkeypatch, tessellation, "_read_rest_bounds", calls)
+    for beta in ((0.51, 0.0, 0.0), (0.49, 0.0, 0.0)):
+        obj.relativity.beta = beta
+        bpy.context.evaluated_depsgraph_get()
+    assert calls == {}, calls
+
+    obj.data.vertices[SIDE + 1].co.z += 1.5
+    obj.data.update()
+    bpy.context.evaluated_depsgraph_get()
+    obj.relativity.beta = (0.5, 0.0, 0.0)
+    bpy.context.evaluated_depsgraph_get()
+    assert calls.get("_read_rest_bounds", 0) >= 1, calls
+    assert not compat.modifier_input(*_input(modifier.find_modifier(obj), "Edges Proven Short"))
+
+
+def test_coarse_box_near_the_camera_is_not_cleared(relativity_addon):
+    """The 12-face box 2 m from the camera at 0.9c (test_adaptive_tessellation.py): the bound does
+    not clear it, and it is subdivided."""
+    import bpy
+    from test_adaptive_tessellation import _box_scene
+
+    modifier = gh.addon_module("geometry.modifier")
+    scene, _camera, box, _origin = _box_scene(bpy)
+    gh.apply_geometry(scene)
+    box.relativity.beta = tuple(box.relativity.beta)  # a velocity change
+    _, vertices = _verdict(bpy, box)
+    assert not compat.modifier_input(*_input(modifier.find_modifier(box), "Edges Proven Short"))
+    assert vertices > 8
