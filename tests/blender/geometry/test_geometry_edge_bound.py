@@ -139,3 +139,28 @@ def test_coarse_box_near_the_camera_is_not_cleared(relativity_addon):
     _, vertices = _verdict(bpy, box)
     assert not compat.modifier_input(*_input(modifier.find_modifier(box), "Edges Proven Short"))
     assert vertices > 8
+
+
+def test_keyframed_motion_is_not_cleared_by_the_bound(relativity_addon):
+    """The bound knows uniform motion only (the panel's velocity): the same fine grid moved by its
+    keyframes at 0.6c gets the modifier's per-edge check, never ``Edges Proven Short`` (with the
+    velocity taken as zero, the bound cleared it: its edges stretched by the motion went unchecked)."""
+    import bpy
+
+    modifier = gh.addon_module("geometry.modifier")
+    scene, obj = _fine_grid(bpy)
+    obj.relativity.beta = (0.0, 0.0, 0.0)
+    obj.relativity.motion = "ANIMATION"
+    step = 0.6 * C / FPS  # metres per frame at 0.6c
+    for frame, x in ((-40, 0.3 - 52 * step), (40, 0.3 + 28 * step)):
+        obj.location.x = x
+        obj.keyframe_insert("location", frame=frame)
+    for fcurve in compat.action_fcurves(obj.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    mod = modifier.find_modifier(obj)
+    assert compat.modifier_input(*_input(mod, "Measure Edges")), "the modifier checks the edges"
+    assert not compat.modifier_input(*_input(mod, "Edges Proven Short"))
