@@ -7,7 +7,11 @@ retarded positions that the surfaces near the camera see, and Cycles traces thei
 Each lamp's light shader (``shaders/relativistic_moving_lamp.osl``) computes, for the receiving
 point, the light's exact retarded position and gives the two lamps around it linear weights and
 the strength ``w D^4 (t / r)^3``: a diffuse surface then gets eq. 19's ``D^4 I cos / r^2`` exactly,
-and its shadow is the weighted blend of the two lamps' shadows.
+and its shadow is the weighted blend of the two lamps' shadows. Two sharp shadows one lamp spacing
+apart blend into a stepped edge, so each lamp is drawn out into a line along the path (LINE lamp
+spacings long: STRIP_SIDES thin one-sided area lights, the shader spreading the lamp's light over
+them): its shadow is soft along the path only, and the neighbours' soft shadows, weighted, put the
+half-shadow where each point's own retarded position does (docs/moving-lights.md).
 
 The lamps are placed from ``scene.ray_cast`` over the camera's view (a grid of its rays, 5 %
 wider, from its reception event): the hit points that get at least 1 % of the brightest one's irradiance set the
@@ -48,8 +52,9 @@ if TYPE_CHECKING:
 SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
 KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in lamp spacings
-STRIP_SIDES = 3  # one-sided strips per piece of the path, facing 120 degrees apart
+STRIP_SIDES = 3  # one-sided strips per lamp (lines) or piece of the path (Continuous), facing 120 degrees apart
 STRIP_WIDTH = 1e-3  # a strip's width over its length
+LINE = 1.5  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 
 
@@ -281,8 +286,10 @@ def _stored_times(scene, light_name):
         return None
     inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
     times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]
-    if objects[0].data.type == "AREA":  # STRIP_SIDES strips per piece: the pieces' starts and the last end
-        times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+    if objects[0].data.type == "AREA":  # STRIP_SIDES strips per lamp (lines) or per piece (Continuous)
+        times = times[::STRIP_SIDES]
+        if inputs[0]["strip"].default_value == 1:  # the pieces' starts and the last end
+            times.append(inputs[-1]["next_time"].default_value)
     return np.array(times, float)
 
 
@@ -364,10 +371,11 @@ def write(
             power_of_d=float(colour.power_of_d),
             camera_power=float(colour.camera_power),
         )
+        camera_position = np.asarray(values["camera_position"], float)
         if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
-            _write_points(scene, light, text, shared, times, positions)
+            _write_points(scene, light, text, shared, times, positions, camera_position)
         else:
-            _write_strips(scene, light, text, shared, times, positions, np.asarray(values["camera_position"], float))
+            _write_strips(scene, light, text, shared, times, positions, camera_position)
 
 
 def _write_inputs(obj, inputs):
@@ -376,21 +384,53 @@ def _write_inputs(obj, inputs):
         _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
 
 
-def _write_points(scene, light, text, shared, times, positions):
-    """One point lamp at each time, lighting the points whose retarded times lie next to it."""
+def _place_strip(obj, centre, axis, length, side, camera_position):
+    """Set strip ``obj`` (an area light) ``length`` long along ``axis`` at ``centre``, side ``side`` of
+    STRIP_SIDES facing 360 / STRIP_SIDES degrees apart about the axis (the first toward the camera);
+    returns its normal (it emits along it)."""
+    first = camera_position - centre
+    first = first - (first @ axis) * axis
+    if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
+        first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
+    first /= np.linalg.norm(first)
+    angle = 2.0 * math.pi * side / STRIP_SIDES  # Rodrigues: the first normal turned about the axis
+    normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
+    rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
+    _set(obj, "location", tuple(float(v) for v in centre))
+    _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
+    _set(obj.data, "size", max(length, 1e-6))
+    _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
+    return normal
+
+
+def _write_points(scene, light, text, shared, times, positions, camera_position):
+    """A lamp at each time, lighting the points whose retarded times lie next to it: a point lamp,
+    or (LINE, two lamps or more) STRIP_SIDES strips LINE lamp spacings long along the path."""
     last = len(times) - 1
-    for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
+    lines = LINE > 0.0 and last > 0
+    sides = STRIP_SIDES if lines else 1
+    lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT")
+    for number, obj in enumerate(lamps):
+        index, side = divmod(number, sides)
         before, after = max(index - 1, 0), min(index + 1, last)
         inputs = dict(
             shared,
-            strip=0,
+            strip=2 if lines else 0,
+            lamp_position=tuple(positions[index]),
             lamp_time=float(times[index]),
             previous_time=float(times[before]),
             previous_position=tuple(positions[before]),
             next_time=float(times[after]),
             next_position=tuple(positions[after]),
         )
-        _set(obj, "location", tuple(float(v) for v in positions[index]))
+        if lines:
+            along = positions[after] - positions[before]
+            gap = float(np.linalg.norm(along)) / (after - before)  # the lamp spacing here
+            axis = along / max(float(np.linalg.norm(along)), 1e-30)
+            normal = _place_strip(obj, positions[index], axis, LINE * gap, side, camera_position)
+            inputs["strip_normal"] = tuple(normal)
+        else:
+            _set(obj, "location", tuple(float(v) for v in positions[index]))
         _write_inputs(obj, inputs)
 
 
@@ -406,14 +446,7 @@ def _write_strips(scene, light, text, shared, times, positions, camera_position)
         along = end - start
         length = float(np.linalg.norm(along))
         axis = along / max(length, 1e-30)
-        first = camera_position - 0.5 * (start + end)
-        first = first - (first @ axis) * axis
-        if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
-            first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
-        first /= np.linalg.norm(first)
-        angle = 2.0 * math.pi * side / STRIP_SIDES  # Rodrigues: the first normal turned about the axis
-        normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
-        rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
+        normal = _place_strip(obj, 0.5 * (start + end), axis, length, side, camera_position)
         after = min(piece + 2, pieces)
         inputs = dict(
             shared,
@@ -432,10 +465,6 @@ def _write_strips(scene, light, text, shared, times, positions, camera_position)
             strip_normal=tuple(normal),
             strip_length=length,
         )
-        _set(obj, "location", tuple(float(v) for v in 0.5 * (start + end)))
-        _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
-        _set(obj.data, "size", max(length, 1e-6))
-        _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
         _write_inputs(obj, inputs)
 
 
