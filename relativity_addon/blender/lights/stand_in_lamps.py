@@ -34,7 +34,7 @@ from mathutils import Matrix, Vector
 from ...errors import RelativityError
 from ...physics import spectral_render
 from ...physics.lorentz import aberrate, camera_to_scene_direction
-from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
+from ...physics.moving_lights import end_on_share, lamp_times, retarded_times, retarded_times_on_path
 from ..camera import cockpit
 from ..colour import light_groups, materials
 from ..common import busy, names
@@ -55,6 +55,7 @@ KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in 
 STRIP_SIDES = 3  # one-sided strips per lamp (lines) or piece of the path (Continuous), facing 120 degrees apart
 STRIP_WIDTH = 1e-3  # a strip's width over its length
 LINE = 1.5  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
+END_ON = 0.2  # point lamps instead of lines when this share of the lit points' light comes along the path
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 
 
@@ -293,6 +294,26 @@ def _stored_times(scene, light_name):
     return np.array(times, float)
 
 
+def _use_lines(points, camera_position, times, positions):
+    """Whether the lamps at ``times`` (``positions``) are drawn out into lines: unless the surface
+    points see the path nearly end on (within 6 degrees of it for END_ON of their light), where a
+    strip along it would be seen edge on and light them through a sliver (or not at all)."""
+    if LINE <= 0.0 or len(times) < 2:
+        return False
+    if len(points) == 0:
+        return True
+    point_times, irradiance = retarded_times_on_path(points, camera_position, times, positions)
+    return end_on_share(point_times, irradiance, points, times, positions, sin_limit=0.1) <= END_ON
+
+
+def _stored_lines(scene, light_name):
+    """Whether the last placement drew the lamps of ``light_name`` as lines."""
+    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
+    if not objects or objects[0] is None or objects[0].data.type != "AREA":
+        return False
+    return objects[0].data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["strip"].default_value == 2
+
+
 def _positions(scene, snap, light, values, reception_time, times):
     """The light's positions at the times ``c (t - t_reception)``."""
     if light.motion == "ANIMATION":
@@ -327,12 +348,15 @@ def write(
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
+        camera_position = np.asarray(values["camera_position"], float)
         stored = _stored_times(scene, light.name)
         times = None if depsgraph is not None else stored
+        lines = _stored_lines(scene, light.name)
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
+            lines = _use_lines(points, camera_position, times, positions)
             keep = busy.rendering() or cockpit.is_applied(scene)
             if keep and stored is not None and len(stored) != len(times):
                 # as many as there are: stand-ins made and deleted between Render Animation's
@@ -371,9 +395,8 @@ def write(
             power_of_d=float(colour.power_of_d),
             camera_power=float(colour.camera_power),
         )
-        camera_position = np.asarray(values["camera_position"], float)
         if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
-            _write_points(scene, light, text, shared, times, positions, camera_position)
+            _write_points(scene, light, text, shared, times, positions, camera_position, lines)
         else:
             _write_strips(scene, light, text, shared, times, positions, camera_position)
 
@@ -403,11 +426,11 @@ def _place_strip(obj, centre, axis, length, side, camera_position):
     return normal
 
 
-def _write_points(scene, light, text, shared, times, positions, camera_position):
+def _write_points(scene, light, text, shared, times, positions, camera_position, lines):
     """A lamp at each time, lighting the points whose retarded times lie next to it: a point lamp,
-    or (LINE, two lamps or more) STRIP_SIDES strips LINE lamp spacings long along the path."""
+    or (``lines``, two lamps or more) STRIP_SIDES strips LINE lamp spacings long along the path."""
     last = len(times) - 1
-    lines = LINE > 0.0 and last > 0
+    lines = lines and last > 0
     sides = STRIP_SIDES if lines else 1
     lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT")
     for number, obj in enumerate(lamps):

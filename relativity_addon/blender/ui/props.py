@@ -315,8 +315,9 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
             (
                 "BLENDED",
                 "Blended Lamps",
-                "Point lamps on the light's path, each point's shadow blended from the two around its retarded "
-                "position: sharp, but stepped where the retarded position changes fast across a shadow",
+                "Lamps on the light's path, each drawn out into a short line along it, each point's shadow "
+                "blended from the two around its retarded position: shadow edges follow the retarded shadow "
+                "without steps, softened along the motion over 1.5 lamp spacings",
                 0,
             ),
             (
