@@ -23,7 +23,6 @@ lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the sc
 from __future__ import annotations
 
 import math
-import os
 import warnings
 from typing import TYPE_CHECKING, Any
 
@@ -39,6 +38,7 @@ from ..camera import cockpit
 from ..colour import light_groups, materials
 from ..common import busy, names
 from ..scene import animation, lens, sources
+from . import lamp_shader
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping, Sequence
@@ -49,7 +49,6 @@ if TYPE_CHECKING:
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import MovingLight, Snapshot
 
-SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
 KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in lamp spacings
 STRIP_SIDES = 3  # one-sided strips per lamp (lines) or piece of the path (Continuous), facing 120 degrees apart
@@ -57,53 +56,6 @@ STRIP_WIDTH = 1e-3  # a strip's width over its length
 LINE = 1.5  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
 END_ON = 0.2  # point lamps instead of lines when this share of the lit points' light comes along the path
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
-
-
-def _cmf_defines():
-    """The colour matching functions every 10 nm (360-830 nm) and XYZ -> linear Rec.709, as OSL
-    macros (OSL has no global arrays): the shipped tables of the spectral mode."""
-    tables = spectral_render.tables()
-    rows = tables["cmfs_nm"] % 10.0 == 0.0
-    cmfs = tables["cmfs"][rows]
-
-    def array(values):
-        return ", ".join(f"{float(v):.7g}" for v in values)
-
-    declare = " ".join(
-        f"float CMF_{axis}[{len(cmfs)}] = {{{array(cmfs[:, index])}}};" for index, axis in enumerate("XYZ")
-    )
-    declare += f" float XYZ_TO_RGB[9] = {{{array(np.asarray(tables['xyz_to_rgb']).ravel())}}};"
-    return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
-
-
-def basis_defines() -> str:
-    """Mallett & Yuksel's basis on its 5 nm grid over its constrained band (outside it the basis
-    is held at the band's edge values, ``physics.spectral_render.reflectance_matrix``) and the white's
-    temperature, as OSL macros: the table the shader interpolates linearly."""
-    tables = spectral_render.tables()
-    low, high = (float(v) for v in tables["basis_band_nm"])
-    rows = (tables["basis_nm"] >= low) & (tables["basis_nm"] <= high)
-    grid, basis = tables["basis_nm"][rows], tables["basis"][rows]
-    step = float(grid[1] - grid[0])
-    if not (grid[0] == low and grid[-1] == high and np.allclose(np.diff(grid), step)):
-        raise RelativityError("The shipped RGB basis table is not on an even grid over its band")
-    values = ", ".join(f"{float(v):.9g}" for v in basis.ravel())
-    return (
-        f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
-        f"#define WHITE_TEMPERATURE {spectral_render.WHITE_TEMPERATURE_K!r}\n"
-        f"#define BASIS_DECLARE float BASIS[{basis.size}] = {{{values}}};\n"
-    )
-
-
-def _shader_text():
-    with open(SHADER_PATH, encoding="utf-8") as handle:
-        source = handle.read().replace("/* @CMF_TABLES@ */", _cmf_defines())
-        source = source.replace("/* @BASIS_TABLE@ */", basis_defines())
-    text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT) or bpy.data.texts.new(names.MOVING_LAMP_SHADER_TEXT)
-    if text.as_string().rstrip("\n") != source.rstrip("\n"):
-        text.clear()
-        text.write(source)
-    return text
 
 
 def view_directions(
@@ -334,7 +286,7 @@ def write(
     t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
     is given or none exist yet; without one, the last placement's times are kept and the lamps move
     along the path to them."""
-    text = _shader_text()
+    text = lamp_shader.shader_text()
     record = _record(scene)
     for stale in set(record) - {light.name for light in lights}:
         for name in record.pop(stale):
@@ -356,8 +308,9 @@ def write(
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
-            lines = _use_lines(points, camera_position, times, positions)
             keep = busy.rendering() or cockpit.is_applied(scene)
+            if not (keep and stored is not None):  # while rendering the lamps stay what they are (below)
+                lines = _use_lines(points, camera_position, times, positions)
             if keep and stored is not None and len(stored) != len(times):
                 # as many as there are: stand-ins made and deleted between Render Animation's
                 # frames (frame_change_post) crashed Blender 5.2's render of the next frame, and
