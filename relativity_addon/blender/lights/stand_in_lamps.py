@@ -9,7 +9,7 @@ point, the light's exact retarded position and gives the two lamps around it lin
 the strength ``w D^4 (t / r)^3``: a diffuse surface then gets eq. 19's ``D^4 I cos / r^2`` exactly,
 and its shadow is the weighted blend of the two lamps' shadows. Two sharp shadows one lamp spacing
 apart blend into a stepped edge, so each lamp is drawn out into a line along the path (LINE lamp
-spacings long: STRIP_SIDES thin one-sided area lights, the shader spreading the lamp's light over
+spacings long: LINE_SIDES thin one-sided area lights, the shader spreading the lamp's light over
 them): its shadow is soft along the path only, and the neighbours' soft shadows, weighted, put the
 half-shadow where each point's own retarded position does (docs/moving-lights.md).
 
@@ -53,7 +53,8 @@ MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two li
 KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in lamp spacings
 STRIP_SIDES = 3  # one-sided strips per lamp (lines) or piece of the path (Continuous), facing 120 degrees apart
 STRIP_WIDTH = 1e-3  # a strip's width over its length
-LINE = 1.5  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
+LINE_SIDES = 2  # strips per line (facing opposite ways)
+LINE = 1.25  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
 END_ON = 0.2  # point lamps instead of lines when this share of the lit points' light comes along the path
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
 
@@ -239,10 +240,11 @@ def _stored_times(scene, light_name):
         return None
     inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
     times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]
-    if objects[0].data.type == "AREA":  # STRIP_SIDES strips per lamp (lines) or per piece (Continuous)
-        times = times[::STRIP_SIDES]
+    if objects[0].data.type == "AREA":  # LINE_SIDES strips per lamp (lines) or STRIP_SIDES per piece
         if inputs[0]["strip"].default_value == 1:  # the pieces' starts and the last end
-            times.append(inputs[-1]["next_time"].default_value)
+            times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+        else:
+            times = times[:: inputs[0]["strip_sides"].default_value]
     return np.array(times, float)
 
 
@@ -360,16 +362,16 @@ def _write_inputs(obj, inputs):
         _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
 
 
-def _place_strip(obj, centre, axis, length, side, camera_position):
+def _place_strip(obj, centre, axis, length, side, camera_position, sides=STRIP_SIDES):
     """Set strip ``obj`` (an area light) ``length`` long along ``axis`` at ``centre``, side ``side`` of
-    STRIP_SIDES facing 360 / STRIP_SIDES degrees apart about the axis (the first toward the camera);
+    ``sides`` facing 360 / ``sides`` degrees apart about the axis (the first toward the camera);
     returns its normal (it emits along it)."""
     first = camera_position - centre
     first = first - (first @ axis) * axis
     if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
         first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
     first /= np.linalg.norm(first)
-    angle = 2.0 * math.pi * side / STRIP_SIDES  # Rodrigues: the first normal turned about the axis
+    angle = 2.0 * math.pi * side / sides  # Rodrigues: the first normal turned about the axis
     normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
     rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
     _set(obj, "location", tuple(float(v) for v in centre))
@@ -381,10 +383,10 @@ def _place_strip(obj, centre, axis, length, side, camera_position):
 
 def _write_points(scene, light, text, shared, times, positions, camera_position, lines):
     """A lamp at each time, lighting the points whose retarded times lie next to it: a point lamp,
-    or (``lines``, two lamps or more) STRIP_SIDES strips LINE lamp spacings long along the path."""
+    or (``lines``, two lamps or more) LINE_SIDES strips LINE lamp spacings long along the path."""
     last = len(times) - 1
     lines = lines and last > 0
-    sides = STRIP_SIDES if lines else 1
+    sides = LINE_SIDES if lines else 1
     lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT")
     for number, obj in enumerate(lamps):
         index, side = divmod(number, sides)
@@ -403,8 +405,8 @@ def _write_points(scene, light, text, shared, times, positions, camera_position,
             along = positions[after] - positions[before]
             gap = float(np.linalg.norm(along)) / (after - before)  # the lamp spacing here
             axis = along / max(float(np.linalg.norm(along)), 1e-30)
-            normal = _place_strip(obj, positions[index], axis, LINE * gap, side, camera_position)
-            inputs["strip_normal"] = tuple(normal)
+            normal = _place_strip(obj, positions[index], axis, LINE * gap, side, camera_position, sides)
+            inputs.update(strip_normal=tuple(normal), strip_sides=sides)
         else:
             _set(obj, "location", tuple(float(v) for v in positions[index]))
         _write_inputs(obj, inputs)
