@@ -317,7 +317,7 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
                 "Blended Lamps",
                 "Lamps on the light's path, each drawn out into a short line along it, each point's shadow "
                 "blended from the two around its retarded position: shadow edges follow the retarded shadow "
-                "without steps, softened along the motion over 1.5 lamp spacings",
+                "without steps, softened along the motion over 1.25 lamp spacings",
                 0,
             ),
             (

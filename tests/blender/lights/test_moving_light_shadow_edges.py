@@ -184,8 +184,8 @@ def test_harsh_shadow_edges_follow_the_retarded_shadow(relativity_addon, factory
 def test_default_harsh_shadow_follows_the_retarded_shadow(relativity_addon, factory_blender, tmp_path):
     """The default setting (Blended Lamps, each lamp a line along the path): the edge within 1 px of
     the exact one on average, found near it on nearly every row, as smooth as the exact edge (no
-    steps). The lines soften the shadow along the motion (over 1.5 lamp spacings through the bar,
-    about 10 px here): the bright floor is judged 8 px clear of it."""
+    steps). The lines soften the shadow along the motion (over 1.25 lamp spacings through the bar,
+    about 9 px here): the bright floor is judged 8 px clear of it."""
     share, mean_offset, scatter = _render_and_measure(factory_blender, tmp_path, None, clear_px=8)
     assert share > 0.9
     assert mean_offset < 1.0
