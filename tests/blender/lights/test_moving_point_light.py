@@ -320,7 +320,10 @@ def test_apparent_geometry_final_render_with_a_moving_observer(relativity_addon,
     observer = (0.2, 0.1, 0.0)
     images = {}
     for method in ("CAMERA", "GEOMETRY"):
-        scene, _camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS, method=method)
+        # twice the samples: with the stand-ins drawn out into lines (the default) the two renders
+        # are the same up to their noise, which differs on Blender 4.5 (measured at 64 samples: mean
+        # ratio 1.0001, mean |difference| 0.032 of the mean; point lamps rendered identically)
+        scene, _camera, _lamp = _floor_scene(bpy, samples=2 * SAMPLES_LAMPS, method=method)
         scene.relativity.beta = observer
         assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
         images[method] = _render(bpy, scene, tmp_path / f"{method}.exr")[..., :3]
