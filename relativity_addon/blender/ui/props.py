@@ -325,8 +325,8 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
                 "Continuous",
                 "Thin strips along the light's path: each point's shadow rays go to the path around its own "
                 "retarded position, so shadow edges follow the retarded shadow without steps, softened over "
-                "half a lamp spacing; much noisier (measured: 3.7x the noise of Blended Lamps at the same samples, "
-                "1.5x the render time)",
+                "half a lamp spacing; much noisier (measured: 2.9x the noise of Blended Lamps at the same samples, "
+                "about the same render time)",
                 1,
             ),
         ),
