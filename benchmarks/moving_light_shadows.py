@@ -1,15 +1,17 @@
-"""Cost and noise of Continuous moving-light shadows against Blended Lamps (docs/moving-lights.md).
+"""Cost and noise of the moving-light shadow renderers (docs/moving-lights.md): Blended Lamps as
+lines (the default), the same lamps as points (``stand_in_lamps.LINE = 0``, the default before) and
+Continuous.
 
     python benchmarks/moving_light_shadows.py [--samples 64] [--resolution 160x120] [--repeats 3]
 
 The floor of tests/blender/lights/test_moving_point_light.py (white, a point lamp 1 above it at
-0.5c, camera 5 above at rest, exact camera) with the black square 0.5 above the floor. The two
-modes are rendered alternately, each at two seeds per round, so that load from other processes
-hits both alike; per round the Continuous render's wall-clock and CPU time are divided by the
-Blended one's, and the median ratios are printed with the load average. Noise, measured without a
-reference: the two seeds' difference over the lit floor (at least a tenth of the brightest pixel,
-both renders), ``std(a - b) / sqrt(2)`` over the mean, per mode; its ratio says how many more
-samples Continuous needs for Blended's noise (the square of it).
+0.5c, camera 5 above at rest, exact camera) with the black square 0.5 above the floor. The
+variants are rendered in turn, each at two seeds per round, so that load from other processes
+hits them alike; per round each render's wall-clock and CPU time are divided by the point lamps'
+, and the median ratios are printed with the load average. Noise, measured without a reference:
+the two seeds' difference over the lit floor (at least a tenth of the brightest pixel, both
+renders), ``std(a - b) / sqrt(2)`` over the mean, per variant; its ratio to the point lamps' says
+how many more samples a variant needs for their noise (the square of it).
 """
 
 import argparse
@@ -29,7 +31,7 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 
 from camera_overhead import empty_cycles_scene  # noqa: E402
 
-MODES = ("BLENDED", "CONTINUOUS")
+VARIANTS = ("points", "lines", "continuous")  # Blended Lamps as points, as lines (the default); Continuous
 
 
 def _quad(bpy, scene, name, centre, half, colour):
@@ -109,32 +111,41 @@ def main():
     from relativity_addon.blender.pipeline import effect
 
     scene = build_scene(bpy, resolution, args.samples)
+    from relativity_addon.blender.lights import stand_in_lamps
+
+    line = stand_in_lamps.LINE
     load = os.getloadavg()
-    times = {mode: [] for mode in MODES}
-    noise = {mode: [] for mode in MODES}
+    times = {variant: [] for variant in VARIANTS}
+    noise = {variant: [] for variant in VARIANTS}
     with tempfile.TemporaryDirectory() as folder:
         for round_index in range(args.repeats):
-            for mode in MODES:
-                scene.relativity.moving_light_shadows = mode
+            for variant in VARIANTS:
+                scene.relativity.moving_light_shadows = "CONTINUOUS" if variant == "continuous" else "BLENDED"
+                stand_in_lamps.LINE = 0.0 if variant == "points" else line
                 effect.apply(scene)
-                runs = [render(bpy, scene, os.path.join(folder, f"{mode}_{seed}.exr"), seed) for seed in (1, 2)]
+                runs = [render(bpy, scene, os.path.join(folder, f"{variant}_{seed}.exr"), seed) for seed in (1, 2)]
                 effect.remove(scene)
-                times[mode].append((runs[0][0] + runs[1][0], runs[0][1] + runs[1][1]))
+                times[variant].append((runs[0][0] + runs[1][0], runs[0][1] + runs[1][1]))
                 a, b = runs[0][2], runs[1][2]
                 lit = (a > 0.1 * a.max()) & (b > 0.1 * b.max())
-                noise[mode].append(float(np.std((a - b)[lit]) / math.sqrt(2.0) / np.mean(0.5 * (a + b)[lit])))
-            print(f"round {round_index + 1}: " + ", ".join(f"{m} {times[m][-1][0]:.1f} s" for m in MODES), flush=True)
-    wall = statistics.median(c[0] / b[0] for b, c in zip(times["BLENDED"], times["CONTINUOUS"], strict=True))
-    cpu = statistics.median(c[1] / b[1] for b, c in zip(times["BLENDED"], times["CONTINUOUS"], strict=True))
-    blended, continuous = statistics.median(noise["BLENDED"]), statistics.median(noise["CONTINUOUS"])
+                noise[variant].append(float(np.std((a - b)[lit]) / math.sqrt(2.0) / np.mean(0.5 * (a + b)[lit])))
+            summary = ", ".join(f"{v} {times[v][-1][0]:.1f} s" for v in VARIANTS)
+            print(f"round {round_index + 1}: {summary}", flush=True)
+    stand_in_lamps.LINE = line
     end_load = os.getloadavg()
-    print(f"{resolution[0]}x{resolution[1]}, {args.samples} samples, {args.repeats} rounds of two seeds per mode")
+    print(f"{resolution[0]}x{resolution[1]}, {args.samples} samples, {args.repeats} rounds of two seeds per variant")
     print(f"load average {load[0]:.1f} at the start, {end_load[0]:.1f} at the end")
-    print(f"render time Continuous / Blended: wall {wall:.2f}x, CPU {cpu:.2f}x")
-    print(
-        f"noise (relative, lit floor): Blended {blended:.3f}, Continuous {continuous:.3f}: "
-        f"ratio {continuous / blended:.2f} (about {(continuous / blended) ** 2:.1f}x the samples for the same noise)"
-    )
+    points = statistics.median(noise["points"])
+    for variant in VARIANTS[1:]:
+        pairs = list(zip(times["points"], times[variant], strict=True))
+        wall = statistics.median(v[0] / p[0] for p, v in pairs)
+        cpu = statistics.median(v[1] / p[1] for p, v in pairs)
+        ratio = statistics.median(noise[variant]) / points
+        print(
+            f"{variant} / points: render time wall {wall:.2f}x, CPU {cpu:.2f}x; noise (relative, lit floor) "
+            f"{statistics.median(noise[variant]):.3f} against {points:.3f}: ratio {ratio:.2f} "
+            f"(about {ratio**2:.1f}x the samples for the same noise)"
+        )
     relativity_addon.unregister()
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .arrays import ArrayLike, FloatArray
+from .lorentz import aberrate
 from .radiance import point_light_irradiance
 from .retarded import light_travel_time_uniform
 from .validation import finite_array, unit_vectors, vector_array, velocity_array
@@ -148,6 +149,38 @@ def lamp_times(
     return np.linspace(low, high, count)
 
 
+def end_on_share(
+    times: ArrayLike,
+    irradiance: ArrayLike,
+    surface_points: ArrayLike,
+    path_times: ArrayLike,
+    path_positions: ArrayLike,
+    sin_limit: float = 0.25,
+    relevance: float = 0.01,
+) -> float:
+    """The share of the lit points' irradiance (those getting at least ``relevance`` of the
+    brightest's, as :func:`lamp_times` counts them) that sees the light's path nearly end on: the
+    direction from the light's retarded position (``times``, on the path of :func:`path_position`)
+    to the point within ``asin(sin_limit)`` of the path's piece there. A thin strip along the path
+    lights nothing from which it is seen edge on."""
+    times = finite_array(times, "times").ravel()
+    irradiance = np.asarray(irradiance, float).ravel()
+    x = vector_array(surface_points, "surface_points").reshape(-1, 3)
+    knots = finite_array(path_times, "path_times")
+    path = vector_array(path_positions, "path_positions")
+    keep = np.isfinite(irradiance) & (irradiance > 0.0)
+    if knots.size < 2 or not np.any(keep):
+        return 0.0
+    keep &= irradiance >= relevance * irradiance[keep].max()
+    index = np.clip(np.searchsorted(knots, times[keep]) - 1, 0, knots.size - 2)
+    along = path[index + 1] - path[index]
+    along /= np.maximum(np.linalg.norm(along, axis=-1, keepdims=True), 1e-300)
+    seen = x[keep] - path_position(times[keep], knots, path)
+    sine = np.linalg.norm(np.cross(seen, along), axis=-1) / np.maximum(np.linalg.norm(seen, axis=-1), 1e-300)
+    weight = irradiance[keep]
+    return float(weight[sine < sin_limit].sum() / weight.sum())
+
+
 def path_position(times: ArrayLike, path_times: ArrayLike, path_positions: ArrayLike) -> FloatArray:
     """The light's position at ``times`` on a path sampled at ascending ``path_times`` (``c t``),
     straight between samples and extended straight beyond the first and last."""
@@ -187,3 +220,14 @@ def retarded_times_on_path(
         doppler = 1.0 / (gamma * (1.0 - np.sum(beta * n, axis=-1)))
         irradiance = doppler**4 / r**2
     return s, irradiance
+
+
+def sun_in_scene_frame(axis: ArrayLike, beta: ArrayLike) -> tuple[FloatArray, float]:
+    """A sun (plane wave) moving with ``beta``: the photon direction in the scene frame (its own
+    frame's ``axis`` aberrated) and ``D = 1 / (gamma (1 - beta . k))``; the irradiance on a surface
+    facing it scales by ``D^2`` (radiance ``D^4`` times the disc's solid angle ``1 / D^2``) and its
+    angular diameter by ``1 / D``."""
+    beta = np.array(beta, float)
+    k = aberrate(np.array(axis, float), -beta)
+    gamma = 1.0 / float(np.sqrt(1.0 - float(beta @ beta)))
+    return k, 1.0 / (gamma * (1.0 - float(beta @ k)))

@@ -203,3 +203,16 @@ def test_path_position_is_straight_between_and_beyond_its_samples():
         moving_lights.path_position(np.array([-1.0, -4.0, 2.0]), knots, points),
         [[0.5, 1.0, 0.0], [-1.0, -2.0, 0.0], [2.0, 4.0, 0.0]],
     )
+
+
+def test_end_on_share_counts_the_light_arriving_along_the_path():
+    """A light on the x axis: points on the axis beyond it see the path end on, points below it
+    broadside; the share is theirs of the irradiance (the dim point under 1 % is left out)."""
+    path_times, path = np.array([-2.0, 0.0]), np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    points = np.array([[3.0, 0.0, 0.0], [3.0, 0.05, 0.0], [0.0, 0.0, -1.0], [-0.5, 0.0, -2.0], [9.0, 0.0, 0.0]])
+    times = np.array([0.0, 0.0, 0.0, -1.0, 0.0])  # on the path: the light at (0, 0, 0), or (-0.5, 0, 0)
+    irradiance = np.array([1.0, 2.0, 3.0, 4.0, 0.001])
+    # sines: 0, 0.05 / 3.0004, 1, 1, 0
+    assert moving_lights.end_on_share(times, irradiance, points, path_times, path, sin_limit=0.1) == 0.3
+    assert moving_lights.end_on_share(times, irradiance, points, path_times, path, sin_limit=0.01) == 0.1
+    assert moving_lights.end_on_share(times, irradiance, points, path_times[:1], path[:1]) == 0.0

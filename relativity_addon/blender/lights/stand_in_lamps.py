@@ -7,7 +7,11 @@ retarded positions that the surfaces near the camera see, and Cycles traces thei
 Each lamp's light shader (``shaders/relativistic_moving_lamp.osl``) computes, for the receiving
 point, the light's exact retarded position and gives the two lamps around it linear weights and
 the strength ``w D^4 (t / r)^3``: a diffuse surface then gets eq. 19's ``D^4 I cos / r^2`` exactly,
-and its shadow is the weighted blend of the two lamps' shadows.
+and its shadow is the weighted blend of the two lamps' shadows. Two sharp shadows one lamp spacing
+apart blend into a stepped edge, so each lamp is drawn out into a line along the path (LINE lamp
+spacings long: LINE_SIDES thin one-sided area lights, the shader spreading the lamp's light over
+them): its shadow is soft along the path only, and the neighbours' soft shadows, weighted, put the
+half-shadow where each point's own retarded position does (docs/moving-lights.md).
 
 The lamps are placed from ``scene.ray_cast`` over the camera's view (a grid of its rays, 5 %
 wider, from its reception event): the hit points that get at least 1 % of the brightest one's irradiance set the
@@ -19,7 +23,6 @@ lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the sc
 from __future__ import annotations
 
 import math
-import os
 import warnings
 from typing import TYPE_CHECKING, Any
 
@@ -29,12 +32,19 @@ from mathutils import Matrix, Vector
 
 from ...errors import RelativityError
 from ...physics import spectral_render
-from ...physics.lorentz import aberrate, camera_to_scene_direction
-from ...physics.moving_lights import lamp_times, retarded_times, retarded_times_on_path
+from ...physics.lorentz import camera_to_scene_direction
+from ...physics.moving_lights import (
+    end_on_share,
+    lamp_times,
+    retarded_times,
+    retarded_times_on_path,
+    sun_in_scene_frame,
+)
 from ..camera import cockpit
 from ..colour import light_groups, materials
 from ..common import busy, names
 from ..scene import animation, lens, sources
+from . import lamp_shader
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping, Sequence
@@ -45,59 +55,14 @@ if TYPE_CHECKING:
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import MovingLight, Snapshot
 
-SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.MOVING_LAMP_SHADER_TEXT)
 MAX_LAMPS = 16  # per moving light: each costs Cycles light samples (only two light a point); more: sharper shadows
 KERNEL = 0.5  # the box of path each point is lit from (continuous shadows), in lamp spacings
-STRIP_SIDES = 3  # one-sided strips per piece of the path, facing 120 degrees apart
+STRIP_SIDES = 3  # one-sided strips per lamp (lines) or piece of the path (Continuous), facing 120 degrees apart
 STRIP_WIDTH = 1e-3  # a strip's width over its length
+LINE_SIDES = 3  # strips per line, facing 120 degrees apart (two facing opposite ways: a plane seen edge on)
+LINE = 1.25  # Blended Lamps: each lamp a line (strips) this many lamp spacings long along the path (0: points)
+END_ON = 0.2  # point lamps instead of lines when this share of the lit points' light comes along the path
 SPACING = 0.1  # wanted distance between neighbouring lamps, as a fraction of the median light distance
-
-
-def _cmf_defines():
-    """The colour matching functions every 10 nm (360-830 nm) and XYZ -> linear Rec.709, as OSL
-    macros (OSL has no global arrays): the shipped tables of the spectral mode."""
-    tables = spectral_render.tables()
-    rows = tables["cmfs_nm"] % 10.0 == 0.0
-    cmfs = tables["cmfs"][rows]
-
-    def array(values):
-        return ", ".join(f"{float(v):.7g}" for v in values)
-
-    declare = " ".join(
-        f"float CMF_{axis}[{len(cmfs)}] = {{{array(cmfs[:, index])}}};" for index, axis in enumerate("XYZ")
-    )
-    declare += f" float XYZ_TO_RGB[9] = {{{array(np.asarray(tables['xyz_to_rgb']).ravel())}}};"
-    return f"#define CMF_COUNT {len(cmfs)}\n#define CMF_DECLARE {declare}\n"
-
-
-def basis_defines() -> str:
-    """Mallett & Yuksel's basis on its 5 nm grid over its constrained band (outside it the basis
-    is held at the band's edge values, ``physics.spectral_render.reflectance_matrix``) and the white's
-    temperature, as OSL macros: the table the shader interpolates linearly."""
-    tables = spectral_render.tables()
-    low, high = (float(v) for v in tables["basis_band_nm"])
-    rows = (tables["basis_nm"] >= low) & (tables["basis_nm"] <= high)
-    grid, basis = tables["basis_nm"][rows], tables["basis"][rows]
-    step = float(grid[1] - grid[0])
-    if not (grid[0] == low and grid[-1] == high and np.allclose(np.diff(grid), step)):
-        raise RelativityError("The shipped RGB basis table is not on an even grid over its band")
-    values = ", ".join(f"{float(v):.9g}" for v in basis.ravel())
-    return (
-        f"#define BASIS_COUNT {len(grid)}\n#define BASIS_LOW {low!r}\n#define BASIS_STEP {step!r}\n"
-        f"#define WHITE_TEMPERATURE {spectral_render.WHITE_TEMPERATURE_K!r}\n"
-        f"#define BASIS_DECLARE float BASIS[{basis.size}] = {{{values}}};\n"
-    )
-
-
-def _shader_text():
-    with open(SHADER_PATH, encoding="utf-8") as handle:
-        source = handle.read().replace("/* @CMF_TABLES@ */", _cmf_defines())
-        source = source.replace("/* @BASIS_TABLE@ */", basis_defines())
-    text = bpy.data.texts.get(names.MOVING_LAMP_SHADER_TEXT) or bpy.data.texts.new(names.MOVING_LAMP_SHADER_TEXT)
-    if text.as_string().rstrip("\n") != source.rstrip("\n"):
-        text.clear()
-        text.write(source)
-    return text
 
 
 def view_directions(
@@ -229,7 +194,7 @@ def _new_lamp(scene, name, text, kind="POINT"):
 
 def new_point_lamp(scene: Scene, name: str) -> Object:
     """A point lamp (radius 0, power 4 pi) with the moving-lamp shader, its inputs unset."""
-    return _new_lamp(scene, name, _shader_text())
+    return _new_lamp(scene, name, lamp_shader.shader_text())
 
 
 def stand_in_names(scene: Scene) -> dict[str, list[str]]:
@@ -313,9 +278,32 @@ def _stored_times(scene, light_name):
         return None
     inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
     times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]
-    if objects[0].data.type == "AREA":  # STRIP_SIDES strips per piece: the pieces' starts and the last end
-        times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+    if objects[0].data.type == "AREA":  # LINE_SIDES strips per lamp (lines) or STRIP_SIDES per piece
+        if inputs[0]["strip"].default_value == 1:  # the pieces' starts and the last end
+            times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+        else:
+            times = times[:: inputs[0]["strip_sides"].default_value]
     return np.array(times, float)
+
+
+def _use_lines(points, camera_position, times, positions):
+    """Whether the lamps at ``times`` (``positions``) are drawn out into lines: unless the surface
+    points see the path nearly end on (within 6 degrees of it for END_ON of their light), where a
+    strip along it would be seen edge on and light them through a sliver (or not at all)."""
+    if LINE <= 0.0 or len(times) < 2:
+        return False
+    if len(points) == 0:
+        return True
+    point_times, irradiance = retarded_times_on_path(points, camera_position, times, positions)
+    return end_on_share(point_times, irradiance, points, times, positions, sin_limit=0.1) <= END_ON
+
+
+def _stored_lines(scene, light_name):
+    """Whether the last placement drew the lamps of ``light_name`` as lines."""
+    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
+    if not objects or objects[0] is None or objects[0].data.type != "AREA":
+        return False
+    return objects[0].data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["strip"].default_value == 2
 
 
 def path_positions(
@@ -341,7 +329,7 @@ def write(
     t_o)``); delete those of lights no longer moving. They are placed (ray casts) when a depsgraph
     is given or none exist yet; without one, the last placement's times are kept and the lamps move
     along the path to them."""
-    text = _shader_text()
+    text = lamp_shader.shader_text()
     record = _record(scene)
     for stale in set(record) - {light.name for light in lights}:
         for name in record.pop(stale):
@@ -355,13 +343,17 @@ def write(
             _write_sun(scene, light, _lamps_for(scene, light.name, 1, text, "SUN")[0])
             continue
         values = parameters(light)
+        camera_position = np.asarray(values["camera_position"], float)
         stored = _stored_times(scene, light.name)
         times = None if depsgraph is not None else stored
+        lines = _stored_lines(scene, light.name)
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
             keep = busy.rendering() or cockpit.is_applied(scene)
+            if not (keep and stored is not None):  # while rendering the lamps stay what they are (below)
+                lines = _use_lines(points, camera_position, times, positions)
             if keep and stored is not None and len(stored) != len(times):
                 # as many as there are: stand-ins made and deleted between Render Animation's
                 # frames (frame_change_post) crashed Blender 5.2's render of the next frame, and
@@ -400,9 +392,9 @@ def write(
             camera_power=float(colour.camera_power),
         )
         if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
-            _write_points(scene, light, text, shared, times, positions)
+            _write_points(scene, light, text, shared, times, positions, camera_position, lines)
         else:
-            _write_strips(scene, light, text, shared, times, positions, np.asarray(values["camera_position"], float))
+            _write_strips(scene, light, text, shared, times, positions, camera_position)
 
 
 def write_inputs(obj: Object, inputs: Mapping[str, Any]) -> None:
@@ -412,21 +404,53 @@ def write_inputs(obj: Object, inputs: Mapping[str, Any]) -> None:
         _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
 
 
-def _write_points(scene, light, text, shared, times, positions):
-    """One point lamp at each time, lighting the points whose retarded times lie next to it."""
+def _place_strip(obj, centre, axis, length, side, camera_position, sides=STRIP_SIDES):
+    """Set strip ``obj`` (an area light) ``length`` long along ``axis`` at ``centre``, side ``side`` of
+    ``sides`` facing 360 / ``sides`` degrees apart about the axis (the first toward the camera);
+    returns its normal (it emits along it)."""
+    first = camera_position - centre
+    first = first - (first @ axis) * axis
+    if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
+        first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
+    first /= np.linalg.norm(first)
+    angle = 2.0 * math.pi * side / sides  # Rodrigues: the first normal turned about the axis
+    normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
+    rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
+    _set(obj, "location", tuple(float(v) for v in centre))
+    _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
+    _set(obj.data, "size", max(length, 1e-6))
+    _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
+    return normal
+
+
+def _write_points(scene, light, text, shared, times, positions, camera_position, lines):
+    """A lamp at each time, lighting the points whose retarded times lie next to it: a point lamp,
+    or (``lines``, two lamps or more) LINE_SIDES strips LINE lamp spacings long along the path."""
     last = len(times) - 1
-    for index, obj in enumerate(_lamps_for(scene, light.name, len(times), text)):
+    lines = lines and last > 0
+    sides = LINE_SIDES if lines else 1
+    lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT")
+    for number, obj in enumerate(lamps):
+        index, side = divmod(number, sides)
         before, after = max(index - 1, 0), min(index + 1, last)
         inputs = dict(
             shared,
-            strip=0,
+            strip=2 if lines else 0,
+            lamp_position=tuple(positions[index]),
             lamp_time=float(times[index]),
             previous_time=float(times[before]),
             previous_position=tuple(positions[before]),
             next_time=float(times[after]),
             next_position=tuple(positions[after]),
         )
-        _set(obj, "location", tuple(float(v) for v in positions[index]))
+        if lines:
+            along = positions[after] - positions[before]
+            gap = float(np.linalg.norm(along)) / (after - before)  # the lamp spacing here
+            axis = along / max(float(np.linalg.norm(along)), 1e-30)
+            normal = _place_strip(obj, positions[index], axis, LINE * gap, side, camera_position, sides)
+            inputs.update(strip_normal=tuple(normal), strip_sides=sides)
+        else:
+            _set(obj, "location", tuple(float(v) for v in positions[index]))
         write_inputs(obj, inputs)
 
 
@@ -442,14 +466,7 @@ def _write_strips(scene, light, text, shared, times, positions, camera_position)
         along = end - start
         length = float(np.linalg.norm(along))
         axis = along / max(length, 1e-30)
-        first = camera_position - 0.5 * (start + end)
-        first = first - (first @ axis) * axis
-        if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
-            first = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
-        first /= np.linalg.norm(first)
-        angle = 2.0 * math.pi * side / STRIP_SIDES  # Rodrigues: the first normal turned about the axis
-        normal = first * math.cos(angle) + np.cross(axis, first) * math.sin(angle)
-        rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
+        normal = _place_strip(obj, 0.5 * (start + end), axis, length, side, camera_position)
         after = min(piece + 2, pieces)
         inputs = dict(
             shared,
@@ -468,22 +485,7 @@ def _write_strips(scene, light, text, shared, times, positions, camera_position)
             strip_normal=tuple(normal),
             strip_length=length,
         )
-        _set(obj, "location", tuple(float(v) for v in 0.5 * (start + end)))
-        _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
-        _set(obj.data, "size", max(length, 1e-6))
-        _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
         write_inputs(obj, inputs)
-
-
-def sun_in_scene_frame(axis: npt.ArrayLike, beta: npt.ArrayLike) -> tuple[FloatArray, float]:
-    """A sun (plane wave) moving with ``beta``: the photon direction in the scene frame (its own
-    frame's ``axis`` aberrated) and ``D = 1 / (gamma (1 - beta . k))``; the irradiance on a surface
-    facing it scales by ``D^2`` (radiance ``D^4`` times the disc's solid angle ``1 / D^2``) and its
-    angular diameter by ``1 / D``."""
-    beta = np.array(beta, float)
-    k = aberrate(np.array(axis, float), -beta)
-    gamma = 1.0 / math.sqrt(1.0 - float(beta @ beta))
-    return k, 1.0 / (gamma * (1.0 - float(beta @ k)))
 
 
 def fast_sun(user: Light, doppler: float) -> tuple[tuple[float, ...], float | None, float]:

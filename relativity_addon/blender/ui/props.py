@@ -315,8 +315,9 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
             (
                 "BLENDED",
                 "Blended Lamps",
-                "Point lamps on the light's path, each point's shadow blended from the two around its retarded "
-                "position: sharp, but stepped where the retarded position changes fast across a shadow",
+                "Lamps on the light's path, each drawn out into a short line along it, each point's shadow "
+                "blended from the two around its retarded position: shadow edges follow the retarded shadow "
+                "without steps, softened along the motion over 1.25 lamp spacings",
                 0,
             ),
             (
@@ -324,8 +325,8 @@ class RELATIVITY_PG_scene_settings(bpy.types.PropertyGroup):
                 "Continuous",
                 "Thin strips along the light's path: each point's shadow rays go to the path around its own "
                 "retarded position, so shadow edges follow the retarded shadow without steps, softened over "
-                "half a lamp spacing; much noisier (measured: 3.7x the noise of Blended Lamps at the same samples, "
-                "1.5x the render time)",
+                "half a lamp spacing; much noisier (measured: 2.9x the noise of Blended Lamps at the same samples, "
+                "about the same render time)",
                 1,
             ),
         ),

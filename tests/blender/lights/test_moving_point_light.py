@@ -147,7 +147,11 @@ def _pixel_x(bpy, scene, camera, world_x):
 
 def test_floor_profile_follows_eq_19_with_retarded_positions(relativity_addon, factory_blender, tmp_path):
     bpy = factory_blender
-    scene, camera, lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
+    # the ahead/behind ratios below are read from the rendered peak's pixel (an argmax): the
+    # stand-ins drawn out into lines (the default) are noisier near the pool than point lamps, and
+    # at 64 or 128 samples that pixel moves (measured: ratios 0.89-1.10 and 1.10-1.42 against
+    # 1.03-1.19; at 256: 1.03-1.20, at 512: 1.02-1.20, max error 0.4 % of the peak: no bias)
+    scene, camera, lamp = _floor_scene(bpy, samples=4 * SAMPLES_LAMPS)
     _effect().apply(scene)
     assert lamp.hide_render  # the lamp at rest does not light the floor as well
     image = _render(bpy, scene, tmp_path / "moving.exr")
@@ -316,7 +320,10 @@ def test_apparent_geometry_final_render_with_a_moving_observer(relativity_addon,
     observer = (0.2, 0.1, 0.0)
     images = {}
     for method in ("CAMERA", "GEOMETRY"):
-        scene, _camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS, method=method)
+        # twice the samples: with the stand-ins drawn out into lines (the default) the two renders
+        # are the same up to their noise, which differs on Blender 4.5 (measured at 64 samples: mean
+        # ratio 1.0001, mean |difference| 0.032 of the mean; point lamps rendered identically)
+        scene, _camera, _lamp = _floor_scene(bpy, samples=2 * SAMPLES_LAMPS, method=method)
         scene.relativity.beta = observer
         assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
         images[method] = _render(bpy, scene, tmp_path / f"{method}.exr")[..., :3]

@@ -114,8 +114,8 @@ def test_the_shaders_basis_table_is_the_physics_cores(relativity_addon, factory_
     core's extended basis (colour-science's table) at and between its grid points."""
     from relativity_addon.physics import spectral
 
-    moving_lamps = dh.addon_module(relativity_addon, "lights.stand_in_lamps")
-    text = moving_lamps.basis_defines()
+    lamp_shader = dh.addon_module(relativity_addon, "lights.lamp_shader")
+    text = lamp_shader.basis_defines()
     low = float(re.search(r"#define BASIS_LOW (\S+)", text).group(1))
     step = float(re.search(r"#define BASIS_STEP (\S+)", text).group(1))
     count = int(re.search(r"#define BASIS_COUNT (\d+)", text).group(1))
