@@ -28,7 +28,7 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import snapshot
-from . import clip_end, instancing, modifier, motion, tessellation
+from . import changes, clip_end, instancing, modifier, motion, tessellation
 from .modifier import applied_objects, object_error
 
 if TYPE_CHECKING:
@@ -72,7 +72,9 @@ _reads = [0]
 
 def note_updates(depsgraph: Depsgraph) -> None:
     """Forget the rest fingerprints of the objects whose geometry ``depsgraph`` evaluated again
-    (called by every sync that gets a handler's depsgraph, also while the add-on computes)."""
+    (called by every sync that gets a handler's depsgraph, also while the add-on computes), and
+    every object it reports updated is no longer current (``changes.py``)."""
+    changes.note_updates(depsgraph)
     if not _known_rest:
         return
     for update in depsgraph.updates:
@@ -127,6 +129,7 @@ def object_signature(
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     verdict = None
+    closed = False
     if depsgraph is not None:
         scene = bpy.data.scenes.get(snap.scene)
         closed = scene is not None and motion.closed_form(obj, scene)
@@ -141,7 +144,7 @@ def object_signature(
         else:
             fingerprint = _rest_fingerprint(evaluated)
     parts = [
-        snap.frame,
+        None if closed else snap.frame,  # the closed form depends on the observer's event, not on the time
         snap.speed_of_light,
         snap.beta,
         snap.camera,
@@ -234,6 +237,7 @@ def update_object(
     warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - delay)
     modifier.write_cache(cache.data, local, beta_seen, codes)
     cache.data[names.DEPTH_KEY] = depth
+    clip_end.note_depth(obj, snap, depth)
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, fingerprint)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
@@ -308,20 +312,33 @@ def update(
     in_frame_change: bool = False,
 ) -> int:
     """Recompute every object carrying the modifier (only those whose inputs changed, with
-    ``only_changed``; ``in_frame_change``: see :func:`update_object`). A failure is recorded on
-    the object's cache and printed, never raised: the viewport keeps the last valid state.
-    Returns the number of objects updated."""
+    ``only_changed``: the signatures of the objects not current, ``changes.py``; ``in_frame_change``:
+    see :func:`update_object`). A failure is recorded on the object's cache and printed, never
+    raised: the viewport keeps the last valid state. Returns the number of objects updated."""
     updated = 0
     with busy.computing():
-        for obj in applied_objects(scene):
-            data = modifier.cache_data(obj)
+        objects = applied_objects(scene)
+        evaluated = None
+        current: dict[int, bool] = {}
+        if only_changed and objects:
             # The signatures hold the evaluated rest shapes: without the handler's depsgraph, the
-            # scene's, evaluated now (update_object evaluates it again after its own edits).
+            # scene's, evaluated now, which also reports Blender's pending updates (note_updates)
+            # before the current objects are taken (update_object evaluates again after its edits).
+            evaluated = _evaluated(depsgraph)
+            current = changes.current_objects(
+                scene.name, scene_key(snap), snap.frame, in_frame_change and depsgraph is not None
+            )
+        for obj in objects:
+            uid = obj.session_uid
+            if uid in current:
+                continue
+            data = modifier.cache_data(obj)
             if (
                 only_changed
                 and data is not None
-                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, _evaluated(depsgraph))
+                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, evaluated)
             ):
+                current[uid] = motion.closed_form(obj, scene)
                 continue
             try:
                 update_object(scene, obj, snap, depsgraph, in_frame_change)
@@ -333,6 +350,24 @@ def update(
                     data[names.ERROR_KEY] = str(error)
                     data[names.SIGNATURE_KEY] = object_signature(snap, obj, _evaluated(depsgraph))
     return updated
+
+
+def scene_key(snap: Snapshot) -> tuple:
+    """What every object's signature takes from the snapshot and the scene but the frame: while it
+    stays, an object Blender did not update keeps its signature (``changes.py``)."""
+    return (
+        snap.scene,
+        snap.speed_of_light,
+        snap.beta,
+        snap.camera,
+        snap.camera_matrix,
+        snap.exact_camera,
+        snap.shutter_time if snap.exact_camera else 0.0,
+        snap.projection,
+        _render_size(snap),
+        snap.fps,
+        modifier.group_generation(),
+    )
 
 
 def _evaluated(depsgraph: Depsgraph | None) -> Depsgraph:
