@@ -29,7 +29,7 @@ from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import snapshot
 from . import changes, clip_end, instancing, modifier, motion, tessellation
-from .modifier import applied_objects, object_error
+from .modifier import applied_objects
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -388,7 +388,7 @@ _skipped_empty = {}
 def scene_errors(scene: Scene) -> list[str]:
     """One-line errors of the last update of each object (empty when every cache is current), and
     the meshes left out for having nothing to draw."""
-    errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
+    errors = [error for _obj, error, _warning in changes.cache_notes(scene) if error is not None]
     for name in _skipped_empty.get(scene.name, ()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:
@@ -399,12 +399,7 @@ def scene_errors(scene: Scene) -> list[str]:
 def update_warnings(scene: Scene) -> list[str]:
     """One-line warnings of the last update of each object that did not fail (what it drew that is
     not the motion the user likely means: keys starting too late); they stop no render."""
-    warnings = []
-    for obj in applied_objects(scene):
-        data = modifier.cache_data(obj)
-        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
-            warnings.append(data[names.WARNING_KEY])
-    return warnings
+    return [warning for _obj, error, warning in changes.cache_notes(scene) if warning and error is None]
 
 
 def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None) -> list[Object]:
@@ -446,8 +441,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
             for obj in objects:
                 modifier.ensure_modifier(obj)
             depsgraph = bpy.context.evaluated_depsgraph_get()
+            # as in a frame change: no evaluation per object (each costs a pass over the scene);
+            # the meshes whose positions need their new subdivision's are computed after one
             for obj in objects:
-                update_object(scene, obj, snap, depsgraph)
+                update_object(scene, obj, snap, depsgraph, in_frame_change=True)
+            waiting = [obj for obj in objects if obj.name in _deferred]
+            if waiting:
+                depsgraph = bpy.context.evaluated_depsgraph_get()
+                for obj in waiting:
+                    update_object(scene, obj, snap, depsgraph)
     except RelativityError:
         for obj in objects:
             modifier.remove_object_effect(obj)
@@ -466,7 +468,9 @@ def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object
         orphans = orphan_caches()
         instancing.forget(scene.name)
     objects = [*applied_objects(scene), *unlinked_objects()] if objects is None else objects
-    restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
+    later: list = []
+    restored = [obj for obj in objects if modifier.remove_object_effect(obj, later)]
+    modifier.remove_later(later)
     for cache in orphans:
         modifier.remove_cache(cache)
     modifier.remove_unused_group()

@@ -17,8 +17,11 @@ from typing import TYPE_CHECKING
 
 import bpy
 
+from ..common import names
+from . import modifier
+
 if TYPE_CHECKING:
-    from bpy.types import Depsgraph
+    from bpy.types import Depsgraph, Object, Scene
 
 # Scene name -> (scene key, frame, {object session_uid: whether its signature holds no frame}).
 _current: dict[str, tuple[object, float, dict[int, bool]]] = {}
@@ -77,9 +80,21 @@ def moved() -> set[int]:
     return _moved
 
 
-def forget(scene_name: str | None = None) -> None:
-    """Nothing current any more (in the scene, or anywhere): the next sync checks every signature."""
-    if scene_name is None:
-        _current.clear()
-    else:
-        _current.pop(scene_name, None)
+# Object session_uid -> (error, warning) its cache held when last read (kept while it is current:
+# only an update writes them, and an updated object is not current until its next sync).
+_notes: dict[int, tuple[str | None, str | None]] = {}
+
+
+def cache_notes(scene: Scene) -> list[tuple[Object, str | None, str | None]]:
+    """(object, error or None, warning or None) of every applied object, read from the caches of
+    those not current (``changes.is_current``)."""
+    found = []
+    for obj in modifier.applied_objects(scene):
+        uid = obj.session_uid
+        notes = _notes.get(uid)
+        if notes is None or not is_current(scene.name, uid):
+            data = modifier.cache_data(obj)
+            notes = (None, None) if data is None else (data.get(names.ERROR_KEY) or None, data.get(names.WARNING_KEY))
+            _notes[uid] = notes
+        found.append((obj, *notes))
+    return found

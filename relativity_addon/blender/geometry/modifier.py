@@ -266,8 +266,10 @@ def object_error(obj: Object) -> str | None:
     return data.get(names.ERROR_KEY) or None if data is not None else None
 
 
-def remove_object_effect(obj: Object) -> bool:
-    """Remove the object's modifier, cache and bakes; the mesh data was never written."""
+def remove_object_effect(obj: Object, later: list[ID] | None = None) -> bool:
+    """Remove the object's modifier, cache and bakes; the mesh data was never written. With
+    ``later``, the cache object and its mesh are appended to it for one :func:`remove_later`
+    (removing objects one at a time costs a pass over every object of the file each)."""
     modifier = find_modifier(obj)
     if modifier is None:
         return False
@@ -278,9 +280,20 @@ def remove_object_effect(obj: Object) -> bool:
     obj.modifiers.remove(modifier)
     if baked is not None:
         bpy.data.meshes.remove(baked)
-    if cache is not None:
+    if cache is not None and later is not None:
+        later += [cache, *([cache.data] if isinstance(cache.data, bpy.types.Mesh) else [])]
+    elif cache is not None:
         remove_cache(cache, with_bake=False)
     return True
+
+
+def remove_later(blocks: list[ID]) -> None:
+    """Remove the cache objects and meshes :func:`remove_object_effect` set aside, at once (a mesh
+    something else still uses stays)."""
+    objects = [block for block in blocks if isinstance(block, bpy.types.Object)]
+    meshes = [block for block in blocks if isinstance(block, bpy.types.Mesh)]
+    bpy.data.batch_remove(objects)
+    bpy.data.batch_remove([mesh for mesh in meshes if mesh.users == 0])
 
 
 def remove_cache(cache: Object, with_bake: bool = True) -> None:
