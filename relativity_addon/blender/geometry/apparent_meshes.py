@@ -197,6 +197,7 @@ def update_object(
     positions wait for the next sync (:func:`deferred`): the handlers and the batch script sync
     again outside the frame change."""
     _deferred.discard(obj.name)
+    changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
