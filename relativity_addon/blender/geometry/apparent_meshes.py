@@ -28,21 +28,17 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import snapshot
-from . import clip_end, instancing, keyframed, modifier, motion, tessellation
-from .modifier import applied_objects, object_error
+from . import changes, clip_end, instancing, keyframed, modifier, motion, tessellation
+from .modifier import applied_objects
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
-    import numpy.typing as npt
     from bpy.types import Depsgraph, Object, Scene
 
     from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
-# An edge longer than this fraction of its distance to the camera is too coarse for the
-# apparent-geometry path to curve (aberration bends straight lines; only vertices move).
-COARSE_EDGE_FRACTION = 0.25
 # Points of a closed-form motion computed at a time: bounds the float64 temporaries, which for
 # every point at once are several times the float32 positions the cache holds.
 CHUNK_POINTS = 1 << 20
@@ -72,7 +68,9 @@ _reads = [0]
 
 def note_updates(depsgraph: Depsgraph) -> None:
     """Forget the rest fingerprints of the objects whose geometry ``depsgraph`` evaluated again
-    (called by every sync that gets a handler's depsgraph, also while the add-on computes)."""
+    (called by every sync that gets a handler's depsgraph, also while the add-on computes), and
+    every object it reports updated is no longer current (``changes.py``)."""
+    changes.note_updates(depsgraph)
     tessellation.note_updates(depsgraph)
     if not _known_rest:
         return
@@ -128,6 +126,7 @@ def object_signature(
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     verdict: object = None
+    closed = False
     if depsgraph is not None:
         scene = bpy.data.scenes.get(snap.scene)
         closed = scene is not None and motion.closed_form(obj, scene)
@@ -145,7 +144,7 @@ def object_signature(
         else:
             fingerprint = _rest_fingerprint(evaluated)
     parts = [
-        snap.frame,
+        None if closed else snap.frame,  # the closed form depends on the observer's event, not on the time
         snap.speed_of_light,
         snap.beta,
         snap.camera,
@@ -198,6 +197,7 @@ def update_object(
     positions wait for the next sync (:func:`deferred`): the handlers and the batch script sync
     again outside the frame change."""
     _deferred.discard(obj.name)
+    changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -250,6 +250,7 @@ def update_object(
     warning = motion.keyframes_start_warning(obj, scene, snap.mesh_observer[0] - delay)
     modifier.write_cache(cache.data, local, beta_seen, codes)
     cache.data[names.DEPTH_KEY] = depth
+    clip_end.note_depth(obj, snap, depth)
     cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, fingerprint)
     if names.ERROR_KEY in cache.data:
         del cache.data[names.ERROR_KEY]
@@ -325,20 +326,33 @@ def update(
     in_frame_change: bool = False,
 ) -> int:
     """Recompute every object carrying the modifier (only those whose inputs changed, with
-    ``only_changed``; ``in_frame_change``: see :func:`update_object`). A failure is recorded on
-    the object's cache and printed, never raised: the viewport keeps the last valid state.
-    Returns the number of objects updated."""
+    ``only_changed``: the signatures of the objects not current, ``changes.py``; ``in_frame_change``:
+    see :func:`update_object`). A failure is recorded on the object's cache and printed, never
+    raised: the viewport keeps the last valid state. Returns the number of objects updated."""
     updated = 0
     with busy.computing():
-        for obj in applied_objects(scene):
-            data = modifier.cache_data(obj)
+        objects = applied_objects(scene)
+        evaluated = None
+        current: dict[int, bool] = {}
+        if only_changed and objects:
             # The signatures hold the evaluated rest shapes: without the handler's depsgraph, the
-            # scene's, evaluated now (update_object evaluates it again after its own edits).
+            # scene's, evaluated now, which also reports Blender's pending updates (note_updates)
+            # before the current objects are taken (update_object evaluates again after its edits).
+            evaluated = _evaluated(depsgraph)
+            current = changes.current_objects(
+                scene.name, scene_key(snap), snap.frame, in_frame_change and depsgraph is not None
+            )
+        for obj in objects:
+            uid = obj.session_uid
+            if uid in current:
+                continue
+            data = modifier.cache_data(obj)
             if (
                 only_changed
                 and data is not None
-                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, _evaluated(depsgraph))
+                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, evaluated)
             ):
+                current[uid] = motion.closed_form(obj, scene)
                 continue
             try:
                 update_object(scene, obj, snap, depsgraph, in_frame_change)
@@ -350,6 +364,24 @@ def update(
                     data[names.ERROR_KEY] = str(error)
                     data[names.SIGNATURE_KEY] = object_signature(snap, obj, _evaluated(depsgraph))
     return updated
+
+
+def scene_key(snap: Snapshot) -> tuple:
+    """What every object's signature takes from the snapshot and the scene but the frame: while it
+    stays, an object Blender did not update keeps its signature (``changes.py``)."""
+    return (
+        snap.scene,
+        snap.speed_of_light,
+        snap.beta,
+        snap.camera,
+        snap.camera_matrix,
+        snap.exact_camera,
+        snap.shutter_time if snap.exact_camera else 0.0,
+        snap.projection,
+        _render_size(snap),
+        snap.fps,
+        modifier.group_generation(),
+    )
 
 
 def _evaluated(depsgraph: Depsgraph | None) -> Depsgraph:
@@ -370,7 +402,7 @@ _skipped_empty = {}
 def scene_errors(scene: Scene) -> list[str]:
     """One-line errors of the last update of each object (empty when every cache is current), and
     the meshes left out for having nothing to draw."""
-    errors = [error for error in map(object_error, applied_objects(scene)) if error is not None]
+    errors = [error for _obj, error, _warning in changes.cache_notes(scene) if error is not None]
     for name in _skipped_empty.get(scene.name, ()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:
@@ -381,12 +413,7 @@ def scene_errors(scene: Scene) -> list[str]:
 def update_warnings(scene: Scene) -> list[str]:
     """One-line warnings of the last update of each object that did not fail (what it drew that is
     not the motion the user likely means: keys starting too late); they stop no render."""
-    warnings = []
-    for obj in applied_objects(scene):
-        data = modifier.cache_data(obj)
-        if data is not None and data.get(names.WARNING_KEY) and names.ERROR_KEY not in data:
-            warnings.append(data[names.WARNING_KEY])
-    return warnings
+    return [warning for _obj, error, warning in changes.cache_notes(scene) if warning and error is None]
 
 
 def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None) -> list[Object]:
@@ -428,8 +455,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
             for obj in objects:
                 modifier.ensure_modifier(obj)
             depsgraph = bpy.context.evaluated_depsgraph_get()
+            # as in a frame change: no evaluation per object (each costs a pass over the scene);
+            # the meshes whose positions need their new subdivision's are computed after one
             for obj in objects:
-                update_object(scene, obj, snap, depsgraph)
+                update_object(scene, obj, snap, depsgraph, in_frame_change=True)
+            waiting = [obj for obj in objects if obj.name in _deferred]
+            if waiting:
+                depsgraph = bpy.context.evaluated_depsgraph_get()
+                for obj in waiting:
+                    update_object(scene, obj, snap, depsgraph)
     except RelativityError:
         for obj in objects:
             modifier.remove_object_effect(obj)
@@ -448,7 +482,9 @@ def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object
         orphans = orphan_caches()
         instancing.forget(scene.name)
     objects = [*applied_objects(scene), *unlinked_objects()] if objects is None else objects
-    restored = [obj for obj in objects if modifier.remove_object_effect(obj)]
+    later: list = []
+    restored = [obj for obj in objects if modifier.remove_object_effect(obj, later)]
+    modifier.remove_later(later)
     for cache in orphans:
         modifier.remove_cache(cache)
     modifier.remove_unused_group()
@@ -488,45 +524,3 @@ def unlinked_objects() -> list[Object]:
 def orphan_caches() -> list[Object]:
     """Cache objects no modifier uses any more (their object was deleted while set up)."""
     return [obj for obj in bpy.data.objects if obj.library is None and obj.users == 0 and modifier.is_cache(obj)]
-
-
-def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:
-    """Longest mesh edge divided by its midpoint's distance to the camera (world units)."""
-    mesh = obj.data
-    if len(mesh.edges) == 0 or len(mesh.edges) > 200_000:
-        return 0.0
-    coordinates = np.empty(len(mesh.vertices) * 3)
-    mesh.vertices.foreach_get("co", coordinates)
-    world = motion.to_world(np.array(obj.matrix_world), coordinates.reshape(-1, 3))
-    edges = np.empty(len(mesh.edges) * 2, dtype=np.int64)
-    mesh.edges.foreach_get("vertices", edges)
-    a, b = world[edges[0::2]], world[edges[1::2]]
-    lengths = np.linalg.norm(b - a, axis=1)
-    distances = np.linalg.norm((a + b) / 2.0 - np.asarray(camera_position), axis=1)
-    return float(np.max(lengths / np.maximum(distances, 1e-9)))
-
-
-def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | None:
-    """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None:
-    with adaptive tessellation, edges left bent beyond the tolerance at the last update (nothing
-    before Set Up: the update measures them); without, or where the update could not measure them,
-    edges long for their distance to the camera."""
-    level = obj.relativity.tessellation
-    advice = "raise Tessellation"
-    if obj.relativity.use_adaptive_tessellation:
-        measured = tessellation.warning(obj)
-        if measured is not None or modifier.find_modifier(obj) is None:
-            return measured or None
-        level = min(level, tessellation.UNMEASURED_LEVELS)  # what the update gives every face then
-        advice = "set Adaptive off and raise Tessellation (Adaptive cannot measure this mesh)"
-    # the modifier halves every edge once per tessellation level before moving the vertices
-    fraction = longest_edge_fraction(obj, camera_position) / 2**level
-    if fraction > COARSE_EDGE_FRACTION:
-        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, {advice}"
-    return None
-
-
-def tessellation_warning(obj: Object) -> str | None:
-    """The adaptive tessellation's line about edges still too bent at the last update
-    (``tessellation.warning``)."""
-    return tessellation.warning(obj)

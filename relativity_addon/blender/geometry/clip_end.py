@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common import names
 from ..scene import lens
-from . import modifier, motion
+from . import changes, modifier, motion
 from .modifier import applied_objects
 
 if TYPE_CHECKING:
@@ -56,24 +56,48 @@ def bounds_depth(snap: Snapshot, obj_eval: Object) -> float:
     return float(max(depth.max(initial=0.0), 0.0))
 
 
+# Object session_uid -> (the farthest seen depth last taken for it, the camera it was taken for:
+# None when it was read from the cache without an evaluated depsgraph).
+_depths: dict[int, tuple[float, object]] = {}
+
+
+def note_depth(obj: Object, snap: Snapshot, depth: float) -> None:
+    """The depth an update computed for ``obj`` from the snapshot (also kept on its cache)."""
+    _depths[obj.session_uid] = (depth, (snap.camera, snap.camera_matrix))
+
+
 def clip_end_warnings(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None) -> list[str]:
     """One line when the boosted meshes reach beyond the camera's Clip End (they are cut off in the
     viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs.
     A closed-form object's depth is its evaluated bounds' (:func:`bounds_depth`), taken from a
-    handler's evaluated ``depsgraph`` and kept for the syncs without one."""
+    handler's evaluated ``depsgraph`` for another camera or when Blender evaluated the object again
+    (``changes.moved``), and kept for the syncs without one; the others' come from their updates
+    (:func:`note_depth`)."""
     camera = scene.objects.get(snap.camera)
     if snap.exact_camera or camera is None or camera.type != "CAMERA":
         return []
+    view = (snap.camera, snap.camera_matrix)
+    moved = changes.moved() if depsgraph is not None else set()
     depths = []
     for obj in applied_objects(scene):
+        uid = obj.session_uid
+        known = _depths.get(uid)
+        if known is not None and uid not in moved and (known[1] == view or depsgraph is None):
+            depths.append((known[0], obj.name))
+            continue
         data = modifier.cache_data(obj)
         if data is None:
             continue
-        if depsgraph is not None and modifier.closed_form_on(modifier.find_modifier(obj)):
+        closed = modifier.closed_form_on(modifier.find_modifier(obj))
+        if depsgraph is not None and closed:
             depth = bounds_depth(snap, obj.evaluated_get(depsgraph))
             if data.get(names.DEPTH_KEY) != depth:
                 data[names.DEPTH_KEY] = depth
-        depths.append((float(data.get(names.DEPTH_KEY, 0.0)), obj.name))
+        depth = float(data.get(names.DEPTH_KEY, 0.0))
+        # the cache's depth is the last update's (for this camera) unless the modifier computes it
+        _depths[uid] = (depth, view if depsgraph is not None or not closed else None)
+        depths.append((depth, obj.name))
+    moved.clear()
     depth, name = max(depths, default=(0.0, ""))
     if depth <= camera.data.clip_end:
         return []

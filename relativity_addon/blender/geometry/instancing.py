@@ -34,8 +34,11 @@ def _may_instance(obj: Object) -> bool:
     system, or geometry nodes of the user's (cheap: tells which scenes need the instance scan)."""
     if obj.instance_type != "NONE" or len(getattr(obj, "particle_systems", ())):
         return True
+    modifiers = obj.modifiers
+    if not len(modifiers):
+        return False
     ours = modifier.find_modifier(obj)
-    return any(each.type == "NODES" and each != ours for each in obj.modifiers)
+    return any(each.type == "NODES" and each != ours for each in modifiers)
 
 
 def _instanced_by_settings(obj: Object) -> Iterator[Object]:
@@ -70,12 +73,13 @@ def _instancing(
     or not) or, in the evaluated scene, one named in ``evaluated``; ``(None, source)``: an object
     named in ``evaluated`` that draws instances or other components the modifier does not move;
     None when neither happens."""
-    scene_objects = list(scene_objects)
-    for instancer in scene_objects:
+    # only these can draw anything again (one pass over the scene, cheap per object)
+    instancers = [obj for obj in scene_objects if _may_instance(obj)]
+    for instancer in instancers:
         for source in _instanced_by_settings(instancer):
             if drawn(source):
                 return instancer, source
-    if not evaluated or not any(_may_instance(obj) for obj in scene_objects):
+    if not evaluated or not instancers:
         return None
     if depsgraph is None:
         with busy.computing():  # the update handlers this evaluation runs must not sync again

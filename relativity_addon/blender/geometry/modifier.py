@@ -17,6 +17,8 @@ kept on the cache mesh too (``bakes.py``), so they go with the effect when it is
 
 from __future__ import annotations
 
+import threading
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import bpy
@@ -27,6 +29,8 @@ from ..common.nodes import ensure_group, interface_identifier, remove_unused_gro
 from .node_group import node_group_spec
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
+
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
 
     from ...physics.arrays import FloatArray
@@ -43,7 +47,8 @@ def ensure_node_group() -> NodeTree:
     read by name before and set again after."""
     tree = bpy.data.node_groups.get(names.GEOMETRY_GROUP)
     kept = []
-    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) != names.GEOMETRY_GROUP_VERSION:
+    rebuilt = tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) != names.GEOMETRY_GROUP_VERSION
+    if rebuilt:
         old = {item.name: item.identifier for item in tree.interface.items_tree if item.item_type == "SOCKET"}
         for obj in bpy.data.objects:
             for mod in obj.modifiers:
@@ -51,6 +56,9 @@ def ensure_node_group() -> NodeTree:
                     values = {name: compat.modifier_input(mod, old[name]) for name in KEPT_INPUTS if name in old}
                     kept.append((mod, values))
     group = ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    if rebuilt:  # new socket identifiers; the signatures are deleted below: no object is current
+        _identifiers.clear()
+        _generation[0] += 1
     for mod, values in kept:
         for name, value in values.items():
             if value is not None:
@@ -59,6 +67,15 @@ def ensure_node_group() -> NodeTree:
         if cache is not None and cache.data is not None and names.SIGNATURE_KEY in cache.data:
             del cache.data[names.SIGNATURE_KEY]  # the next sync sets the new inputs
     return group
+
+
+_generation = [0]
+
+
+def group_generation() -> int:
+    """How many times this session rebuilt the node group of a file's modifiers (which deletes
+    their signatures: part of ``apparent_meshes.scene_key``)."""
+    return _generation[0]
 
 
 def find_modifier(obj: Object) -> Modifier | None:
@@ -77,21 +94,42 @@ def is_cache(obj: Object) -> bool:
     return obj.type == "MESH" and obj.data is not None and names.OWNER_KEY in obj.data
 
 
+_listed = threading.local()  # .scenes: scene name -> its applied objects, inside listed_once()
+
+
+@contextmanager
+def listed_once() -> Iterator[None]:
+    """Inside: :func:`applied_objects` lists each scene's meshes once (a sync adds or removes no
+    modifier), not again in every part that asks."""
+    outer = getattr(_listed, "scenes", None)
+    _listed.scenes = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _listed.scenes = outer
+
+
 def applied_objects(scene: Scene) -> list[Object]:
     """The scene's meshes carrying the modifier; linked objects are the library's (set up there or
     not), never this file's."""
-    return [
+    scenes = getattr(_listed, "scenes", None)
+    if scenes is not None and scene.name in scenes:
+        return list(scenes[scene.name])
+    found = [
         obj
         for obj in scene.objects
         if obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
     ]
+    if scenes is not None:
+        scenes[scene.name] = tuple(found)
+    return found
 
 
 def cache_object(obj: Object) -> Object | None:
     modifier = find_modifier(obj)
     if modifier is None:
         return None
-    return compat.modifier_input(modifier, interface_identifier(modifier.node_group, "Cache"))
+    return compat.modifier_input(modifier, _identifier(modifier.node_group, "Cache"))
 
 
 def cache_data(obj: Object) -> ID | None:
@@ -139,14 +177,33 @@ def set_closed_form(mod: Modifier, inputs: dict[str, tuple[float, ...] | float] 
     return set_inputs(mod, {"Closed Form": inputs is not None, **(inputs or {})})
 
 
+_identifiers: dict[tuple[int, int, object], dict[str, str]] = {}
+
+
+def _input_identifiers(group: NodeTree) -> dict[str, str]:
+    """Name -> identifier of the group's input sockets, read once per group and version."""
+    key = (group.session_uid, group.as_pointer(), group.get(names.GEOMETRY_GROUP_VERSION_KEY))
+    known = _identifiers.get(key)
+    if known is None:
+        known = {
+            item.name: item.identifier
+            for item in group.interface.items_tree
+            if item.item_type == "SOCKET" and item.in_out == "INPUT"
+        }
+        _identifiers.clear()
+        _identifiers[key] = known
+    return known
+
+
+def _identifier(group: NodeTree, name: str) -> str:
+    identifier = _input_identifiers(group).get(name)
+    return identifier if identifier is not None else interface_identifier(group, name)
+
+
 def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
     """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
     whether any did."""
-    identifiers = {
-        item.name: item.identifier
-        for item in mod.node_group.interface.items_tree
-        if item.item_type == "SOCKET" and item.in_out == "INPUT"
-    }
+    identifiers = _input_identifiers(mod.node_group)
     changed = False
     for name, value in wanted.items():
         identifier = identifiers[name]
@@ -167,9 +224,7 @@ def closed_form_on(mod: Modifier) -> bool:
     """Whether the modifier computes the apparent positions itself (the closed form, or keyframed
     motion: ``keyframed.py``)."""
     group = mod.node_group
-    return any(
-        bool(compat.modifier_input(mod, interface_identifier(group, name))) for name in ("Closed Form", "Keyframed")
-    )
+    return any(bool(compat.modifier_input(mod, _identifier(group, name))) for name in ("Closed Form", "Keyframed"))
 
 
 def _shared_with_another_object(obj, cache):
@@ -213,8 +268,10 @@ def object_error(obj: Object) -> str | None:
     return data.get(names.ERROR_KEY) or None if data is not None else None
 
 
-def remove_object_effect(obj: Object) -> bool:
-    """Remove the object's modifier, cache and bakes; the mesh data was never written."""
+def remove_object_effect(obj: Object, later: list[ID] | None = None) -> bool:
+    """Remove the object's modifier, cache and bakes; the mesh data was never written. With
+    ``later``, the cache object and its mesh are appended to it for one :func:`remove_later`
+    (removing objects one at a time costs a pass over every object of the file each)."""
     modifier = find_modifier(obj)
     if modifier is None:
         return False
@@ -225,9 +282,20 @@ def remove_object_effect(obj: Object) -> bool:
     obj.modifiers.remove(modifier)
     if baked is not None:
         bpy.data.meshes.remove(baked)
-    if cache is not None:
+    if cache is not None and later is not None:
+        later += [cache, *([cache.data] if isinstance(cache.data, bpy.types.Mesh) else [])]
+    elif cache is not None:
         remove_cache(cache, with_bake=False)
     return True
+
+
+def remove_later(blocks: list[ID]) -> None:
+    """Remove the cache objects and meshes :func:`remove_object_effect` set aside, at once (a mesh
+    something else still uses stays)."""
+    objects = [block for block in blocks if isinstance(block, bpy.types.Object)]
+    meshes = [block for block in blocks if isinstance(block, bpy.types.Mesh)]
+    bpy.data.batch_remove(objects)
+    bpy.data.batch_remove([mesh for mesh in meshes if mesh.users == 0])
 
 
 def remove_cache(cache: Object, with_bake: bool = True) -> None:

@@ -33,6 +33,7 @@ from ..common.nodes import interface_identifier
 from . import modifier, motion
 
 if TYPE_CHECKING:
+    import numpy.typing as npt
     from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
 
     from ...physics.arrays import FloatArray
@@ -357,3 +358,44 @@ def warning(obj: Object) -> str | None:
     is, None when it did not measure them (the coarse-edge measure then applies)."""
     data = modifier.cache_data(obj)
     return data.get(names.TESSELLATION_WARNING_KEY) if data is not None else None
+
+
+# An edge longer than this fraction of its distance to the camera is too coarse for the
+# apparent-geometry path to curve (aberration bends straight lines; only vertices move).
+COARSE_EDGE_FRACTION = 0.25
+
+
+def longest_edge_fraction(obj: Object, camera_position: npt.ArrayLike) -> float:
+    """Longest mesh edge divided by its midpoint's distance to the camera (world units)."""
+    mesh = obj.data
+    if len(mesh.edges) == 0 or len(mesh.edges) > 200_000:
+        return 0.0
+    coordinates = np.empty(len(mesh.vertices) * 3)
+    mesh.vertices.foreach_get("co", coordinates)
+    world = motion.to_world(np.array(obj.matrix_world), coordinates.reshape(-1, 3))
+    edges = np.empty(len(mesh.edges) * 2, dtype=np.int64)
+    mesh.edges.foreach_get("vertices", edges)
+    a, b = world[edges[0::2]], world[edges[1::2]]
+    lengths = np.linalg.norm(b - a, axis=1)
+    distances = np.linalg.norm((a + b) / 2.0 - np.asarray(camera_position), axis=1)
+    return float(np.max(lengths / np.maximum(distances, 1e-9)))
+
+
+def coarse_mesh_warning(obj: Object, camera_position: npt.ArrayLike) -> str | None:
+    """A one-line warning when the tessellated mesh is too coarse to show curved lines, or None:
+    with adaptive tessellation, edges left bent beyond the tolerance at the last update (nothing
+    before Set Up: the update measures them); without, or where the update could not measure them,
+    edges long for their distance to the camera."""
+    level = obj.relativity.tessellation
+    advice = "raise Tessellation"
+    if obj.relativity.use_adaptive_tessellation:
+        measured = warning(obj)
+        if measured is not None or modifier.find_modifier(obj) is None:
+            return measured or None
+        level = min(level, UNMEASURED_LEVELS)  # what the update gives every face then
+        advice = "set Adaptive off and raise Tessellation (Adaptive cannot measure this mesh)"
+    # the modifier halves every edge once per tessellation level before moving the vertices
+    fraction = longest_edge_fraction(obj, camera_position) / 2**level
+    if fraction > COARSE_EDGE_FRACTION:
+        return f"Edges up to {fraction:.2f}x their distance to the camera: too coarse to curve, {advice}"
+    return None

@@ -29,7 +29,7 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, clip_end, instancing, modifier, shape_keys, tessellation
+from ..geometry import apparent_meshes, changes, clip_end, instancing, modifier, shape_keys, tessellation
 from ..scene import animation, moving_objects, snapshot, traveller
 from . import bake, render_notice
 from .stages import STAGES, Sync
@@ -303,32 +303,33 @@ def sync(
         return None
     if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
         return last_snapshot(scene)
-    apparent_meshes.unlink_caches()  # brought into a collection by Append
-    method = applied_method(scene)
-    if not snapshot.in_final_render(scene):
-        _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)
-    try:
-        snap = snapshot.read(scene, depsgraph)
-        if method is not None and method != snap.method:
-            # applied with the other method (the setting changed where no callback ran)
-            raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
-        if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
-            exact_camera.write(scene, snap)
-        if method == "GEOMETRY":
-            instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
-        if method == "GEOMETRY" and update_geometry:
-            apparent_meshes.update(scene, snap, depsgraph, only_changed=True, in_frame_change=in_frame_change)
-        if method is not None:
-            update = Sync(depsgraph, attach_new_materials, before_render)
-            for stage in STAGES:
-                stage.write(scene, snap, update)
-    except RelativityError as error:
-        if method == "CAMERA" or snapshot.in_final_render(scene):
-            exact_camera.invalidate(scene.camera)
-        _refused(scene, error)
-        return None
-    _record(scene, snap, depsgraph)
-    return snap
+    with modifier.listed_once():  # the applied meshes listed once for the whole sync
+        apparent_meshes.unlink_caches()  # brought into a collection by Append
+        method = applied_method(scene)
+        if not snapshot.in_final_render(scene):
+            _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)
+        try:
+            snap = snapshot.read(scene, depsgraph)
+            if method is not None and method != snap.method:
+                # applied with the other method (the setting changed where no callback ran)
+                raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
+            if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
+                exact_camera.write(scene, snap)
+            if method == "GEOMETRY":
+                instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
+            if method == "GEOMETRY" and update_geometry:
+                apparent_meshes.update(scene, snap, depsgraph, only_changed=True, in_frame_change=in_frame_change)
+            if method is not None:
+                update = Sync(depsgraph, attach_new_materials, before_render)
+                for stage in STAGES:
+                    stage.write(scene, snap, update)
+        except RelativityError as error:
+            if method == "CAMERA" or snapshot.in_final_render(scene):
+                exact_camera.invalidate(scene.camera)
+            _refused(scene, error)
+            return None
+        _record(scene, snap, depsgraph)
+        return snap
 
 
 def setting_changed(scene: Scene) -> None:
@@ -350,6 +351,7 @@ def setting_changed(scene: Scene) -> None:
 def object_changed(scene: Scene, obj: Object) -> None:
     """Update callback of every object setting: a mesh switched on after Set Up gets the apparent
     geometry, a changed blackbody temperature re-attaches its materials, then sync. Never raises."""
+    changes.note_changed(obj.session_uid)  # Blender tags the object after this callback
     if (
         applied_method(scene) == "GEOMETRY"
         and obj.type == "MESH"
@@ -429,26 +431,30 @@ def _record(scene, snap, depsgraph=None):
     except (RelativityError, ValueError):
         _traveller_times.pop(scene.name, None)
     if snap.method == "GEOMETRY":
+        eye = tuple(snap.camera_position)
         for obj in scene.objects:
             if obj.type == "MESH" and obj.relativity.enabled:
+                known = _object_warnings.get(obj.name)
+                if known is not None and known[0][0] == eye and changes.is_current(scene.name, obj.session_uid):
+                    continue  # an applied mesh Blender did not update since its warnings were made
                 _object_warnings[obj.name] = _mesh_warnings(obj, snap)
 
 
 def _mesh_warnings(obj, snap):
     """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change."""
     inputs = (
+        tuple(snap.camera_position),
         tuple(map(tuple, obj.matrix_world)),
         obj.data.name,
         len(obj.data.edges),
-        tuple(snap.camera_position),
         obj.relativity.tessellation,
-        obj.relativity.use_adaptive_tessellation and apparent_meshes.tessellation_warning(obj),
+        obj.relativity.use_adaptive_tessellation and tessellation.warning(obj),
         modifier.find_modifier(obj) is not None,
     )
     known = _object_warnings.get(obj.name)
     if known is not None and known[0] == inputs:
         return known
-    coarse = apparent_meshes.coarse_mesh_warning(obj, snap.camera_position)
+    coarse = tessellation.coarse_mesh_warning(obj, snap.camera_position)
     return inputs, [coarse] if coarse else []
 
 

@@ -1,0 +1,125 @@
+"""Issue 26, the many-object scene: a change on one of N moving meshes costs that mesh only. The
+work a sync does per mesh is counted through hooks on the functions that do it: the signature of
+its inputs (``object_signature``), its update, every write of a modifier input
+(``compat.set_modifier_input``), the clip-end depth of its evaluated bounds and the panel's mesh
+warnings. A velocity change on one mesh must do that work for that mesh only; a frame step with
+nothing moving none at all; a frame step where one mesh's keyframes move it, for that mesh only.
+The meshes left alone keep their evaluated positions exactly; the changed ones move."""
+
+from collections import Counter
+
+import numpy as np
+import pytest
+from test_object_type_sweep import _cube_mesh, _link
+
+import geometry_helpers as gh
+
+C = 4.0
+FPS = 24
+COUNT = 6
+
+
+def _scene(bpy, tessellation):
+    scene, _camera = gh.slow_light_scene(bpy, C, FPS)
+    movers = []
+    for k in range(COUNT):
+        obj = _link(bpy, scene, f"Mover {k}", _cube_mesh(bpy, f"Mover {k}", 0.2))
+        obj.location = (0.8 * (k - COUNT / 2), 0.5, -6.0)
+        obj.relativity.motion = "CONSTANT"
+        obj.relativity.beta = (0.3, 0.0, 0.0)
+        if tessellation is not None:
+            obj.relativity.tessellation = tessellation
+        movers.append(obj)
+    scene.frame_set(12)
+    return scene, movers
+
+
+def _count_work(monkeypatch):
+    """Patch the per-mesh work of a sync; returns {kind: Counter of object names}."""
+    work = {kind: Counter() for kind in ("signature", "update", "input written", "depth", "warnings")}
+    meshes = gh.geometry_module()
+    compat = gh.addon_module("common.compat")
+    clip_end = gh.addon_module("geometry.clip_end")
+    effect = gh.addon_module("pipeline.effect")
+
+    def hook(module, name, kind, which):
+        original = getattr(module, name)
+
+        def counted(*args, _original=original, **kwargs):
+            obj = which(args)
+            work[kind][obj.original.name if getattr(obj, "original", None) is not None else obj.name] += 1
+            return _original(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, counted)
+
+    hook(meshes, "object_signature", "signature", lambda args: args[1])
+    hook(meshes, "update_object", "update", lambda args: args[1])
+    hook(compat, "set_modifier_input", "input written", lambda args: args[0].id_data)
+    hook(clip_end, "bounds_depth", "depth", lambda args: args[1])
+    hook(effect, "_mesh_warnings", "warnings", lambda args: args[0])
+    return work
+
+
+def _done(work):
+    return {kind: dict(counts) for kind, counts in work.items() if counts}
+
+
+def _points(bpy, movers):
+    return [gh.evaluated_points(bpy, obj)[0] for obj in movers]
+
+
+@pytest.mark.parametrize("tessellation", [0, None], ids=["tessellation-0", "tessellation-default"])
+def test_velocity_change_on_one_of_many_meshes_works_on_that_mesh_only(relativity_addon, monkeypatch, tessellation):
+    import bpy
+
+    scene, movers = _scene(bpy, tessellation)
+    gh.apply_geometry(scene)
+    before = _points(bpy, movers)
+    work = _count_work(monkeypatch)
+
+    movers[2].relativity.beta = (-0.4, 0.0, 0.0)  # as the panel does: the update callback runs
+    bpy.context.evaluated_depsgraph_get()  # the viewport's next redraw
+    after = _points(bpy, movers)
+
+    assert work["update"]["Mover 2"] >= 1 and work["input written"]["Mover 2"] >= 1, _done(work)
+    others = {f"Mover {k}" for k in range(COUNT) if k != 2}
+    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
+    assert not touched, f"work done for meshes that did not change: {touched} (all: {_done(work)})"
+    for k in range(COUNT):
+        if k != 2:
+            np.testing.assert_array_equal(after[k], before[k])
+    assert np.abs(after[2] - before[2]).max() > 1e-3, "the changed mesh did not move"
+
+
+def test_frame_step_works_on_the_meshes_the_frame_moves_only(relativity_addon, monkeypatch):
+    import bpy
+
+    scene, movers = _scene(bpy, 0)
+    keyed = movers[3]  # Constant Velocity through where its keyframes put it at each frame
+    for frame, x in ((1, -0.5), (40, 0.5)):
+        keyed.location.x = x
+        keyed.keyframe_insert("location", index=0, frame=frame)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    work = _count_work(monkeypatch)
+    before = _points(bpy, movers)
+
+    scene.frame_set(13)
+    bpy.context.evaluated_depsgraph_get()
+    after = _points(bpy, movers)
+
+    others = {f"Mover {k}" for k in range(COUNT) if k != 3}
+    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
+    assert not touched, f"work done for meshes the frame did not move: {touched} (all: {_done(work)})"
+    assert work["input written"]["Mover 3"] >= 1, _done(work)
+    for k in range(COUNT):
+        if k != 3:
+            np.testing.assert_array_equal(after[k], before[k])
+    assert np.abs(after[3] - before[3]).max() > 1e-3, "the keyframed mesh did not move"
+
+    for kind in work:
+        work[kind].clear()
+    scene.frame_set(13)  # the same frame again: nothing to write
+    bpy.context.evaluated_depsgraph_get()
+    assert not work["update"] and not work["input written"], _done(work)
