@@ -16,6 +16,7 @@ Lorentz-boosted into the frame of the moving observer, and the velocity attribut
 
 import numpy as np
 import pytest
+from test_geometry_closed_form import _grid_mesh
 from test_object_type_sweep import _cube_mesh, _link
 
 import geometry_helpers as gh
@@ -137,21 +138,6 @@ def _count_passes(monkeypatch):
 
         monkeypatch.setattr(module, name, counted)
     return calls
-
-
-def _grid_mesh(bpy, name, side, width):
-    """A flat ``side`` x ``side`` vertex grid of quads, ``width`` wide: edges far shorter than a pixel."""
-    u = np.linspace(-width / 2.0, width / 2.0, side)
-    vertices = [(x, y, 0.0) for y in u for x in u]
-    faces = [
-        (i + side * j, i + 1 + side * j, i + 1 + side * (j + 1), i + side * (j + 1))
-        for j in range(side - 1)
-        for i in range(side - 1)
-    ]
-    mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata(vertices, [], faces)
-    mesh.update()
-    return mesh
 
 
 def _keyframed_mover(bpy, scene, adaptive, levels, accelerating, proper_time=False):
