@@ -122,9 +122,9 @@ def receiver_factor(
     its rest normal over the snapshot's cosine (``k_snapshot`` on the same normal), 1 without normals."""
     k = unit_vectors(k, "k")
     beta = np.broadcast_to(velocity_array(receiver_beta, "receiver_beta"), k.shape)
-    doppler = _gamma(beta) * (1.0 - _dot(beta, k))
+    doppler: FloatArray = _gamma(beta) * (1.0 - _dot(beta, k))
     if receiver_normals is None:
-        return doppler**2
+        return doppler * doppler
     n = unit_vectors(receiver_normals, "receiver_normals")
     snapshot = -_dot(unit_vectors(k_snapshot, "k_snapshot"), n)
     physical = np.maximum(-_dot(aberrate(k, beta), n), 0.0)
