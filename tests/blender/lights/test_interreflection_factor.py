@@ -41,8 +41,11 @@ def _insert_factor(bpy, scene, beta_receiver, receiver_normal, use_factor, use_n
     beta.attribute_type = "GEOMETRY"
     beta.attribute_name = names.BETA_ATTRIBUTE
     rest = next(
-        n for n in tree.nodes if n.bl_idname == "ShaderNodeGroup" and n.node_tree.name == names.REST_NORMAL_GROUP
+        (n for n in tree.nodes if n.bl_idname == "ShaderNodeGroup" and n.node_tree.name == names.REST_NORMAL_GROUP),
+        None,
     )
+    if rest is None:  # nothing moves: no rest normals, the geometry's own
+        rest = tree.nodes.new("ShaderNodeNewGeometry")
     tree.links.new(source, script.inputs["In"])
     tree.links.new(beta.outputs["Vector"], script.inputs["BetaS"])
     tree.links.new(rest.outputs["Normal"], script.inputs["RestNormal"])
@@ -54,12 +57,12 @@ def _insert_factor(bpy, scene, beta_receiver, receiver_normal, use_factor, use_n
     tree.links.new(script.outputs["Out"], colour)
 
 
-@pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH)])
+@pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH), ("rest", 0.0)])
 def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
     """Rendered over the physics model (the test's 487 / 222 pixels): OSL shading with the factor
     off is the suite's 1.12 / 0.95; with the factor and the receiver's normal within 5 % both ways
     (measured 0.982 / 1.006); without the normal better than without the factor both ways, but
-    not within 5 % apart (1.086 / 0.962)."""
+    not within 5 % apart (1.086 / 0.962). At rest the factor changes nothing."""
     bpy = factory_blender
     if osl.unavailable_reason() is not None:
         pytest.skip(osl.unavailable_reason())
@@ -77,6 +80,11 @@ def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path,
     case._save(bpy, tmp_path / f"{name}_factor_render_model.png", images["normal"], physics)
     ratios = {key: round(float(image[sampled].mean() / physics[sampled].mean()), 4) for key, image in images.items()}
     print(f"{name}, {sampled.sum()} px: rendered over physics {ratios}")
+    if name == "rest":  # the control: the factor is 1 when nothing moves
+        assert ratios["off"] == pytest.approx(1.0, abs=0.03)
+        assert ratios["normal"] == pytest.approx(ratios["off"], abs=0.002)
+        assert ratios["no normal"] == pytest.approx(ratios["off"], abs=0.002)
+        return
     assert ratios["off"] == pytest.approx({"apart": 1.12, "approaching": 0.95}[name], abs=0.04)
     assert ratios["normal"] == pytest.approx(1.0, abs=0.05)
     assert abs(ratios["no normal"] - 1.0) < abs(ratios["off"] - 1.0)
