@@ -36,7 +36,7 @@ from .lorentz import aberrate
 from .retarded import light_travel_time_uniform
 from .validation import unit_vectors, vector_array, velocity_array
 
-MAX_SOLID_ANGLE_RATIO = 4.0  # a cap on J (docs/lamp-doppler.md: 2 instead moves the measured means by 0.1 %)
+MAX_SOLID_ANGLE_RATIO = 4.0  # a cap on J against fireflies (docs/lamp-doppler.md: the model's means do not feel it)
 
 
 def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
