@@ -4,9 +4,10 @@ render of ``test_interreflection.py``'s case, against its physics model.
 The sphere's material gets an OSL script node (``bounce_factor.osl``, the formulas of
 ``physics/bounce.py``) between its Doppler-coloured colour and its BSDF: on non-camera rays it
 finds the receiving point (``P + I * ray length``), where that point sees the sphere's point, and
-scales the colour by ``F``. The receiver's velocity and rest normal are given to it, as the
-add-on could not (a material shader does not know the surface a ray came from): this measures
-how far the correction reaches with them and without the normal, not a feature of the add-on.
+scales the colour by ``F``. The receiver's velocity (and, in one variant, its rest normal) is
+given to it, as the add-on could not give it (a material shader does not know the surface a ray
+came from); in another variant the shader traces back to the receiver for its normal (OSL only):
+this measures how far the correction reaches, not a feature of the add-on.
 """
 
 from pathlib import Path
@@ -60,16 +61,19 @@ def _insert_factor(bpy, scene, beta_receiver, receiver_normal, use_factor, use_n
 @pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH), ("rest", 0.0)])
 def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
     """Rendered over the physics model (the test's 487 / 222 pixels): OSL shading with the factor
-    off is the suite's 1.12 / 0.95; with the factor and the receiver's normal within 5 % both ways
-    (measured 0.982 / 1.006); without the normal better than without the factor both ways, but
-    not within 5 % apart (1.086 / 0.962). At rest the factor changes nothing."""
+    off is the suite's 1.12 / 0.95; with the factor and the receiver's rest normal within 5 % both
+    ways (measured 0.982 / 1.006), and the same with the normal the shader traces back to the
+    receiver (its apparent mesh's, turned back to the rest normal with the receiver's velocity);
+    without the normal better than without the factor both ways, but not within 5 % apart
+    (1.086 / 0.962). At rest the factor changes nothing."""
     bpy = factory_blender
     if osl.unavailable_reason() is not None:
         pytest.skip(osl.unavailable_reason())
     beta = np.array([sphere_beta, 0.0, 0.0])
     effect = case._module("pipeline.effect")
     images = {}
-    for key, use_factor, use_normal in (("off", 0.0, 0.0), ("normal", 1.0, 1.0), ("no normal", 1.0, 0.0)):
+    variants = (("off", 0.0, 0.0), ("normal", 1.0, 1.0), ("traced normal", 1.0, 2.0), ("no normal", 1.0, 0.0))
+    for key, use_factor, use_normal in variants:
         scene, rotation = case._scene(bpy, beta, -beta)
         effect.apply(scene)
         _insert_factor(bpy, scene, -beta, rotation[:, 2], use_factor, use_normal)
@@ -84,9 +88,11 @@ def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path,
         assert ratios["off"] == pytest.approx(1.0, abs=0.03)
         assert ratios["normal"] == pytest.approx(ratios["off"], abs=0.002)
         assert ratios["no normal"] == pytest.approx(ratios["off"], abs=0.002)
+        assert ratios["traced normal"] == pytest.approx(ratios["off"], abs=0.002)
         return
     assert ratios["off"] == pytest.approx({"apart": 1.12, "approaching": 0.95}[name], abs=0.04)
     assert ratios["normal"] == pytest.approx(1.0, abs=0.05)
+    assert ratios["traced normal"] == pytest.approx(ratios["normal"], abs=0.005)
     assert abs(ratios["no normal"] - 1.0) < abs(ratios["off"] - 1.0)
     if name == "apart":
         assert ratios["no normal"] > 1.05
