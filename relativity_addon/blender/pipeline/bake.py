@@ -299,11 +299,14 @@ def _all_trees():
             yield tree
 
 
-def _step(scene, frames, sync_for_render, meshes):
+def _step(scene, frames, sync_for_render, meshes, leave_frame):
     """The frames' recorded states and the add-on's images' pixels; the evaluated mesh of every
-    object of ``meshes`` (object -> list, filled) captured at each frame."""
+    object of ``meshes`` (object -> list, filled) captured at each frame; ``leave_frame`` (or None)
+    runs before each frame change."""
     states, images = [], {}
     for index, frame in enumerate(frames):
+        if leave_frame is not None:
+            leave_frame()
         scene.frame_set(frame)
         if sync_for_render() is None:
             raise RelativityError(f"Cannot bake frame {frame}: the relativistic render is refused there")
@@ -341,12 +344,14 @@ def bake(
     sync_for_render: Callable[[], object],
     geometry: Sequence[Object] = (),
     exact_final_render: bool = False,
+    leave_frame: Callable[[], object] | None = None,
 ) -> dict[str, int]:
     """Step frames ``first`` .. ``last``, calling ``sync_for_render`` at each (the sync a render
     runs), and keyframe what changes; capture the evaluated meshes of ``geometry`` (Apparent
     Geometry's moving meshes) at each frame and play them back (``geometry/playback.py``);
     ``exact_final_render``: the scene's camera holds the final render's exact camera, which the
-    bake keeps (and :func:`unbake` removes). Returns counts: frames, F-curves, image sequences,
+    bake keeps (and :func:`unbake` removes); ``leave_frame``: called before each frame change (what a
+    render's ``render_complete`` undoes before the next frame's). Returns counts: frames, F-curves, image sequences,
     meshes, and ``needs_osl`` (1 where what was baked renders only in a Blender with OSL).
     RelativityError (one line) if the frames differ in what they hold (stand-in lamps added or
     removed; with ``geometry`` they are kept, and the range stepped again if a later frame added
@@ -360,10 +365,10 @@ def bake(
     try:
         # played-back geometry: the handlers leave the scene as baked, so stand-in lamps can stay
         with busy.keeping_stand_ins() if geometry else contextlib.nullcontext():
-            states, images = _step(scene, frames, sync_for_render, meshes)
+            states, images = _step(scene, frames, sync_for_render, meshes, leave_frame)
             if geometry and _differ(states):  # stand-ins first needed at a later frame: all there now
                 _discard(meshes)
-                states, images = _step(scene, frames, sync_for_render, meshes)
+                states, images = _step(scene, frames, sync_for_render, meshes, leave_frame)
     except RelativityError:
         _discard(meshes)
         scene.frame_set(start)

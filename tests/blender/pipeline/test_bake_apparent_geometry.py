@@ -167,9 +167,10 @@ def test_render_script_bakes_apparent_geometry_that_renders_without_the_add_on(
     ch.run_render_script(blend, tmp_path / "seed8.exr", "--frames=2-3", "--seed=8", "--samples=16", timeout=600)
     noise = float(np.abs(ch.read_exr(bpy, tmp_path / "seed8_0003.exr") - own[-1]).mean())
     print(f"mean |baked - render.py| per frame {differences}, seed noise {noise:.4g}")
-    # 0.0 with point stand-ins; with the default lines the moving lamp's case is 0.006-0.016 (not
-    # understood: render.py --out and --bake-to decide something differently, see docs/moving-lights.md)
-    assert max(differences) < 0.1 * noise, differences
+    # the same scene and seed: the same pixels, to float rounding (far below the seed noise). With the
+    # moving lamp drawn as lines the bake once made them anew after their copies on the box, so Cycles
+    # sampled the lights in another order: 0.006-0.016 (Blender 4.5), the same image with other noise
+    assert noise > 0.01 and max(differences) < 1e-6, (differences, noise)
 
 
 def test_street_baked_frame_by_frame_equals_the_add_on_s_frames(factory_blender, tmp_path):

@@ -1,0 +1,97 @@
+"""Why a moving light on a moving mesh is noisier with the stand-ins drawn as lines (docs/moving-lights.md,
+"A moving light on a moving object"): the per-pixel error of tests/blender/lights/test_moving_light_on_moving_mesh.py's
+antiparallel case against its model, for variants of the stand-ins that the sphere does not receive
+(light-linked away from it; only the pair lamps light it, and they are the same in every variant).
+
+    python benchmarks/moving_pair_noise.py [--samples 256] [--variants lines,points,...]
+
+Variants: ``lines`` (the default), ``points`` (``stand_in_lamps.LINE = 0``), ``points-many`` (points at a
+third of the spacing: 12 lamps), ``lines-one-side`` (one strip per line), ``lines-short`` (lines 0.2 lamp
+spacings long), ``lines-dim`` (the strips at 1e-6 W), ``lines-dark`` (the strips at 0 W: Cycles drops them),
+``lines-no-tree`` and ``points-no-tree`` (Cycles' light tree off). The strips' power is set in a
+``render_pre`` handler after the add-on's sync. Fixed seed: variants that leave the sphere's sampling
+alone give the same number to the last digit.
+"""
+
+import argparse
+import importlib
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), os.path.join(ROOT, "tests", "blender", "lights")]
+
+VARIANTS = (
+    "lines",
+    "points",
+    "points-many",
+    "lines-one-side",
+    "lines-short",
+    "lines-dim",
+    "lines-dark",
+    "lines-no-tree",
+    "points-no-tree",
+)
+
+
+def measure(bpy, case, stand_ins, variant, samples):
+    """The per-pixel error of ``variant`` (test_moving_light_on_moving_mesh's measure)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    saved = {name: getattr(stand_ins, name) for name in ("LINE", "LINE_SIDES", "SPACING")}
+    build = case._scene
+    power = {"lines-dim": 1e-6, "lines-dark": 0.0}.get(variant)
+
+    def scene_for(*args, **kwargs):
+        scene = build(*args, **kwargs)
+        scene.cycles.samples = samples
+        scene.cycles.use_light_tree = not variant.endswith("no-tree")
+        return scene
+
+    def strips_power(scene, *_args):
+        for obj in scene.objects:
+            if power is not None and obj.type == "LIGHT" and obj.data.type == "AREA":
+                obj.data.energy = power
+
+    stand_ins.LINE = 0.0 if variant.startswith("points") else 0.2 if variant == "lines-short" else saved["LINE"]
+    stand_ins.LINE_SIDES = 1 if variant == "lines-one-side" else saved["LINE_SIDES"]
+    stand_ins.SPACING = saved["SPACING"] / 3.5 if variant == "points-many" else saved["SPACING"]
+    case._scene = scene_for
+    bpy.app.handlers.render_pre.append(strips_power)
+    try:
+        with tempfile.TemporaryDirectory() as folder:
+            pattern, total, shift = case._compare(bpy, np.array((-case.BETA, 0.0, 0.0)), Path(folder), variant)
+    finally:
+        bpy.app.handlers.render_pre.remove(strips_power)
+        case._scene = build
+        for name, value in saved.items():
+            setattr(stand_ins, name, value)
+    return pattern, total, shift
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--samples", type=int, default=256)
+    parser.add_argument("--variants", default=",".join(VARIANTS))
+    options = parser.parse_args()
+    import bpy
+
+    from relativity_addon.batch import enable_addon
+
+    enable_addon()
+    case = importlib.import_module("test_moving_light_on_moving_mesh")
+    case.ADDON_MODULE = "relativity_addon"  # the add-on as this checkout registers it
+    stand_ins = importlib.import_module("relativity_addon.blender.lights.stand_in_lamps")
+    print(f"Blender {bpy.app.version_string}, {options.samples} samples, load average {os.getloadavg()[0]:.1f}")
+    for variant in options.variants.split(","):
+        pattern, total, shift = measure(bpy, case, stand_ins, variant, options.samples)
+        print(f"{variant:>15}: per-pixel error {pattern:.2%}, total {total:.4f}, centroid {shift:.2f} px", flush=True)
+    sys.stdout.flush()
+    os._exit(0)  # bpy 4.5 can hang in exit()
+
+
+if __name__ == "__main__":
+    main()
