@@ -318,9 +318,14 @@ def ensure_node_groups() -> NodeTree:
     """
     lut_images.ensure_doppler_matrix_lut()
     lut_images.ensure_blackbody_lut()
-    for builder in GROUP_BUILDERS:
-        ensure_group(builder(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
+    if not _specs:  # built once per session: constants, and each object setting's change attaches
+        _specs.extend(builder() for builder in GROUP_BUILDERS)
+    for spec in _specs:
+        ensure_group(spec, names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
     return bpy.data.node_groups[DOPPLER_EMISSION]
+
+
+_specs: list[Group] = []  # GROUP_BUILDERS' groups
 
 
 # --- settings -------------------------------------------------------------------------------

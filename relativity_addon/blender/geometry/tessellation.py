@@ -262,7 +262,7 @@ def edge_image_bound(obj: Object, matrix: FloatArray, snap: Snapshot, size: tupl
         beta,
         tuple(x_o),
         tuple(beta_o),
-        repr(snap.world_to_camera),
+        snap.camera_matrix,  # the camera's rotation comes from it (a numpy repr took milliseconds)
         window,
         size,
     )
