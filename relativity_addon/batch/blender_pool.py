@@ -4,9 +4,11 @@ Each process runs ``frame_server.serve``: it loads the .blend once and renders f
 so a frame costs about what it costs in a running Blender. A pool keeps one process per task
 running at once on the worker (one, with one Dask thread per worker), for one job:
 
-- **Dies with the worker**: the process asks Linux to kill it when the thread that started it ends
-  (``PR_SET_PDEATHSIG``); every process is started from one thread of the pool that lives as long
-  as the worker, so a lost worker leaves no Blender writing behind it.
+- **Dies with the worker**: the kernel kills the process when the last copy of its lifeline's write
+  end closes, which the worker holds (also for a process a local cluster's coordinator started
+  before Dask and the worker took over, :class:`PreStarted`); and when the thread that started it
+  ends (``PR_SET_PDEATHSIG``): every process is started from one thread of the pool that lives as
+  long as the worker. A lost worker leaves no Blender writing behind it.
 - **Restarted if it dies**: a process lost while it renders a frame (killed, out of memory) is
   replaced by a fresh one and the frame rendered again, once in the task; lost a second time, the
   task raises :class:`LostProcessError` and Dask's retries run it again, elsewhere if they can.

@@ -94,11 +94,12 @@ def test_blender_processes_load_while_the_local_cluster_starts(moving_blend, tmp
     rendering = {pid for _, _, pid in _done(stdout)}
     blenders = {pid for pid, (_, _, line) in seen.items() if "PR_SET_PDEATHSIG" in line}
     dask = [created for created, _, line in seen.values() if "multiprocessing" in line]
-    assert len(rendering) == 2 and rendering <= blenders, (rendering, seen)
-    assert len(blenders) == 2, seen  # none started besides the two taken over
-    assert dask, seen
-    assert all(seen[pid][1] == process.pid for pid in rendering), seen
-    assert max(seen[pid][0] for pid in rendering) < min(dask), seen
+    found = f"rendering {rendering}; seen {seen}; stdout {stdout}"
+    # Two, or one when a worker rendered all four tiny frames before the other's Blender was ready.
+    assert 1 <= len(rendering) <= 2 and rendering <= blenders, found
+    assert len(blenders) == 2 and dask, found  # none started besides the two taken over
+    assert all(seen[pid][1] == process.pid for pid in blenders), found
+    assert max(seen[pid][0] for pid in blenders) < min(dask), found
 
 
 def test_killed_blender_process_is_restarted_and_its_frame_rendered_again(moving_blend, tmp_path, factory_blender):
