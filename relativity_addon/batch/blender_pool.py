@@ -148,6 +148,7 @@ class BlenderProcess:
 
     @classmethod
     def taken_over(cls, message: bytes, fds: Sequence[int]) -> BlenderProcess:
+        """The process described by ``message`` whose requests, replies and lifeline are ``fds``."""
         process = cls.__new__(cls)
         info = json.loads(message)
         process.process, process.pid, process.log_path, process.setup = None, int(info["pid"]), str(info["log"]), None

@@ -288,9 +288,10 @@ def render(
         common.append(f"--threads={threads}")
     job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
     started = None
-    if options.scheduler is None:
+    if options.scheduler is None and sys.platform.startswith("linux"):
         # A local cluster's Blender processes load while Dask starts (not after: Dask's start
-        # leaves a core idle for a second); each worker takes one over as it starts.
+        # leaves a core idle for a second); each worker takes one over as it starts. Linux only:
+        # a taken-over process dies with its worker through a lifeline the kernel watches.
         from .blender_pool import PreStarted
 
         started = PreStarted(options.workers, common, todo[0])
