@@ -124,7 +124,7 @@ def _rendering(blender):
 
 
 def _lifeline_owner(blender, processes):
-    """The process among ``processes`` holding the other end of ``blender``'s lifeline pipe (its
+    """The Dask worker among ``processes`` holding the other end of ``blender``'s lifeline pipe (its
     file descriptor is on its command line, after the reply one): the worker it renders for, which
     is its parent or, for a process the coordinator started and a worker took over, not."""
     try:
@@ -132,11 +132,11 @@ def _lifeline_owner(blender, processes):
     except (OSError, IndexError):
         return None
     for process in processes:
-        if process.pid == blender.pid:
-            continue
         try:
+            if "multiprocessing" not in " ".join(process.cmdline()):
+                continue
             names = os.listdir(f"/proc/{process.pid}/fd")
-        except OSError:
+        except (OSError, psutil.Error):
             continue
         for name in names:
             try:
@@ -172,7 +172,7 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
                     if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()) or not _rendering(child):
                         continue
                     owner = _lifeline_owner(child, tree)
-                    if owner is not None and "multiprocessing" in " ".join(owner.cmdline()):
+                    if owner is not None:
                         orphan, victim = child, owner
                         break
                 except psutil.NoSuchProcess:

@@ -78,12 +78,15 @@ def test_blender_processes_load_while_the_local_cluster_starts(moving_blend, tmp
                 tree = root.children(recursive=True)
             except psutil.NoSuchProcess:
                 break
+            # The command line read again each time (a child not yet exec'd shows its parent's),
+            # but not from an ended process waiting to be reaped (it shows none).
             for child in tree:
-                if child.pid not in seen:
-                    try:
-                        seen[child.pid] = (child.create_time(), child.ppid(), " ".join(child.cmdline()))
-                    except psutil.Error:
-                        continue
+                try:
+                    line = " ".join(child.cmdline())
+                    if line or child.pid not in seen:
+                        seen[child.pid] = (child.create_time(), child.ppid(), line)
+                except psutil.Error:
+                    continue
             time.sleep(0.01)
         stdout, stderr = process.communicate(timeout=240)
     finally:
@@ -92,7 +95,8 @@ def test_blender_processes_load_while_the_local_cluster_starts(moving_blend, tmp
             process.communicate()
     assert process.returncode == 0, stderr[-3000:]
     rendering = {pid for _, _, pid in _done(stdout)}
-    blenders = {pid for pid, (_, _, line) in seen.items() if "PR_SET_PDEATHSIG" in line}
+    launched = {pid for pid, (_, _, line) in seen.items() if "PR_SET_PDEATHSIG" in line}
+    blenders = {pid for pid in launched if seen[pid][1] not in launched}  # not a Blender's own child
     dask = [created for created, _, line in seen.values() if "multiprocessing" in line]
     found = f"rendering {rendering}; seen {seen}; stdout {stdout}"
     # Two, or one when a worker rendered all four tiny frames before the other's Blender was ready.
