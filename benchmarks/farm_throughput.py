@@ -69,11 +69,12 @@ CLUSTER_FRAME = re.compile(
 
 
 def _kind(process):
-    """coordinator, dask (a worker process or a forkserver) or blender, from the command line."""
+    """coordinator, dask (a worker process or a forkserver) or blender, from the command line; None
+    while it cannot be read (a process just started: read again at the next sample)."""
     try:
         command = " ".join(process.cmdline())
     except psutil.Error:
-        return "dask"
+        return None
     if "frame_server" in command:
         return "blender"
     if "multiprocessing" in command:
@@ -94,7 +95,8 @@ def _sample_tree(root, cpu, stop):
                 times = process.cpu_times()
             except psutil.Error:
                 continue
-            entry = cpu.setdefault(process.pid, [_kind(process), 0.0])
+            entry = cpu.setdefault(process.pid, [None, 0.0])
+            entry[0] = entry[0] or _kind(process)
             entry[1] = max(entry[1], times.user + times.system)
         stop.wait(0.1)
 
@@ -122,7 +124,7 @@ def run(command, cpu=None):
     if cpu is not None:
         kinds = {"coordinator": 0.0, "dask": 0.0, "blender": 0.0}
         for kind, seconds in per_process.values():
-            kinds[kind] += seconds
+            kinds[kind or "dask"] += seconds
         cpu.append({**kinds, "total": sum(kinds.values())})
     return wall, lines
 

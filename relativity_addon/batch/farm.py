@@ -135,12 +135,12 @@ def _frames(options):
     raise BatchError("--workers and --scheduler need --frames A-B or --frame N")
 
 
-def _connect(options, log, arguments, job_name, setup_frame=None):
+def _connect(options, log, arguments, job_name, setup_frame=None, handover=None):
     """(client, cluster or None) for --workers or --scheduler, every worker with the job's
     Blender processes (``farm_worker.BlenderProcesses`` for the task ``arguments``, named
-    ``job_name``, the effect applied at ``setup_frame``): a local cluster's workers start loading
-    the file as they start, a running cluster's when the plugin is registered; any worker that
-    joins later, when it joins."""
+    ``job_name``, the effect applied at ``setup_frame``): a local cluster's workers take over the
+    processes offered at ``handover`` or start loading the file as they start, a running
+    cluster's when the plugin is registered; any worker that joins later, when it joins."""
     try:
         import dask
         from distributed import Client, LocalCluster
@@ -150,7 +150,7 @@ def _connect(options, log, arguments, job_name, setup_frame=None):
         raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'") from None
     import logging
 
-    plugin = farm_worker.BlenderProcesses(arguments, job_name, setup_frame)
+    plugin = farm_worker.BlenderProcesses(arguments, job_name, setup_frame, handover)
 
     if options.scheduler is not None:
         try:
@@ -287,7 +287,20 @@ def render(
     if threads is not None:
         common.append(f"--threads={threads}")
     job_name = f"relativistic-render-{os.getpid()}-{time.time_ns()}"
-    client, cluster = _connect(options, log, common, job_name, todo[0])
+    started = None
+    if options.scheduler is None and sys.platform.startswith("linux"):
+        # A local cluster's Blender processes load while Dask starts (not after: Dask's start
+        # leaves a core idle for a second); each worker takes one over as it starts. Linux only:
+        # a taken-over process dies with its worker through a lifeline the kernel watches.
+        from .blender_pool import PreStarted
+
+        started = PreStarted(options.workers, common, todo[0])
+    try:
+        client, cluster = _connect(options, log, common, job_name, todo[0], started and started.address)
+    except BaseException:
+        if started is not None:
+            started.close()
+        raise
     try:
         from distributed import as_completed
 
@@ -322,5 +335,7 @@ def render(
         client.close()
         if cluster is not None:
             cluster.close()
+        if started is not None:
+            started.close()
         remove_partials(paths.values())
     return job.summary(error_log)

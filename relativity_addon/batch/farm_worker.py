@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from distributed import WorkerPlugin, get_worker
 
-from .blender_pool import BlenderPool
+from .blender_pool import BlenderPool, take_over
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -28,17 +28,26 @@ if TYPE_CHECKING:
 class BlenderProcesses(WorkerPlugin):
     """A worker's Blender processes for one job; ``arguments``: the batch-script command line
     every frame shares (file, --out pattern, options; no frames); ``name``: the job's, unique;
-    ``setup_frame``: the frame each process applies the effect at as it starts (the job's first)."""
+    ``setup_frame``: the frame each process applies the effect at as it starts (the job's first);
+    ``handover``: where a local cluster's coordinator offers the processes it started for the
+    workers before the cluster (``blender_pool.PreStarted``), or None."""
 
-    def __init__(self, arguments: Sequence[str], name: str, setup_frame: int | None = None) -> None:
+    def __init__(
+        self, arguments: Sequence[str], name: str, setup_frame: int | None = None, handover: str | None = None
+    ) -> None:
         self.arguments = list(arguments)
         self.setup_frame = setup_frame
         self.name = name  # the key of ``worker.plugins`` (Dask reads the attribute)
+        self.handover = handover
         self.pool: BlenderPool | None = None
 
     def setup(self, worker: Worker) -> None:
         self.pool = BlenderPool(self.arguments, self.setup_frame)
-        self.pool.prestart()
+        process = take_over(self.handover) if self.handover else None
+        if process is not None:
+            self.pool.adopt(process)
+        else:
+            self.pool.prestart()
 
     def teardown(self, worker: Worker) -> None:
         if self.pool is not None:

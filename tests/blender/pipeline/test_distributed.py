@@ -110,10 +110,48 @@ def test_four_frames_on_two_workers_equal_one_process_and_resume(moving_blend, t
     assert identities() == kept
 
 
+def _rendering(blender):
+    """Whether a worker's Blender process renders: Cycles' progress lines ("| Sample 1/1024") in its
+    log, its standard output (4.5), or Cycles' threads (5.2 prints no progress; measured with one
+    render thread: 5 threads when set up, 12 while rendering; 4.5: 6 and 7)."""
+    try:
+        if blender.num_threads() >= 9:
+            return True
+        with open(os.readlink(f"/proc/{blender.pid}/fd/1"), errors="replace") as log:
+            return "| Sample " in log.read()
+    except (OSError, psutil.Error):
+        return False
+
+
+def _lifeline_owner(blender, processes):
+    """The Dask worker among ``processes`` holding the other end of ``blender``'s lifeline pipe (its
+    file descriptor is on its command line, after the reply one): the worker it renders for, which
+    is its parent or, for a process the coordinator started and a worker took over, not."""
+    try:
+        pipe = os.readlink(f"/proc/{blender.pid}/fd/{blender.cmdline()[6]}")
+    except (OSError, IndexError):
+        return None
+    for process in processes:
+        try:
+            if "multiprocessing" not in " ".join(process.cmdline()):
+                continue
+            names = os.listdir(f"/proc/{process.pid}/fd")
+        except (OSError, psutil.Error):
+            continue
+        for name in names:
+            try:
+                if os.readlink(f"/proc/{process.pid}/fd/{name}") == pipe:
+                    return process
+            except OSError:
+                continue
+    return None
+
+
 def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
-    """SIGKILL to a worker process while the Blender process it started renders a frame: the
-    scheduler reruns the task on a live worker, the Blender process dies with its worker (no
-    second writer), every frame ends whole, exit status 0."""
+    """SIGKILL to a worker process while the Blender process it renders with (started by the
+    coordinator before the cluster and taken over by the worker, or started by the worker) renders
+    a frame: the scheduler reruns the task on a live worker, the Blender process dies with its
+    worker (no second writer), every frame ends whole, exit status 0."""
     bpy = factory_blender
     out = tmp_path / "out" / "f.png"
     # Enough samples that Cycles renders for a few seconds (on a busy machine too): the kill must
@@ -122,22 +160,20 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *common, f"--out={out}", "--workers=2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
     victim = orphan = None
-    rendering = {}  # task process pid -> when it was first seen rendering
     try:
         deadline = time.monotonic() + 240
         while victim is None and time.monotonic() < deadline and process.poll() is None:
-            for child in psutil.Process(process.pid).children(recursive=True):
+            try:
+                tree = psutil.Process(process.pid).children(recursive=True)
+            except psutil.NoSuchProcess:
+                break
+            for child in tree:
                 try:
-                    if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()):
+                    if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()) or not _rendering(child):
                         continue
-                    # Measured with both bpy wheels for a process per task: 4-6 threads up to the
-                    # render, 11-13 while Cycles renders (about 2 s of a 4-5 s process at 32x32). A
-                    # worker's long-lived Blender process rendering on one thread has 7 (4.5.15), so
-                    # there its age decides: 2.8 s after it started it loads the file or renders.
-                    if child.num_threads() >= 9 or time.time() - child.create_time() > 2.5:
-                        rendering.setdefault(child.pid, time.monotonic())
-                    if time.monotonic() - rendering.get(child.pid, time.monotonic()) > 0.3:
-                        orphan, victim = child, child.parent()
+                    owner = _lifeline_owner(child, tree)
+                    if owner is not None:
+                        orphan, victim = child, owner
                         break
                 except psutil.NoSuchProcess:
                     continue
