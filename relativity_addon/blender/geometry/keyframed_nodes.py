@@ -49,9 +49,10 @@ def _multiply_add(a: object, b: object, c: object) -> Node:
     return Node("ShaderNodeVectorMath", {0: a, 1: b, 2: c}, {"operation": "MULTIPLY_ADD"})
 
 
-def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
-    """Nodes for the motion at light-travel distance ``sigma`` (a reference or a value); returns the
-    references of the position relative to the observer, the rate per grid unit and ``s``."""
+def _interval(nodes: dict[str, Node], tag: str, sigma: object) -> None:
+    """Nodes for the interval of light-travel distance ``sigma``: ``{tag}_s`` (grid coordinate),
+    ``{tag}_j`` (the interval, clamped to those given), ``{tag}_g`` (the fraction inside it) and
+    ``{tag}_beyond`` (how far past its end, where the end's slope continues)."""
     nodes.update(
         {
             f"{tag}_s": fmath("MULTIPLY_ADD", sigma, "kf_minus_kappa", "group.Grid Now"),
@@ -69,6 +70,53 @@ def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str
             {"Geometry": "cache_info.Geometry", "Value": f"kf_coefficient{power}.Attribute", "Index": f"{tag}_j"},
             {"data_type": "FLOAT4X4", "domain": "POINT"},
         )
+
+
+def _first_guess(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str]:
+    """Nodes for the motion at the single light-travel distance ``sigma`` (the origin's): one
+    interval for every point, so the cubic and its rate are summed once as 4x4 maps (single values)
+    and each point pays two Transform Points; returns the references of the position relative to
+    the observer and the rate per grid unit. Only the first step's guess: the later steps fix the
+    result, so summing the matrices first (another float32 rounding) changes nothing they find."""
+    _interval(nodes, tag, sigma)
+    g, beyond = f"{tag}_g", f"{tag}_beyond"
+    nodes[f"{tag}_g3"] = fmath("MULTIPLY", g, 3.0)
+    for power in range(4):
+        nodes[f"{tag}_e{power}"] = Node("FunctionNodeSeparateMatrix", {"Matrix": f"{tag}_m{power}.Value"})
+    at, rate = {}, {}
+    for column in range(1, 5):
+        for row in range(1, 4):  # Transform Point ignores the fourth row
+            entry = f"Column {column} Row {row}"
+            m0, m1, m2, m3 = (f"{tag}_e{power}.{entry}" for power in range(4))
+            key = f"{tag}_{column}{row}"
+            nodes.update(
+                {
+                    f"{key}_p2": fmath("MULTIPLY_ADD", m3, g, m2),
+                    f"{key}_p1": fmath("MULTIPLY_ADD", f"{key}_p2", g, m1),
+                    f"{key}_p0": fmath("MULTIPLY_ADD", f"{key}_p1", g, m0),
+                    f"{key}_m2x2": fmath("ADD", m2, m2),
+                    f"{key}_r1": fmath("MULTIPLY_ADD", m3, f"{tag}_g3", f"{key}_m2x2"),
+                    f"{key}_rate": fmath("MULTIPLY_ADD", f"{key}_r1", g, m1),
+                    f"{key}_at": fmath("MULTIPLY_ADD", f"{key}_rate", beyond, f"{key}_p0"),
+                }
+            )
+            at[entry], rate[entry] = f"{key}_at", f"{key}_rate"
+    nodes[f"{tag}_at_matrix"] = Node("FunctionNodeCombineMatrix", at)
+    nodes[f"{tag}_rate_matrix"] = Node("FunctionNodeCombineMatrix", rate)
+    nodes[f"{tag}_x"] = Node(
+        "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_at_matrix.Matrix"}
+    )
+    nodes[f"{tag}_rate"] = Node(
+        "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_rate_matrix.Matrix"}
+    )
+    return f"{tag}_x.Vector", f"{tag}_rate.Vector"
+
+
+def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
+    """Nodes for the motion at light-travel distance ``sigma`` (a reference or a value); returns the
+    references of the position relative to the observer, the rate per grid unit and ``s``."""
+    _interval(nodes, tag, sigma)
+    for power in range(4):
         nodes[f"{tag}_y{power}"] = Node(
             "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_m{power}.Value"}
         )
@@ -136,9 +184,13 @@ def keyframed_nodes() -> dict[str, Node]:
     }
     nodes["kf_minus_kappa"] = fmath("MULTIPLY", "group.Grid Per Distance", -1.0)
     sigma: object = "group.Start Distance"
+    s = "kf0_s"
     for step in range(STEPS):
         last = sigma
-        _x, rate, s = _evaluate(nodes, f"kf{step}", sigma)
+        if step == 0:
+            _x, rate = _first_guess(nodes, "kf0", sigma)
+        else:
+            _x, rate, s = _evaluate(nodes, f"kf{step}", sigma)
         sigma = _step(nodes, f"kf{step}", sigma, _x, rate)
     # the emission point on the last step's uniform motion (r - sigma w): its error is the cubic's
     # departure over the last step, far below float32 rounding once the steps converge (checked below)
