@@ -9,7 +9,8 @@ ratio to the group as built (``as built``) and to the group with Keyframed off (
 Variants: ``steps1``/``steps2``/``steps3``/``steps4`` (the closed-form steps; fewer send more
 points to the Python path, more cost more), ``single`` (every step reads the first step's
 interval: the cost without per-point Sample Index, not the right positions), ``off`` (Keyframed
-off). Times are of the whole modifier (subdivision check, rest, solve, the velocity, the verdict).
+off), ``capture`` (the captures of the rest positions, nothing solved).
+Times are of the whole modifier (subdivision check, rest, solve, the velocity, the verdict).
 """
 
 import argparse
@@ -25,7 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import artist_chain  # noqa: E402
 
 
-def variant_group(bpy, name, steps=None, single=False):
+def variant_group(bpy, name, steps=None, single=False, capture_only=False):
     """A copy of the modifier's node group named ``name``, built with ``steps`` steps and (``single``)
     every step's Sample Index at the first step's interval."""
     from relativity_addon.blender.common import nodes as common_nodes
@@ -47,6 +48,9 @@ def variant_group(bpy, name, steps=None, single=False):
         spec = node_group.node_group_spec()
     finally:
         keyframed_nodes.STEPS, keyframed_nodes.Node = saved
+    if capture_only:  # the captures of the rest positions alone: what solving nothing costs
+        for capture in ("kf_capture", "kf_capture_whole"):
+            spec.nodes[capture].inputs.update({"Seen": "position.Position", "Beta": "position.Position", "Inside": 1.0})
     return common_nodes.build_group(dataclasses.replace(spec, name=name))
 
 
@@ -91,6 +95,8 @@ def main():
             groups[name] = built
         elif name.startswith("steps"):
             groups[name] = variant_group(bpy, f"profile {name}", steps=int(name[5:]))
+        elif name == "capture":
+            groups[name] = variant_group(bpy, "profile capture", capture_only=True)
         elif name == "single":
             groups[name] = variant_group(bpy, "profile single", single=True)
     times = {name: [] for name in groups}

@@ -113,10 +113,25 @@ def _first_guess(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, 
 
 
 def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
-    """Nodes for the motion at light-travel distance ``sigma`` (a reference or a value); returns the
-    references of the position relative to the observer, the rate per grid unit and ``s``."""
-    _interval(nodes, tag, sigma)
+    """Nodes for the motion at light-travel distance ``sigma`` (a field: each point's own interval,
+    ``j = floor(s)``, read by Sample Index); returns the references of the position relative to the
+    observer, the rate per grid unit and ``s``. Unlike the first step's, the interval is not clamped
+    to those given: an ``s`` outside them reads another interval's (or no) coefficients, and the
+    verdict, which checks the last step's ``s``, sends such a point to the Python path; inside, the
+    result is the same."""
+    nodes.update(
+        {
+            f"{tag}_s": fmath("MULTIPLY_ADD", sigma, "kf_minus_kappa", "group.Grid Now"),
+            f"{tag}_j": fmath("FLOOR", f"{tag}_s"),
+            f"{tag}_g": fmath("SUBTRACT", f"{tag}_s", f"{tag}_j"),
+        }
+    )
     for power in range(4):
+        nodes[f"{tag}_m{power}"] = Node(
+            "GeometryNodeSampleIndex",
+            {"Geometry": "cache_info.Geometry", "Value": f"kf_coefficient{power}.Attribute", "Index": f"{tag}_j"},
+            {"data_type": "FLOAT4X4", "domain": "POINT"},
+        )
         nodes[f"{tag}_y{power}"] = Node(
             "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_m{power}.Value"}
         )
@@ -125,12 +140,10 @@ def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str
         {
             f"{tag}_p2": _multiply_add(f"{tag}_y3.Vector", g, f"{tag}_y2.Vector"),
             f"{tag}_p1": _multiply_add(f"{tag}_p2.Vector", g, f"{tag}_y1.Vector"),
-            f"{tag}_p0": _multiply_add(f"{tag}_p1.Vector", g, f"{tag}_y0.Vector"),
-            f"{tag}_g3": fmath("MULTIPLY", g, 3.0),
-            f"{tag}_y2x2": vmath("ADD", f"{tag}_y2.Vector", f"{tag}_y2.Vector"),
-            f"{tag}_r1": _multiply_add(f"{tag}_y3.Vector", f"{tag}_g3", f"{tag}_y2x2.Vector"),
-            f"{tag}_rate": _multiply_add(f"{tag}_r1.Vector", g, f"{tag}_y1.Vector"),
-            f"{tag}_x": _multiply_add(f"{tag}_rate.Vector", f"{tag}_beyond", f"{tag}_p0.Vector"),
+            f"{tag}_x": _multiply_add(f"{tag}_p1.Vector", g, f"{tag}_y0.Vector"),
+            # the rate y1 + 2 g y2 + 3 g^2 y3 = p1 + g (p2 + g y3) (Horner's scheme for the derivative)
+            f"{tag}_t": _multiply_add(f"{tag}_y3.Vector", g, f"{tag}_p2.Vector"),
+            f"{tag}_rate": _multiply_add(f"{tag}_t.Vector", g, f"{tag}_p1.Vector"),
         }
     )
     return f"{tag}_x.Vector", f"{tag}_rate.Vector", f"{tag}_s"
@@ -219,8 +232,9 @@ def keyframed_nodes() -> dict[str, Node]:
             "kf_after_start": Node(
                 "FunctionNodeCompare", {"A": s, "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_EQUAL"}
             ),
+            # strictly: at s = Last Interval + 1 the last step read past the intervals
             "kf_before_end": Node(
-                "FunctionNodeCompare", {"A": s, "B": "kf_s_high"}, {"data_type": "FLOAT", "operation": "LESS_EQUAL"}
+                "FunctionNodeCompare", {"A": s, "B": "kf_s_high"}, {"data_type": "FLOAT", "operation": "LESS_THAN"}
             ),
             "kf_residual": fmath("SUBTRACT", sigma, last),
             "kf_residual_size": fmath("ABSOLUTE", "kf_residual"),
@@ -297,13 +311,17 @@ def window_verdict_nodes(geometry: str) -> dict[str, Node]:
     point's retarded time found inside the intervals given (only with Keyframed on). Output:
     ``store_window.Geometry``."""
     return {
-        "kf_inside": Node(
+        # the count of points not found: Attribute Statistic sorts every value for its Min, not for its Sum
+        "kf_outside": fmath("SUBTRACT", 1.0, "kf_inside_field.Output"),
+        "kf_outside_count": Node(
             "GeometryNodeAttributeStatistic",
-            {"Geometry": geometry, "Attribute": "kf_inside_field.Output"},
+            {"Geometry": geometry, "Attribute": "kf_outside"},
             {"data_type": "FLOAT", "domain": "POINT"},
         ),
         "kf_all_inside": Node(
-            "FunctionNodeCompare", {"A": "kf_inside.Min", "B": 0.5}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+            "FunctionNodeCompare",
+            {"A": "kf_outside_count.Sum", "B": 0.5},
+            {"data_type": "FLOAT", "operation": "LESS_THAN"},
         ),
         "kf_store_window": Node(
             "GeometryNodeStoreNamedAttribute",
