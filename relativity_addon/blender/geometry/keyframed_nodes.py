@@ -4,14 +4,16 @@ each point's retarded time solved on the Catmull-Rom pieces of its motion that
 Python path solves (``physics/sampling.py``; docs/physics.md, "Light-travel time").
 
 In units of scene length: a point's light-travel distance ``sigma = c tau`` puts it at grid
-coordinate ``s = Grid Now - sigma * Grid Per Distance`` (sample interval ``j = floor(s)``, clamped
-to the intervals given, ``f = s - j``), where it is at ``x = y0 + f y1 + f^2 y2 + f^3 y3`` relative
-to the observer, ``y_i`` the interval's coefficient ``i`` (a 4x4 affine map, Sample Index from the
-cache) applied to the rest position; beyond the first or last interval the end's slope continues,
-as in ``apparent.SampledRigidMotion``. Each step moves ``sigma`` to the closed form of uniform
-motion through ``x`` with the velocity there (``|r - sigma w| = sigma``, ``r = x + sigma w``: one
-step for uniform motion, quadratic convergence otherwise); ``STEPS`` of them from the origin's
-``Start Distance`` reach float32 rounding for a body turning and accelerating at 0.9c
+coordinate ``s = Grid Now - sigma * Grid Per Distance`` (sample interval ``j = floor(s)``,
+``f = s - j``), where it is at ``x = y0 + f y1 + f^2 y2 + f^3 y3`` relative to the observer,
+``y_i`` the interval's coefficient ``i`` (a 4x4 affine map, Sample Index from the cache) applied to
+the rest position. The first step's single interval is clamped to those given (beyond the first or
+last the end's slope continues, as in ``apparent.SampledRigidMotion``); the later steps' are not:
+a point whose ``s`` lies outside the intervals at the last step is not found (the verdict).
+Each step moves ``sigma`` to the closed form of uniform motion through ``x`` with the velocity
+there (``|r - sigma w| = sigma``, ``r = x + sigma w``: one step for uniform motion, quadratic
+convergence otherwise); ``STEPS`` of them from the origin's ``Start Distance`` reach float32
+rounding for a body turning and accelerating at 0.9c
 (``tests/blender/geometry/test_geometry_keyframed_modifier.py``). The apparent position in object
 space is affine in the emission point and ``sigma`` (``Emission X/Y/Z/Offset/Delay``: the
 observer's boost and the object's inverse matrix, folded in float64), and the velocity the
@@ -24,8 +26,12 @@ from __future__ import annotations
 from ..common import names
 from ..common.nodes import Literal, Node, fmath, vmath
 
-# Closed-form steps from the origin's light-travel distance (the first reads one interval for all
-# points; each other reads each point's own by Sample Index, most of the modifier's cost).
+# Closed-form steps from the origin's light-travel distance: the first reads one interval for all
+# points and sums its cubic into two 4x4 maps (two Transform Points per point); each other reads
+# each point's own interval by Sample Index (four reads, four Transform Points and the cubic per
+# point), most of the modifier's cost (benchmarks/keyframed_modifier_profile.py). Two steps leave
+# the accelerating bodies of test_geometry_keyframed_modifier.py above RESIDUAL (the verdict then
+# sends them to the Python path at every update).
 STEPS = 3
 # A retarded time counts as found when the last step moved sigma by at most this fraction (+ 1e-6).
 RESIDUAL = 1e-4
@@ -49,9 +55,10 @@ def _multiply_add(a: object, b: object, c: object) -> Node:
     return Node("ShaderNodeVectorMath", {0: a, 1: b, 2: c}, {"operation": "MULTIPLY_ADD"})
 
 
-def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
-    """Nodes for the motion at light-travel distance ``sigma`` (a reference or a value); returns the
-    references of the position relative to the observer, the rate per grid unit and ``s``."""
+def _interval(nodes: dict[str, Node], tag: str, sigma: object) -> None:
+    """Nodes for the interval of light-travel distance ``sigma``: ``{tag}_s`` (grid coordinate),
+    ``{tag}_j`` (the interval, clamped to those given), ``{tag}_g`` (the fraction inside it) and
+    ``{tag}_beyond`` (how far past its end, where the end's slope continues)."""
     nodes.update(
         {
             f"{tag}_s": fmath("MULTIPLY_ADD", sigma, "kf_minus_kappa", "group.Grid Now"),
@@ -69,6 +76,68 @@ def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str
             {"Geometry": "cache_info.Geometry", "Value": f"kf_coefficient{power}.Attribute", "Index": f"{tag}_j"},
             {"data_type": "FLOAT4X4", "domain": "POINT"},
         )
+
+
+def _first_guess(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str]:
+    """Nodes for the motion at the single light-travel distance ``sigma`` (the origin's): one
+    interval for every point, so the cubic and its rate are summed once as 4x4 maps (single values)
+    and each point pays two Transform Points; returns the references of the position relative to
+    the observer and the rate per grid unit. Only the first step's guess: the later steps fix the
+    result, so summing the matrices first (another float32 rounding) changes nothing they find."""
+    _interval(nodes, tag, sigma)
+    g, beyond = f"{tag}_g", f"{tag}_beyond"
+    nodes[f"{tag}_g3"] = fmath("MULTIPLY", g, 3.0)
+    for power in range(4):
+        nodes[f"{tag}_e{power}"] = Node("FunctionNodeSeparateMatrix", {"Matrix": f"{tag}_m{power}.Value"})
+    at, rate = {}, {}
+    for column in range(1, 5):
+        for row in range(1, 4):  # Transform Point ignores the fourth row
+            entry = f"Column {column} Row {row}"
+            m0, m1, m2, m3 = (f"{tag}_e{power}.{entry}" for power in range(4))
+            key = f"{tag}_{column}{row}"
+            nodes.update(
+                {
+                    f"{key}_p2": fmath("MULTIPLY_ADD", m3, g, m2),
+                    f"{key}_p1": fmath("MULTIPLY_ADD", f"{key}_p2", g, m1),
+                    f"{key}_p0": fmath("MULTIPLY_ADD", f"{key}_p1", g, m0),
+                    f"{key}_m2x2": fmath("ADD", m2, m2),
+                    f"{key}_r1": fmath("MULTIPLY_ADD", m3, f"{tag}_g3", f"{key}_m2x2"),
+                    f"{key}_rate": fmath("MULTIPLY_ADD", f"{key}_r1", g, m1),
+                    f"{key}_at": fmath("MULTIPLY_ADD", f"{key}_rate", beyond, f"{key}_p0"),
+                }
+            )
+            at[entry], rate[entry] = f"{key}_at", f"{key}_rate"
+    nodes[f"{tag}_at_matrix"] = Node("FunctionNodeCombineMatrix", at)
+    nodes[f"{tag}_rate_matrix"] = Node("FunctionNodeCombineMatrix", rate)
+    nodes[f"{tag}_x"] = Node(
+        "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_at_matrix.Matrix"}
+    )
+    nodes[f"{tag}_rate"] = Node(
+        "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_rate_matrix.Matrix"}
+    )
+    return f"{tag}_x.Vector", f"{tag}_rate.Vector"
+
+
+def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str, str]:
+    """Nodes for the motion at light-travel distance ``sigma`` (a field: each point's own interval,
+    ``j = floor(s)``, read by Sample Index); returns the references of the position relative to the
+    observer, the rate per grid unit and ``s``. Unlike the first step's, the interval is not clamped
+    to those given: an ``s`` outside them reads another interval's (or no) coefficients, and the
+    verdict, which checks the last step's ``s``, sends such a point to the Python path; inside, the
+    result is the same."""
+    nodes.update(
+        {
+            f"{tag}_s": fmath("MULTIPLY_ADD", sigma, "kf_minus_kappa", "group.Grid Now"),
+            f"{tag}_j": fmath("FLOOR", f"{tag}_s"),
+            f"{tag}_g": fmath("SUBTRACT", f"{tag}_s", f"{tag}_j"),
+        }
+    )
+    for power in range(4):
+        nodes[f"{tag}_m{power}"] = Node(
+            "GeometryNodeSampleIndex",
+            {"Geometry": "cache_info.Geometry", "Value": f"kf_coefficient{power}.Attribute", "Index": f"{tag}_j"},
+            {"data_type": "FLOAT4X4", "domain": "POINT"},
+        )
         nodes[f"{tag}_y{power}"] = Node(
             "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"{tag}_m{power}.Value"}
         )
@@ -77,12 +146,10 @@ def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str
         {
             f"{tag}_p2": _multiply_add(f"{tag}_y3.Vector", g, f"{tag}_y2.Vector"),
             f"{tag}_p1": _multiply_add(f"{tag}_p2.Vector", g, f"{tag}_y1.Vector"),
-            f"{tag}_p0": _multiply_add(f"{tag}_p1.Vector", g, f"{tag}_y0.Vector"),
-            f"{tag}_g3": fmath("MULTIPLY", g, 3.0),
-            f"{tag}_y2x2": vmath("ADD", f"{tag}_y2.Vector", f"{tag}_y2.Vector"),
-            f"{tag}_r1": _multiply_add(f"{tag}_y3.Vector", f"{tag}_g3", f"{tag}_y2x2.Vector"),
-            f"{tag}_rate": _multiply_add(f"{tag}_r1.Vector", g, f"{tag}_y1.Vector"),
-            f"{tag}_x": _multiply_add(f"{tag}_rate.Vector", f"{tag}_beyond", f"{tag}_p0.Vector"),
+            f"{tag}_x": _multiply_add(f"{tag}_p1.Vector", g, f"{tag}_y0.Vector"),
+            # the rate y1 + 2 g y2 + 3 g^2 y3 = p1 + g (p2 + g y3) (Horner's scheme for the derivative)
+            f"{tag}_t": _multiply_add(f"{tag}_y3.Vector", g, f"{tag}_p2.Vector"),
+            f"{tag}_rate": _multiply_add(f"{tag}_t.Vector", g, f"{tag}_p1.Vector"),
         }
     )
     return f"{tag}_x.Vector", f"{tag}_rate.Vector", f"{tag}_s"
@@ -136,9 +203,13 @@ def keyframed_nodes() -> dict[str, Node]:
     }
     nodes["kf_minus_kappa"] = fmath("MULTIPLY", "group.Grid Per Distance", -1.0)
     sigma: object = "group.Start Distance"
+    s = "kf0_s"
     for step in range(STEPS):
         last = sigma
-        _x, rate, s = _evaluate(nodes, f"kf{step}", sigma)
+        if step == 0:
+            _x, rate = _first_guess(nodes, "kf0", sigma)
+        else:
+            _x, rate, s = _evaluate(nodes, f"kf{step}", sigma)
         sigma = _step(nodes, f"kf{step}", sigma, _x, rate)
     # the emission point on the last step's uniform motion (r - sigma w): its error is the cubic's
     # departure over the last step, far below float32 rounding once the steps converge (checked below)
@@ -167,8 +238,9 @@ def keyframed_nodes() -> dict[str, Node]:
             "kf_after_start": Node(
                 "FunctionNodeCompare", {"A": s, "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_EQUAL"}
             ),
+            # strictly: at s = Last Interval + 1 the last step read past the intervals
             "kf_before_end": Node(
-                "FunctionNodeCompare", {"A": s, "B": "kf_s_high"}, {"data_type": "FLOAT", "operation": "LESS_EQUAL"}
+                "FunctionNodeCompare", {"A": s, "B": "kf_s_high"}, {"data_type": "FLOAT", "operation": "LESS_THAN"}
             ),
             "kf_residual": fmath("SUBTRACT", sigma, last),
             "kf_residual_size": fmath("ABSOLUTE", "kf_residual"),
@@ -245,13 +317,17 @@ def window_verdict_nodes(geometry: str) -> dict[str, Node]:
     point's retarded time found inside the intervals given (only with Keyframed on). Output:
     ``store_window.Geometry``."""
     return {
-        "kf_inside": Node(
+        # the count of points not found: Attribute Statistic sorts every value for its Min, not for its Sum
+        "kf_outside": fmath("SUBTRACT", 1.0, "kf_inside_field.Output"),
+        "kf_outside_count": Node(
             "GeometryNodeAttributeStatistic",
-            {"Geometry": geometry, "Attribute": "kf_inside_field.Output"},
+            {"Geometry": geometry, "Attribute": "kf_outside"},
             {"data_type": "FLOAT", "domain": "POINT"},
         ),
         "kf_all_inside": Node(
-            "FunctionNodeCompare", {"A": "kf_inside.Min", "B": 0.5}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
+            "FunctionNodeCompare",
+            {"A": "kf_outside_count.Sum", "B": 0.5},
+            {"data_type": "FLOAT", "operation": "LESS_THAN"},
         ),
         "kf_store_window": Node(
             "GeometryNodeStoreNamedAttribute",

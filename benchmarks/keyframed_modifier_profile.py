@@ -1,0 +1,134 @@
+"""Where the keyframed modifier's evaluation goes (issue 26): the 2M grid of ``artist_chain.py``
+on keyframed motion, set up, then the apparent-geometry modifier re-evaluated (the object tagged,
+the depsgraph updated, a vertex read) with copies of its node group that differ in one part, in
+ONE process, rounds alternating between the variants; each variant's time is printed with its
+ratio to the group as built (``as built``) and to the group with Keyframed off (nothing solved).
+
+    python benchmarks/keyframed_modifier_profile.py [--size 2M] [--rounds 5] [--variants ...]
+
+Variants: ``steps1``/``steps2``/``steps3``/``steps4`` (the closed-form steps; fewer send more
+points to the Python path, more cost more), ``single`` (every step reads the first step's
+interval: the cost without per-point Sample Index, not the right positions), ``off`` (Keyframed
+off), ``capture`` (the captures of the rest positions, nothing solved).
+Times are of the whole modifier (subdivision check, rest, solve, the velocity, the verdict).
+"""
+
+import argparse
+import dataclasses
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import artist_chain  # noqa: E402
+
+
+def variant_group(bpy, name, steps=None, single=False, capture_only=False):
+    """A copy of the modifier's node group named ``name``, built with ``steps`` steps and (``single``)
+    every step's Sample Index at the first step's interval."""
+    from relativity_addon.blender.common import nodes as common_nodes
+    from relativity_addon.blender.geometry import keyframed_nodes, node_group
+
+    saved = keyframed_nodes.STEPS, keyframed_nodes.Node
+    try:
+        if steps is not None:
+            keyframed_nodes.STEPS = steps
+        if single:
+
+            def node(kind, inputs=None, props=None):
+                inputs = dict(inputs or {})
+                if kind == "GeometryNodeSampleIndex" and str(inputs.get("Index", "")).endswith("_j"):
+                    inputs["Index"] = "kf0_j"
+                return common_nodes.Node(kind, inputs, props or {})
+
+            keyframed_nodes.Node = node
+        spec = node_group.node_group_spec()
+    finally:
+        keyframed_nodes.STEPS, keyframed_nodes.Node = saved
+    if capture_only:  # the captures of the rest positions alone: what solving nothing costs
+        for capture in ("kf_capture", "kf_capture_whole"):
+            spec.nodes[capture].inputs.update({"Seen": "position.Position", "Beta": "position.Position", "Inside": 1.0})
+    return common_nodes.build_group(dataclasses.replace(spec, name=name))
+
+
+def use_group(mod, group):
+    """``mod`` on ``group`` with the same input values (read and set by name)."""
+    from relativity_addon.blender.common import compat
+
+    old = {item.name: item.identifier for item in mod.node_group.interface.items_tree if item.item_type == "SOCKET"}
+    values = {name: compat.modifier_input(mod, identifier) for name, identifier in old.items()}
+    # copies: 4.5's vector values are views into the modifier's properties, freed with the group
+    values = {name: tuple(v) if hasattr(v, "to_list") or hasattr(v, "__len__") else v for name, v in values.items()}
+    mod.node_group = group
+    for item in group.interface.items_tree:
+        if item.item_type == "SOCKET" and item.in_out == "INPUT" and values.get(item.name) is not None:
+            compat.set_modifier_input(mod, item.identifier, values[item.name])
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--size", default="2M")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--variants", default="built,off,steps1,steps2,single")
+    options = parser.parse_args()
+    import bpy
+
+    from relativity_addon import batch
+    from relativity_addon.blender.common import compat
+    from relativity_addon.blender.geometry import modifier
+
+    batch.enable_addon()
+    size = artist_chain.parse_size(options.size)
+    scene, _plain, movers, _ = artist_chain.build(bpy, "grid", size, "keyframed", None, (64, 48), 4, only="Effect")
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    obj = movers[0]
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    artist_chain.read_vertex(bpy, obj, depsgraph)
+    mod = modifier.find_modifier(obj)
+    built = mod.node_group
+    groups = {}
+    for name in options.variants.split(","):
+        if name in ("built", "off"):
+            groups[name] = built
+        elif name.startswith("steps"):
+            groups[name] = variant_group(bpy, f"profile {name}", steps=int(name[5:]))
+        elif name == "capture":
+            groups[name] = variant_group(bpy, "profile capture", capture_only=True)
+        elif name == "single":
+            groups[name] = variant_group(bpy, "profile single", single=True)
+    times = {name: [] for name in groups}
+
+    def keyframed_on(value):
+        identifier = next(i.identifier for i in mod.node_group.interface.items_tree if i.name == "Keyframed")
+        compat.set_modifier_input(mod, identifier, value)
+
+    with artist_chain.without_addon_handlers(bpy):
+        for round_ in range(options.rounds + 1):
+            for name, group in groups.items():
+                use_group(mod, group)
+                keyframed_on(name != "off")
+                obj.update_tag()
+                artist_chain.read_vertex(bpy, obj, depsgraph)  # settle the switch's evaluation
+                obj.update_tag()
+                start = time.perf_counter()
+                depsgraph.update()
+                artist_chain.read_vertex(bpy, obj, depsgraph)
+                if round_:  # the first round warms up
+                    times[name].append(time.perf_counter() - start)
+                keyframed_on(True)
+        use_group(mod, built)
+    vertices = len(obj.evaluated_get(depsgraph).data.vertices)
+    print(f"\nkeyframed modifier, {vertices:,} evaluated vertices, {options.rounds} rounds (load {os.getloadavg()})")
+    base, off = statistics.median(times.get("built", [1])), statistics.median(times.get("off", [1]))
+    for name, values in times.items():
+        median = statistics.median(values)
+        print(f"{name:>8} {median:8.3f}s  {median / base:5.2f}x as built  {median / off:6.2f}x off")
+
+
+if __name__ == "__main__":
+    from relativity_addon.blender.common import compat
+
+    compat.run_main(main)
