@@ -106,9 +106,7 @@ def test_wall_under_blackbody_lamp_is_a_blackbody_at_d_t(relativity_addon, tmp_p
     _set_up(bpy, scene, beta, method)
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     y_lamp = dh.blackbody_xyz_colour_science(LAMP_TEMPERATURE)[1]
-    expected = np.mean(
-        [dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * y_rest for d in doppler], axis=0
-    )
+    expected = np.mean(dh.blackbody_xyz_colour_science(doppler * LAMP_TEMPERATURE) / y_lamp * y_rest, axis=0)
 
     spectral, info = _render_spectral(bpy, relativity_addon, scene)
     measured = _xyz(spectral[CENTRE].reshape(-1, 3)).mean(axis=0)
@@ -385,13 +383,10 @@ def test_fast_mode_reads_each_lamp_under_its_own_blackbody(relativity_addon, tmp
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     spectra = {"Warm": 2700.0, "Cool": 5000.0, "Sky": 6504.0}  # the sky's grey: the emitters' 6504 K white
     expected = np.mean(
-        [
-            sum(
-                parts[name] * dh.blackbody_xyz_colour_science(d * t) / dh.blackbody_xyz_colour_science(t)[1]
-                for name, t in spectra.items()
-            )
-            for d in doppler
-        ],
+        sum(
+            parts[name] * dh.blackbody_xyz_colour_science(doppler * t) / dh.blackbody_xyz_colour_science(t)[1]
+            for name, t in spectra.items()
+        ),
         axis=0,
     )
     tree = dh.addon_module(relativity_addon, "common.compat").compositor_tree(scene)
@@ -494,9 +489,7 @@ def test_batch_script_spectral_option(relativity_addon, tmp_path):
     )
     doppler = _pixel_doppler(bpy, scene, camera, beta)[CENTRE].ravel()
     y_lamp = dh.blackbody_xyz_colour_science(LAMP_TEMPERATURE)[1]
-    expected = np.mean(
-        [dh.blackbody_xyz_colour_science(d * LAMP_TEMPERATURE) / y_lamp * rest[1] for d in doppler], axis=0
-    )
+    expected = np.mean(dh.blackbody_xyz_colour_science(doppler * LAMP_TEMPERATURE) / y_lamp * rest[1], axis=0)
     measured = _xyz(image[CENTRE].reshape(-1, 3)).mean(axis=0)
     assert dh.delta_e_2000_normalised(measured, expected) < 2.0
     assert measured[1] / expected[1] == pytest.approx(1.0, abs=0.05)

@@ -81,9 +81,7 @@ def test_object_temperature_reaches_an_emission_inside_a_shared_group(relativity
     doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
     y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
     d = doppler[MARKED].ravel()
-    expected = np.mean(
-        [dh.blackbody_xyz_colour_science(f * TEMPERATURE) / y_t * y for f, y in zip(d, y_rest, strict=True)], axis=0
-    )
+    expected = np.mean(dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * np.asarray(y_rest)[:, None], axis=0)
     xyz = _xyz(moving, MARKED).mean(axis=0)
     delta_e = dh.delta_e_2000_normalised(xyz, expected)
     ratio = xyz[1] / expected[1]

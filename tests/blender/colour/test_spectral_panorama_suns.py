@@ -75,7 +75,7 @@ def test_spectral_equirectangular_render_of_five_suns(relativity_addon):
         patch = luminance[:, columns]
         inner = patch > 0.6 * patch.max()  # whole pixels of the disc, away from its antialiased rim
         measured = dh.linear_rec709_to_xyz(image[:, columns][inner].sum(axis=0))
-        expected = sum(dh.blackbody_xyz_colour_science(value * TEMPERATURE) / rest[1] for value in d[:, columns][inner])
+        expected = (dh.blackbody_xyz_colour_science(d[:, columns][inner] * TEMPERATURE) / rest[1]).sum(axis=0)
         delta_e = dh.delta_e_2000_normalised(measured, expected)
         ratio = measured[1] / expected[1]
         mean_d = float(d[:, columns][inner].mean())

@@ -40,10 +40,8 @@ def _xyz(image, window):
 def _expected(doppler, y_rest):
     """Mean XYZ of blackbodies at ``D T``, each scaled to its ``y_rest`` times ``Y(D T) / Y(T)``."""
     y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
-    return np.mean(
-        [dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y for d, y in zip(doppler, y_rest, strict=True)],
-        axis=0,
-    )
+    y_rest = np.broadcast_to(y_rest, np.shape(doppler))
+    return np.mean(dh.blackbody_xyz_colour_science(np.asarray(doppler) * TEMPERATURE) / y_t * y_rest[:, None], axis=0)
 
 
 def _slab_path_ratio(bpy, scene, camera):

@@ -61,10 +61,7 @@ def _expected(bpy, scene, camera, y_rest):
     for name, (temperature, window) in HALVES.items():
         y_t = dh.blackbody_xyz_colour_science(temperature)[1]
         rest = y_rest[name] * path[window].ravel()
-        colours = [
-            dh.blackbody_xyz_colour_science(d * temperature) / y_t * y
-            for d, y in zip(doppler[window].ravel(), rest, strict=True)
-        ]
+        colours = dh.blackbody_xyz_colour_science(doppler[window].ravel() * temperature) / y_t * rest[:, None]
         expected[name] = (np.mean(colours, axis=0), doppler[window].mean())
     return expected
 

@@ -51,7 +51,7 @@ def _xyz(image, window):
 def _expected(doppler, y_rest):
     """Mean XYZ of blackbodies at ``D T`` scaled to ``y_rest`` times ``Y(D T) / Y(T)``."""
     y_t = dh.blackbody_xyz_colour_science(TEMPERATURE)[1]
-    return np.mean([dh.blackbody_xyz_colour_science(d * TEMPERATURE) / y_t * y_rest for d in doppler], axis=0)
+    return np.mean(dh.blackbody_xyz_colour_science(np.asarray(doppler) * TEMPERATURE) / y_t * y_rest, axis=0)
 
 
 def _render_moving(bpy, scene, camera, lamp, tmp_path):
@@ -124,7 +124,7 @@ def test_visible_sun_disc_is_seen_at_d_t(relativity_addon, tmp_path):
     doppler = doppler[centre].ravel()
     gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
     y_t = dh.blackbody_xyz_colour_science(5762.0)[1]
-    expected = np.mean([dh.blackbody_xyz_colour_science(d * 5762.0) / y_t * y_rest for d in doppler], axis=0)
+    expected = np.mean(dh.blackbody_xyz_colour_science(doppler * 5762.0) / y_t * y_rest, axis=0)
     xyz = _xyz(moving, centre)
     delta_e = dh.delta_e_2000_normalised(xyz, expected)
     print(f"sun at 0.5c: D {doppler.mean():.3f}, Delta E {delta_e:.3f}, Y / expected {xyz[1] / expected[1]:.4f}")

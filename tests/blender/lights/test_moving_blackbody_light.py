@@ -49,10 +49,8 @@ def _geometry(points, lamp):
 
 
 def _blackbodies(doppler):
-    """XYZ of the blackbody at ``D T`` for every ``D`` (rounded to 1e-4: one Planck sum each)."""
-    rounded = np.round(doppler, 4)
-    table = {d: dh.blackbody_xyz_colour_science(d * TEMPERATURE) for d in np.unique(rounded)}
-    return np.array([table[d] for d in rounded.ravel()]).reshape(*doppler.shape, 3)
+    """XYZ of the blackbody at ``D T`` for every ``D``."""
+    return dh.blackbody_xyz_colour_science(np.asarray(doppler) * TEMPERATURE)
 
 
 def _expected_xyz(points, lamp):
