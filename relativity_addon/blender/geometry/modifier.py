@@ -46,8 +46,10 @@ def ensure_node_group() -> NodeTree:
     sockets get new identifiers, so the modifiers' values (the cache, where the bakes live) are
     read by name before and set again after."""
     tree = bpy.data.node_groups.get(names.GEOMETRY_GROUP)
+    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) == names.GEOMETRY_GROUP_VERSION:
+        return tree  # what ensure_group returns then, without building the spec (once per mesh per sync)
     kept = []
-    rebuilt = tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) != names.GEOMETRY_GROUP_VERSION
+    rebuilt = tree is not None
     if rebuilt:
         old = {item.name: item.identifier for item in tree.interface.items_tree if item.item_type == "SOCKET"}
         for obj in bpy.data.objects:
