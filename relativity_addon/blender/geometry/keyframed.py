@@ -94,7 +94,7 @@ def _kept_samples(obj, key, function, step):
         indices = grid.astype(np.int64).tolist()
         missing = sorted({index for index in indices if index not in kept})
         if missing:
-            kept.update(zip(missing, np.asarray(function(np.asarray(missing, dtype=np.float64) * step))))
+            kept.update(zip(missing, np.asarray(function(np.asarray(missing, dtype=np.float64) * step)), strict=True))
         return np.stack([kept[index] for index in indices])
 
     return sampled
