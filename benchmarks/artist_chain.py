@@ -253,6 +253,7 @@ def measure_case(bpy, options, kind, size, motion):
 
     alternate("velocity change", velocity_change, lambda r: plain_rewrite(bpy, plain_scene, plain_changed, 1e-3))
     effect_scene.relativity.beta = (0.0, 0.0, 0.0)
+    bpy.context.evaluated_depsgraph_get()  # as the viewport's redraw: the frame step does not pay for it
 
     def frame_step(round_):
         effect_scene.frame_set(13 + round_)

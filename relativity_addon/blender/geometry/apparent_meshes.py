@@ -354,8 +354,13 @@ def update(
             ):
                 current[uid] = motion.closed_form(obj, scene)
                 continue
+            if evaluated is None:
+                evaluated = _evaluated(depsgraph)
             try:
-                update_object(scene, obj, snap, depsgraph, in_frame_change)
+                # one evaluation for every object: an update tags its own object only, so the others'
+                # evaluated meshes stay what this depsgraph holds (one per object would evaluate the
+                # objects updated before it again, and pass over the scene each time)
+                update_object(scene, obj, snap, evaluated, in_frame_change)
                 updated += 1
             except RelativityError as error:
                 print(f"Relativity: {error}")

@@ -63,7 +63,41 @@ def _matrix_function(obj, scene, fps, step, c):
     if obj.relativity.use_proper_time and motion.plays_own_animation(obj, scene):
         clock = motion.path_clock(obj, fps, step, c)
         return lambda times: animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
-    return lambda times: animation.world_matrices(obj, times * fps)
+    function = lambda times: animation.world_matrices(obj, times * fps)  # noqa: E731
+    signature = animation.keyframes_signature(obj)
+    return function if signature is None else _kept_samples(obj, (signature, fps, step), function, step)
+
+
+# Object session_uid -> (key, {grid index: world matrix}): the keyframes' world matrices at the sample
+# times ``index * step`` evaluated so far, kept while the keys (``animation.keyframes_signature``), the
+# frame rate and the step stay. A frame step or an observer change then evaluates only the samples
+# it has not evaluated before (a frame step moves the window by Samples per Frame), and the widenings
+# of one window (``sampling.motion_intervals``) none twice.
+_samples: dict[int, tuple[object, dict[int, FloatArray]]] = {}
+MAX_KEPT_SAMPLES = 4096  # per object: forgotten beyond (an object stepping through a long animation)
+
+
+def _kept_samples(obj, key, function, step):
+    """``function`` (world matrices at scene times) evaluated once per grid time: the kept samples
+    for times on the grid ``index * step`` (as ``sampling`` builds them), ``function`` for others."""
+    known = _samples.get(obj.session_uid)
+    if known is None or known[0] != key or len(known[1]) > MAX_KEPT_SAMPLES:
+        known = (key, {})
+        _samples[obj.session_uid] = known
+    kept = known[1]
+
+    def sampled(times):
+        times = np.asarray(times, dtype=np.float64)
+        grid = np.rint(times / step)
+        if times.ndim != 1 or not np.array_equal(grid * step, times):
+            return function(times)
+        indices = grid.astype(np.int64).tolist()
+        missing = sorted({index for index in indices if index not in kept})
+        if missing:
+            kept.update(zip(missing, np.asarray(function(np.asarray(missing, dtype=np.float64) * step)), strict=True))
+        return np.stack([kept[index] for index in indices])
+
+    return sampled
 
 
 def is_on(mod: Modifier | None) -> bool:

@@ -156,7 +156,16 @@ def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
                         fcurve.mute,
                         fcurve.extrapolation,
                         tuple(
-                            (tuple(p.co), tuple(p.handle_left), tuple(p.handle_right), p.interpolation, p.easing)
+                            (
+                                tuple(p.co),
+                                tuple(p.handle_left),
+                                tuple(p.handle_right),
+                                p.interpolation,
+                                p.easing,
+                                p.back,
+                                p.amplitude,
+                                p.period,
+                            )
                             for p in fcurve.keyframe_points
                         ),
                     )

@@ -123,3 +123,83 @@ def test_frame_step_works_on_the_meshes_the_frame_moves_only(relativity_addon, m
     scene.frame_set(13)  # the same frame again: nothing to write
     bpy.context.evaluated_depsgraph_get()
     assert not work["update"] and not work["input written"], _done(work)
+
+
+def _keyframed_scene(bpy):
+    """COUNT cubes on linear location keys (about 0.5c along x), Motion Animation."""
+    scene, _camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = (0.2, 0.0, 0.0)
+    movers = []
+    for k in range(COUNT):
+        obj = _link(bpy, scene, f"Mover {k}", _cube_mesh(bpy, f"Mover {k}", 0.2))
+        x = 0.8 * (k - COUNT / 2)
+        obj.location = (x, 0.5, -6.0)
+        gh.keyframe_linear(obj, "location", 0, ((-120, x - 10.0), (48, x + 4.0)))
+        obj.relativity.motion = "ANIMATION"
+        movers.append(obj)
+    scene.frame_set(12)
+    return scene, movers
+
+
+def test_observer_change_on_many_keyframed_meshes_evaluates_once(relativity_addon, monkeypatch):
+    """A velocity change of the observer moves every keyframed mesh: each is recomputed once, against
+    one evaluation of the depsgraph (not one per mesh, each evaluating the meshes updated before it
+    again), and ends where a fresh Set Up at that velocity puts it."""
+    import bpy
+
+    scene, movers = _keyframed_scene(bpy)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    before = _points(bpy, movers)
+    work = _count_work(monkeypatch)
+    evaluations = []
+    handler = lambda _scene, _depsgraph: evaluations.append(1)  # noqa: E731
+    bpy.app.handlers.depsgraph_update_post.append(handler)
+    try:
+        scene.relativity.beta = (-0.3, 0.1, 0.0)  # as the panel does: the update callback runs
+        bpy.context.evaluated_depsgraph_get()  # the viewport's next redraw
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(handler)
+    after = _points(bpy, movers)
+
+    assert work["update"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
+    assert len(evaluations) <= 2, f"{len(evaluations)} depsgraph evaluations for {COUNT} meshes ({_done(work)})"
+    for k in range(COUNT):
+        assert np.abs(after[k] - before[k]).max() > 1e-3, f"Mover {k} did not move"
+
+    gh.remove_effect(scene)
+    gh.apply_geometry(scene)
+    fresh = _points(bpy, movers)
+    for k in range(COUNT):
+        np.testing.assert_allclose(after[k], fresh[k], atol=1e-6)
+
+
+def test_key_change_on_one_of_many_keyframed_meshes_works_on_that_mesh_only(relativity_addon, monkeypatch):
+    """One mesh's keys made faster (its velocity changed, as the Graph Editor does): that mesh is
+    recomputed, the others are not and keep their evaluated positions exactly."""
+    import bpy
+
+    scene, movers = _keyframed_scene(bpy)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    # the first evaluation's verdicts (every retarded time inside the intervals) recompute every mesh
+    # once more after Set Up; a sync then finds them current
+    gh.addon_module("pipeline.effect").sync(scene)
+    before = _points(bpy, movers)
+    work = _count_work(monkeypatch)
+
+    fcurve = next(f for f in gh.compat.action_fcurves(movers[2].animation_data) if f.data_path == "location")
+    fcurve.keyframe_points[-1].co.y += 6.0
+    fcurve.update()
+    movers[2].update_tag(refresh={"TIME"})  # what an edit of the keys tags
+    bpy.context.evaluated_depsgraph_get()
+    after = _points(bpy, movers)
+
+    assert work["update"]["Mover 2"] >= 1, _done(work)
+    others = {f"Mover {k}" for k in range(COUNT) if k != 2}
+    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
+    assert not touched, f"work done for meshes that did not change: {touched} (all: {_done(work)})"
+    for k in range(COUNT):
+        if k != 2:
+            np.testing.assert_array_equal(after[k], before[k])
+    assert np.abs(after[2] - before[2]).max() > 1e-3, "the changed mesh did not move"
