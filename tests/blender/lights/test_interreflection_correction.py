@@ -52,3 +52,65 @@ def test_set_up_corrects_the_bounce(relativity_addon, factory_blender, tmp_path,
     assert carrying == ["White"] and none == []
     assert ratio == pytest.approx(1.0, abs=0.05)
     assert direct == pytest.approx(1.0, abs=0.01)
+
+
+def test_at_rest_control(relativity_addon, factory_blender, tmp_path):
+    """Nothing moves: no material gets the factor and the OSL render matches the model (3 %)."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    image, rotation, carrying = _render(bpy, tmp_path, np.zeros(3), "rest")
+    physics = case._model(rotation, np.zeros(3), np.zeros(3))
+    sampled = case._inner(case._seen_panel(rotation, np.zeros(3), np.zeros(3))[0]) & np.isfinite(physics)
+    ratio = float(image[sampled].mean() / physics[sampled].mean())
+    print(f"rest: rendered over physics {ratio:.4f}")
+    assert carrying == []
+    assert ratio == pytest.approx(1.0, abs=0.03)
+
+
+def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_addon, factory_blender):
+    """Set Up on OSL adds the node and its text, Remove gives the file back (``scene_dump``); off
+    OSL, and with a moving observer, one panel line says the bounce is uncorrected."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "pipeline"))
+    import scene_dump
+
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    before = scene_dump.dump(bpy)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert names.BOUNCE_SHADER_TEXT in bpy.data.texts
+    tree = bpy.data.materials["White"].node_tree
+    assert tree.nodes[names.BOUNCE_NODE_NAME].outputs["Out"].is_linked
+    assert not any("bounced" in line for line in effect.scene_warnings(scene))
+    effect.remove(scene)
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, "\n".join(lines[:20])
+    scene.cycles.shading_system = False
+    effect.apply(scene)
+    effect.sync(scene)
+    found = [line for line in effect.scene_warnings(scene) if "bounced" in line]
+    assert found == [
+        "Light bounced between moving objects is not corrected (Cycles' Open Shading Language is off): "
+        "up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+    ]
+    assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
+    effect.remove(scene)
+    scene.cycles.shading_system = True
+    scene.relativity.beta = (0.0, 0.0, 0.3)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
+        "Light bounced between moving objects is not corrected (a moving observer): "
+        "up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+    ]
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
+    effect.remove(scene)
