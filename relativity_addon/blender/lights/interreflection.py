@@ -53,7 +53,7 @@ def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None)
         return "a moving observer"
     no_osl = osl.unavailable_reason()
     if no_osl is not None:
-        return no_osl
+        return no_osl[0].lower() + no_osl[1:]
     if not scene.cycles.shading_system:
         return f"Cycles' Open Shading Language is off; switched on, it corrects it at about {MEASURED_COST} render time"
     return None
