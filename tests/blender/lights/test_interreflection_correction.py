@@ -115,3 +115,30 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_
     ]
     assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
     effect.remove(scene)
+
+
+def test_the_lookup_follows_the_sync(relativity_addon, factory_blender):
+    """A changed velocity or position reaches the shader's boxes and velocities at the next sync
+    (the text rewritten, the node recompiled with its sockets)."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    effect.apply(scene)
+    effect.sync(scene)
+    first = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert f"beta = vector({case.EACH:.7g}, 0, 0)" in first
+    scene.objects["Sphere"].relativity.beta = (0.0, 0.4, 0.0)
+    effect.sync(scene)
+    second = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert "beta = vector(0, 0.4, 0)" in second and f"beta = vector({case.EACH:.7g}, 0, 0)" not in second
+    scene.objects["Sphere"].location.z += 0.5  # (Constant motion: the location is where it is at every frame)
+    effect.sync(scene)
+    third = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert third != second  # the sphere's box moved with it
+    node = bpy.data.materials["White"].node_tree.nodes[names.BOUNCE_NODE_NAME]
+    assert "Out" in node.outputs and node.outputs["Out"].is_linked
+    effect.remove(scene)
