@@ -50,12 +50,14 @@ def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None)
     if len(found) < 2:
         return "fewer than two moving objects"
     if snap.speed > 0.0:
-        return "a moving observer"
+        return "the observer moves"
     no_osl = osl.unavailable_reason()
     if no_osl is not None:
         return no_osl[0].lower() + no_osl[1:]
     if not scene.cycles.shading_system:
-        return f"Cycles' Open Shading Language is off; switched on, it corrects it at about {MEASURED_COST} render time"
+        return (
+            f"Cycles' Open Shading Language is off (switched on, it corrects it at about {MEASURED_COST} render time)"
+        )
     return None
 
 
@@ -221,6 +223,6 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if reason is None or reason in ("off the Apparent Geometry path", "fewer than two moving objects"):
         return []
     return [
-        f"Light bounced between moving objects is not corrected ({reason}): "
-        f"up to {MEASURED_ERROR} off at 0.5c (docs/lamp-doppler.md)"
+        f"Light bounced between moving objects is not corrected, up to {MEASURED_ERROR} off at 0.5c "
+        f"(docs/lamp-doppler.md): {reason}"
     ]

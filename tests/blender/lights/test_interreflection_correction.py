@@ -12,6 +12,8 @@ import test_interreflection as case
 import camera_helpers as ch
 from relativity_addon.blender.common import names, osl
 
+UNCORRECTED = "Light bounced between moving objects is not corrected, up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+
 
 def _render(bpy, tmp_path, beta, name, use_osl=True):
     """The panel's (and the sphere's) pixels rendered through Set Up, and the panel's model."""
@@ -99,9 +101,7 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_
     effect.sync(scene)
     found = [line for line in effect.scene_warnings(scene) if "bounced" in line]
     assert found == [
-        "Light bounced between moving objects is not corrected (Cycles' Open Shading Language is off; "
-        "switched on, it corrects it at about 1.16x render time): "
-        "up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+        f"{UNCORRECTED}: Cycles' Open Shading Language is off (switched on, it corrects it at about 1.16x render time)"
     ]
     assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
     effect.remove(scene)
@@ -110,8 +110,7 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_
     effect.apply(scene)
     effect.sync(scene)
     assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
-        "Light bounced between moving objects is not corrected (a moving observer): "
-        "up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+        f"{UNCORRECTED}: the observer moves"
     ]
     assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
     effect.remove(scene)
@@ -141,4 +140,28 @@ def test_the_lookup_follows_the_sync(relativity_addon, factory_blender):
     assert third != second  # the sphere's box moved with it
     node = bpy.data.materials["White"].node_tree.nodes[names.BOUNCE_NODE_NAME]
     assert "Out" in node.outputs and node.outputs["Out"].is_linked
+    effect.remove(scene)
+
+
+def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender, monkeypatch):
+    """Without OSL (as Debian's 5.2: ``_cycles.with_osl`` False, no oslquery), Set Up works and one
+    panel line says the bounce is uncorrected and why; nothing is added."""
+    import sys
+
+    import _cycles
+
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    monkeypatch.setattr(_cycles, "with_osl", False)
+    monkeypatch.setitem(sys.modules, "oslquery", None)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
+        f"{UNCORRECTED}: this Blender build has no OSL (Open Shading Language)"
+    ]
+    assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
     effect.remove(scene)
