@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..camera import clamping, cockpit
 from ..colour import cockpit_sky, doppler_colour, light_groups, volumes, world_doppler
-from ..lights import cockpit_lamps, lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..lights import cockpit_lamps, interreflection, lamps_on_moving_objects, lamps_seen_directly, moving_lights
 from . import metadata
 
 if TYPE_CHECKING:
@@ -119,6 +119,14 @@ STAGES: tuple[Stage, ...] = (
         write=lambda scene, snap, sync: lamps_on_moving_objects.write(scene, snap),
         remove=lamps_on_moving_objects.remove,
         warnings=lamps_on_moving_objects.warnings,
+    ),
+    Stage(
+        "light bounced between moving objects",
+        interreflection,
+        apply=interreflection.apply,
+        write=lambda scene, snap, sync: interreflection.write(scene, snap),
+        remove=interreflection.remove,
+        warnings=interreflection.warnings,
     ),
     Stage(
         "lamps seen directly",

@@ -7,7 +7,9 @@ finds the receiving point (``P + I * ray length``), where that point sees the sp
 scales the colour by ``F``. The receiver's velocity (and, in one variant, its rest normal) is
 given to it, as the add-on could not give it (a material shader does not know the surface a ray
 came from); in another variant the shader traces back to the receiver for its normal (OSL only):
-this measures how far the correction reaches, not a feature of the add-on.
+this measures how far the correction reaches. The add-on's own correction
+(``lights/interreflection.py``, which would act on these OSL scenes at the render's sync) is kept
+out here; ``test_interreflection_correction.py`` renders it.
 """
 
 from pathlib import Path
@@ -59,7 +61,7 @@ def _insert_factor(bpy, scene, beta_receiver, receiver_normal, use_factor, use_n
 
 
 @pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH), ("rest", 0.0)])
-def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
+def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path, monkeypatch, name, sphere_beta):
     """Rendered over the physics model (the test's 487 / 222 pixels): OSL shading with the factor
     off is the suite's 1.12 / 0.95; with the factor and the receiver's rest normal within 5 % both
     ways (measured 0.982 / 1.006), and the same with the normal the shader traces back to the
@@ -70,6 +72,7 @@ def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path,
     if osl.unavailable_reason() is not None:
         pytest.skip(osl.unavailable_reason())
     beta = np.array([sphere_beta, 0.0, 0.0])
+    monkeypatch.setattr(case._module("lights.interreflection"), "_reason", lambda *args: "the test's own shader")
     effect = case._module("pipeline.effect")
     images = {}
     variants = (("off", 0.0, 0.0), ("normal", 1.0, 1.0), ("traced normal", 1.0, 2.0), ("no normal", 1.0, 0.0))

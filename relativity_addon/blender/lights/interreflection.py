@@ -1,0 +1,228 @@
+"""Light bounced between moving objects (docs/lamp-doppler.md, "Light bounced between moving objects").
+
+Cycles renders one static snapshot, so light one moving object sends another reaches it with the
+wrong geometry and no Doppler factor between the two frames (measured 1.12x the physics at 0.5c
+apart, 0.95x approaching). This stage puts an OSL script node (``shaders/relativistic_bounce.osl``,
+the factor of ``physics/bounce.py``) between each moving object's surface shader and its material
+output: on non-camera rays it scales the closure by the per-ray factor. The receiver's velocity
+cannot be read back from a ray, so the shader text is generated per scene with the moving objects'
+apparent bounding boxes and velocities (``receiver_velocity``), rewritten and recompiled when they
+change (every sync). Observer at rest only; the scene's own Open Shading Language setting decides
+(OSL shading is slower than SVM: not switched on for the user, a panel line says what is left).
+
+Everything is recorded (the inserted node and the old link on each material; the text datablock)
+and :func:`remove` deletes exactly that.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+import bpy
+import numpy as np
+
+from ..common import names, osl
+from . import lamps_on_moving_objects
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from bpy.types import Material, Scene, Text
+
+    from ..scene.snapshot import Snapshot
+    from .lamps_on_moving_objects import Mover
+
+SHADER_PATH = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "shaders", names.BOUNCE_SHADER_TEXT)
+MATERIAL_KEY = names.BOUNCE_MATERIAL_KEY
+NODE_NAME = names.BOUNCE_NODE_NAME
+MARKER = "//@GENERATED@"
+MARGIN = 0.05  # the boxes grown by this share of their size on each side: the corners' images bound the image loosely
+MEASURED_ERROR = "12 %"  # docs/lamp-doppler.md: the snapshot's bounce 1.121x the physics at 0.5c apart
+MEASURED_COST = "1.16x"  # benchmarks/bounce_cost.py: OSL + factor over SVM, the test's scene (OSL alone 1.10x)
+
+
+def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
+    """Why the bounce between moving objects is left uncorrected (one line), or None."""
+    if snap.method != "GEOMETRY" or scene.render.engine != "CYCLES":
+        return "off the Apparent Geometry path"
+    found = lamps_on_moving_objects.movers(scene, snap) if movers is None else movers
+    if len(found) < 2:
+        return "fewer than two moving objects"
+    if snap.speed > 0.0:
+        return "the observer moves"
+    no_osl = osl.unavailable_reason()
+    if no_osl is not None:
+        return no_osl[0].lower() + no_osl[1:]
+    if not scene.cycles.shading_system:
+        return (
+            f"Cycles' Open Shading Language is off (switched on, it corrects it at about {MEASURED_COST} render time)"
+        )
+    return None
+
+
+def _vector(values: Sequence[float]) -> str:
+    return ", ".join(f"{float(v):.7g}" for v in values)
+
+
+def generated(camera: Sequence[float], movers: Sequence[Mover]) -> str:
+    """The shader's scene part: the camera's position and one box test per moving object."""
+    lines = [f"#define CAMERA point({_vector(camera)})", "", "int receiver_velocity(point R, output vector beta)", "{"]
+    lines.append("  float best = 1e30;")
+    for mover in movers:
+        points = np.array((mover.centre, *mover.corners), dtype=np.float64)
+        low, high = points.min(axis=0), points.max(axis=0)
+        grow = MARGIN * (high - low).max() + 1e-4
+        low, high = low - grow, high + grow
+        volume = float(np.prod(high - low))
+        lines.append(
+            f"  if (inside(R, point({_vector(low)}), point({_vector(high)})) && {volume:.7g} < best) "
+            f"{{ best = {volume:.7g}; beta = vector({_vector(mover.beta)}); }}  /* {mover.name} */"
+        )
+    lines += ["  return best < 1e30;", "}"]
+    return "\n".join(lines)
+
+
+def shader_source(camera: Sequence[float], movers: Sequence[Mover]) -> str:
+    with open(SHADER_PATH, encoding="utf-8") as handle:
+        return handle.read().replace(MARKER, generated(camera, movers))
+
+
+def _text(source: str) -> tuple[Text, bool]:
+    """The add-on's text datablock holding ``source``, and whether it changed."""
+    text = bpy.data.texts.get(names.BOUNCE_SHADER_TEXT)
+    if text is None:
+        text = bpy.data.texts.new(names.BOUNCE_SHADER_TEXT)
+    if text.as_string().rstrip("\n") == source.rstrip("\n"):
+        return text, False
+    text.clear()
+    text.write(source)
+    return text, True
+
+
+def _output(tree):
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.target in ("ALL", "CYCLES")]
+    active = [n for n in outputs if n.is_active_output]
+    return (active or outputs or [None])[0]
+
+
+def attach(material: Material | None, text: Text) -> bool:
+    """Insert the script node between the material's surface shader and its output."""
+    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+        return False
+    tree = material.node_tree
+    output = _output(tree)
+    if output is None or not output.inputs["Surface"].is_linked:
+        return False
+    source = output.inputs["Surface"].links[0].from_socket
+    node = tree.nodes.new("ShaderNodeScript")
+    node.name = node.label = NODE_NAME
+    node.mode = "INTERNAL"
+    node.script = text  # compiles (oslquery importable: osl.unavailable_reason) and creates the sockets
+    node.location = (output.location.x - 150.0, output.location.y - 250.0)
+    node.hide = True
+    material[MATERIAL_KEY] = {
+        "node": node.name,
+        "output": output.name,
+        "source_node": source.node.name,
+        "source_socket": source.identifier,
+    }
+    if "Out" not in node.outputs or "Surface" not in node.inputs:
+        detach(material)
+        return False
+    beta = tree.nodes.new("ShaderNodeAttribute")
+    beta.name = beta.label = f"{NODE_NAME} Velocity"
+    beta.attribute_type = "GEOMETRY"
+    beta.attribute_name = names.BETA_ATTRIBUTE
+    beta.location = (node.location.x - 200.0, node.location.y - 50.0)
+    beta.hide = True
+    material[MATERIAL_KEY] = {**material[MATERIAL_KEY].to_dict(), "velocity": beta.name}
+    tree.links.new(source, node.inputs["Surface"])
+    tree.links.new(beta.outputs["Vector"], node.inputs["BetaS"])
+    tree.links.new(node.outputs["Out"], output.inputs["Surface"])
+    return True
+
+
+def detach(material: Material | None) -> bool:
+    """Remove the inserted nodes and link the old surface shader to the output again."""
+    if material is None or MATERIAL_KEY not in material:
+        return False
+    record = material[MATERIAL_KEY].to_dict()
+    tree = material.node_tree
+    if tree is not None:
+        for key in ("node", "velocity"):
+            node = tree.nodes.get(record.get(key, ""))
+            if node is not None:
+                tree.nodes.remove(node)
+        output = tree.nodes.get(record["output"])
+        source_node = tree.nodes.get(record["source_node"])
+        source = (
+            None
+            if source_node is None
+            else next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+        )
+        if output is not None and source is not None:
+            tree.links.new(source, output.inputs["Surface"])
+    del material[MATERIAL_KEY]
+    return True
+
+
+def _recompile(materials: Sequence[Material]) -> None:
+    from cycles import osl as cycles_osl  # Cycles' own add-on, present where OSL is
+
+    def report(kind: object, message: object) -> None:
+        pass  # a failed compile leaves the node's old bytecode; attach checks the sockets
+
+    for material in materials:
+        node = material.node_tree.nodes.get(material[MATERIAL_KEY]["node"])
+        if node is not None:
+            cycles_osl.update_script_node(node, report)
+
+
+def write(scene: Scene, snap: Snapshot) -> int:
+    """Bring the factor up to date: the text (camera, boxes, velocities), the moving objects'
+    materials. Everything removed when it does not apply (:func:`_reason`). Returns the number
+    of materials carrying the factor."""
+    found = lamps_on_moving_objects.movers(scene, snap) if snap.method == "GEOMETRY" else []
+    if _reason(scene, snap, found) is not None:
+        remove(scene)
+        return 0
+    text, changed = _text(shader_source(tuple(float(x) for x in snap.camera_position), found))
+    materials = {}
+    for mover in found:
+        for slot in scene.objects[mover.name].material_slots:
+            if slot.material is not None:
+                materials[slot.material.name] = slot.material
+    for material in bpy.data.materials:  # no longer on a moving object
+        if MATERIAL_KEY in material and material.name not in materials:
+            detach(material)
+    attached = [m for m in materials.values() if attach(m, text) or MATERIAL_KEY in m]
+    if changed:
+        _recompile([m for m in attached if MATERIAL_KEY in m])
+    return len(attached)
+
+
+def apply(scene: Scene, snap: Snapshot) -> int:
+    return write(scene, snap)
+
+
+def remove(scene: Scene) -> None:
+    """Detach the node from every material and delete the text."""
+    for material in bpy.data.materials:
+        detach(material)
+    text = bpy.data.texts.get(names.BOUNCE_SHADER_TEXT)
+    if text is not None:
+        bpy.data.texts.remove(text)
+
+
+def warnings(scene: Scene, snap: Snapshot) -> list[str]:
+    """One line when two moving objects light each other uncorrected for a reason the user can change."""
+    if snap.method != "GEOMETRY":
+        return []
+    reason = _reason(scene, snap)
+    if reason is None or reason in ("off the Apparent Geometry path", "fewer than two moving objects"):
+        return []
+    return [
+        f"Light bounced between moving objects is not corrected, up to {MEASURED_ERROR} off at 0.5c "
+        f"(docs/lamp-doppler.md): {reason}"
+    ]

@@ -1,0 +1,167 @@
+"""The bounce between moving objects corrected by the add-on's own Set Up (issue 27, item 6;
+``lights/interreflection.py``): ``test_interreflection.py``'s case, 0.5c apart and approaching,
+rendered with the scene on Cycles' Open Shading Language, against that file's physics model
+(written from docs/physics.md alone). Camera rays stay unchanged (the sphere, seen directly, lit
+only by the lamp), and Remove gives the scene back.
+"""
+
+import numpy as np
+import pytest
+import test_interreflection as case
+
+import camera_helpers as ch
+from relativity_addon.blender.common import names, osl
+
+UNCORRECTED = "Light bounced between moving objects is not corrected, up to 12 % off at 0.5c (docs/lamp-doppler.md)"
+
+
+def _render(bpy, tmp_path, beta, name, use_osl=True):
+    """The panel's (and the sphere's) pixels rendered through Set Up, and the panel's model."""
+    scene, rotation = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = use_osl
+    effect = case._module("pipeline.effect")
+    effect.apply(scene)
+    image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"{name}.exr"))
+    carrying = [m.name for m in bpy.data.materials if names.BOUNCE_MATERIAL_KEY in m]
+    effect.remove(scene)
+    return image, rotation, carrying
+
+
+@pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH)])
+def test_set_up_corrects_the_bounce(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
+    """Through Set Up, on OSL: the panel's bounce light within 5 % of the physics model both ways
+    (uncorrected, on main: 1.121 apart, 0.950 approaching); the sphere's own pixels (camera rays,
+    direct light) as without the correction (SVM shading, the same scene)."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    beta = np.array([sphere_beta, 0.0, 0.0])
+    corrected, rotation, carrying = _render(bpy, tmp_path, beta, name)
+    plain, _, none = _render(bpy, tmp_path, beta, f"{name}_svm", use_osl=False)
+    physics = case._model(rotation, beta, -beta)
+    sampled = case._inner(case._seen_panel(rotation, beta, -beta)[0]) & np.isfinite(physics)
+    case._save(bpy, tmp_path / f"{name}_corrected_render_model.png", corrected, physics)
+    ratio = float(corrected[sampled].mean() / physics[sampled].mean())
+    uncorrected = float(plain[sampled].mean() / physics[sampled].mean())
+    rays = ch.pixel_rays(case.RESOLUTION, case.SENSOR, case.LENS)
+    sphere_path, _ = case._sphere_hit(case.CAMERA, 0.0, rays, beta)
+    sphere = np.isfinite(sphere_path) & case._inner(np.where(np.isfinite(sphere_path), 1.0, np.nan))
+    direct = float(corrected[sphere].mean() / plain[sphere].mean())
+    print(
+        f"{name}: {sampled.sum()} panel px, rendered over physics: corrected {ratio:.4f}, "
+        f"SVM uncorrected {uncorrected:.4f}; sphere {sphere.sum()} px, corrected over SVM {direct:.4f}"
+    )
+    assert ratio == pytest.approx(1.0, abs=0.05)
+    assert direct == pytest.approx(1.0, abs=0.01)
+    assert carrying == ["White"] and none == []
+
+
+def test_at_rest_control(relativity_addon, factory_blender, tmp_path):
+    """Nothing moves: no material gets the factor and the OSL render matches the model (3 %)."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    image, rotation, carrying = _render(bpy, tmp_path, np.zeros(3), "rest")
+    physics = case._model(rotation, np.zeros(3), np.zeros(3))
+    sampled = case._inner(case._seen_panel(rotation, np.zeros(3), np.zeros(3))[0]) & np.isfinite(physics)
+    ratio = float(image[sampled].mean() / physics[sampled].mean())
+    print(f"rest: rendered over physics {ratio:.4f}")
+    assert carrying == []
+    assert ratio == pytest.approx(1.0, abs=0.03)
+
+
+def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_addon, factory_blender):
+    """Set Up on OSL adds the node and its text, Remove gives the file back (``scene_dump``); off
+    OSL, and with a moving observer, one panel line says the bounce is uncorrected."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "pipeline"))
+    import scene_dump
+
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    before = scene_dump.dump(bpy)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert names.BOUNCE_SHADER_TEXT in bpy.data.texts
+    tree = bpy.data.materials["White"].node_tree
+    assert tree.nodes[names.BOUNCE_NODE_NAME].outputs["Out"].is_linked
+    assert not any("bounced" in line for line in effect.scene_warnings(scene))
+    effect.remove(scene)
+    lines = scene_dump.differences(before, scene_dump.dump(bpy))
+    assert not lines, "\n".join(lines[:20])
+    scene.cycles.shading_system = False
+    effect.apply(scene)
+    effect.sync(scene)
+    found = [line for line in effect.scene_warnings(scene) if "bounced" in line]
+    assert found == [
+        f"{UNCORRECTED}: Cycles' Open Shading Language is off (switched on, it corrects it at about 1.16x render time)"
+    ]
+    assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
+    effect.remove(scene)
+    scene.cycles.shading_system = True
+    scene.relativity.beta = (0.0, 0.0, 0.3)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
+        f"{UNCORRECTED}: the observer moves"
+    ]
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
+    effect.remove(scene)
+
+
+def test_the_lookup_follows_the_sync(relativity_addon, factory_blender):
+    """A changed velocity or position reaches the shader's boxes and velocities at the next sync
+    (the text rewritten, the node recompiled with its sockets)."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    effect.apply(scene)
+    effect.sync(scene)
+    first = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert f"beta = vector({case.EACH:.7g}, 0, 0)" in first
+    scene.objects["Sphere"].relativity.beta = (0.0, 0.4, 0.0)
+    effect.sync(scene)
+    second = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert "beta = vector(0, 0.4, 0)" in second and f"beta = vector({case.EACH:.7g}, 0, 0)" not in second
+    scene.objects["Sphere"].location.z += 0.5  # (Constant motion: the location is where it is at every frame)
+    effect.sync(scene)
+    third = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
+    assert third != second  # the sphere's box moved with it
+    node = bpy.data.materials["White"].node_tree.nodes[names.BOUNCE_NODE_NAME]
+    assert "Out" in node.outputs and node.outputs["Out"].is_linked
+    effect.remove(scene)
+
+
+def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender, monkeypatch):
+    """Without OSL (as Debian's 5.2: ``_cycles.with_osl`` False, no oslquery), Set Up works and one
+    panel line says the bounce is uncorrected and why; nothing is added."""
+    import sys
+
+    import _cycles
+
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    scene.cycles.shading_system = True
+    monkeypatch.setattr(_cycles, "with_osl", False)
+    monkeypatch.setitem(sys.modules, "oslquery", None)
+    effect.apply(scene)
+    effect.sync(scene)
+    assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
+        f"{UNCORRECTED}: this Blender build has no OSL (Open Shading Language)"
+    ]
+    assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
+    effect.remove(scene)
