@@ -119,6 +119,7 @@ REST_NORMAL_MATERIAL_KEY = "relativity_rest_normal_node"  # on materials: the in
 REST_NORMAL_GROUP = "Relativity Rest Normal"  # shader group: rest-frame normal in world axes
 REST_NORMAL_GROUP_VERSION = 1
 BOUNCE_SHADER_TEXT = "relativistic_bounce.osl"  # text datablock of the bounce factor (lights/interreflection.py)
+BOUNCE_TEXT_KEY = "relativity_bounce_text"  # on scenes: the name of the scene's own bounce text datablock
 BOUNCE_MATERIAL_KEY = "relativity_bounce_node"  # on materials: the inserted script node and the old link
 BOUNCE_NODE_NAME = "Relativity Bounce"  # the script node between a moving object's surface and its output
 MOVING_LAMP_SHADER_TEXT = "relativistic_moving_lamp.osl"  # text datablock of the stand-in lamps' light shader

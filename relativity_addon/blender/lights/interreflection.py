@@ -88,11 +88,23 @@ def shader_source(camera: Sequence[float], movers: Sequence[Mover]) -> str:
         return handle.read().replace(MARKER, generated(camera, movers))
 
 
-def _text(source: str) -> tuple[Text, bool]:
-    """The add-on's text datablock holding ``source``, and whether it changed."""
-    text = bpy.data.texts.get(names.BOUNCE_SHADER_TEXT)
+def _scene_text(scene: Scene) -> Text | None:
+    """The scene's own text datablock (each set-up scene has one: its camera and movers)."""
+    name = scene.get(names.BOUNCE_TEXT_KEY)
+    return bpy.data.texts.get(name) if isinstance(name, str) else None
+
+
+def _carries(material: Material, text_name: str) -> bool:
+    """Whether the material carries the factor of the scene whose text is ``text_name``."""
+    return MATERIAL_KEY in material and material[MATERIAL_KEY].get("text") == text_name
+
+
+def _text(scene: Scene, source: str) -> tuple[Text, bool]:
+    """The scene's text datablock holding ``source``, and whether it changed."""
+    text = _scene_text(scene)
     if text is None:
         text = bpy.data.texts.new(names.BOUNCE_SHADER_TEXT)
+        scene[names.BOUNCE_TEXT_KEY] = text.name
     if text.as_string().rstrip("\n") == source.rstrip("\n"):
         return text, False
     text.clear()
@@ -126,6 +138,7 @@ def attach(material: Material | None, text: Text) -> bool:
         "output": output.name,
         "source_node": source.node.name,
         "source_socket": source.identifier,
+        "text": text.name,
     }
     if "Out" not in node.outputs or "Surface" not in node.inputs:
         detach(material)
@@ -187,18 +200,19 @@ def write(scene: Scene, snap: Snapshot) -> int:
     if _reason(scene, snap, found) is not None:
         remove(scene)
         return 0
-    text, changed = _text(shader_source(tuple(float(x) for x in snap.camera_position), found))
+    text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
     materials = {}
     for mover in found:
         for slot in scene.objects[mover.name].material_slots:
             if slot.material is not None:
                 materials[slot.material.name] = slot.material
-    for material in bpy.data.materials:  # no longer on a moving object
-        if MATERIAL_KEY in material and material.name not in materials:
+    for material in bpy.data.materials:  # no longer on one of this scene's moving objects
+        if _carries(material, text.name) and material.name not in materials:
             detach(material)
+    # (a material another set-up scene's movers carry keeps that scene's lookup)
     attached = [m for m in materials.values() if attach(m, text) or MATERIAL_KEY in m]
     if changed:
-        _recompile([m for m in attached if MATERIAL_KEY in m])
+        _recompile([m for m in attached if _carries(m, text.name)])
     return len(attached)
 
 
@@ -207,12 +221,16 @@ def apply(scene: Scene, snap: Snapshot) -> int:
 
 
 def remove(scene: Scene) -> None:
-    """Detach the node from every material and delete the text."""
-    for material in bpy.data.materials:
-        detach(material)
-    text = bpy.data.texts.get(names.BOUNCE_SHADER_TEXT)
+    """Detach the node from the materials that carry this scene's factor and delete its text;
+    another set-up scene's are left alone."""
+    text = _scene_text(scene)
     if text is not None:
+        for material in bpy.data.materials:
+            if _carries(material, text.name):
+                detach(material)
         bpy.data.texts.remove(text)
+    if names.BOUNCE_TEXT_KEY in scene:
+        del scene[names.BOUNCE_TEXT_KEY]
 
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:

@@ -165,3 +165,44 @@ def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender
     assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
     assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
     effect.remove(scene)
+
+
+def test_remove_on_one_scene_leaves_another_set_up_scene_corrected(relativity_addon, factory_blender):
+    """Two set-up scenes, each with its own moving pair and material: each gets its own text (its
+    camera and movers), and Remove on one leaves the other's node and text in place."""
+    bpy = factory_blender
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    first, _ = case._scene(bpy, beta, -beta)
+    first.cycles.shading_system = True
+    second = first.copy()  # a linked copy: the same objects...
+    second.name = "Second"
+    for obj in list(second.collection.objects):
+        second.collection.objects.unlink(obj)
+    grey = bpy.data.materials["White"].copy()
+    grey.name = "Second White"
+    for name in ("Sphere", "Panel", "Camera"):  # ...replaced by copies with their own material
+        copy = first.objects[name].copy()
+        if copy.type == "MESH":
+            copy.data = copy.data.copy()
+            copy.data.materials[0] = grey
+        second.collection.objects.link(copy)
+        if name == "Camera":
+            second.camera = copy
+    for scene in (first, second):
+        effect.apply(scene)
+        effect.sync(scene)
+    texts = {scene.name: scene.get(names.BOUNCE_TEXT_KEY) for scene in (first, second)}
+    effect.remove(first)
+    node = grey.node_tree.nodes.get(names.BOUNCE_NODE_NAME)
+    assert node is not None and node.outputs["Out"].is_linked, "Remove on one scene took the other's correction"
+    assert names.BOUNCE_MATERIAL_KEY not in bpy.data.materials["White"]
+    assert len(set(texts.values())) == 2, texts
+    assert texts[first.name] not in bpy.data.texts and texts[second.name] in bpy.data.texts
+    effect.sync(second)
+    assert grey.node_tree.nodes.get(names.BOUNCE_NODE_NAME) is not None
+    effect.remove(second)
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
+    assert not any(t.name.startswith(names.BOUNCE_SHADER_TEXT) for t in bpy.data.texts)
