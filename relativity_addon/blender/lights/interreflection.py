@@ -23,6 +23,7 @@ import bpy
 import numpy as np
 
 from ..common import names, osl
+from ..geometry import modifier
 from . import lamps_on_moving_objects
 
 if TYPE_CHECKING:
@@ -42,12 +43,23 @@ MEASURED_ERROR = "12 %"  # docs/lamp-doppler.md: the snapshot's bounce 1.121x th
 MEASURED_COST = "1.16x"  # benchmarks/bounce_cost.py: OSL + factor over SVM, the test's scene (OSL alone 1.10x)
 
 
-def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
-    """Why the bounce between moving objects is left uncorrected (one line), or None."""
+def _moving_count(scene: Scene) -> int:
+    """How many of the scene's set-up meshes have a motion of their own (cheap: no positions)."""
+    count = 0
+    for obj in modifier.applied_objects(scene):
+        settings = obj.relativity
+        if settings.motion == "CONSTANT" and any(settings.beta):
+            count += 1
+        elif settings.motion == "ANIMATION" and not settings.use_deformation:
+            count += 1
+    return count
+
+
+def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
+    """The reasons that need no object's position (checked first: a sync pays nothing for them)."""
     if snap.method != "GEOMETRY" or scene.render.engine != "CYCLES":
         return "off the Apparent Geometry path"
-    found = lamps_on_moving_objects.movers(scene, snap) if movers is None else movers
-    if len(found) < 2:
+    if _moving_count(scene) < 2:
         return "fewer than two moving objects"
     if snap.speed > 0.0:
         return "the observer moves"
@@ -58,6 +70,17 @@ def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None)
         return (
             f"Cycles' Open Shading Language is off (switched on, it corrects it at about {MEASURED_COST} render time)"
         )
+    return None
+
+
+def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
+    """Why the bounce between moving objects is left uncorrected (one line), or None."""
+    cheap = _cheap_reason(scene, snap)
+    if cheap is not None:
+        return cheap
+    found = lamps_on_moving_objects.movers(scene, snap) if movers is None else movers
+    if len(found) < 2:
+        return "fewer than two moving objects"
     return None
 
 
@@ -196,8 +219,9 @@ def write(scene: Scene, snap: Snapshot) -> int:
     """Bring the factor up to date: the text (camera, boxes, velocities), the moving objects'
     materials. Everything removed when it does not apply (:func:`_reason`). Returns the number
     of materials carrying the factor."""
-    found = lamps_on_moving_objects.movers(scene, snap) if snap.method == "GEOMETRY" else []
-    if _reason(scene, snap, found) is not None:
+    cheap = _cheap_reason(scene, snap)
+    found = lamps_on_moving_objects.movers(scene, snap) if cheap is None else []
+    if cheap is not None or _reason(scene, snap, found) is not None:
         remove(scene)
         return 0
     text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
@@ -237,7 +261,7 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """One line when two moving objects light each other uncorrected for a reason the user can change."""
     if snap.method != "GEOMETRY":
         return []
-    reason = _reason(scene, snap)
+    reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
     if reason is None or reason in ("off the Apparent Geometry path", "fewer than two moving objects"):
         return []
     return [
