@@ -16,9 +16,9 @@ from typing import TYPE_CHECKING
 import bpy
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Iterable, Sequence
 
-    from bpy.types import NodeTree
+    from bpy.types import Material, NodeTree
 
 
 class Literal(str):
@@ -171,3 +171,29 @@ def remove_unused_groups(names: Iterable[str]) -> None:
         tree = bpy.data.node_groups.get(name)
         if tree is not None and tree.users == 0:
             bpy.data.node_groups.remove(tree)
+
+
+def detach_inserted(material: Material | None, key: str, node_keys: Sequence[str]) -> bool:
+    """Undo a node insertion recorded on ``material[key]`` (``output``, ``source_node``,
+    ``source_socket`` and the inserted nodes' names under ``node_keys``): the inserted nodes
+    removed, the old surface shader linked to the output again, the record deleted."""
+    if material is None or key not in material:
+        return False
+    record = material[key].to_dict()
+    tree = material.node_tree
+    if tree is not None:
+        for node_key in node_keys:
+            node = tree.nodes.get(record.get(node_key, ""))
+            if node is not None:
+                tree.nodes.remove(node)
+        output = tree.nodes.get(record["output"])
+        source_node = tree.nodes.get(record["source_node"])
+        source = (
+            None
+            if source_node is None
+            else next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
+        )
+        if output is not None and source is not None:
+            tree.links.new(source, output.inputs["Surface"])
+    del material[key]
+    return True

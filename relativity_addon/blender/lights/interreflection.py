@@ -23,6 +23,7 @@ import bpy
 import numpy as np
 
 from ..common import names, osl
+from ..common.nodes import detach_inserted
 from ..geometry import modifier
 from . import lamps_on_moving_objects
 
@@ -181,26 +182,7 @@ def attach(material: Material | None, text: Text) -> bool:
 
 def detach(material: Material | None) -> bool:
     """Remove the inserted nodes and link the old surface shader to the output again."""
-    if material is None or MATERIAL_KEY not in material:
-        return False
-    record = material[MATERIAL_KEY].to_dict()
-    tree = material.node_tree
-    if tree is not None:
-        for key in ("node", "velocity"):
-            node = tree.nodes.get(record.get(key, ""))
-            if node is not None:
-                tree.nodes.remove(node)
-        output = tree.nodes.get(record["output"])
-        source_node = tree.nodes.get(record["source_node"])
-        source = (
-            None
-            if source_node is None
-            else next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
-        )
-        if output is not None and source is not None:
-            tree.links.new(source, output.inputs["Surface"])
-    del material[MATERIAL_KEY]
-    return True
+    return detach_inserted(material, MATERIAL_KEY, ("node", "velocity"))
 
 
 def _recompile(materials: Sequence[Material]) -> None:

@@ -33,6 +33,7 @@ from ...physics import spectral_render
 from ..camera import exact_camera
 from ..colour import materials
 from ..common import busy, names, osl
+from ..common.nodes import detach_inserted
 from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
@@ -322,26 +323,7 @@ def attach(material: Material | None, group: NodeTree) -> bool:
 
 def detach(material: Material | None) -> bool:
     """Remove the inserted nodes and link the old surface shader to the output again."""
-    if material is None or MATERIAL_KEY not in material:
-        return False
-    record = material[MATERIAL_KEY].to_dict()
-    tree = material.node_tree
-    if tree is not None:
-        for key in ("group_node", "add_node"):
-            node = tree.nodes.get(record[key])
-            if node is not None:
-                tree.nodes.remove(node)
-        output = tree.nodes.get(record["output"])
-        source_node = tree.nodes.get(record["source_node"])
-        source = (
-            None
-            if source_node is None
-            else next((s for s in source_node.outputs if s.identifier == record["source_socket"]), None)
-        )
-        if output is not None and source is not None:
-            tree.links.new(source, output.inputs["Surface"])
-    del material[MATERIAL_KEY]
-    return True
+    return detach_inserted(material, MATERIAL_KEY, ("group_node", "add_node"))
 
 
 def _scene_materials(scene):
