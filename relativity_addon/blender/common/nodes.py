@@ -197,3 +197,10 @@ def detach_inserted(material: Material | None, key: str, node_keys: Sequence[str
             tree.links.new(source, output.inputs["Surface"])
     del material[key]
     return True
+
+
+def cycles_material_output(tree: NodeTree) -> typing.Any:
+    """The material output node Cycles renders (the active one among those for Cycles or all), or None."""
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.target in ("ALL", "CYCLES")]
+    active = [n for n in outputs if n.is_active_output]
+    return next(iter(active or outputs), None)

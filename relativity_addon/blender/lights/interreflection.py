@@ -23,7 +23,7 @@ import bpy
 import numpy as np
 
 from ..common import names, osl
-from ..common.nodes import detach_inserted
+from ..common.nodes import cycles_material_output, detach_inserted
 from ..geometry import modifier
 from . import lamps_on_moving_objects
 
@@ -136,18 +136,12 @@ def _text(scene: Scene, source: str) -> tuple[Text, bool]:
     return text, True
 
 
-def _output(tree):
-    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.target in ("ALL", "CYCLES")]
-    active = [n for n in outputs if n.is_active_output]
-    return (active or outputs or [None])[0]
-
-
 def attach(material: Material | None, text: Text) -> bool:
     """Insert the script node between the material's surface shader and its output."""
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
     tree = material.node_tree
-    output = _output(tree)
+    output = cycles_material_output(tree)
     if output is None or not output.inputs["Surface"].is_linked:
         return False
     source = output.inputs["Surface"].links[0].from_socket

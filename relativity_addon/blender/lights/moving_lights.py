@@ -33,7 +33,7 @@ from ...physics import spectral_render
 from ..camera import exact_camera
 from ..colour import materials
 from ..common import busy, names, osl
-from ..common.nodes import detach_inserted
+from ..common.nodes import cycles_material_output, detach_inserted
 from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
@@ -249,14 +249,6 @@ def _write_parameters(group, snap):
 # --- materials ------------------------------------------------------------------------------
 
 
-def _material_output(tree):
-    outputs = [
-        node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputMaterial" and node.target in ("ALL", "CYCLES")
-    ]
-    active = [node for node in outputs if node.is_active_output]
-    return (active or outputs or [None])[0]
-
-
 def _albedo_socket(tree, surface):
     """The colour input of the first Principled or Diffuse BSDF upstream of the surface socket."""
     seen, queue = set(), [surface]
@@ -285,7 +277,7 @@ def attach(material: Material | None, group: NodeTree) -> bool:
     if material is None or material.node_tree is None or MATERIAL_KEY in material:
         return False
     tree = material.node_tree
-    output = _material_output(tree)
+    output = cycles_material_output(tree)
     if output is None or not output.inputs["Surface"].is_linked:
         return False
     albedo = _albedo_socket(tree, output.inputs["Surface"])
