@@ -124,6 +124,22 @@ def _correctable(material):
     return output, source, blackbody, intensity
 
 
+def _blackbody_group(tree, node, blackbody, intensity):
+    """The correction's group node in ``tree`` for the Principled Volume ``node`` (its blackbody's
+    temperature linked or set, its constant intensity and tint)."""
+    ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
+    group = tree.nodes.new("ShaderNodeGroup")
+    group.node_tree = bpy.data.node_groups[GROUP]
+    group.name = group.label = f"{NODE_PREFIX} {node.name}"
+    if isinstance(blackbody.temperature, float):
+        group.inputs["Temperature"].default_value = blackbody.temperature
+    else:
+        tree.links.new(blackbody.temperature, group.inputs["Temperature"])
+    group.inputs["Intensity"].default_value = intensity
+    group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+    return group
+
+
 def attach(material: Material, grids: bool = False) -> bool:
     """Add the camera-ray correction to a material whose volume is a Principled Volume blackbody
     (after ``materials.attach``, whose records restore it on detach). Returns whether it did.
@@ -143,16 +159,7 @@ def attach(material: Material, grids: bool = False) -> bool:
     tree = material.node_tree
     output, source, blackbody, intensity = found
     node = source.node
-    ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
-    group = tree.nodes.new("ShaderNodeGroup")
-    group.node_tree = bpy.data.node_groups[GROUP]
-    group.name = group.label = f"{NODE_PREFIX} {node.name}"
-    if isinstance(blackbody.temperature, float):
-        group.inputs["Temperature"].default_value = blackbody.temperature
-    else:
-        tree.links.new(blackbody.temperature, group.inputs["Temperature"])
-    group.inputs["Intensity"].default_value = intensity
-    group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+    group = _blackbody_group(tree, node, blackbody, intensity)
     created = [group]
     grid_name = node.inputs["Temperature Attribute"].default_value if grids else ""
     if grid_name:
@@ -279,16 +286,7 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
                 inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
                 did = did or bool(reader)
             continue
-        ensure_group(volume_blackbody_group(), names.GROUP_VERSION_KEY, names.SHADER_GROUPS_VERSION)
-        group = inner.nodes.new("ShaderNodeGroup")
-        group.node_tree = bpy.data.node_groups[GROUP]
-        group.name = group.label = f"{NODE_PREFIX} {node.name}"
-        if isinstance(blackbody.temperature, float):
-            group.inputs["Temperature"].default_value = blackbody.temperature
-        else:
-            inner.links.new(blackbody.temperature, group.inputs["Temperature"])
-        group.inputs["Intensity"].default_value = intensity
-        group.inputs["Tint"].default_value = tuple(node.inputs["Blackbody Tint"].default_value)[0]
+        group = _blackbody_group(inner, node, blackbody, intensity)
         group.inputs["Fast Part"].default_value = 0.0  # on where every user takes the boundary (grouped_volumes)
         created = [group, *_grid_reader(inner, node, group, grids)]
         emission = inner.nodes.new("ShaderNodeEmission")

@@ -11,7 +11,6 @@ its luminance must change by ``D^4`` (Weiskopf et al. 1999 eq. 15, docs/physics.
 slab's path-length change under aberration, ``D`` from each pixel's viewing direction.
 """
 
-import math
 import sys
 from pathlib import Path
 
@@ -74,6 +73,36 @@ def _xyz(image, window):
     return dh.linear_rec709_to_xyz(image[window].reshape(-1, 3))
 
 
+def observe(scene):
+    """The observer moving toward the slab at ``BETA`` (the exact camera), ``c = 1``."""
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = BETA
+    scene.relativity.speed_of_light = 1.0
+
+
+def halves_off(bpy, scene, camera, image, y_rest, power=4, label=""):
+    """The halves of ``image`` (rows top first) not seen as colour-science's blackbody at ``D T``
+    (Delta E 2000 <= 1) with their rest luminance ``y_rest`` times ``D^power`` and the slab's
+    path-length change (within 5 %), ``D`` from each pixel's viewing direction."""
+    doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
+    path = _slab_path_ratio(bpy, scene, camera)
+    failures = []
+    for name, (grid, window) in HALVES.items():
+        temperature = grid * BASE_TEMPERATURE
+        xyz = _xyz(image, window)
+        d = doppler[window].ravel()
+        expected_colour = np.mean(dh.blackbody_xyz_colour_science(d * temperature), axis=0)
+        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
+        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**power)
+        print(
+            f"{label}{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, "
+            f"Y / D^{power} Y_rest {ratio:.4f}"
+        )
+        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
+            failures.append(name)
+    return failures
+
+
 @pytest.mark.parametrize("searchlight", [True, False], ids=["searchlight", "rest_brightness"])
 def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp_path, searchlight):
     """With the searchlight off (Doppler only, Rest Brightness) the power is 0: ``D^0``, the rest
@@ -94,32 +123,12 @@ def test_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_addon, tmp
     links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
     nodes_before = len(material.node_tree.nodes)
 
-    scene.relativity.method = "CAMERA"
-    scene.relativity.beta = BETA
-    scene.relativity.speed_of_light = 1.0
+    observe(scene)
     scene.relativity.use_searchlight = searchlight
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     moving = dh.render(bpy, scene, tmp_path / "moving.exr")
     assert np.all(np.isfinite(moving))
-
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
-    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
-    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
-    path = _slab_path_ratio(bpy, scene, camera)
-    failures = []
-    for name, (grid, window) in HALVES.items():
-        temperature = grid * BASE_TEMPERATURE
-        xyz = _xyz(moving, window)
-        d = doppler[window].ravel()
-        expected_colour = np.mean(dh.blackbody_xyz_colour_science(d * temperature), axis=0)
-        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
-        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**power)
-        print(
-            f"{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^{power} Y_rest {ratio:.4f}"
-        )
-        if not (delta_e < 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
-            failures.append(name)
-    assert not failures
+    assert not halves_off(bpy, scene, camera, moving, y_rest, power)
 
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
@@ -139,31 +148,13 @@ def test_temperature_grid_in_spectral_mode_is_seen_at_d_t_with_d4_luminance(rela
     links_before = sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links)
     nodes_before = len(material.node_tree.nodes)
 
-    scene.relativity.method = "CAMERA"
-    scene.relativity.beta = BETA
-    scene.relativity.speed_of_light = 1.0
+    observe(scene)
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
     pixels, _info = spectral_render.render(scene, 3)
     spectral = pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
-
-    view = -dh.pixel_photon_directions(bpy, scene, camera)
-    gamma = 1.0 / math.sqrt(1.0 - np.dot(BETA, BETA))
-    doppler = 1.0 / (gamma * (1.0 - view @ np.asarray(BETA)))
-    path = _slab_path_ratio(bpy, scene, camera)
-    failures = []
-    for name, (grid, window) in HALVES.items():
-        temperature = grid * BASE_TEMPERATURE
-        xyz = _xyz(spectral, window)
-        d = doppler[window].ravel()
-        expected_colour = np.mean(dh.blackbody_xyz_colour_science(d * temperature), axis=0)
-        delta_e = dh.delta_e_2000_normalised(xyz.mean(axis=0), expected_colour)
-        ratio = xyz[:, 1].mean() / np.mean(y_rest[name] * path[window].ravel() * d**4)
-        print(f"spectral {name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, Y / D^4 Y {ratio:.4f}")
-        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
-            failures.append(name)
-    assert not failures
+    assert not halves_off(bpy, scene, camera, spectral, y_rest, label="spectral ")
 
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
