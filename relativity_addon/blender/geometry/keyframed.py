@@ -40,6 +40,9 @@ MAX_INTERVALS = 1024
 MAX_WIDENING = 8.0
 REACH_KEY = "relativity_reach"  # on the cache mesh: the rest points' largest distance from the origin
 WIDEN_KEY = "relativity_widen"  # on the cache mesh: the window's factor after outside verdicts
+# Intervals whose motion departs from uniform motion by at most this fraction of the distance from the
+# observer (plus the reach) get the closed form (the keys' float32 rounding: about 1e-7 of the keys' values)
+UNIFORM_TOLERANCE = 1e-6
 
 
 def can_show(obj: Object, scene: Scene) -> bool:
@@ -126,9 +129,10 @@ def note_rest(data: Mesh, rest: FloatArray) -> None:
 
 def modifier_inputs(
     obj: Object, obj_eval: Object, snap: Snapshot, scene: Scene, reach: float
-) -> tuple[dict[str, object], FloatArray] | None:
+) -> tuple[dict[str, object], FloatArray | None] | None:
     """The modifier's keyframed inputs (``keyframed_nodes.KEYFRAMED_INPUTS``) and the intervals'
-    coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event, or None when the intervals
+    coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event; the closed form's inputs and None
+    where the intervals are uniform motion (``sampling.uniform_motion``); or None when the intervals
     would be more than MAX_INTERVALS or reach back before the keyframes start moving the object (the
     Python path then, which warns when a point is seen there). Raises RelativityError."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
@@ -148,6 +152,14 @@ def modifier_inputs(
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     inverse = motion.affine_inverse(matrix)[:3, :3]
+    uniform = sampling.uniform_motion(
+        pieces, reach, UNIFORM_TOLERANCE * (reach + float(np.abs(pieces.coefficients[0, 0, :, 3]).max()))
+    )
+    if uniform is not None:  # uniform motion over the window: the modifier's closed form (no per-point reads)
+        affine, rate = uniform
+        offset = affine[:, 3] + (t_o / step - pieces.first) * rate  # the origin at t_o, relative to x_o
+        closed = motion.uniform_motion_inputs(affine[:, :3], offset, rate / (c * step), matrix, x_o, beta_o)
+        return {"Keyframed": False, "Closed Form": True, **closed}, None
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -158,6 +170,7 @@ def modifier_inputs(
 
     inputs = {
         "Keyframed": True,
+        "Closed Form": False,
         "Last Interval": float(len(pieces.coefficients) - 1),
         "Grid Now": t_o / step - pieces.first,
         "Grid Per Distance": 1.0 / (c * step),
@@ -224,7 +237,10 @@ def update(
     if found is None:
         return None
     inputs, coefficients = found
-    write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
-    modifier.set_inputs(mod, {"Closed Form": False, **inputs})
+    if coefficients is not None:
+        write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
+    elif len(data.vertices) != (0 if codes is None else len(codes)):  # the closed form: the face codes alone
+        modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
+    modifier.set_inputs(mod, inputs)
     modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
     return True
