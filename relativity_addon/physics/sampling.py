@@ -194,32 +194,3 @@ def motion_intervals(
         [p1, 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2)], axis=1
     )
     return MotionIntervals(first, coefficients, c * tau, speed)
-
-
-def uniform_motion(intervals: MotionIntervals, reach: float, tolerance: float) -> tuple[FloatArray, FloatArray] | None:
-    """The intervals' motion as uniform motion of a rigid shape, ``(affine, rate)``: the world position
-    of the object-space point ``p`` (within ``reach`` of the origin, object space) at grid coordinate
-    ``s`` (interval ``j``, ``f = s - j``) minus ``x_o`` is ``affine[:, :3] @ p + affine[:, 3] + s rate``
-    on every interval, to within ``tolerance`` (scene units) for every such point; None when it is not.
-
-    Catmull-Rom through knots on one straight line, equally spaced in time and with one 3x3 (no
-    turning, no change of scale or contraction), is that line (docs/physics.md, "Light-travel time":
-    the closed form of uniform motion then holds for every point; the keys' float32 rounding is
-    far below ``tolerance``)."""
-    coefficients = np.asarray(intervals.coefficients, dtype=np.float64)
-    knots = coefficients[:, 0]  # (K, 3, 4): the motion at the start of each interval
-    count = len(knots)
-    affine = knots[0]
-    rate = (knots[-1, :, 3] - affine[:, 3]) / (count - 1) if count > 1 else coefficients[0, 1, :, 3]
-    line = np.zeros((count, 3, 4))
-    line[:, :, 3] = np.arange(count)[:, None] * rate
-    # departures: of each knot from the line, of each slope from the rate, and the curvature's terms
-    slope = np.zeros((3, 4))
-    slope[:, 3] = rate
-    departures = np.concatenate(
-        [knots - affine - line, coefficients[:, 1] - slope, coefficients[:, 2], coefficients[:, 3]]
-    )
-    # a 3x4 departure D moves a point p by at most |D[:, :3]| |p| + |D[:, 3]|
-    shape = np.linalg.norm(departures[:, :, :3], ord=2, axis=(1, 2))
-    moved = shape * reach + np.linalg.norm(departures[:, :, 3], axis=1)
-    return (affine, rate) if float(np.max(moved)) <= tolerance else None

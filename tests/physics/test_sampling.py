@@ -135,32 +135,3 @@ def test_no_points_give_empty_results():
         matrices, 0.1, np.zeros((0, 3)), 0.0, np.ones(3), np.zeros(3), 1.0
     )
     assert seen.shape == (0, 3) and tau.shape == (0,) and beta_seen.shape == (0, 3)
-
-
-def test_uniform_motion_of_the_intervals():
-    """``uniform_motion`` finds the straight line of a body moving uniformly (turned by a fixed angle)
-    and puts each point of it where the motion puts it, contracted along the velocity (points within
-    the reach); a body accelerating, or turning, over the window is not uniform."""
-    c, step, t_o, reach = 10.0, 1.0 / 192, 0.3, 2.0
-    x_o = np.array([0.5, -0.2, 1.0])
-    start, velocity = np.array([-1.0, 0.4, -5.0]), np.array([6.0, -2.0, 1.0])
-    intervals = sampling.motion_intervals(uniform_motion(start, velocity), step, t_o, x_o, c, reach, 4096)
-    assert intervals is not None and len(intervals.coefficients) > 20
-    found = sampling.uniform_motion(intervals, reach, 1e-9)
-    assert found is not None
-    affine, rate = found
-    points = RNG.uniform(-1.0, 1.0, (50, 3))
-    points *= reach / np.linalg.norm(points, axis=1, keepdims=True).max()
-    s = RNG.uniform(0.0, len(intervals.coefficients), 50)
-    times = (intervals.first + s) * step
-    rotated = points @ uniform_motion(np.zeros(3), np.zeros(3))(np.zeros(1))[0, :3, :3].T
-    expected = contract(rotated, velocity / c) + start + np.multiply.outer(times, velocity) - x_o
-    np.testing.assert_allclose(points @ affine[:, :3].T + affine[:, 3] + s[:, None] * rate, expected, atol=1e-9)
-
-    for matrices in (
-        accelerated_spinning_motion(np.array([3.0, 0.0, 0.0]), 0.0),
-        accelerated_spinning_motion(np.zeros(3), 0.5),
-    ):
-        curved = sampling.motion_intervals(matrices, step, t_o, x_o, c, reach, 4096)
-        assert curved is not None
-        assert sampling.uniform_motion(curved, reach, 1e-6) is None

@@ -40,9 +40,6 @@ MAX_INTERVALS = 1024
 MAX_WIDENING = 8.0
 REACH_KEY = "relativity_reach"  # on the cache mesh: the rest points' largest distance from the origin
 WIDEN_KEY = "relativity_widen"  # on the cache mesh: the window's factor after outside verdicts
-# Intervals whose motion departs from uniform motion by at most this fraction of the distance from the
-# observer (plus the reach) get the closed form (the keys' float32 rounding: about 1e-7 of the keys' values)
-UNIFORM_TOLERANCE = 1e-6
 
 
 def can_show(obj: Object, scene: Scene) -> bool:
@@ -132,9 +129,10 @@ def modifier_inputs(
 ) -> tuple[dict[str, object], FloatArray | None] | None:
     """The modifier's keyframed inputs (``keyframed_nodes.KEYFRAMED_INPUTS``) and the intervals'
     coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event; the closed form's inputs and None
-    where the intervals are uniform motion (``sampling.uniform_motion``); or None when the intervals
-    would be more than MAX_INTERVALS or reach back before the keyframes start moving the object (the
-    Python path then, which warns when a point is seen there). Raises RelativityError."""
+    where the keys move the object uniformly over the intervals (``animation.straight_keys``: no
+    interval read per point); or None when the intervals would be more than MAX_INTERVALS or reach
+    back before the keyframes start moving the object (the Python path then, which warns when a
+    point is seen there). Raises RelativityError."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
     motion.check_parent_motion(obj)
@@ -152,13 +150,15 @@ def modifier_inputs(
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     inverse = motion.affine_inverse(matrix)[:3, :3]
-    uniform = sampling.uniform_motion(
-        pieces, reach, UNIFORM_TOLERANCE * (reach + float(np.abs(pieces.coefficients[0, 0, :, 3]).max()))
+    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
+    line = animation.straight_keys(
+        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
     )
-    if uniform is not None:  # uniform motion over the window: the modifier's closed form (no per-point reads)
-        affine, rate = uniform
-        offset = affine[:, 3] + (t_o / step - pieces.first) * rate  # the origin at t_o, relative to x_o
-        closed = motion.uniform_motion_inputs(affine[:, :3], offset, rate / (c * step), matrix, x_o, beta_o)
+    if line is not None:
+        start, per_frame = line
+        shape = animation.world_matrices(obj, [t_o * fps])[0, :3, :3]
+        origin = start + per_frame * (t_o * fps)
+        closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
