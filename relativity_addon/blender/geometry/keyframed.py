@@ -26,7 +26,7 @@ from ...physics import sampling
 from ..common import compat, names
 from ..common.nodes import interface_identifier
 from ..scene import animation
-from . import modifier, motion, shape_keys
+from . import modifier, motion, shape_keys, tessellation
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
@@ -239,8 +239,16 @@ def update(
     inputs, coefficients = found
     if coefficients is not None:
         write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
-    elif len(data.vertices) != (0 if codes is None else len(codes)):  # the closed form: the face codes alone
-        modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
+    else:  # the closed form
+        if len(data.vertices) != (0 if codes is None else len(codes)):  # the face codes alone
+            modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
+        if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
+            at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
+            offset = cast("tuple[float, float, float]", inputs["Scene Offset"])
+            at_t_o[:3, 3] = np.asarray(offset) + np.asarray(snap.mesh_observer[1])
+            size = tessellation.render_size(scene)
+            bound = tessellation.edge_image_bound(obj, at_t_o, snap, size, inputs["Velocity"])
+            measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
     modifier.set_inputs(mod, inputs)
     modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
     return True

@@ -16,13 +16,10 @@ from test_object_type_sweep import _cube_mesh, _link
 import geometry_helpers as gh
 
 
-def _inputs(obj):
+def _inputs(obj, names=("Closed Form", "Keyframed")):
     modifier = gh.addon_module("geometry.modifier")
     mod = modifier.find_modifier(obj)
-    return {
-        name: bool(gh.compat.modifier_input(mod, modifier._identifier(mod.node_group, name)))
-        for name in ("Closed Form", "Keyframed")
-    }
+    return {name: bool(gh.compat.modifier_input(mod, modifier._identifier(mod.node_group, name))) for name in names}
 
 
 def _uniform_mover(bpy, scene, adaptive):
@@ -49,6 +46,9 @@ def test_uniform_keyframed_motion_takes_the_closed_form(relativity_addon, monkey
     scene.frame_set(12)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
+    # the closed form's bound on the edges' images clears the grid's here: no edge visited
+    edges = ("Measure Edges", "Edges Proven Short")
+    assert _inputs(obj, edges) == dict.fromkeys(edges, adaptive)
     calls = _count_passes(monkeypatch)
 
     scene.relativity.beta = OBSERVER_CHANGED
@@ -86,4 +86,37 @@ def test_uniform_keyframed_motion_takes_the_closed_form(relativity_addon, monkey
     scene.frame_set(12)
     assert _inputs(obj) == {"Closed Form": True, "Keyframed": False}
     expected, _velocity = _seen(obj, rest, 12 / FPS, x_o, OBSERVER_CHANGED)
+    np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
+
+
+def test_accelerating_keys_keep_the_keyframed_solve_and_its_fallback(relativity_addon, monkeypatch):
+    """Bezier location keys alone (accelerating from about 0.1c to 0.8c, nothing turning): not a straight
+    line, so the modifier solves the keyframed motion; with its window made too narrow (the recorded
+    reach made tiny) the verdict sends the update to the Python path, where the relation puts the mesh."""
+    import bpy
+
+    keyframed = gh.addon_module("geometry.keyframed")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    obj = _link(bpy, scene, "Mover", _cube_mesh(bpy, "Mover", 0.3))
+    obj.location = (0.0, -0.4, -5.0)
+    for frame, x in ((-120, -3.2), (0, -1.6), (48, 2.2)):
+        obj.location.x = x
+        obj.keyframe_insert("location", index=0, frame=frame)
+    obj.relativity.motion = "ANIMATION"
+    obj.relativity.tessellation = 0
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    assert _inputs(obj) == {"Closed Form": False, "Keyframed": True}
+
+    modifier.cache_data(obj)[keyframed.REACH_KEY] = 1e-6
+    calls = _count_passes(monkeypatch)
+    scene.relativity.beta = OBSERVER_CHANGED
+    bpy.context.evaluated_depsgraph_get()
+    bpy.context.evaluated_depsgraph_get()  # the sync after the evaluation that said so
+    assert calls["apparent_world_positions"] > 0
+    assert _inputs(obj) == {"Closed Form": False, "Keyframed": False}
+    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+    expected, _velocity = _seen(obj, rest, 12 / FPS, np.array(camera.matrix_world.translation), OBSERVER_CHANGED)
     np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
