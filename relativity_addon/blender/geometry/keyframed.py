@@ -251,4 +251,6 @@ def update(
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
     modifier.set_inputs(mod, inputs)
     modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays
+        tessellation.announce(obj)
     return True
