@@ -130,7 +130,9 @@ def object_signature(
     if depsgraph is not None:
         scene = bpy.data.scenes.get(snap.scene)
         closed = scene is not None and motion.closed_form(obj, scene)
-        keyframed_on = not closed and keyframed.is_on(modifier.find_modifier(obj))
+        mod = modifier.find_modifier(obj)
+        # keyframed motion in the modifier (or, uniform over its window, the closed form: keyframed.py)
+        keyframed_on = not closed and mod is not None and modifier.closed_form_on(mod)
         measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
         short = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
         # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals

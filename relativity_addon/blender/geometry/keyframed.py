@@ -26,7 +26,7 @@ from ...physics import sampling
 from ..common import compat, names
 from ..common.nodes import interface_identifier
 from ..scene import animation
-from . import modifier, motion, shape_keys
+from . import modifier, motion, shape_keys, tessellation
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
@@ -126,11 +126,13 @@ def note_rest(data: Mesh, rest: FloatArray) -> None:
 
 def modifier_inputs(
     obj: Object, obj_eval: Object, snap: Snapshot, scene: Scene, reach: float
-) -> tuple[dict[str, object], FloatArray] | None:
+) -> tuple[dict[str, object], FloatArray | None] | None:
     """The modifier's keyframed inputs (``keyframed_nodes.KEYFRAMED_INPUTS``) and the intervals'
-    coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event, or None when the intervals
-    would be more than MAX_INTERVALS or reach back before the keyframes start moving the object (the
-    Python path then, which warns when a point is seen there). Raises RelativityError."""
+    coefficients ``(K, 4, 3, 4)`` for the snapshot's observer event; the closed form's inputs and None
+    where the keys move the object uniformly over the intervals (``animation.straight_keys``: no
+    interval read per point); or None when the intervals would be more than MAX_INTERVALS or reach
+    back before the keyframes start moving the object (the Python path then, which warns when a
+    point is seen there). Raises RelativityError."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
     motion.check_parent_motion(obj)
@@ -148,6 +150,16 @@ def modifier_inputs(
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     inverse = motion.affine_inverse(matrix)[:3, :3]
+    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
+    line = animation.straight_keys(
+        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
+    )
+    if line is not None:
+        start, per_frame = line
+        shape = animation.world_matrices(obj, [t_o * fps])[0, :3, :3]
+        origin = start + per_frame * (t_o * fps)
+        closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
+        return {"Keyframed": False, "Closed Form": True, **closed}, None
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -158,6 +170,7 @@ def modifier_inputs(
 
     inputs = {
         "Keyframed": True,
+        "Closed Form": False,
         "Last Interval": float(len(pieces.coefficients) - 1),
         "Grid Now": t_o / step - pieces.first,
         "Grid Per Distance": 1.0 / (c * step),
@@ -224,7 +237,20 @@ def update(
     if found is None:
         return None
     inputs, coefficients = found
-    write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
-    modifier.set_inputs(mod, {"Closed Form": False, **inputs})
+    if coefficients is not None:
+        write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
+    else:  # the closed form
+        if len(data.vertices) != (0 if codes is None else len(codes)):  # the face codes alone
+            modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
+        if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
+            at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
+            offset = cast("tuple[float, float, float]", inputs["Scene Offset"])
+            at_t_o[:3, 3] = np.asarray(offset) + np.asarray(snap.mesh_observer[1])
+            size = tessellation.render_size(scene)
+            bound = tessellation.edge_image_bound(obj, at_t_o, snap, size, inputs["Velocity"])
+            measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
+    modifier.set_inputs(mod, inputs)
     modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays
+        tessellation.announce(obj)
     return True

@@ -144,11 +144,21 @@ def closed_form_inputs(obj: Object, obj_eval: Object, snap: Snapshot) -> dict[st
     w = np.zeros(3)
     if obj.relativity.motion == "CONSTANT":
         w = np.array(check_velocity(obj.relativity.beta, f"object {obj.name!r} velocity"))
+    return uniform_motion_inputs(matrix[:3, :3], matrix[:3, 3], w, matrix, x_o, beta_o)
+
+
+def uniform_motion_inputs(
+    shape: FloatArray, origin: FloatArray, w: FloatArray, matrix: FloatArray, x_o: FloatArray, beta_o: FloatArray
+) -> dict[str, tuple[float, ...] | float]:
+    """The closed-form inputs of uniform motion (also keyframed motion uniform over the window of its
+    retarded times, ``keyframed.py``): at the observer's time the origin is at ``origin`` (scene) and
+    the rest shape's 3x3 is ``shape``, contracted along ``w`` (the velocity, fraction of c); seen from
+    the observer at ``x_o`` moving with ``beta_o``, in the object space of the world ``matrix``."""
     beta_o = np.asarray(beta_o, dtype=np.float64)
     x_o = np.asarray(x_o, dtype=np.float64)
     # r = A x_rest + k: the point at the observer's time, relative to the observer
-    scene = apparent.lorentz_contraction_matrix(w) @ matrix[:3, :3]
-    offset = matrix[:3, 3] - x_o
+    scene = apparent.lorentz_contraction_matrix(w) @ np.asarray(shape, dtype=np.float64)
+    offset = np.asarray(origin, dtype=np.float64) - x_o
     # the emission event (-s, e = r - s w) boosted: e' = B e + gamma s beta_o (Lorentz boost)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -171,7 +181,7 @@ def closed_form_inputs(obj: Object, obj_eval: Object, snap: Snapshot) -> dict[st
         "Local X": vector(local[:, 0]),
         "Local Y": vector(local[:, 1]),
         "Local Z": vector(local[:, 2]),
-        "Local Offset": vector(to_local @ offset - inverse @ offset),
+        "Local Offset": vector(to_local @ offset + inverse @ (x_o - matrix[:3, 3])),
         "Delay Direction": vector(gamma * (inverse @ beta_o) - to_local @ w),
         "Seen Velocity": vector(seen),
     }

@@ -244,13 +244,19 @@ def _read_rest_bounds(mesh: Mesh) -> tuple[FloatArray, FloatArray, float]:
     return rest.min(axis=0).astype(np.float64), rest.max(axis=0).astype(np.float64), longest
 
 
-def edge_image_bound(obj: Object, matrix: FloatArray, snap: Snapshot, size: tuple[float, float]) -> float:
+def edge_image_bound(
+    obj: Object, matrix: FloatArray, snap: Snapshot, size: tuple[float, float], velocity: object = None
+) -> float:
     """``physics/tessellation.edge_image_bound`` of a closed-form object (pixels), inf where it
-    cannot be computed: a velocity change that it clears needs no edge visited."""
+    cannot be computed: a velocity change that it clears needs no edge visited. ``velocity``
+    (fraction of c): the uniform motion's, when not the object's setting (keyframed motion uniform
+    over its window, ``keyframed.py``; ``matrix`` then at the observer's time)."""
     bounds = rest_bounds(obj)
     if bounds is None:
         return float("inf")
     beta = tuple(obj.relativity.beta) if obj.relativity.motion == "CONSTANT" else (0.0, 0.0, 0.0)
+    if velocity is not None:
+        beta = tuple(map(float, cast("tuple[float, float, float]", velocity)))
     _t_o, x_o, beta_o = snap.mesh_observer
     window = cast("tuple[float, float, float, float]", tuple(snap.projection[1:5]))
     # a frame step changes none of these for most objects: the last bound stands

@@ -25,7 +25,7 @@ from ..common import compat
 
 if TYPE_CHECKING:
     import numpy.typing as npt
-    from bpy.types import Object, Scene
+    from bpy.types import FCurve, Object, Scene
 
 
 def frames_per_second(scene: Scene) -> float:
@@ -257,3 +257,51 @@ def check_supported(obj: Object, scene: Scene | None = None) -> None:
             f"Velocity from animation reads keyframes only, and {problem}; "
             "bake the camera motion to keyframes or set the velocity manually"
         )
+
+
+def _straight_channel(fcurve: FCurve, low: float, high: float) -> tuple[float, float] | None:
+    """``(value at frame 0, change per frame)`` of an F-curve that is a straight line from frame
+    ``low`` to ``high`` (one value at every key and handle; one linear segment between two keys;
+    before its first key or after its last with constant extrapolation), else None."""
+    points = sorted(fcurve.keyframe_points, key=lambda point: point.co[0])
+    if len(fcurve.modifiers) or not points:
+        return None
+    values = {value for point in points for value in (point.co[1], point.handle_left[1], point.handle_right[1])}
+    if len(values) == 1:
+        return float(points[0].co[1]), 0.0
+    if fcurve.extrapolation == "CONSTANT" and (high <= points[0].co[0] or low >= points[-1].co[0]):
+        return float((points[0] if high <= points[0].co[0] else points[-1]).co[1]), 0.0
+    for left, right in zip(points, points[1:], strict=False):
+        if left.co[0] <= low and high <= right.co[0]:
+            if left.interpolation != "LINEAR":
+                return None
+            slope = (float(right.co[1]) - float(left.co[1])) / (float(right.co[0]) - float(left.co[0]))
+            return float(left.co[1]) - slope * float(left.co[0]), slope
+    return None
+
+
+def straight_keys(
+    obj: Object, low: float, high: float
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
+    """``(translation at frame 0, its change per frame)`` of the object's world matrix when, from
+    frame ``low`` to ``high``, its keyframes move it along a straight line at a constant rate and
+    neither turn nor scale it (every location and delta location channel straight there, every
+    other transform channel one value, no parent), else None. In float64 from the keys themselves:
+    the line the keys draw, without the float32 rounding of Blender's evaluation
+    (:func:`world_matrices`)."""
+    if obj.parent is not None:
+        return None
+    curves = _transform_fcurves(obj)
+    start, rate = np.zeros(3), np.zeros(3)
+    for (path, index), fcurve in curves.items():
+        line = _straight_channel(fcurve, low, high)
+        if line is None or (path not in LOCATION_PATHS and line[1] != 0.0):
+            return None
+        if path in LOCATION_PATHS:
+            start[index] += line[0]
+            rate[index] += line[1]
+    for path in LOCATION_PATHS:  # the channels no F-curve animates: the object's own values
+        for index in range(3):
+            if (path, index) not in curves:
+                start[index] += float(getattr(obj, path)[index])
+    return start, rate
