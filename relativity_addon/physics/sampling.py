@@ -143,6 +143,7 @@ def motion_intervals(
     c: float,
     reach: float,
     max_intervals: int,
+    guess: float | None = None,
 ) -> MotionIntervals | None:
     """The pieces of the motion of :func:`apparent_positions_from_matrix_function` (the same samples,
     contraction and Catmull-Rom cubic) over the intervals where the retarded times of every point
@@ -154,17 +155,29 @@ def motion_intervals(
     (``v``: the origin's largest speed) and a point's ``|g| <= reach``, so its ``tau`` lies within
     ``reach / (c - v)`` of the origin's. ``v`` is the largest knot speed of the window (the bound
     widened by 5% and two steps for the cubic between knots; the modifier checks that every
-    retarded time it finds lies inside); the window is widened until it holds its own bound."""
+    retarded time it finds lies inside); the window is widened until it holds its own bound. The
+    origin's ``tau`` comes from :func:`origin_light_travel_time` (``guess``: a light-travel time
+    to start from, e.g. the last one), the window's speed and size bounds start from the knots
+    around it; where that solve does not settle, from the general solver and zero speed."""
     c = speed_of_light(c)
     step = float(positive_array(step, "step"))
     x_o = vector_array(x_o, "x_o")
-    origin = apparent_positions_from_matrix_function(
-        world_matrices_at_times, step, np.zeros((1, 3)), t_o, x_o, np.zeros(3), c
-    )
-    tau = float(origin[1][0])
-    speed = 0.0
-    now = np.asarray(world_matrices_at_times(np.array([t_o])), dtype=np.float64)[0, :3, :3]
-    size = float(np.linalg.svd(now, compute_uv=False)[0])
+    found = origin_light_travel_time(world_matrices_at_times, step, t_o, x_o, c, guess)
+    if found is None:  # not settled on the knots read, or a knot not slower than light: the general solver
+        origin = apparent_positions_from_matrix_function(
+            world_matrices_at_times, step, np.zeros((1, 3)), t_o, x_o, np.zeros(3), c
+        )
+        tau = float(origin[1][0])
+        speed = 0.0
+        now = np.asarray(world_matrices_at_times(np.array([t_o])), dtype=np.float64)[0, :3, :3]
+        size = float(np.linalg.svd(now, compute_uv=False)[0])
+    else:
+        # started from the knots around the origin's retarded time: their speed with the loop's
+        # room, and the cubic's bound on their 3x3 (a uniform motion's window settles at once)
+        tau, near = found
+        near_speed = float(np.max(np.linalg.norm(near[2:, :3, 3] - near[:-2, :3, 3], axis=1))) / (2.0 * step * c)
+        speed = near_speed + 0.1 * (1.0 - near_speed) if near_speed > 0.0 else 0.0
+        size = 1.25 * float(np.max(np.linalg.svd(near[1:-1, :3, :3], compute_uv=False)[:, 0]))
     for _ in range(8):
         if speed >= 1.0:
             return None
@@ -194,3 +207,64 @@ def motion_intervals(
         [p1, 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2)], axis=1
     )
     return MotionIntervals(first, coefficients, c * tau, speed)
+
+
+def origin_light_travel_time(
+    world_matrices_at_times: MatrixFunction,
+    step: float,
+    t_o: float,
+    x_o: FloatArray,
+    c: float,
+    guess: float | None = None,
+    max_iterations: int = 40,
+) -> tuple[float, FloatArray] | None:
+    """The light-travel time ``tau`` (seconds) of the origin of the motion of
+    :func:`apparent_positions_from_matrix_function` seen from ``(t_o, x_o)`` (docs/physics.md,
+    "Light-travel time (retarded positions)": ``c tau = |x_o - O(t_o - tau)|``), with the origin
+    ``O`` the Catmull-Rom cubic through the sampled matrices' translations (which the contraction
+    keeps), and the knots ``k - 2 .. k + 3`` around its interval ``k`` (``(6, 4, 4)``, not
+    contracted). Newton's method on ``g(tau) = c tau - |O(t_o - tau) - x_o|`` (``g' >= c - |O'| > 0``)
+    from ``guess`` (default: the origin's distance at ``t_o`` over ``c``), reading knots a few at a
+    time (one call per block, so a kept grid costs a lookup). None when it does not settle in
+    ``max_iterations``, or an interval's knots around the root are not slower than light (the
+    general solver then, which says why)."""
+    block: dict[int, FloatArray] = {}
+
+    def knots(first: int, last: int) -> FloatArray:
+        missing = [k for k in range(first, last + 1) if k not in block]
+        if missing:
+            low, high = min(missing), max(missing)
+            values = np.asarray(world_matrices_at_times(np.arange(low, high + 1) * step), dtype=np.float64)
+            block.update(zip(range(low, high + 1), values, strict=True))
+        return np.stack([block[k] for k in range(first, last + 1)])
+
+    def origin(t: float) -> tuple[FloatArray, FloatArray, int]:
+        s = t / step
+        k = math.floor(s)
+        f = s - k
+        p0, p1, p2, p3 = knots(k - 1, k + 2)[:, :3, 3]
+        c1, c2, c3 = 0.5 * (p2 - p0), p0 - 2.5 * p1 + 2.0 * p2 - 0.5 * p3, 0.5 * (p3 - p0) + 1.5 * (p1 - p2)
+        return p1 + (c1 + (c2 + c3 * f) * f) * f, (c1 + (2.0 * c2 + 3.0 * c3 * f) * f) / step, k
+
+    if guess is None or not math.isfinite(guess) or guess < 0.0:
+        guess = float(np.linalg.norm(origin(t_o)[0] - x_o)) / c
+    tau = float(guess)
+    for _ in range(max_iterations):
+        position, velocity, k = origin(t_o - tau)
+        offset = position - x_o
+        distance = float(np.sqrt(offset @ offset))
+        slope = c + (float(offset @ velocity) / distance if distance > 0.0 else 0.0)
+        if slope <= 0.0:
+            return None
+        change = (c * tau - distance) / slope
+        tau = max(tau - change, 0.0)
+        if abs(change) <= 1e-13 * (1.0 + abs(tau)):
+            break
+    else:
+        return None
+    k = math.floor((t_o - tau) / step)
+    near = knots(k - 2, k + 3)
+    speeds = np.linalg.norm(near[2:, :3, 3] - near[:-2, :3, 3], axis=1) / (2.0 * step)
+    if not np.all(speeds < c):
+        return None
+    return tau, near

@@ -135,3 +135,48 @@ def test_no_points_give_empty_results():
         matrices, 0.1, np.zeros((0, 3)), 0.0, np.ones(3), np.zeros(3), 1.0
     )
     assert seen.shape == (0, 3) and tau.shape == (0,) and beta_seen.shape == (0, 3)
+
+
+@pytest.mark.parametrize("guess", [None, 0.0, 5.0, 40.0])
+def test_origin_light_travel_time_solves_the_light_cone(guess):
+    """The origin's ``tau`` (issue 26: Newton's method on the knots, from any start): uniform motion
+    against the closed form of docs/physics.md (Catmull-Rom is exact for it), an accelerating
+    spinning body against ``|x_o - O(t_o - tau)| = c tau`` on the exact motion (within the cubic's
+    interpolation error), and the window of :func:`motion_intervals` built on it holds the same
+    pieces as the one built on the general solver's ``tau``."""
+    c = 10.0
+    velocity = np.array([0.3, -0.6, 0.2]) * c
+    matrices = uniform_motion(np.array([1.0, 4.0, -30.0]), velocity)
+    t_o, x_o = 3.0, np.array([0.0, -2.0, 1.0])
+    tau, near = sampling.origin_light_travel_time(matrices, 1.0 / 192.0, t_o, x_o, c, guess)
+    now = matrices(np.array([t_o]))[0, :3, 3]
+    expected = apparent.apparent_positions_uniform(t_o, x_o, now[None], velocity / c, c, np.zeros(3))[1][0]
+    assert tau == pytest.approx(expected, rel=1e-12)
+    assert near.shape == (6, 4, 4)
+
+    accelerating = accelerated_spinning_motion(np.array([1.5, -0.5, 0.8]), 2.0)
+    x_o = np.array([1.0, 8.0, 0.0])
+    found = sampling.origin_light_travel_time(accelerating, 1.0 / 240.0, 2.0, x_o, c, guess)
+    if guess == 40.0:  # a start where this origin is faster than light: given up (the general solver then)
+        assert found is None
+    else:
+        tau = found[0]
+        emitted = accelerating(np.array([2.0 - tau]))[0, :3, 3]
+        assert abs(np.linalg.norm(x_o - emitted) - c * tau) < 1e-7 * c * tau
+
+    step, reach = 1.0 / 192.0, 0.7
+    pieces = sampling.motion_intervals(matrices, step, t_o, np.array([0.0, -2.0, 1.0]), c, reach, 1024, guess)
+    general = sampling.apparent_positions_from_matrix_function(
+        matrices, step, np.zeros((1, 3)), t_o, np.array([0.0, -2.0, 1.0]), np.zeros(3), c
+    )[1][0]
+    assert pieces.start_distance == pytest.approx(c * general, rel=1e-12)
+    assert pieces.first * step <= t_o - general - reach / (c * (1 - 0.7)) <= (pieces.first + 1) * step + 1.0
+
+
+def test_origin_light_travel_time_gives_way_near_light_speed():
+    """Knots of an origin at c around the root: None (the general solver then raises, naming it)."""
+    c = 1.0
+    matrices = uniform_motion(np.array([0.0, 10.0, 0.0]), np.array([0.0, 1.0, 0.0]), rotation_z=0.0)
+    assert sampling.origin_light_travel_time(matrices, 0.05, 5.0, np.zeros(3), c) is None
+    with pytest.raises(ValueError, match="slower than light"):
+        sampling.motion_intervals(matrices, 0.05, 5.0, np.zeros(3), c, 0.5, 1024)

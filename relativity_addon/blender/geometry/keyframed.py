@@ -100,6 +100,11 @@ def _kept_samples(obj, key, function, step):
     return sampled
 
 
+# Object session_uid -> the origin's light-travel time at its last update: where the next solve
+# starts (a frame step or an observer change moves it a little).
+_last_tau: dict[int, float] = {}
+
+
 def is_on(mod: Modifier | None) -> bool:
     """Whether the modifier computes keyframed motion itself."""
     if mod is None:
@@ -140,9 +145,12 @@ def modifier_inputs(
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
     try:
         function = _matrix_function(obj, scene, fps, step, c)
-        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS)
+        guess = _last_tau.get(obj.session_uid)
+        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
     except ValueError as error:
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    if pieces is not None:
+        _last_tau[obj.session_uid] = pieces.start_distance / c
     held_before = animation.held_before_frame(obj)
     if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
         return None  # the Python path then (and its warning when a point is seen before the keys move it)

@@ -203,3 +203,49 @@ def test_key_change_on_one_of_many_keyframed_meshes_works_on_that_mesh_only(rela
         if k != 2:
             np.testing.assert_array_equal(after[k], before[k])
     assert np.abs(after[2] - before[2]).max() > 1e-3, "the changed mesh did not move"
+
+
+def test_keyframed_meshes_solve_their_origin_from_the_knots(relativity_addon, monkeypatch):
+    """Issue 26, per-mesh Python of keyframed motion: an observer change and a frame step on many
+    keyframed meshes solve each origin's retarded time on the kept knots (Newton from the last one),
+    never with the general sampled solver (``sampling.apparent_positions_from_matrix_function``, which
+    samples a window around a guess and solves it: most of each mesh's Python before), and every mesh
+    ends where the Python path puts it (``keyframed.MAX_INTERVALS`` 0), at the new frame too."""
+    import importlib
+
+    import bpy
+
+    scene, movers = _keyframed_scene(bpy)
+    for obj in movers:  # no Python edge measure, which solves every point with the general solver
+        obj.relativity.tessellation = 0
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    effect = gh.addon_module("pipeline.effect")
+    effect.sync(scene)
+    sampling = importlib.import_module(f"{gh.ADDON_MODULE}.physics.sampling")
+    calls = []
+    original = sampling.apparent_positions_from_matrix_function
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(sampling, "apparent_positions_from_matrix_function", counted)
+    work = _count_work(monkeypatch)
+    scene.relativity.beta = (-0.3, 0.1, 0.0)  # as the panel does
+    bpy.context.evaluated_depsgraph_get()
+    scene.frame_set(13)
+    bpy.context.evaluated_depsgraph_get()
+    modifier_points = _points(bpy, movers)
+    assert work["update"] == Counter({f"Mover {k}": 2 for k in range(COUNT)}), _done(work)
+    assert not calls, f"the general solver ran {len(calls)} times for {COUNT} meshes"
+
+    monkeypatch.setattr(sampling, "apparent_positions_from_matrix_function", original)
+    monkeypatch.setattr(gh.addon_module("geometry.keyframed"), "MAX_INTERVALS", 0)  # the Python path
+    scene.relativity.beta = (-0.3, 0.1, 0.05)
+    scene.relativity.beta = (-0.3, 0.1, 0.0)
+    bpy.context.evaluated_depsgraph_get()
+    python_points = _points(bpy, movers)
+    for k in range(COUNT):
+        assert np.abs(modifier_points[k] - python_points[k]).max() < 1e-5, f"Mover {k}"
+        assert np.abs(python_points[k] - modifier_points[(k + 1) % COUNT]).max() > 1e-2  # meshes tell apart
