@@ -10,7 +10,8 @@ excludes the moving objects. The lamps are placed on the light's path over the t
 object's bounding box sees the light in its own frame: ``x - D_R r k' = x_L(t_e) + u bhat_R``
 (``lamp_doppler.apparent_lamp_offset`` with the emission point for the lamp), which lies on the path
 when the two motions are parallel (exact there; otherwise its place along the path). The shader's
-linear weights between them then sum Cycles' ``cos / t^2`` to eq. 18's ``cos(alpha') / r'^2``.
+linear weights between them then sum Cycles' ``cos / t^2`` to eq. 18's ``cos(alpha') / r'^2``. Each
+lamp is a sphere far too small to show (:func:`lamp_radius`), for Cycles' light tree.
 
 A fixed number of lamps per pair, so an animation render or a bake keeps the same datablocks from
 frame to frame. Everything made is recorded on the scene (``names.MOVING_PAIR_KEY``) and deleted by
