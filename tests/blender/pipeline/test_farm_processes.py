@@ -10,7 +10,6 @@ import re
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import psutil
@@ -68,31 +67,21 @@ def test_blender_processes_load_while_the_local_cluster_starts(moving_blend, tmp
     worker, and no other Blender process is started."""
     out = tmp_path / "out" / "f.png"
     options = ("--frames=1-4", "--beta=0,0,-0.5", "--samples=2", "--resolution=32x32", f"--out={out}", "--workers=2")
-    command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *options]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
     seen = {}  # pid -> (created, parent pid, command line)
-    try:
-        root = psutil.Process(process.pid)
-        while process.poll() is None:
+
+    def look(tree):
+        # The command line read again each time (a child not yet exec'd shows its parent's),
+        # but not from an ended process waiting to be reaped (it shows none).
+        for child in tree:
             try:
-                tree = root.children(recursive=True)
-            except psutil.NoSuchProcess:
-                break
-            # The command line read again each time (a child not yet exec'd shows its parent's),
-            # but not from an ended process waiting to be reaped (it shows none).
-            for child in tree:
-                try:
-                    line = " ".join(child.cmdline())
-                    if line or child.pid not in seen:
-                        seen[child.pid] = (child.create_time(), child.ppid(), line)
-                except psutil.Error:
-                    continue
-            time.sleep(0.01)
-        stdout, stderr = process.communicate(timeout=240)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.communicate()
+                line = " ".join(child.cmdline())
+                if line or child.pid not in seen:
+                    seen[child.pid] = (child.create_time(), child.ppid(), line)
+            except psutil.Error:
+                continue
+        return False
+
+    process, stdout, stderr = wh.watch_render_script(moving_blend, options, look)
     assert process.returncode == 0, stderr[-3000:]
     rendering = {pid for _, _, pid in _done(stdout)}
     launched = {pid for pid, (_, _, line) in seen.items() if "PR_SET_PDEATHSIG" in line}
