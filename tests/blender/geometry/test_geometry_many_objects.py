@@ -68,6 +68,18 @@ def _points(bpy, movers):
     return [gh.evaluated_points(bpy, obj)[0] for obj in movers]
 
 
+def _assert_only_changed(work, before, after, changed):
+    """No counted work for any mover but ``Mover {changed}``; the others' evaluated positions are
+    unchanged to the bit, and that one moved."""
+    others = {f"Mover {k}" for k in range(COUNT) if k != changed}
+    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
+    assert not touched, f"work done for meshes other than Mover {changed}: {touched} (all: {_done(work)})"
+    for k in range(COUNT):
+        if k != changed:
+            np.testing.assert_array_equal(after[k], before[k])
+    assert np.abs(after[changed] - before[changed]).max() > 1e-3, f"Mover {changed} did not move"
+
+
 @pytest.mark.parametrize("tessellation", [0, None], ids=["tessellation-0", "tessellation-default"])
 def test_velocity_change_on_one_of_many_meshes_works_on_that_mesh_only(relativity_addon, monkeypatch, tessellation):
     import bpy
@@ -82,13 +94,7 @@ def test_velocity_change_on_one_of_many_meshes_works_on_that_mesh_only(relativit
     after = _points(bpy, movers)
 
     assert work["update"]["Mover 2"] >= 1 and work["input written"]["Mover 2"] >= 1, _done(work)
-    others = {f"Mover {k}" for k in range(COUNT) if k != 2}
-    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
-    assert not touched, f"work done for meshes that did not change: {touched} (all: {_done(work)})"
-    for k in range(COUNT):
-        if k != 2:
-            np.testing.assert_array_equal(after[k], before[k])
-    assert np.abs(after[2] - before[2]).max() > 1e-3, "the changed mesh did not move"
+    _assert_only_changed(work, before, after, 2)
 
 
 def test_frame_step_works_on_the_meshes_the_frame_moves_only(relativity_addon, monkeypatch):
@@ -109,14 +115,8 @@ def test_frame_step_works_on_the_meshes_the_frame_moves_only(relativity_addon, m
     bpy.context.evaluated_depsgraph_get()
     after = _points(bpy, movers)
 
-    others = {f"Mover {k}" for k in range(COUNT) if k != 3}
-    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
-    assert not touched, f"work done for meshes the frame did not move: {touched} (all: {_done(work)})"
     assert work["input written"]["Mover 3"] >= 1, _done(work)
-    for k in range(COUNT):
-        if k != 3:
-            np.testing.assert_array_equal(after[k], before[k])
-    assert np.abs(after[3] - before[3]).max() > 1e-3, "the keyframed mesh did not move"
+    _assert_only_changed(work, before, after, 3)
 
     for kind in work:
         work[kind].clear()
@@ -196,13 +196,7 @@ def test_key_change_on_one_of_many_keyframed_meshes_works_on_that_mesh_only(rela
     after = _points(bpy, movers)
 
     assert work["update"]["Mover 2"] >= 1, _done(work)
-    others = {f"Mover {k}" for k in range(COUNT) if k != 2}
-    touched = {kind: sorted(set(counts) & others) for kind, counts in work.items() if set(counts) & others}
-    assert not touched, f"work done for meshes that did not change: {touched} (all: {_done(work)})"
-    for k in range(COUNT):
-        if k != 2:
-            np.testing.assert_array_equal(after[k], before[k])
-    assert np.abs(after[2] - before[2]).max() > 1e-3, "the changed mesh did not move"
+    _assert_only_changed(work, before, after, 2)
 
 
 def test_keyframed_meshes_solve_their_origin_from_the_knots(relativity_addon, monkeypatch):

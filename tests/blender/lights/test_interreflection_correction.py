@@ -27,6 +27,17 @@ def _render(bpy, tmp_path, beta, name, use_osl=True):
     return image, rotation, carrying
 
 
+@pytest.fixture
+def osl_scene(relativity_addon, factory_blender):
+    """``test_interreflection.py``'s pair approaching at 0.5c, on Cycles' OSL (skipped without it)."""
+    if osl.unavailable_reason() is not None:
+        pytest.skip(osl.unavailable_reason())
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(factory_blender, beta, -beta)
+    scene.cycles.shading_system = True
+    return scene
+
+
 @pytest.mark.parametrize(("name", "sphere_beta"), [("apart", -case.EACH), ("approaching", case.EACH)])
 def test_set_up_corrects_the_bounce(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
     """Through Set Up, on OSL: the panel's bounce light within 5 % of the physics model both ways
@@ -70,7 +81,7 @@ def test_at_rest_control(relativity_addon, factory_blender, tmp_path):
     assert ratio == pytest.approx(1.0, abs=0.03)
 
 
-def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_addon, factory_blender):
+def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(factory_blender, osl_scene):
     """Set Up on OSL adds the node and its text, Remove gives the file back (``scene_dump``); off
     OSL, and with a moving observer, one panel line says the bounce is uncorrected."""
     import sys
@@ -80,12 +91,8 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_
     import scene_dump
 
     bpy = factory_blender
-    if osl.unavailable_reason() is not None:
-        pytest.skip(osl.unavailable_reason())
     effect = case._module("pipeline.effect")
-    beta = np.array([case.EACH, 0.0, 0.0])
-    scene, _ = case._scene(bpy, beta, -beta)
-    scene.cycles.shading_system = True
+    scene = osl_scene
     before = scene_dump.dump(bpy)
     effect.apply(scene)
     effect.sync(scene)
@@ -116,16 +123,12 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(relativity_
     effect.remove(scene)
 
 
-def test_the_lookup_follows_the_sync(relativity_addon, factory_blender):
+def test_the_lookup_follows_the_sync(factory_blender, osl_scene):
     """A changed velocity or position reaches the shader's boxes and velocities at the next sync
     (the text rewritten, the node recompiled with its sockets)."""
     bpy = factory_blender
-    if osl.unavailable_reason() is not None:
-        pytest.skip(osl.unavailable_reason())
     effect = case._module("pipeline.effect")
-    beta = np.array([case.EACH, 0.0, 0.0])
-    scene, _ = case._scene(bpy, beta, -beta)
-    scene.cycles.shading_system = True
+    scene = osl_scene
     effect.apply(scene)
     effect.sync(scene)
     first = bpy.data.texts[names.BOUNCE_SHADER_TEXT].as_string()
@@ -167,16 +170,12 @@ def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender
     effect.remove(scene)
 
 
-def test_remove_on_one_scene_leaves_another_set_up_scene_corrected(relativity_addon, factory_blender):
+def test_remove_on_one_scene_leaves_another_set_up_scene_corrected(factory_blender, osl_scene):
     """Two set-up scenes, each with its own moving pair and material: each gets its own text (its
     camera and movers), and Remove on one leaves the other's node and text in place."""
     bpy = factory_blender
-    if osl.unavailable_reason() is not None:
-        pytest.skip(osl.unavailable_reason())
     effect = case._module("pipeline.effect")
-    beta = np.array([case.EACH, 0.0, 0.0])
-    first, _ = case._scene(bpy, beta, -beta)
-    first.cycles.shading_system = True
+    first = osl_scene
     second = first.copy()  # a linked copy: the same objects...
     second.name = "Second"
     for obj in list(second.collection.objects):

@@ -8,9 +8,11 @@ same helpers.
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
+import psutil
 
 from relativity_addon.blender.common import compat
 
@@ -81,6 +83,32 @@ def run_render_script(blend, *options, timeout=300):
     """``python examples/render.py blend options...`` as a user runs it."""
     command = [sys.executable, str(RENDER_SCRIPT), str(blend), *[str(o) for o in options]]
     return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=_env())
+
+
+def watch_render_script(blend, options, look, interval=0.01, timeout=240):
+    """``python examples/render.py blend options...`` in a process of its own, whose process tree
+    (every descendant, as ``psutil`` processes) is handed to ``look(tree)`` every ``interval``
+    seconds until ``look`` returns True, the job ends or ``timeout`` seconds pass; then the job is
+    waited for, ``timeout`` seconds at most (killed if the test fails first). Returns the finished
+    ``Popen``, stdout and stderr."""
+    command = [sys.executable, str(RENDER_SCRIPT), str(blend), *[str(o) for o in options]]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=_env())
+    try:
+        root, deadline = psutil.Process(process.pid), time.monotonic() + timeout
+        while process.poll() is None and time.monotonic() < deadline:
+            try:
+                tree = root.children(recursive=True)
+            except psutil.NoSuchProcess:
+                break
+            if look(tree):
+                break
+            time.sleep(interval)
+        stdout, stderr = process.communicate(timeout=timeout)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    return process, stdout, stderr
 
 
 def run_python(code, *args, timeout=300):

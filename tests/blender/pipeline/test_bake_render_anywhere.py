@@ -107,11 +107,10 @@ def test_baked_flythrough_renders_the_same_frames_without_the_add_on(relativity_
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"), check_existing=False)
     plain = [ch.read_exr(bpy, path) for path in render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES)]
     differences = [float(np.abs(p - o).mean()) for p, o in zip(plain, own, strict=True)]
-    # the control: the same file not baked, rendered the same way, plays frame 3's state only
-    unbaked = [
-        ch.read_exr(bpy, p) for p in render_plain_animation(tmp_path / "unbaked.blend", tmp_path, FRAMES, "unbaked")
-    ]
-    stale = [float(np.abs(u - o).mean()) for u, o in zip(unbaked, own, strict=True)]
+    # the control: the same file not baked, rendered the same way, plays frame 3's state only (its
+    # first frame, the one the control reads, alone)
+    unbaked = render_plain_animation(tmp_path / "unbaked.blend", tmp_path, FRAMES[:1], "unbaked", chunk=FRAMES[:1] * 2)
+    stale = [float(np.abs(ch.read_exr(bpy, u) - o).mean()) for u, o in zip(unbaked, own[:1], strict=True)]
     moving = float(np.abs(own[-1] - own[0]).mean())
     print(
         f"mean |baked - add-on| per frame {differences}, not baked {stale}, seed noise {noise:.4g}, "

@@ -157,51 +157,40 @@ def test_killed_worker_loses_no_frame(moving_blend, tmp_path, factory_blender):
     # Enough samples that Cycles renders for a few seconds (on a busy machine too): the kill must
     # land while it renders.
     common = ("--frames=1-2", "--beta=0,0,-0.5", "--samples=1024", "--resolution=96x96")
-    command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *common, f"--out={out}", "--workers=2"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
-    victim = orphan = None
-    try:
-        deadline = time.monotonic() + 240
-        while victim is None and time.monotonic() < deadline and process.poll() is None:
+    found = {}  # "orphan_dead": whether the killed worker's Blender process ended within a second
+
+    def look(tree):
+        for child in tree:
             try:
-                tree = psutil.Process(process.pid).children(recursive=True)
-            except psutil.NoSuchProcess:
-                break
-            for child in tree:
-                try:
-                    if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()) or not _rendering(child):
-                        continue
-                    owner = _lifeline_owner(child, tree)
-                    if owner is not None:
-                        orphan, victim = child, owner
-                        break
-                except psutil.NoSuchProcess:
+                if "PR_SET_PDEATHSIG" not in " ".join(child.cmdline()) or not _rendering(child):
                     continue
-            time.sleep(0.02)
-        if victim is None:
-            stdout, stderr = process.communicate(timeout=180) if process.poll() is None else process.communicate()
-            pytest.fail(
-                f"no task process seen rendering (job exit {process.returncode}); "
-                f"stdout: {stdout[-1500:]} stderr: {stderr[-1500:]}"
-            )
-        assert "distributed" in " ".join(victim.cmdline()) or "multiprocessing" in " ".join(victim.cmdline())
-        victim.send_signal(signal.SIGKILL)
-        # Its Blender process dies with it at once (it had about a second of rendering left), so
-        # no second writer races the task's rerun.
-        orphan_dead, until = False, time.monotonic() + 1.0
-        while not orphan_dead and time.monotonic() < until:
-            try:
-                orphan_dead = orphan.status() == psutil.STATUS_ZOMBIE
+                owner = _lifeline_owner(child, tree)
             except psutil.NoSuchProcess:
-                orphan_dead = True
-            time.sleep(0.01)
-        stdout, stderr = process.communicate(timeout=180)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.communicate()
+                continue
+            if owner is None:
+                continue
+            assert "distributed" in " ".join(owner.cmdline()) or "multiprocessing" in " ".join(owner.cmdline())
+            owner.send_signal(signal.SIGKILL)
+            # Its Blender process dies with it at once (it had about a second of rendering left),
+            # so no second writer races the task's rerun.
+            found["orphan_dead"], until = False, time.monotonic() + 1.0
+            while not found["orphan_dead"] and time.monotonic() < until:
+                try:
+                    found["orphan_dead"] = child.status() == psutil.STATUS_ZOMBIE
+                except psutil.NoSuchProcess:
+                    found["orphan_dead"] = True
+                time.sleep(0.01)
+            return True
+        return False
+
+    process, stdout, stderr = wh.watch_render_script(moving_blend, (*common, f"--out={out}", "--workers=2"), look, 0.02)
+    if not found:
+        pytest.fail(
+            f"no task process seen rendering (job exit {process.returncode}); "
+            f"stdout: {stdout[-1500:]} stderr: {stderr[-1500:]}"
+        )
     assert process.returncode == 0, stderr[-3000:]
-    assert orphan_dead, "the killed worker's Blender process kept running"
+    assert found["orphan_dead"], "the killed worker's Blender process kept running"
     lines = [line for line in stdout.splitlines() if re.match(r"render\.py: frame \d", line)]
     assert sorted(re.search(r"frame (\d+)", line).group(1) for line in lines) == ["1", "2"], stdout
     assert "2 frames: 2 rendered, 0 skipped (already complete), 0 failed" in stdout

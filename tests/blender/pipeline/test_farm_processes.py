@@ -10,7 +10,6 @@ import re
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import psutil
@@ -33,73 +32,53 @@ def _done(stdout):
     return [(int(frame), worker, int(pid)) for frame, worker, pid in DONE.findall(stdout)]
 
 
-def test_each_worker_renders_its_frames_in_one_blender_process(moving_blend, tmp_path):
-    """Six one-frame tasks on two workers: every frame names the Blender process that rendered it;
-    a worker's frames all come from one process, so at most two processes render six frames."""
+def test_each_worker_renders_in_one_blender_process_loaded_while_the_cluster_starts(moving_blend, tmp_path):
+    """Six one-frame tasks on two workers (one job, its process tree watched as it runs; these were
+    two tests running the same job):
+
+    - every frame names the Blender process that rendered it; a worker's frames all come from one
+      process, so at most two processes render six frames;
+    - the coordinator starts one Blender process per worker before it starts Dask, and each worker
+      takes one over as it starts, so loading Blender, the file and the effect overlaps the
+      cluster's start instead of following it: the processes that render were created before any
+      of Dask's processes (forkserver, workers) and are the coordinator's children; one per worker,
+      and no other Blender process is started."""
     out = tmp_path / "out" / "f.png"
-    result = wh.run_render_script(
-        moving_blend,
-        "--frames=1-6",
-        "--beta=0,0,-0.5",
-        "--samples=2",
-        "--resolution=32x32",
-        f"--out={out}",
-        "--workers=2",
-    )
-    assert result.returncode == 0, result.stderr[-3000:]
-    done = _done(result.stdout)
-    assert sorted(frame for frame, _, _ in done) == [1, 2, 3, 4, 5, 6], result.stdout
+    options = ("--frames=1-6", "--beta=0,0,-0.5", "--samples=2", "--resolution=32x32", f"--out={out}", "--workers=2")
+    seen = {}  # pid -> (created, parent pid, command line)
+
+    def look(tree):
+        # The command line read again each time (a child not yet exec'd shows its parent's),
+        # but not from an ended process waiting to be reaped (it shows none).
+        for child in tree:
+            try:
+                line = " ".join(child.cmdline())
+                if line or child.pid not in seen:
+                    seen[child.pid] = (child.create_time(), child.ppid(), line)
+            except psutil.Error:
+                continue
+        return False
+
+    process, stdout, stderr = wh.watch_render_script(moving_blend, options, look)
+    assert process.returncode == 0, stderr[-3000:]
+    done = _done(stdout)
+    assert sorted(frame for frame, _, _ in done) == [1, 2, 3, 4, 5, 6], stdout
     processes = {}
     for _, worker, pid in done:
         processes.setdefault(worker, set()).add(pid)
     assert all(len(pids) == 1 for pids in processes.values()), processes  # one Blender per worker
     assert len({pid for _, _, pid in done}) <= 2 < len(done), done  # reused across frames
-    assert "6 frames: 6 rendered, 0 skipped (already complete), 0 failed" in result.stdout
+    assert "6 frames: 6 rendered, 0 skipped (already complete), 0 failed" in stdout
     assert sorted(os.listdir(out.parent)) == [f"f_{frame:04d}.png" for frame in range(1, 7)]
     pids = {pid for _, _, pid in done}
     assert not any(psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE for pid in pids)
 
-
-def test_blender_processes_load_while_the_local_cluster_starts(moving_blend, tmp_path):
-    """--workers: the coordinator starts one Blender process per worker before it starts Dask, and
-    each worker takes one over as it starts, so loading Blender, the file and the effect overlaps
-    the cluster's start instead of following it: the processes that render were created before
-    any of Dask's processes (forkserver, workers) and are the coordinator's children; one per
-    worker, and no other Blender process is started."""
-    out = tmp_path / "out" / "f.png"
-    options = ("--frames=1-4", "--beta=0,0,-0.5", "--samples=2", "--resolution=32x32", f"--out={out}", "--workers=2")
-    command = [sys.executable, str(wh.RENDER_SCRIPT), str(moving_blend), *options]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=wh._env())
-    seen = {}  # pid -> (created, parent pid, command line)
-    try:
-        root = psutil.Process(process.pid)
-        while process.poll() is None:
-            try:
-                tree = root.children(recursive=True)
-            except psutil.NoSuchProcess:
-                break
-            # The command line read again each time (a child not yet exec'd shows its parent's),
-            # but not from an ended process waiting to be reaped (it shows none).
-            for child in tree:
-                try:
-                    line = " ".join(child.cmdline())
-                    if line or child.pid not in seen:
-                        seen[child.pid] = (child.create_time(), child.ppid(), line)
-                except psutil.Error:
-                    continue
-            time.sleep(0.01)
-        stdout, stderr = process.communicate(timeout=240)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.communicate()
-    assert process.returncode == 0, stderr[-3000:]
-    rendering = {pid for _, _, pid in _done(stdout)}
+    rendering = {pid for _, _, pid in done}
     launched = {pid for pid, (_, _, line) in seen.items() if "PR_SET_PDEATHSIG" in line}
     blenders = {pid for pid in launched if seen[pid][1] not in launched}  # not a Blender's own child
     dask = [created for created, _, line in seen.values() if "multiprocessing" in line]
     found = f"rendering {rendering}; seen {seen}; stdout {stdout}"
-    # Two, or one when a worker rendered all four tiny frames before the other's Blender was ready.
+    # Two, or one when a worker rendered all six tiny frames before the other's Blender was ready.
     assert 1 <= len(rendering) <= 2 and rendering <= blenders, found
     assert len(blenders) == 2 and dask, found  # none started besides the two taken over
     assert all(seen[pid][1] == process.pid for pid in blenders), found
