@@ -1,7 +1,7 @@
 """What the artist waits for on the Apparent Geometry path, against Blender doing the same work.
 
     python benchmarks/artist_chain.py [--sizes 0.5M,2M,8M] [--scenes grid,objects]
-        [--motions constant,keyframed] [--tessellation default|0|N] [--rounds 3]
+        [--motions constant,keyframed,eased] [--tessellation default|0|N] [--rounds 3]
         [--resolution 64x48] [--samples 4] [--lamp] [--no-memory] [--profile chain.prof]
 
 Generated scenes: one grid mesh of about SIZE vertices, or SIZE / 2,000 small grids of 2,025
@@ -16,6 +16,8 @@ is divided by that round's plain time, and the median ratio is printed with the 
     until a vertex of the evaluated mesh is read after ``evaluated_depsgraph_get``: constant
     motion changes the velocity of the grid (of one object in the many-object scene); keyframed
     motion, whose velocity is its keys, changes the observer's velocity (every object moves).
+    ``keyframed``: two linear location keys (uniform motion); ``eased``: the same keys with Blender's
+    default Bezier interpolation (the motion eases in and out: accelerating at every frame).
     Plain: ``foreach_set`` of the same vertex positions (the objects the change moves) on the
     plain meshes, ``mesh.update()``, the plain scene's depsgraph updated, a vertex read.
 (b) frame step (``frame_set`` to the next frame, a vertex read) against the plain rewrite of
@@ -104,11 +106,12 @@ def build_objects(bpy, scene, kind, size, motion, tessellation):
         obj.location = location
         scene.collection.objects.link(obj)
         objects.append(obj)
-        if motion == "keyframed":
+        if motion in ("keyframed", "eased"):
             for frame in (-240, 480):  # keys around every retarded time the rounds use
                 obj.location.x = location[0] + BETA * C * (frame - 1) / scene.render.fps
                 obj.keyframe_insert("location", index=0, frame=frame)
-            _linear(obj)
+            if motion == "keyframed":
+                _linear(obj)  # "eased": Blender's default Bezier keys, accelerating everywhere
     return objects
 
 
