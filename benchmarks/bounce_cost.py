@@ -6,12 +6,13 @@ The scene of tests/blender/lights/test_interreflection.py (a sphere and a panel 
 point lamp, one diffuse bounce, camera at rest), Set Up by the add-on, Cycles on the CPU, rendered
 alternately per round in three set-ups so that load from other processes hits them alike:
 
-- **SVM**: Cycles' default shading (the bounce uncorrected, 1.12x the physics);
+- **SVM**: Cycles' default shading, the correction kept out (the bounce uncorrected, 1.12x the physics);
+- **SVM + factor**: the add-on's node form (``lights/bounce_nodes.py``) on both objects' materials;
 - **OSL, no factor**: Open Shading Language on, the correction kept out (what OSL alone costs);
 - **OSL + factor**: Open Shading Language on, the add-on's script node on both objects' materials.
 
 Prints each render's time, its ratio to the same round's SVM time, the median ratio over the
-rounds, and the load average before and after.
+rounds, the factors over their own shading alone, and the load average before and after.
 """
 
 import argparse
@@ -53,7 +54,8 @@ def main():
     case.SAMPLES = options.samples
     own_reason = interreflection._reason
     setups = {
-        "SVM": (False, own_reason),
+        "SVM": (False, lambda *args: "kept out"),
+        "SVM + factor": (False, own_reason),
         "OSL, no factor": (True, lambda *args: "kept out"),
         "OSL + factor": (True, own_reason),
     }
@@ -86,6 +88,7 @@ def main():
     print("median over SVM: " + ", ".join(f"{name} {statistics.median(r):.3f}" for name, r in ratios.items()))
     factor = [b / a for a, b in zip(ratios["OSL, no factor"], ratios["OSL + factor"], strict=True)]
     print(f"median OSL + factor over OSL, no factor: {statistics.median(factor):.3f}")
+    print(f"median SVM + factor over SVM: {statistics.median(ratios['SVM + factor']):.3f}")
     print(f"load average after: {os.getloadavg()}", flush=True)
 
 

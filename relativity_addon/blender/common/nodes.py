@@ -96,17 +96,20 @@ def _new_interface_socket(tree, name, in_out, socket_type, default):
             setattr(socket, attribute, value)
 
 
-def build_group(spec: Group) -> NodeTree:
-    """Create or rebuild the node group described by ``spec`` (a :class:`Group`)."""
+def build_group(spec: Group, keep_interface: bool = False) -> NodeTree:
+    """Create or rebuild the node group described by ``spec`` (a :class:`Group`); with
+    ``keep_interface`` an existing group keeps its sockets (the links of the nodes using it stay)."""
     tree = bpy.data.node_groups.get(spec.name)
     if tree is None or tree.bl_idname != spec.tree_type:
         tree = bpy.data.node_groups.new(spec.name, spec.tree_type)
+        keep_interface = False
     tree.nodes.clear()
-    tree.interface.clear()
-    for name, socket_type, default in spec.inputs:
-        _new_interface_socket(tree, name, "INPUT", socket_type, default)
-    for name, socket_type, _reference in spec.outputs:
-        _new_interface_socket(tree, name, "OUTPUT", socket_type, None)
+    if not keep_interface:
+        tree.interface.clear()
+        for name, socket_type, default in spec.inputs:
+            _new_interface_socket(tree, name, "INPUT", socket_type, default)
+        for name, socket_type, _reference in spec.outputs:
+            _new_interface_socket(tree, name, "OUTPUT", socket_type, None)
     group_in = tree.nodes.new("NodeGroupInput")
     group_out = tree.nodes.new("NodeGroupOutput")
     built = {}

@@ -2,35 +2,38 @@
 
 Cycles renders one static snapshot, so light one moving object sends another reaches it with the
 wrong geometry and no Doppler factor between the two frames (measured 1.12x the physics at 0.5c
-apart, 0.95x approaching). This stage puts an OSL script node (``shaders/relativistic_bounce.osl``,
-the factor of ``physics/bounce.py``) between each moving object's surface shader and its material
-output: on non-camera rays it scales the closure by the per-ray factor. The receiver's velocity
-cannot be read back from a ray, so the shader text is generated per scene with the moving objects'
-apparent bounding boxes and velocities (``receiver_velocity``), rewritten and recompiled when they
-change (every sync). Observer at rest only; the scene's own Open Shading Language setting decides
-(OSL shading is slower than SVM: not switched on for the user, a panel line says what is left).
+apart, 0.95x approaching). This stage puts the per-ray factor of ``physics/bounce.py`` between each
+moving object's surface shader and its material output; on non-camera rays it scales the closure.
+Two forms, by the scene's shading system:
 
-Everything is recorded (the inserted node and the old link on each material; the text datablock)
-and :func:`remove` deletes exactly that.
+- Open Shading Language on (and available): a script node (``shaders/relativistic_bounce.osl``);
+  the receiver's velocity from the moving objects' apparent bounding boxes written into the shader's
+  text per scene (rewritten and recompiled when they change, every sync), its rest normal traced;
+- SVM, Cycles' default, and builds without OSL: a node group per scene (``bounce_nodes.py``), the
+  receiver's velocity and rest normal from each moving object's rest box, the values node inputs
+  the sync writes.
+
+Observer at rest only. Everything is recorded (the inserted node and the old link on each
+material; the text datablock or node group on the scene) and :func:`remove` deletes exactly that.
 """
 
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import bpy
 import numpy as np
 
 from ..common import names, osl
-from ..common.nodes import cycles_material_output, detach_inserted
+from ..common.nodes import build_group, cycles_material_output, detach_inserted, ensure_group, remove_unused_groups
 from ..geometry import modifier
-from . import lamps_on_moving_objects
+from . import bounce_nodes, lamps_on_moving_objects
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
-    from bpy.types import Material, Scene, Text
+    from bpy.types import Material, NodeTree, Scene, Text
 
     from ..scene.snapshot import Snapshot
     from .lamps_on_moving_objects import Mover
@@ -41,7 +44,6 @@ NODE_NAME = names.BOUNCE_NODE_NAME
 MARKER = "//@GENERATED@"
 MARGIN = 0.05  # the boxes grown by this share of their size on each side: the corners' images bound the image loosely
 MEASURED_ERROR = "12 %"  # docs/lamp-doppler.md: the snapshot's bounce 1.121x the physics at 0.5c apart
-MEASURED_COST = "1.16x"  # benchmarks/bounce_cost.py: OSL + factor over SVM, the test's scene (OSL alone 1.10x)
 
 
 def _moving_count(scene: Scene) -> int:
@@ -64,14 +66,12 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
         return "fewer than two moving objects"
     if snap.speed > 0.0:
         return "the observer moves"
-    no_osl = osl.unavailable_reason()
-    if no_osl is not None:
-        return no_osl[0].lower() + no_osl[1:]
-    if not scene.cycles.shading_system:
-        return (
-            f"Cycles' Open Shading Language is off (switched on, it corrects it at about {MEASURED_COST} render time)"
-        )
     return None
+
+
+def uses_osl(scene: Scene) -> bool:
+    """Whether the scene takes the OSL form (OSL shading on and available) or the node form."""
+    return bool(scene.cycles.shading_system) and osl.unavailable_reason() is None
 
 
 def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
@@ -118,9 +118,10 @@ def _scene_text(scene: Scene) -> Text | None:
     return bpy.data.texts.get(name) if isinstance(name, str) else None
 
 
-def _carries(material: Material, text_name: str) -> bool:
-    """Whether the material carries the factor of the scene whose text is ``text_name``."""
-    return MATERIAL_KEY in material and material[MATERIAL_KEY].get("text") == text_name
+def _carries(material: Material, text_name: str, kind: str = "text") -> bool:
+    """Whether the material carries the factor of the scene whose text (or, ``kind`` "group",
+    node group) is ``text_name``."""
+    return MATERIAL_KEY in material and material[MATERIAL_KEY].get(kind) == text_name
 
 
 def _text(scene: Scene, source: str) -> tuple[Text, bool]:
@@ -191,21 +192,19 @@ def _recompile(materials: Sequence[Material]) -> None:
             cycles_osl.update_script_node(node, report)
 
 
-def write(scene: Scene, snap: Snapshot) -> int:
-    """Bring the factor up to date: the text (camera, boxes, velocities), the moving objects'
-    materials. Everything removed when it does not apply (:func:`_reason`). Returns the number
-    of materials carrying the factor."""
-    cheap = _cheap_reason(scene, snap)
-    found = lamps_on_moving_objects.movers(scene, snap) if cheap is None else []
-    if cheap is not None or _reason(scene, snap, found) is not None:
-        remove(scene)
-        return 0
-    text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
+def _materials(scene: Scene, found: Sequence[Mover]) -> dict[str, Material]:
     materials = {}
     for mover in found:
         for slot in scene.objects[mover.name].material_slots:
             if slot.material is not None:
                 materials[slot.material.name] = slot.material
+    return materials
+
+
+def _write_osl(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
+    _remove_group(scene)
+    text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
+    materials = _materials(scene, found)
     for material in bpy.data.materials:  # no longer on one of this scene's moving objects
         if _carries(material, text.name) and material.name not in materials:
             detach(material)
@@ -216,13 +215,93 @@ def write(scene: Scene, snap: Snapshot) -> int:
     return len(attached)
 
 
+def _scene_group(scene: Scene, camera: Sequence[float], found: Sequence[Mover]) -> NodeTree:
+    """The scene's node group with one receiver box per moving object, its values written (the
+    nodes rebuilt only when the number of moving objects changed)."""
+    for spec in (bounce_nodes.receiver_group(), bounce_nodes.factor_group()):
+        ensure_group(spec, names.GROUP_VERSION_KEY, names.BOUNCE_GROUPS_VERSION)
+    name = scene.get(names.BOUNCE_GROUP_KEY)
+    tree = bpy.data.node_groups.get(name) if isinstance(name, str) else None
+    if tree is None:
+        name = f"{names.BOUNCE_SCENE_GROUP} {scene.name}"
+        tree = build_group(bounce_nodes.scene_group_spec(name, len(found)))
+        scene[names.BOUNCE_GROUP_KEY] = tree.name
+    elif bounce_nodes.receiver_node_name(len(found) - 1) not in tree.nodes or (
+        bounce_nodes.receiver_node_name(len(found)) in tree.nodes
+    ):
+        tree = build_group(bounce_nodes.scene_group_spec(tree.name, len(found)), keep_interface=True)
+    _set_inputs(tree.nodes["factor"], {"Camera": tuple(float(x) for x in camera)})
+    for index, mover in enumerate(found):
+        obj = scene.objects[mover.name]
+        low, high = lamps_on_moving_objects.rest_box(obj)
+        values = bounce_nodes.receiver_values(
+            camera, mover.centre, mover.beta, np.array(obj.matrix_world)[:3, :3], low, high, MARGIN
+        )
+        _set_inputs(tree.nodes[bounce_nodes.receiver_node_name(index)], values)
+    return tree
+
+
+def _set_inputs(node: Any, values: Mapping[str, float | tuple[float, ...]]) -> None:
+    """Write the inputs that changed beyond float32 rounding (a write is a depsgraph update: no loops)."""
+    for key, value in values.items():
+        socket = node.inputs[key]
+        if not np.allclose(np.asarray(socket.default_value, dtype=np.float64), value, rtol=1e-6, atol=1e-9):
+            socket.default_value = value
+
+
+def attach_group(material: Material | None, group: NodeTree) -> bool:
+    """Insert the scene's bounce group between the material's surface shader and its output."""
+    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+        return False
+    tree = material.node_tree
+    output = cycles_material_output(tree)
+    if output is None or not output.inputs["Surface"].is_linked:
+        return False
+    source = output.inputs["Surface"].links[0].from_socket
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.name = node.label = NODE_NAME
+    node.location = (output.location.x - 150.0, output.location.y - 250.0)
+    node.hide = True
+    material[MATERIAL_KEY] = {
+        "node": node.name,
+        "output": output.name,
+        "source_node": source.node.name,
+        "source_socket": source.identifier,
+        "group": group.name,
+    }
+    tree.links.new(source, node.inputs["Surface"])
+    tree.links.new(node.outputs["Surface"], output.inputs["Surface"])
+    return True
+
+
+def _write_nodes(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
+    _remove_text(scene)
+    group = _scene_group(scene, tuple(float(x) for x in snap.camera_position), found)
+    materials = _materials(scene, found)
+    for material in bpy.data.materials:
+        if _carries(material, group.name, "group") and material.name not in materials:
+            detach(material)
+    return len([m for m in materials.values() if attach_group(m, group) or MATERIAL_KEY in m])
+
+
+def write(scene: Scene, snap: Snapshot) -> int:
+    """Bring the factor up to date: the lookup (camera, boxes, velocities), the moving objects'
+    materials, in the form the scene's shading takes (:func:`uses_osl`). Everything removed when
+    it does not apply (:func:`_reason`). Returns the number of materials carrying the factor."""
+    cheap = _cheap_reason(scene, snap)
+    found = lamps_on_moving_objects.movers(scene, snap) if cheap is None else []
+    if cheap is not None or _reason(scene, snap, found) is not None:
+        remove(scene)
+        return 0
+    return _write_osl(scene, snap, found) if uses_osl(scene) else _write_nodes(scene, snap, found)
+
+
 def apply(scene: Scene, snap: Snapshot) -> int:
     return write(scene, snap)
 
 
-def remove(scene: Scene) -> None:
-    """Detach the node from the materials that carry this scene's factor and delete its text;
-    another set-up scene's are left alone."""
+def _remove_text(scene: Scene) -> None:
     text = _scene_text(scene)
     if text is not None:
         for material in bpy.data.materials:
@@ -231,6 +310,27 @@ def remove(scene: Scene) -> None:
         bpy.data.texts.remove(text)
     if names.BOUNCE_TEXT_KEY in scene:
         del scene[names.BOUNCE_TEXT_KEY]
+
+
+def _remove_group(scene: Scene) -> None:
+    name = scene.get(names.BOUNCE_GROUP_KEY)
+    if isinstance(name, str):
+        for material in bpy.data.materials:
+            if _carries(material, name, "group"):
+                detach(material)
+        tree = bpy.data.node_groups.get(name)
+        if tree is not None and tree.users == 0:
+            bpy.data.node_groups.remove(tree)
+        remove_unused_groups((names.BOUNCE_RECEIVER_GROUP, names.BOUNCE_FACTOR_GROUP))
+    if names.BOUNCE_GROUP_KEY in scene:
+        del scene[names.BOUNCE_GROUP_KEY]
+
+
+def remove(scene: Scene) -> None:
+    """Detach the node from the materials that carry this scene's factor and delete its text or
+    node group; another set-up scene's are left alone."""
+    _remove_text(scene)
+    _remove_group(scene)
 
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:

@@ -129,6 +129,12 @@ def _box(obj):
     return box
 
 
+def rest_box(obj: Object) -> tuple[FloatArray, FloatArray]:
+    """The low and high corners of the mesh's bounding box (object space, rest shape)."""
+    box = _box(obj)
+    return box.min(axis=0), box.max(axis=0)
+
+
 def movers(scene: Scene, snap: Snapshot) -> list[Mover]:
     """The moving objects of the Apparent Geometry path: centre and scene-frame velocity, with
     light-travel time from the camera event and no boost (the scene frame)."""

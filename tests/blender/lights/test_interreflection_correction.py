@@ -42,29 +42,29 @@ def osl_scene(relativity_addon, factory_blender):
 def test_set_up_corrects_the_bounce(relativity_addon, factory_blender, tmp_path, name, sphere_beta):
     """Through Set Up, on OSL: the panel's bounce light within 5 % of the physics model both ways
     (uncorrected, on main: 1.121 apart, 0.950 approaching); the sphere's own pixels (camera rays,
-    direct light) as without the correction (SVM shading, the same scene)."""
+    direct light) as on SVM shading (the node form, ``test_interreflection_svm.py``)."""
     bpy = factory_blender
     if osl.unavailable_reason() is not None:
         pytest.skip(osl.unavailable_reason())
     beta = np.array([sphere_beta, 0.0, 0.0])
     corrected, rotation, carrying = _render(bpy, tmp_path, beta, name)
-    plain, _, none = _render(bpy, tmp_path, beta, f"{name}_svm", use_osl=False)
+    plain, _, svm_carrying = _render(bpy, tmp_path, beta, f"{name}_svm", use_osl=False)
     physics = case._model(rotation, beta, -beta)
     sampled = case._inner(case._seen_panel(rotation, beta, -beta)[0]) & np.isfinite(physics)
     case._save(bpy, tmp_path / f"{name}_corrected_render_model.png", corrected, physics)
     ratio = float(corrected[sampled].mean() / physics[sampled].mean())
-    uncorrected = float(plain[sampled].mean() / physics[sampled].mean())
+    svm = float(plain[sampled].mean() / physics[sampled].mean())
     rays = ch.pixel_rays(case.RESOLUTION, case.SENSOR, case.LENS)
     sphere_path, _ = case._sphere_hit(case.CAMERA, 0.0, rays, beta)
     sphere = np.isfinite(sphere_path) & case._inner(np.where(np.isfinite(sphere_path), 1.0, np.nan))
     direct = float(corrected[sphere].mean() / plain[sphere].mean())
     print(
         f"{name}: {sampled.sum()} panel px, rendered over physics: corrected {ratio:.4f}, "
-        f"SVM uncorrected {uncorrected:.4f}; sphere {sphere.sum()} px, corrected over SVM {direct:.4f}"
+        f"SVM (node form) {svm:.4f}; sphere {sphere.sum()} px, OSL over SVM {direct:.4f}"
     )
     assert ratio == pytest.approx(1.0, abs=0.05)
     assert direct == pytest.approx(1.0, abs=0.01)
-    assert carrying == ["White"] and none == []
+    assert carrying == ["White"] and len(svm_carrying) == 1  # (the second scene's material: White.001)
 
 
 def test_at_rest_control(relativity_addon, factory_blender, tmp_path):
@@ -83,7 +83,8 @@ def test_at_rest_control(relativity_addon, factory_blender, tmp_path):
 
 def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(factory_blender, osl_scene):
     """Set Up on OSL adds the node and its text, Remove gives the file back (``scene_dump``); off
-    OSL, and with a moving observer, one panel line says the bounce is uncorrected."""
+    OSL the node form replaces it (no text, no panel line); with a moving observer one panel line
+    says the bounce is uncorrected."""
     import sys
     from pathlib import Path
 
@@ -106,11 +107,9 @@ def test_remove_gives_the_scene_back_and_the_panel_says_what_is_left(factory_ble
     scene.cycles.shading_system = False
     effect.apply(scene)
     effect.sync(scene)
-    found = [line for line in effect.scene_warnings(scene) if "bounced" in line]
-    assert found == [
-        f"{UNCORRECTED}: Cycles' Open Shading Language is off (switched on, it corrects it at about 1.16x render time)"
-    ]
+    assert not [line for line in effect.scene_warnings(scene) if "bounced" in line]
     assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
+    assert "group" in bpy.data.materials["White"][names.BOUNCE_MATERIAL_KEY]
     effect.remove(scene)
     scene.cycles.shading_system = True
     scene.relativity.beta = (0.0, 0.0, 0.3)
@@ -146,9 +145,9 @@ def test_the_lookup_follows_the_sync(factory_blender, osl_scene):
     effect.remove(scene)
 
 
-def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender, monkeypatch):
-    """Without OSL (as Debian's 5.2: ``_cycles.with_osl`` False, no oslquery), Set Up works and one
-    panel line says the bounce is uncorrected and why; nothing is added."""
+def test_a_build_without_osl_gets_the_node_form(relativity_addon, factory_blender, monkeypatch):
+    """Without OSL (as Debian's 5.2: ``_cycles.with_osl`` False, no oslquery), with the scene's OSL
+    switch on, Set Up takes the node form: no text, no panel line."""
     import sys
 
     import _cycles
@@ -162,12 +161,11 @@ def test_a_build_without_osl_gets_a_panel_line(relativity_addon, factory_blender
     monkeypatch.setitem(sys.modules, "oslquery", None)
     effect.apply(scene)
     effect.sync(scene)
-    assert [line for line in effect.scene_warnings(scene) if "bounced" in line] == [
-        f"{UNCORRECTED}: this Blender build has no OSL (Open Shading Language)"
-    ]
+    assert not [line for line in effect.scene_warnings(scene) if "bounced" in line]
     assert names.BOUNCE_SHADER_TEXT not in bpy.data.texts
-    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
+    assert "group" in bpy.data.materials["White"][names.BOUNCE_MATERIAL_KEY]
     effect.remove(scene)
+    assert not any(names.BOUNCE_MATERIAL_KEY in m for m in bpy.data.materials)
 
 
 def test_remove_on_one_scene_leaves_another_set_up_scene_corrected(factory_blender, osl_scene):
