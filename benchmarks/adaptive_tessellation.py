@@ -18,6 +18,8 @@ import statistics
 import sys
 import time
 
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 

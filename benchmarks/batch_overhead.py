@@ -26,6 +26,8 @@ import sys
 import tempfile
 import time
 
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
+
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RENDER_SCRIPT = os.path.join(REPO_ROOT, "examples", "render.py")
 

@@ -24,6 +24,8 @@ import sys
 import tempfile
 import time
 
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "tools"))

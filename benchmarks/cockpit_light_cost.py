@@ -19,6 +19,8 @@ import statistics
 import sys
 import tempfile
 
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))

@@ -46,6 +46,7 @@ import threading
 import time
 
 import psutil
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RENDER_SCRIPT = os.path.join(REPO_ROOT, "examples", "render.py")

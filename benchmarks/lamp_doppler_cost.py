@@ -24,6 +24,7 @@ import tempfile
 import time
 
 import numpy as np
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 

@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
