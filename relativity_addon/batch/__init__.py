@@ -237,7 +237,7 @@ def prepare(options: argparse.Namespace, with_blend_file: bool) -> Scene:
     comes later (:func:`apply_effect`). Shared by the batch script and the farm's Blender process."""
     import bpy
 
-    check_combinations(options)  # the script checked it all before loading bpy; the farm's processes not
+    check_combinations(options)  # again: the farm's Blender processes come here without check_before_loading
     if with_blend_file:
         check_blend_file(options.blend_file)
         try:
