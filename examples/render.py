@@ -15,7 +15,8 @@ rays), --time-of-flight (light delay only, Gray Fig. 1c), --speed-of-light C, --
 replaces a run of '#' in PATH), --seed N, --reference (render the file's own camera unchanged),
 --proper-time (frame K at the traveller's time K / fps), --threads N, --resume (skip frames whose
 output is already a complete image). Prints one progress line per frame with the time left.
-Exits non-zero with a one-line reason on any failure.
+Exits non-zero with a one-line reason on any failure; an option wrong without looking at the scene
+is refused before Blender loads.
 
 On a Dask cluster (docs/farm.md): --workers N (a local cluster of N worker processes) or
 --scheduler tcp://HOST:8786, with --chunk N (frames per task) and --retries N; each worker renders

@@ -8,15 +8,25 @@ Every failure ends in ``BatchError`` with a one-line reason; ``main`` turns it i
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import os
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 from ..errors import BatchError, RelativityError
 from . import bake_to
-from .frame_files import format_seconds, frame_output_path, output_problem, partial_path
-from .options import LENS_CHOICES, _running_inside_blender, _split_argv, build_parser
+from .frame_files import format_seconds, frame_output_path, partial_path
+from .options import (
+    LENS_CHOICES,
+    _running_inside_blender,
+    _split_argv,
+    build_parser,
+    check_before_loading,
+    check_blend_file,
+    check_combinations,
+    check_out_suffix,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -63,12 +73,9 @@ def addon_module(name: str) -> ModuleType:
 
 
 def _apply_options(scene, options):
+    """``options`` onto the scene's settings; checked first by :func:`options.check_combinations`."""
     settings = scene.relativity
     if options.beta is not None:
-        if options.velocity_from_animation:
-            raise BatchError("give either --beta or --velocity-from-animation, not both")
-        if not all(math.isfinite(b) for b in options.beta):
-            raise BatchError("--beta must be finite")
         settings.velocity_source = "MANUAL"
         settings.beta = options.beta
     if options.velocity_from_animation:
@@ -92,14 +99,10 @@ def _apply_options(scene, options):
     for name in ("shutter_plane_point", "shutter_plane_normal"):
         value = getattr(options, name)
         if value is not None:
-            if not all(math.isfinite(v) for v in value):
-                raise BatchError(f"--{name.replace('_', '-')} must be finite")
             setattr(settings, name, value)
     if options.lens is not None:
         settings.imaging_element = LENS_CHOICES[options.lens]
     if options.window_time is not None:
-        if not math.isfinite(options.window_time):
-            raise BatchError("--window-time must be finite")
         settings.use_lorentz_window = True
         settings.lorentz_window_shutter = "SHUTTER_MODEL"
         settings.lorentz_window_time = options.window_time
@@ -133,17 +136,16 @@ def view_paths(path: str) -> list[str]:
 
 
 def _output_format(scene, out_path):
+    check_out_suffix(out_path)
     extension = os.path.splitext(out_path)[1].lower()
     image_settings = scene.render.image_settings
     if extension == ".png":
         image_settings.file_format = "PNG"
         image_settings.color_mode = "RGBA"
-    elif extension == ".exr":
+    else:
         image_settings.file_format = "OPEN_EXR"
         image_settings.color_depth = "32"
         image_settings.color_mode = "RGBA"
-    else:
-        raise BatchError(f"--out must end in .png or .exr, got {out_path!r}")
     scene.render.use_file_extension = False
 
 
@@ -235,9 +237,9 @@ def prepare(options: argparse.Namespace, with_blend_file: bool) -> Scene:
     comes later (:func:`apply_effect`). Shared by the batch script and the farm's Blender process."""
     import bpy
 
+    check_combinations(options)  # again: the farm's Blender processes come here without check_before_loading
     if with_blend_file:
-        if not os.path.isfile(options.blend_file):
-            raise BatchError(f"no such .blend file: {options.blend_file}")
+        check_blend_file(options.blend_file)
         try:
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(options.blend_file))
         except RuntimeError as error:
@@ -259,13 +261,7 @@ def prepare(options: argparse.Namespace, with_blend_file: bool) -> Scene:
     if options.bake_to is None:
         _output_format(scene, options.out)
     if options.stereo:
-        if options.spectral:
-            raise BatchError("--stereo and --spectral cannot be combined")
         _stereo_output(scene, options.stereo)
-    if options.spectral and options.reference:
-        raise BatchError("--spectral needs the exact camera (--method camera), not --reference")
-    if options.proper_time and options.reference:
-        raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
     if not options.reference:
         _apply_options(scene, options)
     return scene
@@ -339,23 +335,43 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
 
 
 def command_line() -> None:
-    """The entry point of ``examples/render.py``. A distributed render's coordinator never imports
-    bpy (its worker processes, which start by importing the main script, neither)."""
+    """The entry point of ``examples/render.py``. Every check that needs no scene runs before
+    ``import bpy`` (a bad option costs no Blender load; ``--help`` neither); a distributed render's
+    coordinator never imports bpy (its worker processes, which start by importing the main script,
+    neither). Without bpy, a single-process run says so first, whatever else is wrong."""
+    if _running_inside_blender(sys.argv):  # Blender is loaded already
+        _run_in_blender()
+        return
     try:
         options, _ = parse(sys.argv)
-        distributed = options.workers is not None or options.scheduler is not None
-    except BatchError:
-        distributed = False
-    if distributed and not _running_inside_blender(sys.argv):
+    except BatchError as error:
+        options, bad_option = None, error
+    if options is not None and (options.workers is not None or options.scheduler is not None):
         sys.exit(main())
+    if importlib.util.find_spec("bpy") is None:
+        _no_bpy()
+    try:
+        if options is None:
+            raise bad_option
+        check_before_loading(options, inside_blender=False)
+    except BatchError as error:
+        sys.exit(f"render.py: error: {error}")
+    _run_in_blender()
+
+
+def _no_bpy() -> NoReturn:
+    sys.exit(
+        "render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
+        "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
+        "examples/render.py -- OPTIONS"
+    )
+
+
+def _run_in_blender() -> None:
     try:
         import bpy  # noqa: F401
     except ImportError:
-        sys.exit(
-            "render.py: error: needs Blender's Python or the bpy module: run it with the bpy wheel's "
-            "Python (./dev.sh demo sets one up in .venv-5.2), or blender -b FILE.blend --python "
-            "examples/render.py -- OPTIONS"
-        )
+        _no_bpy()
     from ..blender.common import compat
 
     compat.run_main(main)
@@ -365,14 +381,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
     try:
         options, parser = parse(argv)
-        problem = output_problem(options.out) if options.out is not None else None
-        if problem is not None:  # before loading or rendering anything
-            raise BatchError(problem)
+        check_before_loading(options, inside_blender=_running_inside_blender(argv))
         if options.workers is not None or options.scheduler is not None:
-            if _running_inside_blender(argv):
-                raise BatchError(
-                    "--workers and --scheduler need the bpy wheel form: python examples/render.py FILE.blend ..."
-                )
             from . import farm
 
             return farm.render(options, parser)

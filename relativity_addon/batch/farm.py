@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import BatchError
 from . import frame_files
+from .options import check_blend_file, check_out_suffix
 
 if TYPE_CHECKING:
     import argparse
@@ -258,15 +259,13 @@ def render(
 ) -> int:
     """Run the distributed render; returns the exit status (1 if any frame failed)."""
     error_log = error_log or (lambda line: print(line, file=sys.stderr, flush=True))
+    check_blend_file(options.blend_file)
     blend = os.path.abspath(options.blend_file)
-    if not os.path.isfile(blend):
-        raise BatchError(f"no such .blend file: {options.blend_file}")
     if options.retries < 0:
         raise BatchError("--retries must be 0 or more")
     frames = _frames(options)
+    check_out_suffix(options.out)
     out = os.path.abspath(options.out)
-    if os.path.splitext(out)[1].lower() not in (".png", ".exr"):
-        raise BatchError(f"--out must end in .png or .exr, got {options.out!r}")
     pattern = output_pattern(out, len(frames) > 1)
     paths = {frame: frame_files.frame_output_path(pattern, frame, several=False) for frame in frames}
     os.makedirs(os.path.dirname(out), exist_ok=True)

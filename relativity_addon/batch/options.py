@@ -1,12 +1,19 @@
-"""The batch script's command line (``examples/render.py``): the parser and how the arguments are
-found in either invocation form (the ``bpy`` wheel, or inside Blender after ``--``)."""
+"""The batch script's command line (``examples/render.py``): the parser, how the arguments are
+found in either invocation form (the ``bpy`` wheel, or inside Blender after ``--``), and every check
+of the options that needs no scene (:func:`check_before_loading`), run before ``import bpy`` so a typo
+costs no Blender load."""
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import math
+import os
+import struct
 
 from ..errors import BatchError
 from ..physics.shutter import ShutterModel
+from .frame_files import output_problem
 
 
 class _Parser(argparse.ArgumentParser):
@@ -192,3 +199,74 @@ def _split_argv(argv):
     if _running_inside_blender(argv):
         return (argv[argv.index("--") + 1 :] if "--" in argv else []), False
     return argv[1:], True
+
+
+def check_blend_file(path: str) -> None:
+    if not os.path.isfile(path):
+        raise BatchError(f"no such .blend file: {path}")
+
+
+def check_out_suffix(out_path: str) -> None:
+    if os.path.splitext(out_path)[1].lower() not in (".png", ".exr"):
+        raise BatchError(f"--out must end in .png or .exr, got {out_path!r}")
+
+
+def _check_finite(values, option):
+    if not all(math.isfinite(v) for v in values):
+        raise BatchError(f"{option} must be finite")
+
+
+def _stored_speed(beta):
+    """|beta| as the scene will check it: of the components stored as Blender's 32-bit floats
+    (None past the float range: the scene's own check reports that)."""
+    try:
+        stored = struct.unpack("3f", struct.pack("3f", *beta))
+    except OverflowError:
+        return None
+    return math.sqrt(sum(b * b for b in stored))
+
+
+def check_combinations(options: argparse.Namespace) -> None:
+    """Options that contradict each other or carry numbers no scene accepts (BatchError, one line)."""
+    if options.stereo and options.spectral:
+        raise BatchError("--stereo and --spectral cannot be combined")
+    if options.spectral and options.reference:
+        raise BatchError("--spectral needs the exact camera (--method camera), not --reference")
+    if options.proper_time and options.reference:
+        raise BatchError("--proper-time steps a relativistic observer's clock, not with --reference")
+    if options.reference:  # the file's own camera: the relativistic settings are not applied
+        return
+    if options.beta is not None:
+        if options.velocity_from_animation:
+            raise BatchError("give either --beta or --velocity-from-animation, not both")
+        _check_finite(options.beta, "--beta")
+        speed = _stored_speed(options.beta)
+        if speed is not None and speed >= 1.0:  # in the words of blender/scene/snapshot.check_velocity
+            raise BatchError(f"Observer velocity beta: speed |beta| = {speed:.6g} must be below 1 (the speed of light)")
+    for name in ("shutter_plane_point", "shutter_plane_normal"):
+        if getattr(options, name) is not None:
+            _check_finite(getattr(options, name), f"--{name.replace('_', '-')}")
+    if options.window_time is not None:
+        _check_finite([options.window_time], "--window-time")
+
+
+def check_before_loading(options: argparse.Namespace, inside_blender: bool) -> None:
+    """Every check that needs no Blender, in the order the script meets them: the output's folder,
+    the .blend file, the output's type, the options' combinations and numbers, and what a distributed
+    render needs. BatchError with a one-line reason; the scene's own checks come after the load."""
+    if options.out is not None:
+        problem = output_problem(options.out)
+        if problem is not None:
+            raise BatchError(problem)
+    if not inside_blender:
+        check_blend_file(options.blend_file)
+    if options.bake_to is None:
+        check_out_suffix(options.out)
+    check_combinations(options)
+    if options.workers is not None or options.scheduler is not None:
+        if inside_blender:
+            raise BatchError(
+                "--workers and --scheduler need the bpy wheel form: python examples/render.py FILE.blend ..."
+            )
+        if any(importlib.util.find_spec(name) is None for name in ("dask", "distributed")):
+            raise BatchError("--workers and --scheduler need Dask: pip install 'dask[distributed]'")
