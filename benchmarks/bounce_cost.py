@@ -22,11 +22,12 @@ alternately per round in seven set-ups so that load from other processes hits th
 Prints each render's time, its ratio to the same round's SVM time, the median ratio over the
 rounds, the factors over their own shading alone, and the load average before and after. Blender's
 user resources in a fresh folder (``user_resources.py``); the process ends with ``os._exit`` after
-printing, as bpy 4.5 can sit idle in its exit.
+printing, as bpy 4.5 can sit idle in its exit (removing its own temporary folders first).
 """
 
 import argparse
 import os
+import shutil
 import statistics
 import sys
 import tempfile
@@ -106,6 +107,8 @@ def main():
     print(f"median SVM + factor over SVM: {statistics.median(ratios['SVM + factor']):.3f}")
     print(f"load average after: {os.getloadavg()}", flush=True)
     sys.stdout.flush()
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.rmtree(getattr(user_resources, "FOLDER", out), ignore_errors=True)  # os._exit skips atexit
     os._exit(0)  # bpy 4.5 can sit idle in exit() after the renders
 
 
