@@ -4,25 +4,37 @@
 
 The scene of tests/blender/lights/test_interreflection.py (a sphere and a panel 0.5c apart, one
 point lamp, one diffuse bounce, camera at rest), Set Up by the add-on, Cycles on the CPU, rendered
-alternately per round in three set-ups so that load from other processes hits them alike:
+alternately per round in seven set-ups so that load from other processes hits them alike:
 
 - **SVM**: Cycles' default shading, the correction kept out (the bounce uncorrected, 1.12x the physics);
 - **SVM + factor**: the add-on's node form (``lights/bounce_nodes.py``) on both objects' materials;
+- **SVM + factor, camera gate**: the node form's output behind a Mix Shader on Is Camera Ray whose
+  camera side is the surface unchanged (the same image): whether SVM's jump over a mix input of
+  weight zero skips the factor's nodes on camera rays;
+- **SVM + factor, math only**: the node form with its box lookup and ``F`` evaluated on every ray
+  (SVM has no branch that skips them), into one copy of the closure at weight 1 (``F > -1``)
+  instead of eight at ``F / 8``: the nodes' cost without the copies (the image is uncorrected);
+- **SVM + factor, copies only**: the eight copies at weight 1/8 each, ``F`` unused (Cycles drops
+  the nodes nothing uses): the copies' cost without the nodes (the image is uncorrected);
 - **OSL, no factor**: Open Shading Language on, the correction kept out (what OSL alone costs);
 - **OSL + factor**: Open Shading Language on, the add-on's script node on both objects' materials.
 
 Prints each render's time, its ratio to the same round's SVM time, the median ratio over the
-rounds, the factors over their own shading alone, and the load average before and after.
+rounds, the factors over their own shading alone, and the load average before and after. Blender's
+user resources in a fresh folder (``user_resources.py``); the process ends with ``os._exit`` after
+printing, as bpy 4.5 can sit idle in its exit (removing its own temporary folders first).
 """
 
 import argparse
 import os
+import shutil
 import statistics
 import sys
 import tempfile
 import time
 
 import numpy as np
+import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [
@@ -54,10 +66,13 @@ def main():
     case.SAMPLES = options.samples
     own_reason = interreflection._reason
     setups = {
-        "SVM": (False, lambda *args: "kept out"),
-        "SVM + factor": (False, own_reason),
-        "OSL, no factor": (True, lambda *args: "kept out"),
-        "OSL + factor": (True, own_reason),
+        "SVM": (False, lambda *args: "kept out", None),
+        "SVM + factor": (False, own_reason, None),
+        "SVM + factor, camera gate": (False, own_reason, "camera gate"),
+        "SVM + factor, math only": (False, own_reason, "math only"),
+        "SVM + factor, copies only": (False, own_reason, "copies only"),
+        "OSL, no factor": (True, lambda *args: "kept out", None),
+        "OSL + factor": (True, own_reason, None),
     }
     print(f"load average before: {os.getloadavg()}")
     print(f"{case.RESOLUTION[0]} x {case.RESOLUTION[1]}, {options.samples} samples, 0.5c apart")
@@ -66,12 +81,13 @@ def main():
     beta = np.array([-case.EACH, 0.0, 0.0])
     for round_index in range(options.rounds):
         times = {}
-        for name, (use_osl, reason) in setups.items():
+        for name, (use_osl, reason, variant) in setups.items():
             bpy.ops.wm.read_factory_settings(use_empty=True)
             scene, _ = case._scene(bpy, beta, -beta)
             scene.cycles.shading_system = use_osl
             interreflection._reason = reason
             effect.apply(scene)
+            _rewire(bpy, variant)
             carrying = sum(interreflection.MATERIAL_KEY in m for m in bpy.data.materials)
             scene.render.filepath = os.path.join(out, f"{round_index}.exr")
             scene.render.image_settings.file_format = "OPEN_EXR"
@@ -90,6 +106,41 @@ def main():
     print(f"median OSL + factor over OSL, no factor: {statistics.median(factor):.3f}")
     print(f"median SVM + factor over SVM: {statistics.median(ratios['SVM + factor']):.3f}")
     print(f"load average after: {os.getloadavg()}", flush=True)
+    sys.stdout.flush()
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.rmtree(getattr(user_resources, "FOLDER", out), ignore_errors=True)  # os._exit skips atexit
+    os._exit(0)  # bpy 4.5 can sit idle in exit() after the renders
+
+
+def _rewire(bpy, variant):
+    """The factor group rewired for a cost breakdown (``variant``, see the module's doc)."""
+    if variant is None:
+        return
+    from relativity_addon.blender.common import names
+    from relativity_addon.blender.lights import bounce_nodes
+
+    tree = bpy.data.node_groups[names.BOUNCE_FACTOR_GROUP]
+    output = next(node for node in tree.nodes if node.bl_idname == "NodeGroupOutput")
+    if variant == "camera gate":
+        surface = next(node for node in tree.nodes if node.bl_idname == "NodeGroupInput").outputs["Surface"]
+        gate = tree.nodes.new("ShaderNodeMixShader")
+        tree.links.new(tree.nodes["path"].outputs["Is Camera Ray"], gate.inputs[0])
+        tree.links.new(tree.nodes[f"double{bounce_nodes.DOUBLINGS - 1}"].outputs[0], gate.inputs[1])
+        tree.links.new(surface, gate.inputs[2])
+        tree.links.new(gate.outputs[0], output.inputs[0])
+        return
+    share = tree.nodes["scaled"].inputs[0]
+    for link in list(share.links):
+        tree.links.remove(link)
+    if variant == "copies only":
+        share.default_value = 1.0 / bounce_nodes.MAX_FACTOR
+        return
+    one = tree.nodes.new("ShaderNodeMath")
+    one.operation = "GREATER_THAN"
+    one.inputs[1].default_value = -1.0
+    tree.links.new(tree.nodes["gain"].outputs[0], one.inputs[0])  # gain = 1 + use (F - 1) >= 0
+    tree.links.new(one.outputs[0], share)
+    tree.links.new(tree.nodes["scaled"].outputs[0], output.inputs[0])
 
 
 if __name__ == "__main__":
