@@ -9,7 +9,6 @@ import os
 import shutil
 import tempfile
 
-import user_resources  # noqa: F401  (before bpy: this checkout's add-on, not an installed copy)
 
 if "BLENDER_USER_RESOURCES" not in os.environ:
     FOLDER = tempfile.mkdtemp(prefix="relativity-benchmark-user-")
