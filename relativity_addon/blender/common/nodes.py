@@ -207,3 +207,15 @@ def cycles_material_output(tree: NodeTree) -> typing.Any:
     outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.target in ("ALL", "CYCLES")]
     active = [n for n in outputs if n.is_active_output]
     return next(iter(active or outputs), None)
+
+
+def linked_surface(material: typing.Any, key: str) -> typing.Any:
+    """``(tree, output)``: where a stage can insert nodes on ``material``'s surface (its node tree and
+    the output Cycles renders, whose Surface is linked), or None where the material has no tree,
+    already carries the stage's record ``key`` or renders no linked surface."""
+    if material.node_tree is None or key in material:
+        return None
+    output = cycles_material_output(material.node_tree)
+    if output is None or not output.inputs["Surface"].is_linked:
+        return None
+    return material.node_tree, output

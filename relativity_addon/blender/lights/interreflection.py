@@ -26,7 +26,7 @@ import bpy
 import numpy as np
 
 from ..common import names, osl
-from ..common.nodes import build_group, cycles_material_output, detach_inserted, ensure_group, remove_unused_groups
+from ..common.nodes import build_group, detach_inserted, ensure_group, linked_surface, remove_unused_groups
 from ..geometry import modifier
 from . import bounce_nodes, lamps_on_moving_objects
 
@@ -139,12 +139,9 @@ def _text(scene: Scene, source: str) -> tuple[Text, bool]:
 
 def attach(material: Material | None, text: Text) -> bool:
     """Insert the script node between the material's surface shader and its output."""
-    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+    if material is None or (found := linked_surface(material, MATERIAL_KEY)) is None:
         return False
-    tree = material.node_tree
-    output = cycles_material_output(tree)
-    if output is None or not output.inputs["Surface"].is_linked:
-        return False
+    tree, output = found
     source = output.inputs["Surface"].links[0].from_socket
     node = tree.nodes.new("ShaderNodeScript")
     node.name = node.label = NODE_NAME
@@ -251,12 +248,9 @@ def _set_inputs(node: Any, values: Mapping[str, float | tuple[float, ...]]) -> N
 
 def attach_group(material: Material | None, group: NodeTree) -> bool:
     """Insert the scene's bounce group between the material's surface shader and its output."""
-    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+    if material is None or (found := linked_surface(material, MATERIAL_KEY)) is None:
         return False
-    tree = material.node_tree
-    output = cycles_material_output(tree)
-    if output is None or not output.inputs["Surface"].is_linked:
-        return False
+    tree, output = found
     source = output.inputs["Surface"].links[0].from_socket
     node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = group

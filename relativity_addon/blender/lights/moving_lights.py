@@ -33,7 +33,7 @@ from ...physics import spectral_render
 from ..camera import exact_camera
 from ..colour import materials
 from ..common import busy, names, osl
-from ..common.nodes import cycles_material_output, detach_inserted
+from ..common.nodes import detach_inserted, linked_surface
 from ..scene import emitting_meshes, sources
 from . import stand_in_lamps
 
@@ -274,12 +274,9 @@ def _albedo_source(socket):
 
 def attach(material: Material | None, group: NodeTree) -> bool:
     """Add the group's emission to the material's surface: ``surface + moving lights``."""
-    if material is None or material.node_tree is None or MATERIAL_KEY in material:
+    if material is None or (found := linked_surface(material, MATERIAL_KEY)) is None:
         return False
-    tree = material.node_tree
-    output = cycles_material_output(tree)
-    if output is None or not output.inputs["Surface"].is_linked:
-        return False
+    tree, output = found
     albedo = _albedo_socket(tree, output.inputs["Surface"])
     if albedo is None:
         return False
