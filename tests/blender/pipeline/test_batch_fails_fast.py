@@ -126,7 +126,8 @@ def any_blend(tmp_path):
 @pytest.mark.parametrize(
     "options, reason",
     [
-        # test_batch_script's bad options (there with a real .blend), refused the same way
+        # the bad options test_batch_script checked with a real .blend (one subprocess each, loading
+        # Blender): refused the same way, before bpy
         (("--frames=4-2",), "last frame before first"),
         (("--frames=x",), "FIRST-LAST"),
         (("--frame=1", "--frames=1-2"), "not allowed with"),

@@ -109,30 +109,6 @@ def test_blender_command_line_form_equals_python_form(plain_blend, tmp_path, fac
     wh.assert_fails_with(result, "bad option")
 
 
-@pytest.mark.parametrize(
-    "options, reason",
-    [
-        (("--frames=4-2",), "last frame before first"),
-        (("--frames=x",), "FIRST-LAST"),
-        (("--frame=1", "--frames=1-2"), "not allowed with"),
-        (("--frame=two",), "invalid int"),
-        (("--resolution=64by48",), "WIDTHxHEIGHT"),
-        (("--resolution=0x48",), "positive"),
-        (("--samples=0",), "positive integer"),
-        (("--method=fast",), "invalid choice"),
-        (("--beta=0.8,0.6,0",), "below 1"),
-        (("--beta=0,0,-1.5",), "below 1"),
-        (("--beta=inf,0,0",), "finite"),
-        (("--beta=0,0,-0.5", "--velocity-from-animation"), "not both"),
-        (("--unknown-option",), "unrecognized"),
-    ],
-)
-def test_bad_options_fail_with_one_line(plain_blend, tmp_path, options, reason):
-    out = tmp_path / "never.png"
-    wh.assert_fails_with(wh.run_render_script(plain_blend, *options, f"--out={out}"), reason)
-    assert not out.exists()
-
-
 def test_missing_out_bad_extension_missing_file_and_camera(plain_blend, tmp_path, factory_blender):
     wh.assert_fails_with(wh.run_render_script(plain_blend, "--beta=0,0,-0.5"), "--out")
     wh.assert_fails_with(wh.run_render_script(plain_blend, f"--out={tmp_path / 'x.jpg'}"), ".png or .exr")
