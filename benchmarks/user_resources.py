@@ -9,7 +9,6 @@ import os
 import shutil
 import tempfile
 
-
 if "BLENDER_USER_RESOURCES" not in os.environ:
     FOLDER = tempfile.mkdtemp(prefix="relativity-benchmark-user-")
     os.environ["BLENDER_USER_RESOURCES"] = FOLDER
