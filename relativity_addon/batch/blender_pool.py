@@ -20,6 +20,7 @@ running at once on the worker (one, with one Dask thread per worker), for one jo
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import select
@@ -43,7 +44,7 @@ PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(_
 # the last copy closes, whatever it is doing, no thread of its own involved), then serves frames
 # from the worker's own copy of the add-on. argv: parent pid, package root, reply file descriptor,
 # lifeline file descriptor, the frame to apply the effect at ("" for the first frame asked for),
-# script options.
+# the CPUs to import Blender on ("" for all: ``start_cpus``), script options.
 LAUNCH = """
 import os, sys
 parent = int(sys.argv.pop(1))
@@ -51,6 +52,10 @@ root = sys.argv.pop(1)
 reply_fd = int(sys.argv.pop(1))
 lifeline = int(sys.argv.pop(1))
 setup_frame = sys.argv.pop(1)
+start_cpus = sys.argv.pop(1)
+everywhere = os.sched_getaffinity(0) if start_cpus else None
+if start_cpus:
+    os.sched_setaffinity(0, [int(cpu) for cpu in start_cpus.split(",")])
 if sys.platform.startswith("linux"):
     import ctypes, fcntl, select, signal
     ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
@@ -64,6 +69,12 @@ if sys.platform.startswith("linux"):
 sys.path.insert(0, root)
 from relativity_addon.batch import frame_server
 from relativity_addon.blender.common import compat
+if everywhere:  # Blender's thread pool is sized now: every thread back on every CPU
+    for thread in os.listdir("/proc/self/task"):
+        try:
+            os.sched_setaffinity(int(thread), everywhere)
+        except OSError:
+            pass
 compat.run_main(lambda: frame_server.serve(sys.argv, reply_fd, int(setup_frame) if setup_frame else None))
 """
 
@@ -71,6 +82,32 @@ compat.run_main(lambda: frame_server.serve(sys.argv, reply_fd, int(setup_frame) 
 class LostProcessError(Exception):
     """A Blender process ended while it owed a reply (killed by a signal, out of memory, a crash):
     Dask runs the task again, elsewhere if it can."""
+
+
+_STARTS = itertools.count()
+
+
+def start_cpus(arguments: Sequence[str]) -> list[int]:
+    """The CPUs a Blender process rendering with ``--threads=N`` (in ``arguments``) imports ``bpy``
+    on: N of those this process may use, a different N for each process started here; none (no
+    limit) when N is not fewer. Blender sizes its thread pool (TBB) to the CPUs it may use when
+    ``bpy`` is imported and keeps that size when the process is allowed on every CPU again (the
+    launch code does that right after the import). Without it, on Blender 4.5 a process rendering
+    with one Cycles thread on two cores kept TBB's second thread spinning (in ``sched_yield``) for the
+    whole frame: twice the frame's CPU on an idle machine, and CPU taken from the other worker's
+    render on a busy one (``docs/farm.md``, Throughput; the pattern of oneTBB issue 1417: threads
+    beyond a lowered ``max_allowed_parallelism`` spin). Not seen on Blender 5.2."""
+    threads = None
+    for argument in arguments:
+        if argument.startswith("--threads="):
+            threads = int(argument.split("=", 1)[1])
+    if threads is None or threads < 1 or not hasattr(os, "sched_getaffinity"):
+        return []
+    allowed = sorted(os.sched_getaffinity(0))
+    if threads >= len(allowed):
+        return []
+    first = next(_STARTS) * threads
+    return [allowed[(first + index) % len(allowed)] for index in range(threads)]
 
 
 def _log_tail(path, lines=3):
@@ -110,7 +147,8 @@ class BlenderProcess:
         life_read, self.lifeline = os.pipe()
         handle, self.log_path = tempfile.mkstemp(prefix="relativity-blender-", suffix=".log")
         setup = "" if setup_frame is None else str(setup_frame)
-        launch = [str(os.getpid()), PACKAGE_ROOT, str(write_fd), str(life_read), setup]
+        cpus = ",".join(str(cpu) for cpu in start_cpus(arguments))
+        launch = [str(os.getpid()), PACKAGE_ROOT, str(write_fd), str(life_read), setup, cpus]
         command = [sys.executable, "-c", LAUNCH, *launch, *arguments]
         env = dict(os.environ)
         env.pop("PYTHONPATH", None)

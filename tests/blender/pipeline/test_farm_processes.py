@@ -10,6 +10,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import psutil
@@ -184,6 +185,68 @@ def test_blender_process_is_set_up_before_its_first_frame_is_asked_for(factory_b
     assert results[1]["reason"] is None and results[0]["pid"] == results[1]["pid"], results
     assert sorted(os.listdir(tmp_path)) == ["f_0002.png", "fast.blend"]
     assert frame_files.problem(tmp_path / "f_0002.png") is None
+
+
+def _threads(pid):
+    """Thread id -> (state, CPU seconds) of each thread of process ``pid`` now (/proc)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    found = {}
+    for thread in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{thread}/stat", encoding="ascii") as stat:
+                fields = stat.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # ended meanwhile
+        found[int(thread)] = (fields[0], (int(fields[11]) + int(fields[12])) / ticks)
+    return found
+
+
+@pytest.mark.skipif(
+    not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2, reason="needs two CPUs and Linux"
+)
+def test_blender_process_of_one_thread_spins_no_other_thread(moving_blend, tmp_path):
+    """A worker's Blender process rendering with one Cycles thread (``--threads=1``, what
+    ``--workers`` gives each process on a machine of as many cores) renders its frame with that one
+    thread: no thread of the process that lived before the frame (Blender's thread pool, OpenEXR's,
+    numpy's), the main thread aside (it syncs the scene and writes the file), wants a CPU through
+    the frame. On Blender 4.5 without ``blender_pool.start_cpus``, TBB's second thread spun in
+    ``sched_yield`` through every frame: runnable (state R) in every sample, and from 0.05 s of CPU
+    per frame on a busy machine to the whole frame's, 4.7 s, on an idle one. Read from /proc: the
+    threads' states every 20 ms while the frame renders (runnable whether or not the machine's
+    load lets it run), and their CPU counters."""
+    options = ["--beta=0,0,-0.5", "--samples=512", "--resolution=64x64", "--seed=2", "--threads=1"]
+    pool = blender_pool.BlenderPool([str(moving_blend), f"--out={tmp_path / 'f_####.png'}", *options], 1)
+    samples, rendering = [], threading.Event()
+
+    def watch(pid):
+        while not rendering.is_set():
+            samples.append(_threads(pid))
+            rendering.wait(0.02)
+
+    try:
+        pool.prestart()
+        process = pool._idle[0]
+        assert process.setup_failure() is None
+        assert pool.render([1])[0]["reason"] is None  # the first render: the camera's compile, caches
+        before = _threads(process.pid)
+        watcher = threading.Thread(target=watch, args=(process.pid,))
+        watcher.start()
+        try:
+            result = pool.render([2])[0]
+        finally:
+            rendering.set()
+            watcher.join()
+        after = _threads(process.pid)
+    finally:
+        pool.close()
+    assert result["reason"] is None and result["pid"] == process.pid, result
+    lived = set(before) - {process.pid}
+    runnable = [sum(1 for sample in samples if sample.get(thread, ("S",))[0] == "R") for thread in sorted(lived)]
+    cpu = [round(after[thread][1] - before[thread][1], 2) for thread in sorted(lived) if thread in after]
+    found = f"runnable in {runnable} of {len(samples)} samples; CPU {cpu} s; frame {result['seconds']:.2f} s"
+    assert len(samples) >= 10, found
+    assert max(runnable, default=0) < len(samples) / 2, found
+    assert sum(cpu) < 0.05, found
 
 
 def test_frame_server_reads_every_request_of_one_write_and_ends_when_idle(monkeypatch):
