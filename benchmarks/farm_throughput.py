@@ -3,7 +3,7 @@ long-lived Blender process) against one process rendering the frames in turn on 
 side in one run.
 
     python benchmarks/farm_throughput.py [--frames 16] [--resolution 160x120] [--samples 256]
-        [--workers CORES] [--repeats 2] [--compare-with OTHER_CHECKOUT]
+        [--workers CORES] [--cluster-threads 1] [--repeats 2] [--compare-with OTHER_CHECKOUT]
 
 The two commands run alternately (single process, cluster, then again), so that load from other
 processes hits them alike; each is timed from launch to exit as a user sees it (the cluster's
@@ -31,7 +31,8 @@ start and every Blender start included). Printed, medians over the rounds:
 ``--compare-with DIR`` runs the cluster a second time in each round from another checkout (its
 ``examples/render.py``, e.g. the main branch's), after this one's, under the same load.
 
-The single process renders with ``--threads`` = cores, each worker's Blender with one thread.
+The single process renders with ``--threads`` = cores, each worker's Blender with
+``--cluster-threads`` (default one).
 Start the measurement with ``uptime`` and read the ratios: the machine may be shared.
 """
 
@@ -154,6 +155,7 @@ def _cluster_round(command, options, into):
     into["tail"].append(tasks[-1][0] - others_done)
     rendering = sum(float(m.group(2)) for _, m in tasks)
     into["amortised"].append((wall * options.workers - rendering) / options.frames)
+    into["blender_beyond_frames"].append(cpu[0]["blender"] - rendering * options.cluster_threads)
 
 
 def measure(blend, work, options):
@@ -179,13 +181,13 @@ def measure(blend, work, options):
             *common,
             f"--out={os.path.join(work, name, 'f.png')}",
             f"--workers={options.workers}",
-            "--threads=1",
+            f"--threads={options.cluster_threads}",
             "--no-resume",
         ]
         for name, script in clusters.items()
     }
     keys = ("wall", "cpu_coordinator", "cpu_dask", "cpu_blender", "cpu_total", "frame", "task_overhead")
-    keys += ("max_overhead", "start", "tail", "amortised")
+    keys += ("max_overhead", "start", "tail", "amortised", "blender_beyond_frames")
     results = {name: {key: [] for key in keys} for name in ["single", *commands]}
     run([*single[:3], "--frames=1-1", *single[4:]])  # warm-up: file cache, bytecode, kernels
     for _ in range(options.repeats):
@@ -208,10 +210,16 @@ def _report(name, m, single, options):
     print(f"    throughput, cluster / single process: {single['wall'] / m['wall']:.2f}")
     print(
         f"    CPU: {m['cpu_total']:.1f} s (coordinator with scheduler and nannies {m['cpu_coordinator']:.1f} s, "
-        f"Dask worker processes {m['cpu_dask']:.1f} s, Blender processes {m['cpu_blender']:.1f} s); "
-        f"single / cluster {single['cpu_total'] / m['cpu_total']:.2f}"
+        f"Dask worker processes {m['cpu_dask']:.1f} s, Blender processes {m['cpu_blender']:.1f} s)"
     )
-    print(f"    a frame in a running Blender process: {m['frame']:.2f} s (worker, 1 thread)")
+    ratio = single["cpu_total"] / m["cpu_total"]
+    verdict = "met" if ratio >= 0.93 else "not met"
+    print(f"    CPU ratio, single process / cluster: {ratio:.3f} (target >= 0.93: {verdict})")
+    print(
+        f"    Blender processes' CPU beyond their frames' times x {options.cluster_threads} thread(s): "
+        f"{m['blender_beyond_frames']:.1f} s (starts, and threads busy beside the render; idle machine only)"
+    )
+    print(f"    a frame in a running Blender process: {m['frame']:.2f} s (worker, {options.cluster_threads} thread(s))")
     print(f"    per-task overhead (task on its worker minus the frame in Blender): median {m['task_overhead']:.3f} s,")
     print(f"      largest {m['max_overhead']:.2f} s (a worker's first task: waits for its Blender to be set up)")
     print(f"    launch to the first finished frame: {m['start']:.2f} s; tail (last frame after the")
@@ -225,6 +233,7 @@ def main():
     parser.add_argument("--resolution", default="160x120")
     parser.add_argument("--samples", type=int, default=256)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="default: one per core")
+    parser.add_argument("--cluster-threads", type=int, default=1, help="Cycles threads of each worker's Blender")
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--compare-with", help="another checkout whose cluster runs too, after this one's")
     options = parser.parse_args()
@@ -242,8 +251,8 @@ def main():
     print(
         f"{options.frames} frames of {options.resolution}, {options.samples} samples, exact camera; one process "
         f"({os.cpu_count()} threads) vs Dask LocalCluster of {options.workers} single-threaded workers (a long-lived "
-        f"Blender process each); medians of {options.repeats} alternating rounds; load average at the start "
-        f"{os.getloadavg()[0]:.2f}",
+        f"Blender process each, {options.cluster_threads} Cycles thread(s)); medians of {options.repeats} alternating "
+        f"rounds; load average at the start {os.getloadavg()[0]:.2f}",
         flush=True,
     )
     m = measure(blend, work, options)
