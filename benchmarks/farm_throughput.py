@@ -28,6 +28,13 @@ start and every Blender start included). Printed, medians over the rounds:
   wall time times its workers minus the frames' render times, over the frames (everything a
   frame pays besides its own render, the cluster's and the processes' starts included).
 
+``--parts`` instead accounts for a Blender process's CPU, part by part (one process each, in
+turn): importing ``bpy``, opening the file with the add-on, applying the effect, then per frame
+the threads that rendered it (ended with it), the main thread (the add-on's handlers apart) and
+the threads that lived before the frame (Blender's thread pool and the like, which should be idle):
+for a worker's process of one Cycles thread as ``blender_pool`` starts it, the same without its
+start on one CPU (as before ``blender_pool.start_cpus``), and the single process's (all cores).
+
 ``--compare-with DIR`` runs the cluster a second time in each round from another checkout (its
 ``examples/render.py``, e.g. the main branch's), after this one's, under the same load.
 
@@ -37,6 +44,7 @@ Start the measurement with ``uptime`` and read the ratios: the machine may be sh
 """
 
 import argparse
+import json
 import os
 import re
 import statistics
@@ -60,6 +68,69 @@ from camera_overhead import build_scene
 build_scene(bpy, (64, 48), 1)
 bpy.context.scene.frame_start, bpy.context.scene.frame_end = 1, 250
 bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2], check_existing=False)
+"""
+
+PARTS = """
+import json, os, resource, sys, time
+repo, threads, start_on_one, frames = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1", int(sys.argv[4])
+arguments = ["parts", *sys.argv[5:], f"--threads={threads}"]
+everywhere = os.sched_getaffinity(0)
+if start_on_one and threads < len(everywhere):  # as blender_pool.LAUNCH does
+    os.sched_setaffinity(0, sorted(everywhere)[:threads])
+sys.path.insert(0, repo)
+TICK = os.sysconf("SC_CLK_TCK")
+
+def cpu():
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+def threads_cpu():
+    found = {}
+    for thread in os.listdir("/proc/self/task"):
+        try:
+            with open(f"/proc/self/task/{thread}/stat") as stat:
+                fields = stat.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        found[int(thread)] = (int(fields[11]) + int(fields[12])) / TICK
+    return found
+
+parts, started = {}, cpu()
+import bpy
+for thread in os.listdir("/proc/self/task"):
+    os.sched_setaffinity(int(thread), everywhere)
+parts["import bpy"] = cpu() - started
+from relativity_addon.batch import frame_server
+started = cpu()
+server = frame_server._Frames(arguments)
+parts["file, add-on"] = cpu() - started
+started = cpu()
+server.set_up_at(1)
+parts["effect"] = cpu() - started
+handlers = [0.0]
+
+def timed(function):
+    def wrapper(*args):
+        started = cpu()
+        try:
+            return function(*args)
+        finally:
+            handlers[0] += cpu() - started
+    return wrapper
+
+for name in ("frame_change_pre", "frame_change_post", "render_init", "render_pre", "render_post", "render_complete"):
+    listed = getattr(bpy.app.handlers, name)
+    for index, function in enumerate(list(listed)):
+        listed[index] = timed(function)
+for frame in range(1, frames + 1):
+    before, started, handlers[0], wall = threads_cpu(), cpu(), 0.0, time.perf_counter()
+    reason, _ = server.render(frame)
+    wall, total, after = time.perf_counter() - wall, cpu() - started, threads_cpu()
+    main = after[os.getpid()] - before[os.getpid()]
+    lived = sum(after[t] - before[t] for t in after if t in before and t != os.getpid())
+    print(json.dumps({"frame": frame, "wall": wall, "cpu": total, "handlers": handlers[0], "main": main - handlers[0],
+                      "lived": lived, "ended": total - main - lived, "reason": reason, **parts}), flush=True)
+os._exit(0)
 """
 
 ENV = dict(os.environ)
@@ -227,6 +298,41 @@ def _report(name, m, single, options):
     print(f"    amortised overhead per frame (cluster wall x workers - render times, / frames): {m['amortised']:.2f} s")
 
 
+def parts(blend, work, options):
+    """Print where a Blender process's CPU goes (``--parts``)."""
+    common = [blend, f"--resolution={options.resolution}", f"--samples={options.samples}", "--beta=0,0.48,-0.13"]
+    cores = os.cpu_count() or 1
+    cases = [
+        (f"worker's process, {options.cluster_threads} thread(s), as started now", options.cluster_threads, "1"),
+        (f"the same, {options.cluster_threads} thread(s), bpy imported on every CPU", options.cluster_threads, "0"),
+        (f"single process, {cores} threads", cores, "0"),
+    ]
+    print("CPU seconds per part; per frame: median of the frames after the first (first frame in brackets)")
+    for label, threads, start_on_one in cases:
+        out = os.path.join(work, f"parts-{threads}-{start_on_one}", "f_####.png")
+        command = [sys.executable, "-c", PARTS, REPO_ROOT, str(threads), start_on_one, str(options.frames)]
+        command += [*common, f"--out={out}"]
+        result = subprocess.run(command, capture_output=True, text=True, env=ENV, cwd=REPO_ROOT, check=False)
+        rows = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
+        if result.returncode != 0 or len(rows) != options.frames or any(row["reason"] for row in rows):
+            sys.exit(f"farm_throughput: --parts failed: {result.stderr[-1500:]} {rows}")
+        print(
+            f"  {label}: import bpy {rows[0]['import bpy']:.2f}, file and add-on {rows[0]['file, add-on']:.2f}, ",
+            end="",
+        )
+        print(f"effect {rows[0]['effect']:.2f}")
+        for key, text in (
+            ("wall", "frame's wall time"),
+            ("cpu", "frame's CPU"),
+            ("ended", "threads that ended with the frame (the render's)"),
+            ("main", "main thread, the add-on's handlers apart"),
+            ("handlers", "the add-on's handlers"),
+            ("lived", "threads that lived before the frame"),
+        ):
+            later = statistics.median(row[key] for row in rows[1:]) if len(rows) > 1 else rows[0][key]
+            print(f"    {text}: {later:.3f} ({rows[0][key]:.3f})")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=16)
@@ -236,6 +342,7 @@ def main():
     parser.add_argument("--cluster-threads", type=int, default=1, help="Cycles threads of each worker's Blender")
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--compare-with", help="another checkout whose cluster runs too, after this one's")
+    parser.add_argument("--parts", action="store_true", help="where a Blender process's CPU goes, part by part")
     options = parser.parse_args()
 
     work = tempfile.mkdtemp(prefix="farm-throughput-")
@@ -248,6 +355,14 @@ def main():
         capture_output=True,
         env=ENV,
     )
+    if options.parts:
+        print(
+            f"--parts: {options.frames} frames of {options.resolution}, {options.samples} samples, exact camera; load "
+            f"average at the start {os.getloadavg()[0]:.2f}"
+        )
+        parts(blend, work, options)
+        print(f"(load average at the end: {os.getloadavg()[0]:.2f})")
+        return
     print(
         f"{options.frames} frames of {options.resolution}, {options.samples} samples, exact camera; one process "
         f"({os.cpu_count()} threads) vs Dask LocalCluster of {options.workers} single-threaded workers (a long-lived "
