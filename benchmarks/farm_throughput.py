@@ -169,7 +169,7 @@ def _sample_tree(root, cpu, stop):
             except psutil.Error:
                 continue
             entry = cpu.setdefault(process.pid, [None, 0.0])
-            entry[0] = entry[0] or _kind(process)
+            entry[0] = _kind(process) or entry[0]  # read again: a child not yet exec'd shows its parent's
             entry[1] = max(entry[1], times.user + times.system)
         stop.wait(0.1)
 
