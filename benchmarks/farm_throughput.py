@@ -143,10 +143,12 @@ CLUSTER_FRAME = re.compile(
 
 def _kind(process):
     """coordinator, dask (a worker process or a forkserver) or blender, from the command line; None
-    while it cannot be read (a process just started: read again at the next sample)."""
+    while it cannot be read (a process just started, or ended and not yet reaped)."""
     try:
         command = " ".join(process.cmdline())
     except psutil.Error:
+        return None
+    if not command:
         return None
     if "frame_server" in command:
         return "blender"
