@@ -27,7 +27,8 @@ behind the camera (they add no visible light), per count four set-ups rendered a
 (**SVM**, **SVM + factor**, **OSL**, **OSL + factor**; the correction kept out where named so),
 and for each: the time of Set Up (``effect.apply``), of a sync with nothing changed and of one
 after a velocity changed, the nodes the scene's bounce group runs (its groups' nodes counted
-inside), and the render time over the same round's SVM render.
+inside), and the render time over the same round's SVM render. ``--limit N`` sets the node
+form's limit on moving objects (``interreflection.MAX_NODE_MOVERS``) to measure it past the add-on's.
 
 Prints each render's time, its ratio to the same round's SVM time, the median ratio over the
 rounds, the factors over their own shading alone, and the load average before and after. Blender's
@@ -62,6 +63,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=4)
     parser.add_argument("--movers", default="", help="numbers of moving objects, e.g. 2,8,32 (the growth)")
     parser.add_argument("--shared", action="store_true", help="the extra movers share one velocity and rotation")
+    parser.add_argument("--limit", type=int, default=0, help="the node form's limit (0: the add-on's)")
     options = parser.parse_args()
     if options.movers:
         _growth(options)
@@ -130,7 +132,6 @@ def main():
 def _extra_movers(bpy, scene, count, shared):
     """``count`` small moving spheres with the scene's white material, far behind the camera (no
     visible light), each with its own velocity (or one for all: ``shared``)."""
-    import test_interreflection as case
 
     import camera_helpers as ch
 
@@ -180,6 +181,8 @@ def _growth(options):
 
     case.RESOLUTION = (128 * options.scale, 96 * options.scale)
     case.SAMPLES = options.samples
+    if options.limit and hasattr(interreflection, "MAX_NODE_MOVERS"):
+        interreflection.MAX_NODE_MOVERS = options.limit  # the node form measured past the add-on's limit
     own_reason = interreflection._reason
     kept_out = lambda *args: "kept out"  # noqa: E731
     setups = {"SVM": (False, kept_out), "SVM + factor": (False, own_reason), "OSL": (True, kept_out)}
