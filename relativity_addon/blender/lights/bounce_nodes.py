@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...physics import bounce
 from ..common import names
 from ..common.nodes import Group, Literal, Node, fmath, group_node, vmath
 
@@ -37,6 +38,7 @@ DOUBLINGS = 3
 MAX_FACTOR = 2.0**DOUBLINGS  # the largest F the closure scaling reaches (J alone is capped at 4)
 FAR = 1.0e30  # "no box yet": any box is smaller
 TINY = 1.0e-12
+MAX_COSINE_RATIO = bounce.MAX_COSINE_RATIO
 
 RECEIVER_INPUTS = ("Origin", "Beta", "Row X", "Row Y", "Row Z", "Normal X", "Normal Y", "Normal Z", "Half")
 RECEIVER_FLOATS = ("Grow", "Volume")
@@ -243,7 +245,8 @@ def factor_group() -> Group:
             "after": fmath("DIVIDE", "km_rest", "Dp"),
             "after_pos": fmath("MAXIMUM", "after", 0.0),
             "before_safe": fmath("MAXIMUM", "before", 1.0e-6),
-            "cp_box": fmath("DIVIDE", "after_pos", "before_safe"),
+            "cp_ratio": fmath("DIVIDE", "after_pos", "before_safe"),
+            "cp_box": fmath("MINIMUM", "cp_ratio", MAX_COSINE_RATIO),  # physics/bounce.py's cap
             # no box holds R (a receiver at rest: Beta P = 0, normal unknown): c_p = 1
             "cp_1": fmath("SUBTRACT", "cp_box", 1.0),
             "cp": fmath("MULTIPLY_ADD", "group.Found", "cp_1", 1.0),
