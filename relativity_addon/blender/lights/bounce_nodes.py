@@ -11,7 +11,8 @@ point ``R`` is mapped back to the object's rest frame exactly for uniform motion
 ``L`` the object's rotation and scale, ``C`` the contraction): ``R`` takes the velocity of the
 smallest box holding ``q`` (grown by a margin), and as its rest normal the normal of the box face
 nearest ``q``, turned toward the emitter (exact for flat and box-shaped receivers; measured in
-the docs for the test's panel). The values are node inputs the sync writes
+the docs for the test's panel); in no box ``R`` is taken at rest with ``c_p = 1`` (its normal
+unknown). The values are node inputs the sync writes
 (:func:`receiver_values`); the nodes are rebuilt only when the number of moving objects changes.
 
 SVM cannot multiply a closure by a number: a Mix Shader (its factor clamped to [0, 1]) with

@@ -13,7 +13,9 @@ Two forms, by the scene's shading system:
   receiver's velocity and rest normal from each moving object's rest box, the values node inputs
   the sync writes.
 
-Observer at rest only. Everything is recorded (the inserted node and the old link on each
+A receiving point in no moving object's box is taken at rest (``beta_p = 0``). Observer at rest
+only; the node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
+every shading point), beyond which the panel says the bounce is uncorrected. Everything is recorded (the inserted node and the old link on each
 material; the text datablock or node group on the scene) and :func:`remove` deletes exactly that.
 """
 
