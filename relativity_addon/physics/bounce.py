@@ -37,6 +37,10 @@ from .retarded import light_travel_time_uniform
 from .validation import unit_vectors, vector_array, velocity_array
 
 MAX_SOLID_ANGLE_RATIO = 4.0  # a cap on J against fireflies (docs/lamp-doppler.md: the model's means do not feel it)
+# A cap on c_p: where the receiver's normal is not its own (a curved receiver takes its box face's)
+# the snapshot's cosine can be near 0 while the physical one is not; a 45-degree error made the
+# model's mean 7e9x the physics approaching, capped 1.57x (docs/lamp-doppler.md, "Many moving objects").
+MAX_COSINE_RATIO = 4.0
 
 
 def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -119,7 +123,8 @@ def receiver_factor(
 ) -> FloatArray:
     """``D_p^2 c_p``: the receiver's frame. ``D_p = gamma_p (1 - beta_p . k)`` (radiance ``D_p^4``,
     solid angle ``1 / D_p^2``); ``c_p`` the cosine of ``k`` aberrated into the receiver's frame on
-    its rest normal over the snapshot's cosine (``k_snapshot`` on the same normal), 1 without normals."""
+    its rest normal over the snapshot's cosine (``k_snapshot`` on the same normal), at most
+    :data:`MAX_COSINE_RATIO`; 1 without normals."""
     k = unit_vectors(k, "k")
     beta = np.broadcast_to(velocity_array(receiver_beta, "receiver_beta"), k.shape)
     doppler: FloatArray = _gamma(beta) * (1.0 - _dot(beta, k))
@@ -128,7 +133,7 @@ def receiver_factor(
     n = unit_vectors(receiver_normals, "receiver_normals")
     snapshot = -_dot(unit_vectors(k_snapshot, "k_snapshot"), n)
     physical = np.maximum(-_dot(aberrate(k, beta), n), 0.0)
-    result: FloatArray = doppler**2 * physical / np.maximum(snapshot, 1e-12)
+    result: FloatArray = doppler**2 * np.minimum(physical / np.maximum(snapshot, 1e-12), MAX_COSINE_RATIO)
     return result
 
 

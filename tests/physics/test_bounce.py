@@ -135,3 +135,14 @@ def test_at_rest_the_snapshot_is_right():
 def test_refuses_light_speed():
     with pytest.raises(ValueError, match="below 1"):
         bounce.bounce_correction(np.zeros(3), [1.0, 0, 0], [1.0, 0, 0], [3.0, 0, 0], np.zeros(3), CAMERA)
+
+
+def test_receiver_cosine_ratio_is_capped():
+    """A snapshot cosine near 0 on a normal that is not the receiver's own (a curved receiver takes
+    its box face's on SVM) gives ``c_p`` at most ``MAX_COSINE_RATIO`` (no firefly): at rest, a
+    grazing ``k_snapshot`` and a ``k`` along the normal."""
+    normal = np.array([0.0, 0.0, 1.0])
+    k = -normal
+    k_snapshot = np.array([1.0, 0.0, -1.0e-7])
+    factor = bounce.receiver_factor(k, np.zeros(3), k_snapshot / np.linalg.norm(k_snapshot), normal)
+    assert factor == pytest.approx(bounce.MAX_COSINE_RATIO)

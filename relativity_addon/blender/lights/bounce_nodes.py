@@ -11,7 +11,8 @@ point ``R`` is mapped back to the object's rest frame exactly for uniform motion
 ``L`` the object's rotation and scale, ``C`` the contraction): ``R`` takes the velocity of the
 smallest box holding ``q`` (grown by a margin), and as its rest normal the normal of the box face
 nearest ``q``, turned toward the emitter (exact for flat and box-shaped receivers; measured in
-the docs for the test's panel). The values are node inputs the sync writes
+the docs for the test's panel); in no box ``R`` is taken at rest with ``c_p = 1`` (its normal
+unknown). The values are node inputs the sync writes
 (:func:`receiver_values`); the nodes are rebuilt only when the number of moving objects changes.
 
 SVM cannot multiply a closure by a number: a Mix Shader (its factor clamped to [0, 1]) with
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...physics import bounce
 from ..common import names
 from ..common.nodes import Group, Literal, Node, fmath, group_node, vmath
 
@@ -37,6 +39,7 @@ DOUBLINGS = 3
 MAX_FACTOR = 2.0**DOUBLINGS  # the largest F the closure scaling reaches (J alone is capped at 4)
 FAR = 1.0e30  # "no box yet": any box is smaller
 TINY = 1.0e-12
+MAX_COSINE_RATIO = bounce.MAX_COSINE_RATIO
 
 RECEIVER_INPUTS = ("Origin", "Beta", "Row X", "Row Y", "Row Z", "Normal X", "Normal Y", "Normal Z", "Half")
 RECEIVER_FLOATS = ("Grow", "Volume")
@@ -50,9 +53,7 @@ def receiver_group() -> Group:
     """One moving object's box: whether ``R`` lies in it (smaller than the best so far), and then
     its velocity and the rest normal of the face nearest ``R`` (world axes), chained."""
     nodes = {
-        "to_camera": vmath("SUBTRACT", "group.R", "group.Camera"),
-        "distance": vmath("LENGTH", "to_camera"),
-        "moved": vmath("SCALE", "group.Beta", scale="distance.Value"),
+        "moved": vmath("SCALE", "group.Beta", scale="group.Distance"),
         "advanced": vmath("ADD", "group.R", "moved"),
         "offset": vmath("SUBTRACT", "advanced", "group.Origin"),
         "qx": vmath("DOT_PRODUCT", "offset", "group.Row X"),
@@ -86,7 +87,7 @@ def receiver_group() -> Group:
     }
     inputs = (
         _vector_input("R"),
-        _vector_input("Camera"),
+        ("Distance", "NodeSocketFloat", 0.0),
         *(_vector_input(name) for name in RECEIVER_INPUTS),
         ("Grow", "NodeSocketFloat", 0.0),
         ("Volume", "NodeSocketFloat", 0.0),
@@ -113,43 +114,24 @@ def _merged(*parts: dict) -> dict:
     return merged
 
 
-def _rest_normal_nodes(prefix: str, normal: str, chat: str, beta: str, bb: str) -> dict:
-    """``n ~ A^T N = C (N - chat (beta . N) / (1 + chat . beta))``: an apparent normal's rest normal."""
+def _rest_normal_nodes(prefix: str, normal: str, chat: str, beta: str, cb1: str, one_bb: str, bb_safe: str) -> dict:
+    """``n ~ A^T N = C (N - chat (beta . N) / (1 + chat . beta))``: an apparent normal's rest normal
+    (``cb1`` = 1 + chat . beta, ``one_bb`` = 1 - beta . beta, ``bb_safe`` = max(beta . beta, tiny))."""
     p = prefix
     return {
         f"{p}bn": vmath("DOT_PRODUCT", beta, normal),
-        f"{p}cb": vmath("DOT_PRODUCT", chat, beta),
-        f"{p}cb1": fmath("ADD", f"{p}cb.Value", 1.0),
-        f"{p}along": fmath("DIVIDE", f"{p}bn.Value", f"{p}cb1"),
+        f"{p}along": fmath("DIVIDE", f"{p}bn.Value", cb1),
         f"{p}shift": vmath("SCALE", chat, scale=f"{p}along"),
         f"{p}v": vmath("SUBTRACT", normal, f"{p}shift"),
         # C v = v - (1 - sqrt(1 - bb)) (beta . v) / bb beta
-        f"{p}root": fmath("SQRT", f"{p}one_bb"),
-        f"{p}one_bb": fmath("SUBTRACT", 1.0, bb),
+        f"{p}root": fmath("SQRT", one_bb),
         f"{p}shrink": fmath("SUBTRACT", 1.0, f"{p}root"),
-        f"{p}bb_safe": fmath("MAXIMUM", bb, TINY),
         f"{p}bv": vmath("DOT_PRODUCT", beta, f"{p}v"),
-        f"{p}bv_bb": fmath("DIVIDE", f"{p}bv.Value", f"{p}bb_safe"),
+        f"{p}bv_bb": fmath("DIVIDE", f"{p}bv.Value", bb_safe),
         f"{p}cut": fmath("MULTIPLY", f"{p}shrink", f"{p}bv_bb"),
         f"{p}cut_vector": vmath("SCALE", beta, scale=f"{p}cut"),
         f"{p}contracted": vmath("SUBTRACT", f"{p}v", f"{p}cut_vector"),
         f"{p}n": vmath("NORMALIZE", f"{p}contracted"),
-    }
-
-
-def _aberrate_nodes(prefix: str, k: str, beta: str, gamma: str) -> dict:
-    """``k`` aberrated into the frame moving with ``beta``: ``normalize(k + (g^2 / (g + 1) (beta . k) - g) beta)``."""
-    p = prefix
-    return {
-        f"{p}bk": vmath("DOT_PRODUCT", beta, k),
-        f"{p}g2": fmath("MULTIPLY", gamma, gamma),
-        f"{p}g1": fmath("ADD", gamma, 1.0),
-        f"{p}gg": fmath("DIVIDE", f"{p}g2", f"{p}g1"),
-        f"{p}c": fmath("MULTIPLY_ADD", f"{p}gg", f"{p}bk.Value", f"{p}minus_g"),
-        f"{p}minus_g": fmath("MULTIPLY", gamma, -1.0),
-        f"{p}shift": vmath("SCALE", beta, scale=f"{p}c"),
-        f"{p}sum": vmath("ADD", k, f"{p}shift"),
-        f"{p}k": vmath("NORMALIZE", f"{p}sum"),
     }
 
 
@@ -173,9 +155,7 @@ def factor_group() -> Group:
             # where R sees this point: its world line back to R's light cone (uniform motion)
             "from_camera": vmath("SUBTRACT", "geometry.Position", "group.Camera"),
             "tx": vmath("LENGTH", "from_camera"),
-            "r_from_camera": vmath("SUBTRACT", "R", "group.Camera"),
-            "tr": vmath("LENGTH", "r_from_camera"),
-            "dt": fmath("SUBTRACT", "tx.Value", "tr.Value"),
+            "dt": fmath("SUBTRACT", "tx.Value", "group.Distance"),
             "moved": vmath("SCALE", "emitter.Vector", scale="dt"),
             "p": vmath("ADD", "geometry.Position", "moved"),
             "D": vmath("SUBTRACT", "R", "p"),
@@ -195,15 +175,15 @@ def factor_group() -> Group:
             "dsnap": vmath("LENGTH", "snap_raw"),
             "ks": vmath("NORMALIZE", "snap_raw"),
             "chat": vmath("NORMALIZE", "from_camera"),
-        },
-        _rest_normal_nodes("e_", "geometry.Normal", "chat", "emitter.Vector", "bb_vec.Value"),
-        {
-            # J: the rest element's solid angle at R physically over its snapshot image's
             "cb": vmath("DOT_PRODUCT", "chat", "emitter.Vector"),
             "cb1": fmath("ADD", "cb.Value", 1.0),
+            "bb_safe": fmath("MAXIMUM", "bb_vec.Value", TINY),
+        },
+        _rest_normal_nodes("e_", "geometry.Normal", "chat", "emitter.Vector", "cb1", "c2", "bb_safe"),
+        {
+            # J: the rest element's solid angle at R physically over its snapshot image's
             "det_inv": fmath("MULTIPLY", "gs", "cb1"),
             "bn": vmath("DOT_PRODUCT", "emitter.Vector", "e_n"),
-            "bb_safe": fmath("MAXIMUM", "bb_vec.Value", TINY),
             "bn_bb": fmath("DIVIDE", "bn.Value", "bb_safe"),
             "gs1": fmath("SUBTRACT", "gs", 1.0),
             "stretch_s": fmath("MULTIPLY", "gs1", "bn_bb"),
@@ -217,10 +197,16 @@ def factor_group() -> Group:
             "faces": fmath("GREATER_THAN", "snap", 0.0),
             "snap_safe": fmath("MAXIMUM", "snap", TINY),
         },
-        _aberrate_nodes("as_", "k", "emitter.Vector", "gs"),
         {
-            "cos_dot": vmath("DOT_PRODUCT", "e_n", "as_k"),
-            "cos_rest": fmath("MAXIMUM", "cos_dot.Value", 0.0),
+            # n . k' with k' = (k + ((g - 1) (beta . k) / bb - g) beta) / (g (1 - beta . k)), unit
+            # (aberration into the emitter's frame): (n . k + (beta . k) stretch_s - g (beta . n)) / (g den)
+            "nk": vmath("DOT_PRODUCT", "e_n", "k"),
+            "nk_along": fmath("MULTIPLY_ADD", "bk.Value", "stretch_s", "nk.Value"),
+            "g_bn": fmath("MULTIPLY", "gs", "bn.Value"),
+            "nk_rest": fmath("SUBTRACT", "nk_along", "g_bn"),
+            "g_den": fmath("MULTIPLY", "gs", "den"),
+            "cos_k": fmath("DIVIDE", "nk_rest", "g_den"),
+            "cos_rest": fmath("MAXIMUM", "cos_k", 0.0),
             "d2": fmath("MULTIPLY", "dsnap.Value", "dsnap.Value"),
             "tau2": fmath("MULTIPLY", "tau", "tau"),
             "j_num": fmath("MULTIPLY", "cos_rest", "d2"),
@@ -243,27 +229,35 @@ def factor_group() -> Group:
             "one_bpk": fmath("SUBTRACT", 1.0, "bpk.Value"),
             "Dp": fmath("MULTIPLY", "gp", "one_bpk"),
             "Dp2": fmath("MULTIPLY", "Dp", "Dp"),
+            # its rest normal m turned along ks (away from this point): the snapshot's cosine ks . m,
+            # the physical one k'_p . m = (k . m + ((gp - 1) (bp . k) / bp2 - gp) (bp . m)) / Dp
             "side": vmath("DOT_PRODUCT", "group.Receiver Normal", "ks"),
             "sign": fmath("SIGN", "side.Value"),
-            "flip": fmath("MULTIPLY", "sign", -1.0),
-            "nR": vmath("SCALE", "group.Receiver Normal", scale="flip"),  # -ks . nR >= 0
+            "m": vmath("SCALE", "group.Receiver Normal", scale="sign"),
             "before": fmath("ABSOLUTE", "side.Value"),
-        },
-        _aberrate_nodes("kp_", "k", "group.Beta P", "gp"),
-        {
-            "after_dot": vmath("DOT_PRODUCT", "kp_k", "nR"),
-            "after": fmath("MULTIPLY", "after_dot.Value", -1.0, clamp=False),
+            "km": vmath("DOT_PRODUCT", "k", "m"),
+            "bm": vmath("DOT_PRODUCT", "group.Beta P", "m"),
+            "gp1": fmath("SUBTRACT", "gp", 1.0),
+            "bp2_safe": fmath("MAXIMUM", "bp2.Value", TINY),
+            "gp1_bpk": fmath("MULTIPLY", "gp1", "bpk.Value"),
+            "along_p": fmath("DIVIDE", "gp1_bpk", "bp2_safe"),
+            "shift_p": fmath("SUBTRACT", "along_p", "gp"),
+            "km_rest": fmath("MULTIPLY_ADD", "shift_p", "bm.Value", "km.Value"),
+            "after": fmath("DIVIDE", "km_rest", "Dp"),
             "after_pos": fmath("MAXIMUM", "after", 0.0),
             "before_safe": fmath("MAXIMUM", "before", 1.0e-6),
-            "cp": fmath("DIVIDE", "after_pos", "before_safe"),
+            "cp_ratio": fmath("DIVIDE", "after_pos", "before_safe"),
+            "cp_box": fmath("MINIMUM", "cp_ratio", MAX_COSINE_RATIO),  # physics/bounce.py's cap
+            # no box holds R (a receiver at rest: Beta P = 0, normal unknown): c_p = 1
+            "cp_1": fmath("SUBTRACT", "cp_box", 1.0),
+            "cp": fmath("MULTIPLY_ADD", "group.Found", "cp_1", 1.0),
             "receiver": fmath("MULTIPLY", "Dp2", "cp"),
             "js": fmath("MULTIPLY", "J", "searchlight"),
             "F": fmath("MULTIPLY", "js", "receiver"),
-            # applied on non-camera rays from a moving object's box only: 1 + use (F - 1)
+            # applied on non-camera rays (from a moving object's box, or from a receiver at rest): 1 + use (F - 1)
             "not_camera": fmath("SUBTRACT", 1.0, "path.Is Camera Ray"),
             "travelled": fmath("GREATER_THAN", "path.Ray Length", 0.0),
-            "found": fmath("MULTIPLY", "not_camera", "group.Found"),
-            "use": fmath("MULTIPLY", "found", "travelled"),
+            "use": fmath("MULTIPLY", "not_camera", "travelled"),
             "F1": fmath("SUBTRACT", "F", 1.0),
             "gain": fmath("MULTIPLY_ADD", "use", "F1", 1.0),
             "share": fmath("DIVIDE", "gain", MAX_FACTOR),
@@ -277,6 +271,7 @@ def factor_group() -> Group:
     inputs = (
         ("Surface", "NodeSocketShader", None),
         _vector_input("Camera"),
+        ("Distance", "NodeSocketFloat", 0.0),
         _vector_input("Beta P"),
         _vector_input("Receiver Normal"),
         ("Found", "NodeSocketFloat", 0.0),
@@ -291,10 +286,12 @@ def scene_group_spec(name: str, count: int) -> Group:
         "path": Node("ShaderNodeLightPath"),
         "toward": vmath("SCALE", "geometry.Incoming", scale="path.Ray Length"),
         "R": vmath("ADD", "geometry.Position", "toward"),
+        "to_camera": vmath("SUBTRACT", "R", (0.0, 0.0, 0.0)),  # its second input: the camera (the sync writes it)
+        "distance": vmath("LENGTH", "to_camera"),  # |R - camera|, shared by the boxes and the factor
     }
     previous = None
     for index in range(count):
-        links = {"R": "R"}
+        links = {"R": "R", "Distance": "distance.Value"}
         if previous is not None:
             links.update(
                 {
@@ -309,7 +306,7 @@ def scene_group_spec(name: str, count: int) -> Group:
     if previous is not None:
         nodes["found"] = fmath("LESS_THAN", f"{previous}.Best Volume", FAR * 0.5)
         found = {"Beta P": f"{previous}.Best Beta", "Receiver Normal": f"{previous}.Best Normal", "Found": "found"}
-    nodes["factor"] = group_node(FACTOR, {"Surface": "group.Surface", **found})
+    nodes["factor"] = group_node(FACTOR, {"Surface": "group.Surface", "Distance": "distance.Value", **found})
     shader = (("Surface", "NodeSocketShader", None),)
     return Group(name, "ShaderNodeTree", shader, (("Surface", "NodeSocketShader", "factor"),), nodes)
 
@@ -351,7 +348,6 @@ def receiver_values(
         "Half": vector(size / 2.0),
         "Grow": grow,
         "Volume": volume,
-        "Camera": vector(camera),
     }
     for axis, row, face in zip("XYZ", rows, inverse, strict=True):
         values[f"Row {axis}"] = vector(row)

@@ -13,7 +13,9 @@ Two forms, by the scene's shading system:
   receiver's velocity and rest normal from each moving object's rest box, the values node inputs
   the sync writes.
 
-Observer at rest only. Everything is recorded (the inserted node and the old link on each
+A receiving point in no moving object's box is taken at rest (``beta_p = 0``). Observer at rest
+only; the node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
+every shading point), beyond which the panel says the bounce is uncorrected. Everything is recorded (the inserted node and the old link on each
 material; the text datablock or node group on the scene) and :func:`remove` deletes exactly that.
 """
 
@@ -44,6 +46,11 @@ NODE_NAME = names.BOUNCE_NODE_NAME
 MARKER = "//@GENERATED@"
 MARGIN = 0.05  # the boxes grown by this share of their size on each side: the corners' images bound the image loosely
 MEASURED_ERROR = "12 %"  # docs/lamp-doppler.md: the snapshot's bounce 1.121x the physics at 0.5c apart
+# The node form runs every moving object's box on every shading point of every moving object's
+# material: beyond this many moving objects it is not built (docs/lamp-doppler.md, "Cost", measured
+# by benchmarks/bounce_cost.py --movers) and the panel says the bounce is uncorrected.
+MAX_NODE_MOVERS = 8
+NODE_COST_AT_MAX = "3x"  # the node form's render time over the uncorrected one at MAX_NODE_MOVERS
 
 
 def _moving_count(scene: Scene) -> int:
@@ -66,6 +73,11 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
         return "fewer than two moving objects"
     if snap.speed > 0.0:
         return "the observer moves"
+    if not uses_osl(scene) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
+        return (
+            f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
+            f"{NODE_COST_AT_MAX} slower; OSL shading corrects it)"
+        )
     return None
 
 
@@ -227,7 +239,9 @@ def _scene_group(scene: Scene, camera: Sequence[float], found: Sequence[Mover]) 
         bounce_nodes.receiver_node_name(len(found)) in tree.nodes
     ):
         tree = build_group(bounce_nodes.scene_group_spec(tree.name, len(found)), keep_interface=True)
-    _set_inputs(tree.nodes["factor"], {"Camera": tuple(float(x) for x in camera)})
+    eye = tuple(float(x) for x in camera)
+    _set_inputs(tree.nodes["factor"], {"Camera": eye})
+    _set_inputs(tree.nodes["to_camera"], {1: eye})
     for index, mover in enumerate(found):
         obj = scene.objects[mover.name]
         low, high = lamps_on_moving_objects.rest_box(obj)
@@ -238,7 +252,7 @@ def _scene_group(scene: Scene, camera: Sequence[float], found: Sequence[Mover]) 
     return tree
 
 
-def _set_inputs(node: Any, values: Mapping[str, float | tuple[float, ...]]) -> None:
+def _set_inputs(node: Any, values: Mapping[Any, float | tuple[float, ...]]) -> None:
     """Write the inputs that changed beyond float32 rounding (a write is a depsgraph update: no loops)."""
     for key, value in values.items():
         socket = node.inputs[key]
