@@ -15,8 +15,9 @@ Two forms, by the scene's shading system:
 
 A receiving point in no moving object's box is taken at rest (``beta_p = 0``). Observer at rest
 only; the node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
-every shading point), beyond which the panel says the bounce is uncorrected. Everything is recorded (the inserted node and the old link on each
-material; the text datablock or node group on the scene) and :func:`remove` deletes exactly that.
+every shading point), beyond which the panel says the bounce is uncorrected. Everything is
+recorded (the inserted node and the old link on each material; the text datablock or node group
+on the scene) and :func:`remove` deletes exactly that.
 """
 
 from __future__ import annotations
@@ -51,6 +52,9 @@ MEASURED_ERROR = "12 %"  # docs/lamp-doppler.md: the snapshot's bounce 1.121x th
 # by benchmarks/bounce_cost.py --movers) and the panel says the bounce is uncorrected.
 MAX_NODE_MOVERS = 8
 NODE_COST_AT_MAX = "3x"  # the node form's render time over the uncorrected one at MAX_NODE_MOVERS
+# docs/lamp-doppler.md, "Receivers at rest": a sphere alone at 0.5c lighting a panel at rest, the
+# snapshot's bounce 0.55x receding and 3.58x approaching (the stage is built for two or more movers)
+AT_REST_ERROR = "3.6x"
 
 
 def _moving_count(scene: Scene) -> int:
@@ -342,10 +346,16 @@ def remove(scene: Scene) -> None:
 
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:
-    """One line when two moving objects light each other uncorrected for a reason the user can change."""
+    """One line when two moving objects light each other uncorrected for a reason the user can change,
+    or when one moving object lights objects at rest uncorrected."""
     if snap.method != "GEOMETRY":
         return []
     reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
+    if reason == "fewer than two moving objects" and _moving_count(scene) == 1:
+        return [
+            f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
+            "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
+        ]
     if reason is None or reason in ("off the Apparent Geometry path", "fewer than two moving objects"):
         return []
     return [

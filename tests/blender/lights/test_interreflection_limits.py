@@ -178,3 +178,25 @@ def test_more_moving_objects_than_the_node_form_takes(relativity_addon, factory_
     effect.remove(scene)
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, "\n".join(lines[:20])
+
+
+def test_one_moving_object_lighting_objects_at_rest_is_said(relativity_addon, factory_blender):
+    """With one moving object the stage is off (built for two or more), so the light it sends onto
+    objects at rest stays the snapshot's (docs/lamp-doppler.md: 0.55x and 3.58x at 0.5c): the panel
+    says so in one line; with a second moving object (the stage on) that line is gone."""
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, np.zeros(3))
+    effect.apply(scene)
+    lines = [line for line in effect.scene_warnings(scene) if "objects at rest" in line]
+    assert lines == [
+        "Light the moving object sends onto objects at rest is not corrected, up to 3.6x off at 0.5c "
+        "(docs/lamp-doppler.md): the correction is built for two or more moving objects"
+    ]
+    effect.remove(scene)
+    _extra_movers(bpy, scene, 1)
+    effect.apply(scene)
+    assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
+    assert not [line for line in effect.scene_warnings(scene) if "objects at rest" in line]
+    effect.remove(scene)
