@@ -143,6 +143,9 @@ def modifier_inputs(
     motion.check_parent_motion(obj)
     fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    corners = _box_corners(obj)  # the polynomial takes no verdict: its window holds the whole rest box
+    if corners is not None:
+        reach = max(reach, float(np.max(np.linalg.norm(corners, axis=1))))
     try:
         function = _matrix_function(obj, scene, fps, step, c)
         guess = _last_tau.get(obj.session_uid)
@@ -169,7 +172,9 @@ def modifier_inputs(
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
-    polynomial = _window_polynomial(obj, pieces, grid_now, grid_per_distance, x_o, reach, step, c)
+    polynomial = None
+    if corners is not None:
+        polynomial = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -216,20 +221,25 @@ def modifier_inputs(
 _polynomials: dict[int, polynomial_motion.WindowPolynomial] = {}
 
 
-def _window_polynomial(obj, pieces, grid_now, grid_per_distance, x_o, reach, step, c):
-    """One polynomial over the intervals (``physics/polynomial_motion.py``) for keys that only move
-    the object (``animation.translates_only``), where it follows the intervals to the samples'
-    rounding and the modifier's steps converge on the rest box's corners, else None (the intervals
-    then, read per point)."""
+def _box_corners(obj):
+    """The rest box's corners (object space) of an object whose keys only move it
+    (``animation.translates_only``: the polynomial may serve it), else None."""
     bounds = tessellation.rest_bounds(obj)
     if bounds is None or not animation.translates_only(obj):
         return None
+    return np.where(np.arange(8)[:, None] >> np.arange(3) & 1, bounds[1], bounds[0])
+
+
+def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c):
+    """One polynomial over the intervals (``physics/polynomial_motion.py``) where it follows them to
+    the samples' rounding and the modifier's steps converge on the rest box's ``corners``, else None
+    (the intervals then, read per point). No verdict is taken over the points: the window was bounded
+    for every point within ``reach`` of the origin, the rest box's farthest corner included."""
     tolerance = polynomial_motion.rounding_tolerance(pieces, x_o, reach, step, c)
     polynomial = polynomial_motion.fit_window(pieces, grid_now, grid_per_distance, reach, tolerance)
-    if polynomial is None:
+    if polynomial is None or not polynomial_motion.converges(polynomial, corners):
         return None
-    corners = np.where(np.arange(8)[:, None] >> np.arange(3) & 1, bounds[1], bounds[0])
-    return polynomial if polynomial_motion.converges(polynomial, corners) else None
+    return polynomial
 
 
 def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray | None) -> None:
