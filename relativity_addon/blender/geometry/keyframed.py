@@ -143,9 +143,7 @@ def modifier_inputs(
     motion.check_parent_motion(obj)
     fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
-    corners = _box_corners(obj)  # the polynomial takes no verdict: its window holds the whole rest box
-    if corners is not None:
-        reach = max(reach, float(np.max(np.linalg.norm(corners, axis=1))))
+    corners = _box_corners(obj)
     try:
         function = _matrix_function(obj, scene, fps, step, c)
         guess = _last_tau.get(obj.session_uid)
@@ -234,7 +232,10 @@ def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach,
     """One polynomial over the intervals (``physics/polynomial_motion.py``) where it follows them to
     the samples' rounding and the modifier's steps converge on the rest box's ``corners``, else None
     (the intervals then, read per point). No verdict is taken over the points: the window was bounded
-    for every point within ``reach`` of the origin, the rest box's farthest corner included."""
+    for every point within ``reach`` of the origin, and the rest box's farthest corner must lie
+    within it (a box whose corners reach farther than its points, a sphere's, keeps the intervals)."""
+    if float(np.max(np.linalg.norm(corners, axis=1))) > reach * (1.0 + 1e-6):  # (float32 reads)
+        return None  # the window holds only points within reach (a stale reach: the verdict says so)
     tolerance = polynomial_motion.rounding_tolerance(pieces, x_o, reach, step, c)
     polynomial = polynomial_motion.fit_window(pieces, grid_now, grid_per_distance, reach, tolerance)
     if polynomial is None or not polynomial_motion.converges(polynomial, corners):
