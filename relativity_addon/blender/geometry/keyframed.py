@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from ...errors import RelativityError
-from ...physics import sampling
+from ...physics import polynomial_motion, sampling
 from ..common import compat, names
 from ..common.nodes import interface_identifier
 from ..scene import animation
@@ -143,6 +143,7 @@ def modifier_inputs(
     motion.check_parent_motion(obj)
     fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
+    corners = _box_corners(obj)
     try:
         function = _matrix_function(obj, scene, fps, step, c)
         guess = _last_tau.get(obj.session_uid)
@@ -168,6 +169,10 @@ def modifier_inputs(
         origin = start + per_frame * (t_o * fps)
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
+    grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
+    polynomial = None
+    if corners is not None:
+        polynomial = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -179,9 +184,10 @@ def modifier_inputs(
     inputs = {
         "Keyframed": True,
         "Closed Form": False,
+        "Polynomial": polynomial is not None,
         "Last Interval": float(len(pieces.coefficients) - 1),
-        "Grid Now": t_o / step - pieces.first,
-        "Grid Per Distance": 1.0 / (c * step),
+        "Grid Now": grid_now,
+        "Grid Per Distance": grid_per_distance,
         "Start Distance": pieces.start_distance,
         "Emission X": vector(emission[:, 0]),
         "Emission Y": vector(emission[:, 1]),
@@ -192,7 +198,49 @@ def modifier_inputs(
         "Observer Inverse Gamma": 1.0 / gamma,
         "Observer Factor": gamma / (gamma + 1.0),
     }
-    return inputs, pieces.coefficients
+    if polynomial is None:
+        return inputs, pieces.coefficients
+    inputs.update(
+        {
+            "Polynomial Centre": polynomial.centre,
+            "Polynomial Rate": 1.0 / polynomial.half,
+            **{
+                f"Polynomial {power} {part}": vector(polynomial.coefficients[power][:, column])
+                for power in range(polynomial_motion.DEGREE + 1)
+                for column, part in enumerate(("X", "Y", "Z", "Offset"))
+            },
+        }
+    )
+    _polynomials[obj.session_uid] = polynomial
+    return inputs, None  # no interval read: the cache holds the face codes alone
+
+
+# Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
+_polynomials: dict[int, polynomial_motion.WindowPolynomial] = {}
+
+
+def _box_corners(obj):
+    """The rest box's corners (object space) of an object whose keys only move it
+    (``animation.translates_only``: the polynomial may serve it), else None."""
+    bounds = tessellation.rest_bounds(obj)
+    if bounds is None or not animation.translates_only(obj):
+        return None
+    return np.where(np.arange(8)[:, None] >> np.arange(3) & 1, bounds[1], bounds[0])
+
+
+def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c):
+    """One polynomial over the intervals (``physics/polynomial_motion.py``) where it follows them to
+    the samples' rounding and the modifier's steps converge on the rest box's ``corners``, else None
+    (the intervals then, read per point). No verdict is taken over the points: the window was bounded
+    for every point within ``reach`` of the origin, and the rest box's farthest corner must lie
+    within it (a box whose corners reach farther than its points, a sphere's, keeps the intervals)."""
+    if float(np.max(np.linalg.norm(corners, axis=1))) > reach * (1.0 + 1e-6):  # (float32 reads)
+        return None  # the window holds only points within reach (a stale reach: the verdict says so)
+    tolerance = polynomial_motion.rounding_tolerance(pieces, x_o, reach, step, c)
+    polynomial = polynomial_motion.fit_window(pieces, grid_now, grid_per_distance, reach, tolerance)
+    if polynomial is None or not polynomial_motion.converges(polynomial, corners):
+        return None
+    return polynomial
 
 
 def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray | None) -> None:
@@ -210,6 +258,31 @@ def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray
         matrices[:, 3, 3] = 1.0
         attribute.data.foreach_set("value", np.ascontiguousarray(matrices.transpose(0, 2, 1)).ravel())
     data.update()
+
+
+def _edge_bound(obj, obj_eval, snap, scene, inputs):
+    """The closed form's bound on the edges' images (pixels) for the closed form's ``inputs``; for
+    the polynomial's, the largest of the bounds of the uniform motions through the origin at the
+    window's centre with the origin's velocity at the window's two ends and centre (the motion
+    departs from each by less than the samples' rounding over the retarded times' spread)."""
+    x_o = np.asarray(snap.mesh_observer[1])
+    size = tessellation.render_size(scene)
+    if not inputs.get("Keyframed"):
+        motions = [(np.asarray(cast("tuple[float, float, float]", inputs["Scene Offset"])), inputs["Velocity"])]
+    else:
+        polynomial = _polynomials[obj.session_uid]
+        origin = polynomial.coefficients[:, :, 3]  # (D + 1, 3): the origin relative to the observer
+        motions = []
+        for u in (-1.0, 0.0, 1.0):
+            powers = np.arange(1, len(origin))
+            w = (powers * u ** (powers - 1)) @ origin[1:] / polynomial.half
+            motions.append((origin[0] + polynomial.centre * origin[1] / polynomial.half, tuple(w)))
+    bound = 0.0
+    for offset, velocity in motions:
+        at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
+        at_t_o[:3, 3] = offset + x_o
+        bound = max(bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, velocity))
+    return bound
 
 
 def update(
@@ -247,15 +320,11 @@ def update(
     inputs, coefficients = found
     if coefficients is not None:
         write_intervals(data, coefficients, codes)  # the cache changed: the object is evaluated again
-    else:  # the closed form
+    else:  # the closed form, or the polynomial
         if len(data.vertices) != (0 if codes is None else len(codes)):  # the face codes alone
             modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
-            at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
-            offset = cast("tuple[float, float, float]", inputs["Scene Offset"])
-            at_t_o[:3, 3] = np.asarray(offset) + np.asarray(snap.mesh_observer[1])
-            size = tessellation.render_size(scene)
-            bound = tessellation.edge_image_bound(obj, at_t_o, snap, size, inputs["Velocity"])
+            bound = _edge_bound(obj, obj_eval, snap, scene, inputs)
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
     modifier.set_inputs(mod, inputs)
     modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from ..common import names
 from ..common.nodes import Literal, Node, fmath, vmath
+from .polynomial_nodes import POLYNOMIAL_INPUTS, polynomial_nodes
 
 # Closed-form steps from the origin's light-travel distance: the first reads one interval for all
 # points and sums its cubic into two 4x4 maps (two Transform Points per point); each other reads
@@ -48,6 +49,7 @@ KEYFRAMED_INPUTS = (
     ),
     ("Observer Inverse Gamma", "NodeSocketFloat", {"default_value": 1.0}),
     ("Observer Factor", "NodeSocketFloat", {"default_value": 0.5}),
+    *POLYNOMIAL_INPUTS,
 )
 
 
@@ -155,12 +157,14 @@ def _evaluate(nodes: dict[str, Node], tag: str, sigma: object) -> tuple[str, str
     return f"{tag}_x.Vector", f"{tag}_rate.Vector", f"{tag}_s"
 
 
-def _step(nodes: dict[str, Node], tag: str, sigma: object, x: str, rate: str) -> str:
+def _step(
+    nodes: dict[str, Node], tag: str, sigma: object, x: str, rate: str, scale: str = "group.Grid Per Distance"
+) -> str:
     """Nodes for the next light-travel distance: uniform motion through ``x`` with its velocity
-    ``w`` (units of c) solved in closed form (in whichever form avoids cancellation)."""
+    ``w = rate * scale`` (units of c) solved in closed form (in whichever form avoids cancellation)."""
     nodes.update(
         {
-            f"{tag}_w": vmath("SCALE", rate, scale="group.Grid Per Distance"),
+            f"{tag}_w": vmath("SCALE", rate, scale=scale),
             f"{tag}_r": _multiply_add(f"{tag}_w.Vector", sigma, x),
             f"{tag}_a": vmath("DOT_PRODUCT", f"{tag}_r.Vector", f"{tag}_w.Vector"),
             f"{tag}_q": vmath("DOT_PRODUCT", f"{tag}_r.Vector", f"{tag}_r.Vector"),
@@ -186,6 +190,31 @@ def _step(nodes: dict[str, Node], tag: str, sigma: object, x: str, rate: str) ->
         }
     )
     return f"{tag}_sigma.Output"
+
+
+def _seen(nodes: dict[str, Node], tag: str, x: str, sigma: object, w: str) -> tuple[str, str]:
+    """Nodes for what the observer sees of the emission point ``x`` (relative to the observer) at
+    light-travel distance ``sigma`` moving with ``w`` (fraction of c): the apparent position in
+    object space and the velocity seen (references)."""
+    nodes.update(
+        {
+            # the apparent position, object space: Emission (x, y, z) + Offset + sigma Delay
+            f"{tag}_e": Node("ShaderNodeSeparateXYZ", {"Vector": x}),
+            f"{tag}_lx": _multiply_add(f"{tag}_e.X", "group.Emission X", "group.Emission Offset"),
+            f"{tag}_ly": _multiply_add(f"{tag}_e.Y", "group.Emission Y", f"{tag}_lx.Vector"),
+            f"{tag}_lz": _multiply_add(f"{tag}_e.Z", "group.Emission Z", f"{tag}_ly.Vector"),
+            f"{tag}_local": _multiply_add(sigma, "group.Emission Delay", f"{tag}_lz.Vector"),
+            # u' = [u / gamma + v (1 + F v.u)] / (1 + v.u), v = Observer Velocity, F = gamma / (gamma + 1)
+            f"{tag}_vu": vmath("DOT_PRODUCT", w, "group.Observer Velocity"),
+            f"{tag}_along": fmath("MULTIPLY_ADD", "group.Observer Factor", f"{tag}_vu.Value", 1.0),
+            f"{tag}_slow": vmath("SCALE", w, scale="group.Observer Inverse Gamma"),
+            f"{tag}_sum": _multiply_add("group.Observer Velocity", f"{tag}_along", f"{tag}_slow.Vector"),
+            f"{tag}_denominator": fmath("ADD", f"{tag}_vu.Value", 1.0),
+            f"{tag}_inverse": fmath("DIVIDE", 1.0, f"{tag}_denominator"),
+            f"{tag}_beta_seen": vmath("SCALE", f"{tag}_sum.Vector", scale=f"{tag}_inverse"),
+        }
+    )
+    return f"{tag}_local.Vector", f"{tag}_beta_seen.Vector"
 
 
 def keyframed_nodes() -> dict[str, Node]:
@@ -219,20 +248,6 @@ def keyframed_nodes() -> dict[str, Node]:
         {
             "kf_minus_sigma": fmath("MULTIPLY", sigma, -1.0),
             "kf_x": _multiply_add(f"{tag}_w.Vector", "kf_minus_sigma", f"{tag}_r.Vector"),
-            # the apparent position, object space: Emission (x, y, z) + Offset + sigma Delay
-            "kf_e": Node("ShaderNodeSeparateXYZ", {"Vector": x}),
-            "kf_lx": _multiply_add("kf_e.X", "group.Emission X", "group.Emission Offset"),
-            "kf_ly": _multiply_add("kf_e.Y", "group.Emission Y", "kf_lx.Vector"),
-            "kf_lz": _multiply_add("kf_e.Z", "group.Emission Z", "kf_ly.Vector"),
-            "kf_local": _multiply_add(sigma, "group.Emission Delay", "kf_lz.Vector"),
-            # u' = [u / gamma + v (1 + F v.u)] / (1 + v.u), v = Observer Velocity, F = gamma / (gamma + 1)
-            "kf_vu": vmath("DOT_PRODUCT", f"{tag}_w.Vector", "group.Observer Velocity"),
-            "kf_along": fmath("MULTIPLY_ADD", "group.Observer Factor", "kf_vu.Value", 1.0),
-            "kf_slow": vmath("SCALE", f"{tag}_w.Vector", scale="group.Observer Inverse Gamma"),
-            "kf_sum": _multiply_add("group.Observer Velocity", "kf_along", "kf_slow.Vector"),
-            "kf_denominator": fmath("ADD", "kf_vu.Value", 1.0),
-            "kf_inverse": fmath("DIVIDE", 1.0, "kf_denominator"),
-            "kf_beta_seen": vmath("SCALE", "kf_sum.Vector", scale="kf_inverse"),
             # found: s within the intervals, and the last step small
             "kf_s_high": fmath("ADD", "group.Last Interval", 1.0),
             "kf_after_start": Node(
@@ -260,45 +275,28 @@ def keyframed_nodes() -> dict[str, Node]:
             ),
         }
     )
+    local, beta = _seen(nodes, "kf", x, sigma, f"{tag}_w.Vector")
+    polynomial, kp_x, kp_sigma, kp_w = polynomial_nodes(_step)
+    nodes.update(polynomial)
+    kp_local, kp_beta = _seen(nodes, "kp", kp_x, kp_sigma, kp_w)
     items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"), ("FLOAT", "Inside"))}
-    captured = {"Seen": "kf_local.Vector", "Beta": "kf_beta_seen.Vector", "Inside": "kf_found.Boolean"}
+    captured = {"Seen": local, "Beta": beta, "Inside": "kf_found.Boolean"}
+    kp_items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"))}
+    kp_captured = {"Seen": kp_local, "Beta": kp_beta}
     nodes.update(
         {
             "kf_capture": Node("GeometryNodeCaptureAttribute", {"Geometry": "store_rest.Geometry", **captured}, items),
             "kf_capture_whole": Node(
                 "GeometryNodeCaptureAttribute", {"Geometry": "whole_rest.Geometry", **captured}, items
             ),
-            # Switches on single values: only the side asked for is computed
-            "kf_geometry": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "store_rest.Geometry", "True": "kf_capture.Geometry"},
-                {"input_type": "GEOMETRY"},
+            "kp_capture": Node(
+                "GeometryNodeCaptureAttribute", {"Geometry": "store_rest.Geometry", **kp_captured}, kp_items
             ),
-            "kf_whole_geometry": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "whole_rest.Geometry", "True": "kf_capture_whole.Geometry"},
-                {"input_type": "GEOMETRY"},
+            "kp_capture_whole": Node(
+                "GeometryNodeCaptureAttribute", {"Geometry": "whole_rest.Geometry", **kp_captured}, kp_items
             ),
-            "kf_whole_seen": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "apparent.Vector", "True": "kf_capture_whole.Seen"},
-                {"input_type": "VECTOR"},
-            ),
-            "kf_seen": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "sample_position.Value", "True": "kf_capture.Seen"},
-                {"input_type": "VECTOR"},
-            ),
-            "kf_beta": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "edges_short.Output", "False": "kf_capture.Beta", "True": "kf_capture_whole.Beta"},
-                {"input_type": "VECTOR"},
-            ),
-            "kf_cache_beta": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "sample_beta.Value", "True": "kf_beta.Output"},
-                {"input_type": "VECTOR"},
-            ),
+            "kf_beta": _switch("edges_short.Output", "kf_capture.Beta", "kf_capture_whole.Beta", "VECTOR"),
+            "kp_beta": _switch("edges_short.Output", "kf_capture.Beta", "kf_capture_whole.Beta", "VECTOR", "kp"),
             "kf_inside_field": Node(
                 "GeometryNodeSwitch",
                 {"Switch": "edges_short.Output", "False": "kf_capture.Inside", "True": "kf_capture_whole.Inside"},
@@ -309,7 +307,29 @@ def keyframed_nodes() -> dict[str, Node]:
             ),
         }
     )
+    # Switches on single values: only the side asked for is computed (Keyframed, then Polynomial)
+    for name, off, solved, kind in _ROUTES:
+        polynomial_side = solved.replace("kf_capture", "kp_capture").replace("kf_beta", "kp_beta")
+        nodes[f"{name}_solved"] = _switch("group.Polynomial", solved, polynomial_side, kind)
+        nodes[name] = _switch("group.Keyframed", off, f"{name}_solved.Output", kind)
     return nodes
+
+
+# (output, without Keyframed, the general solve's): the polynomial's is the same with kp_ for kf_
+_ROUTES = (
+    ("kf_geometry", "store_rest.Geometry", "kf_capture.Geometry", "GEOMETRY"),
+    ("kf_whole_geometry", "whole_rest.Geometry", "kf_capture_whole.Geometry", "GEOMETRY"),
+    ("kf_whole_seen", "apparent.Vector", "kf_capture_whole.Seen", "VECTOR"),
+    ("kf_seen", "sample_position.Value", "kf_capture.Seen", "VECTOR"),
+    ("kf_cache_beta", "sample_beta.Value", "kf_beta.Output", "VECTOR"),
+)
+
+
+def _switch(switch: str, false: object, true: object, kind: str, prefix: str = "kf") -> Node:
+    """A Switch on ``switch`` (``prefix`` ``kp``: both sides the polynomial's captures)."""
+    if prefix == "kp":
+        false, true = (str(side).replace("kf_capture", "kp_capture") for side in (false, true))
+    return Node("GeometryNodeSwitch", {"Switch": switch, "False": false, "True": true}, {"input_type": kind})
 
 
 def window_verdict_nodes(geometry: str) -> dict[str, Node]:
@@ -329,9 +349,11 @@ def window_verdict_nodes(geometry: str) -> dict[str, Node]:
             {"A": "kf_outside_count.Sum", "B": 0.5},
             {"data_type": "FLOAT", "operation": "LESS_THAN"},
         ),
+        # the polynomial's window and convergence were checked in Python (keyframed.py): no statistic
+        "kf_window_ok": _switch("group.Polynomial", "kf_all_inside.Result", True, "BOOLEAN"),
         "kf_store_window": Node(
             "GeometryNodeStoreNamedAttribute",
-            {"Geometry": geometry, "Name": Literal(names.WINDOW_OK_ATTRIBUTE), "Value": "kf_all_inside.Result"},
+            {"Geometry": geometry, "Name": Literal(names.WINDOW_OK_ATTRIBUTE), "Value": "kf_window_ok.Output"},
             {"data_type": "BOOLEAN", "domain": "FACE"},
         ),
         "store_window": Node(

@@ -305,3 +305,19 @@ def straight_keys(
             if (path, index) not in curves:
                 start[index] += float(getattr(obj, path)[index])
     return start, rate
+
+
+def translates_only(obj: Object) -> bool:
+    """Whether the object's keyframes only move it: no parent, no F-curve modifiers, every rotation
+    and scale channel one value at every key and handle (the conditions of :func:`straight_keys`
+    but the location channels' interpolation)."""
+    if obj.parent is not None:
+        return False
+    for (path, _index), fcurve in _transform_fcurves(obj).items():
+        if len(fcurve.modifiers):
+            return False
+        if path not in LOCATION_PATHS:
+            points = fcurve.keyframe_points
+            if len({value for p in points for value in (p.co[1], p.handle_left[1], p.handle_right[1])}) > 1:
+                return False
+    return True

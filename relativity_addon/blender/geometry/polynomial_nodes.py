@@ -1,0 +1,91 @@
+"""Keyframed motion that one polynomial in time covers over the window of its retarded times
+(``physics/polynomial_motion.py``; ``keyframed.py`` decides): the modifier's small solve, linked by
+``keyframed_nodes.py`` under its ``Keyframed`` switch when ``Polynomial`` is on. No interval is read
+per point (no Sample Index) and no verdict is taken over the points: ``keyframed.py`` checked in
+Python that the polynomial follows the sampled motion to its rounding and that the steps converge.
+
+Per point: ``P_i = C_i p`` (one Transform Point per coefficient, the matrices single values), the
+closed form of uniform motion through ``P_0`` at the window's centre with velocity ``P_1 / half``
+(``|r - sigma w| = sigma``), then NEWTON_STEPS Newton steps on ``|x(u)|^2 - sigma^2``, ``x`` and its
+rate by Horner's scheme; the emission point moved to the last ``sigma`` along the velocity there.
+"""
+
+from __future__ import annotations
+
+from ...physics.polynomial_motion import DEGREE, NEWTON_STEPS
+from ..common.nodes import Node, fmath, vmath
+
+_PARTS = ("X", "Y", "Z", "Offset")
+POLYNOMIAL_INPUTS = (
+    ("Polynomial", "NodeSocketBool", {"default_value": False}),
+    ("Polynomial Centre", "NodeSocketFloat", {"default_value": 0.0}),
+    ("Polynomial Rate", "NodeSocketFloat", {"default_value": 1.0}),
+    *((f"Polynomial {power} {part}", "NodeSocketVector", None) for power in range(DEGREE + 1) for part in _PARTS),
+)
+
+
+def _multiply_add(a: object, b: object, c: object) -> Node:
+    return Node("ShaderNodeVectorMath", {0: a, 1: b, 2: c}, {"operation": "MULTIPLY_ADD"})
+
+
+def polynomial_nodes(step_nodes: object) -> tuple[dict[str, Node], str, str, str]:
+    """The solve's nodes on ``position`` (the rest positions); ``step_nodes(nodes, tag, sigma, x,
+    rate, scale)`` adds the closed form of uniform motion (``keyframed_nodes._step``). Returns the
+    nodes and the references of the emission point relative to the observer, its light-travel
+    distance and its velocity (fraction of c)."""
+    nodes: dict[str, Node] = {
+        "kp_minus_rate": fmath("MULTIPLY", "group.Polynomial Rate", -1.0),
+        "kp_offset": fmath("MULTIPLY", "group.Polynomial Centre", "group.Polynomial Rate"),
+    }
+    terms = []
+    for power in range(DEGREE + 1):
+        entries = {}
+        for column, part in enumerate(_PARTS, start=1):
+            vector = f"group.Polynomial {power} {part}"
+            nodes[f"kp_c{power}{column}"] = Node("ShaderNodeSeparateXYZ", {"Vector": vector})
+            for row, axis in enumerate("XYZ", start=1):
+                entries[f"Column {column} Row {row}"] = f"kp_c{power}{column}.{axis}"
+        nodes[f"kp_m{power}"] = Node("FunctionNodeCombineMatrix", entries)
+        nodes[f"kp_p{power}"] = Node(
+            "FunctionNodeTransformPoint", {"Vector": "position.Position", "Transform": f"kp_m{power}.Matrix"}
+        )
+        terms.append(f"kp_p{power}.Vector")
+    # the start: uniform motion through P_0 at the centre with the velocity P_1 / half
+    sigma = step_nodes(nodes, "kp_start", "group.Polynomial Centre", terms[0], terms[1], "group.Polynomial Rate")
+    x = w = m = ""
+    for step in range(NEWTON_STEPS):
+        tag = f"kp{step}"
+        u = f"{tag}_u"
+        nodes[u] = fmath("MULTIPLY_ADD", sigma, "kp_minus_rate", "kp_offset")
+        value, slope = terms[-1], terms[-1]
+        for power in range(DEGREE - 1, -1, -1):  # Horner's scheme, the derivative alongside
+            if power < DEGREE - 1:
+                nodes[f"{tag}_d{power}"] = _multiply_add(slope, u, value)
+                slope = f"{tag}_d{power}.Vector"
+            nodes[f"{tag}_v{power}"] = _multiply_add(value, u, terms[power])
+            value = f"{tag}_v{power}.Vector"
+        x = value
+        nodes.update(
+            {
+                f"{tag}_xx": vmath("DOT_PRODUCT", x, x),
+                f"{tag}_xr": vmath("DOT_PRODUCT", x, slope),
+                f"{tag}_ss": fmath("MULTIPLY", sigma, sigma),
+                f"{tag}_num": fmath("SUBTRACT", f"{tag}_ss", f"{tag}_xx.Value"),
+                f"{tag}_den": fmath("MULTIPLY_ADD", f"{tag}_xr.Value", "group.Polynomial Rate", sigma),
+                f"{tag}_m": fmath("DIVIDE", f"{tag}_num", f"{tag}_den"),
+                f"{tag}_sigma": fmath("MULTIPLY_ADD", f"{tag}_m", -0.5, sigma),
+            }
+        )
+        w, m = f"{tag}_w", f"{tag}_half_m"
+        sigma = f"{tag}_sigma"
+    last = f"kp{NEWTON_STEPS - 1}"
+    nodes.update(
+        {
+            # the velocity (fraction of c) where the last step evaluated; the emission point moved to
+            # the last sigma along it: x(sigma') = x - (sigma' - sigma) w, sigma' - sigma = -m / 2
+            w: vmath("SCALE", slope, scale="group.Polynomial Rate"),
+            m: fmath("MULTIPLY", f"{last}_m", 0.5),
+            "kp_x": _multiply_add(w + ".Vector", m, x),
+        }
+    )
+    return nodes, "kp_x.Vector", sigma, w + ".Vector"
