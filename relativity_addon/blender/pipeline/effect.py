@@ -305,7 +305,9 @@ def sync(
     evaluated again (``apparent_meshes.update_object``).
     Never raises."""
     if depsgraph is not None:
-        apparent_meshes.note_updates(depsgraph)  # also while computing: what Blender evaluated again
+        # also while computing: what Blender evaluated again (a render's fresh depsgraph: only
+        # the meshes whose inputs differ from the viewport's; no shading-only update: changes.reported)
+        apparent_meshes.note_updates(changes.reported(depsgraph))
     if busy.is_computing():
         return None
     if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
