@@ -26,7 +26,8 @@ import bpy
 import numpy as np
 
 from ...errors import RelativityError
-from ..common import busy, names
+from ..common import busy, compat, names
+from ..common.nodes import interface_identifier
 from ..scene import snapshot
 from . import changes, clip_end, instancing, keyframed, modifier, motion, tessellation
 from .modifier import applied_objects
@@ -119,10 +120,17 @@ def geometry_key(obj: Object) -> tuple | None:
 
 
 def object_signature(
-    snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None, fingerprint: tuple[int, int] | None = None
+    snap: Snapshot,
+    obj: Object,
+    depsgraph: Depsgraph | None = None,
+    fingerprint: tuple[int, int] | None = None,
+    expected: tuple[bool | None, bool | None] = (None, None),
 ) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache
-    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
+    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``).
+    ``expected``: the modifier's verdicts (edges short, window found) that the update expects from
+    the next evaluation, in place of ``depsgraph``'s where its evaluation made none (None: take
+    the evaluation's), so that an evaluation confirming them changes nothing."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     verdict: object = None
@@ -135,8 +143,10 @@ def object_signature(
         keyframed_on = not closed and mod is not None and modifier.closed_form_on(mod)
         measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
         short = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
+        short = expected[0] if expected[0] is not None and measured else short
         # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals
-        verdict = (short, keyframed.window_found(evaluated)) if keyframed_on else short
+        window = keyframed.window_found(evaluated) if expected[1] is None else expected[1]
+        verdict = (short, window) if keyframed_on else short
         if fingerprint is not None:
             pass
         elif (closed or keyframed_on) and (not measured or short):
@@ -201,6 +211,8 @@ def update_object(
     _deferred.discard(obj.name)
     changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
+    # the verdicts the last evaluation made (else none yet, as at Set Up: the update expects its own)
+    checked = modifier.closed_form_on(mod) and _input(mod, "Measure Edges"), keyframed.is_on(mod)
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
@@ -225,11 +237,16 @@ def update_object(
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
+    # the verdict the modifier's check gives at the next evaluation if it agrees with this decision
+    short = (
+        None if checked[0] or measure is None or decision is None else decision.level == 0 and decision.codes is None
+    )
     if closed:
-        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
+        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short)
     obj_eval = obj.evaluated_get(depsgraph)
     if in_modifier and keyframed.update(obj, depsgraph, snap, scene, mod, cache, codes, measure):
-        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+        expected = (short, None if checked[1] or not keyframed.is_on(mod) else True)  # the window holds its bound
+        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=expected)
         for key in (names.ERROR_KEY, names.WARNING_KEY):
             if key in cache.data:
                 del cache.data[key]
@@ -264,7 +281,11 @@ def update_object(
     return len(local)
 
 
-def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure):
+def _input(mod, name):
+    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, name)))
+
+
+def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short):
     """:func:`update_object` of a closed-form object (``motion.closed_form``): the modifier
     computes the positions and the velocity attribute; this sets its inputs (a few vectors), and
     reads and writes no vertex. The farthest seen depth comes from the evaluated bounds
@@ -280,7 +301,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
     if len(cache.data.vertices) != points:  # positions of an update on the cache's path
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         changed = True
-    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=(short, None))
     for key in (names.ERROR_KEY, names.WARNING_KEY):
         if key in cache.data:
             del cache.data[key]
