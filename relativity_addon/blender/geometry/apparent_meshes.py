@@ -26,8 +26,7 @@ import bpy
 import numpy as np
 
 from ...errors import RelativityError
-from ..common import busy, compat, names
-from ..common.nodes import interface_identifier
+from ..common import busy, names
 from ..scene import snapshot
 from . import changes, clip_end, instancing, keyframed, modifier, motion, tessellation
 from .modifier import applied_objects
@@ -128,9 +127,8 @@ def object_signature(
 ) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache
     (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``).
-    ``expected``: the modifier's verdicts (edges short, window found) that the update expects from
-    the next evaluation, in place of ``depsgraph``'s where its evaluation made none (None: take
-    the evaluation's), so that an evaluation confirming them changes nothing."""
+    ``expected``: the verdicts (edges short, window found) the update expects, in place of those of
+    an evaluation that made none (None: the evaluation's); an evaluation confirming them changes nothing."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     verdict: object = None
@@ -198,7 +196,12 @@ def deferred() -> bool:
 
 
 def update_object(
-    scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None, in_frame_change: bool = False
+    scene: Scene,
+    obj: Object,
+    snap: Snapshot,
+    depsgraph: Depsgraph | None = None,
+    in_frame_change: bool = False,
+    check_first: bool = False,
 ) -> int:
     """Recompute the cache of one object for the snapshot's frame. Raises RelativityError.
 
@@ -211,8 +214,7 @@ def update_object(
     _deferred.discard(obj.name)
     changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
-    # the verdicts the last evaluation made (else none yet, as at Set Up: the update expects its own)
-    checked = modifier.closed_form_on(mod) and _input(mod, "Measure Edges"), keyframed.is_on(mod)
+    checked = keyframed.verdicts_made(mod)  # none yet at Set Up: the update then expects its own
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
@@ -220,7 +222,8 @@ def update_object(
     in_modifier = closed or keyframed.can_show(obj, scene)
     measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if in_modifier else None
     try:
-        if measure is not None and (measure["Edges Proven Short"] or tessellation.edges_short(obj_eval)):
+        unchecked = check_first and not checked[0]  # Set Up: the modifier's check first (apply)
+        if measure is not None and (measure["Edges Proven Short"] or tessellation.edges_short(obj_eval) or unchecked):
             # the bound shows every edge's image short, or the modifier found them so at its last
             # evaluation and left the mesh whole; it checks again at the next (a longer edge shows
             # in the signature: decided then)
@@ -237,10 +240,8 @@ def update_object(
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
-    # the verdict the modifier's check gives at the next evaluation if it agrees with this decision
-    short = (
-        None if checked[0] or measure is None or decision is None else decision.level == 0 and decision.codes is None
-    )
+    agrees = decision is not None and decision.level == 0 and decision.codes is None  # the check's verdict then
+    short = None if checked[0] or measure is None or decision is None else agrees
     if closed:
         return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short)
     obj_eval = obj.evaluated_get(depsgraph)
@@ -252,6 +253,10 @@ def update_object(
                 del cache.data[key]
         obj.update_tag()
         return len(obj_eval.data.vertices)
+    if measure is not None and unchecked:  # on the Python path: no check, decided after an evaluation
+        _deferred.add(obj.name)
+        cache.data[names.SIGNATURE_KEY] = ""
+        return 0
     changed = modifier.set_closed_form(mod, None)
     changed |= modifier.set_inputs(mod, {"Measure Edges": False, "Keyframed": False})
     if changed:  # the rest positions are stored before the closed form: they are current
@@ -279,10 +284,6 @@ def update_object(
         del cache.data[names.WARNING_KEY]
     obj.update_tag()
     return len(local)
-
-
-def _input(mod, name):
-    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, name)))
 
 
 def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short):
@@ -483,10 +484,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
             for obj in objects:
                 modifier.ensure_modifier(obj)
             depsgraph = bpy.context.evaluated_depsgraph_get()
-            # as in a frame change: no evaluation per object (each costs a pass over the scene);
-            # the meshes whose positions need their new subdivision's are computed after one
+            # as in a frame change: no evaluation per object (each costs a pass over the scene); the
+            # modifiers check the edges first: after one evaluation, the meshes whose verdicts are not
+            # what their update expected are computed again, those needing a new subdivision after one more
             for obj in objects:
-                update_object(scene, obj, snap, depsgraph, in_frame_change=True)
+                update_object(scene, obj, snap, depsgraph, in_frame_change=True, check_first=True)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            for obj in [obj for obj in objects if obj.name not in _deferred]:
+                if modifier.cache_data(obj).get(names.SIGNATURE_KEY) != object_signature(snap, obj, depsgraph):
+                    update_object(scene, obj, snap, depsgraph, in_frame_change=True)
             waiting = [obj for obj in objects if obj.name in _deferred]
             if waiting:
                 depsgraph = bpy.context.evaluated_depsgraph_get()

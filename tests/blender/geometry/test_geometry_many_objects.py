@@ -250,8 +250,10 @@ def test_set_up_computes_each_keyframed_mesh_once(relativity_addon, monkeypatch,
     """Issue 26, Set Up of many keyframed meshes: Set Up, the evaluation after it and the syncs that
     follow compute each mesh's keyframed inputs once (``keyframed.update``; on main the first
     evaluation's verdicts, which the signature stored at Set Up did not hold yet, made the next sync
-    compute every mesh again), and the meshes are where a recomputation from scratch puts them.
-    Linear keys take the closed form, eased (Bezier) keys the keyframed solve."""
+    compute every mesh again) and run no Python edge measure where the modifier's check finds every
+    edge short (``tessellation.decide``: on main once per mesh before the check), and the meshes are
+    where a recomputation from scratch puts them. Linear keys take the closed form, eased (Bezier)
+    keys the keyframed solve."""
     import bpy
 
     scene, movers = _keyframed_scene(bpy)
@@ -269,6 +271,10 @@ def test_set_up_computes_each_keyframed_mesh_once(relativity_addon, monkeypatch,
         return original(obj, *args, **kwargs)
 
     monkeypatch.setattr(keyframed, "update", counted)
+    tessellation = gh.addon_module("geometry.tessellation")
+    measured = []
+    decide = tessellation.decide
+    monkeypatch.setattr(tessellation, "decide", lambda *args: measured.append(args[1].name) or decide(*args))
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()  # the viewport's redraw: the verdicts
     effect = gh.addon_module("pipeline.effect")
@@ -278,6 +284,7 @@ def test_set_up_computes_each_keyframed_mesh_once(relativity_addon, monkeypatch,
     on = [gh.addon_module("geometry.modifier").find_modifier(obj) for obj in movers]
     assert all(keyframed.is_on(mod) for mod in on) == (interpolation == "BEZIER"), "not the expected path"
     assert updates == Counter({f"Mover {k}": 1 for k in range(COUNT)}), dict(updates)
+    assert not measured, f"the Python edge measure ran for {measured}"
 
     for obj in movers:  # every mesh computed again from scratch, for the same frame and observer
         gh.addon_module("geometry.modifier").cache_data(obj)[gh.addon_module("common.names").SIGNATURE_KEY] = ""
