@@ -18,8 +18,8 @@ GEOMETRY_GROUP = "Relativity Apparent Geometry"  # geometry-nodes group
 GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
 GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
 # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form; 4: keyframed motion in
-# the modifier; 5: Edges Proven Short
-GEOMETRY_GROUP_VERSION = 6
+# the modifier; 5: Edges Proven Short; 7: the keyframed captures read by index (no attribute left on the output)
+GEOMETRY_GROUP_VERSION = 7
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)

@@ -262,36 +262,44 @@ def keyframed_nodes() -> dict[str, Node]:
     )
     items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"), ("FLOAT", "Inside"))}
     captured = {"Seen": "kf_local.Vector", "Beta": "kf_beta_seen.Vector", "Inside": "kf_found.Boolean"}
+    # The captures stay on side branches, read by index (a copy): Blender 4.5 keeps a capture's
+    # anonymous attribute on the modifier's output mesh (5.2 drops it), 28 bytes per point in every
+    # evaluated mesh, the render's too; read this way, it goes with the branch.
+    for capture, geometry in (("kf_capture", "store_rest.Geometry"), ("kf_capture_whole", "whole_rest.Geometry")):
+        nodes[capture] = Node("GeometryNodeCaptureAttribute", {"Geometry": geometry, **captured}, items)
+        for item, data_type in (("Seen", "FLOAT_VECTOR"), ("Beta", "FLOAT_VECTOR"), ("Inside", "FLOAT")):
+            nodes[f"{capture}_{item.lower()}"] = Node(
+                "GeometryNodeSampleIndex",
+                {"Geometry": f"{capture}.Geometry", "Value": f"{capture}.{item}", "Index": "index.Index"},
+                {"data_type": data_type, "domain": "POINT"},
+            )
     nodes.update(
         {
-            "kf_capture": Node("GeometryNodeCaptureAttribute", {"Geometry": "store_rest.Geometry", **captured}, items),
-            "kf_capture_whole": Node(
-                "GeometryNodeCaptureAttribute", {"Geometry": "whole_rest.Geometry", **captured}, items
-            ),
-            # Switches on single values: only the side asked for is computed
+            # (no geometry switch: the captured values are read on store_rest's and whole_rest's points)
             "kf_geometry": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "store_rest.Geometry", "True": "kf_capture.Geometry"},
-                {"input_type": "GEOMETRY"},
+                "GeometryNodeSwitch", {"Switch": False, "False": "store_rest.Geometry"}, {"input_type": "GEOMETRY"}
             ),
             "kf_whole_geometry": Node(
-                "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "whole_rest.Geometry", "True": "kf_capture_whole.Geometry"},
-                {"input_type": "GEOMETRY"},
+                "GeometryNodeSwitch", {"Switch": False, "False": "whole_rest.Geometry"}, {"input_type": "GEOMETRY"}
             ),
+            # Switches on single values: only the side asked for is computed
             "kf_whole_seen": Node(
                 "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "apparent.Vector", "True": "kf_capture_whole.Seen"},
+                {"Switch": "group.Keyframed", "False": "apparent.Vector", "True": "kf_capture_whole_seen.Value"},
                 {"input_type": "VECTOR"},
             ),
             "kf_seen": Node(
                 "GeometryNodeSwitch",
-                {"Switch": "group.Keyframed", "False": "sample_position.Value", "True": "kf_capture.Seen"},
+                {"Switch": "group.Keyframed", "False": "sample_position.Value", "True": "kf_capture_seen.Value"},
                 {"input_type": "VECTOR"},
             ),
             "kf_beta": Node(
                 "GeometryNodeSwitch",
-                {"Switch": "edges_short.Output", "False": "kf_capture.Beta", "True": "kf_capture_whole.Beta"},
+                {
+                    "Switch": "edges_short.Output",
+                    "False": "kf_capture_beta.Value",
+                    "True": "kf_capture_whole_beta.Value",
+                },
                 {"input_type": "VECTOR"},
             ),
             "kf_cache_beta": Node(
@@ -301,7 +309,11 @@ def keyframed_nodes() -> dict[str, Node]:
             ),
             "kf_inside_field": Node(
                 "GeometryNodeSwitch",
-                {"Switch": "edges_short.Output", "False": "kf_capture.Inside", "True": "kf_capture_whole.Inside"},
+                {
+                    "Switch": "edges_short.Output",
+                    "False": "kf_capture_inside.Value",
+                    "True": "kf_capture_whole_inside.Value",
+                },
                 {"input_type": "FLOAT"},
             ),
             "in_modifier": Node(
