@@ -119,10 +119,16 @@ def geometry_key(obj: Object) -> tuple | None:
 
 
 def object_signature(
-    snap: Snapshot, obj: Object, depsgraph: Depsgraph | None = None, fingerprint: tuple[int, int] | None = None
+    snap: Snapshot,
+    obj: Object,
+    depsgraph: Depsgraph | None = None,
+    fingerprint: tuple[int, int] | None = None,
+    expected: tuple[bool | None, bool | None] = (None, None),
 ) -> str:
     """Everything the object's apparent positions depend on, as a string stored with its cache
-    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``)."""
+    (the evaluated rest shape too, given the update's ``depsgraph``, or its ``fingerprint``).
+    ``expected``: the verdicts (edges short, window found) the update expects, in place of those of
+    an evaluation that made none (None: the evaluation's); an evaluation confirming them changes nothing."""
     relativity = obj.relativity
     evaluated = obj.evaluated_get(depsgraph) if depsgraph is not None else obj
     verdict: object = None
@@ -135,8 +141,10 @@ def object_signature(
         keyframed_on = not closed and mod is not None and modifier.closed_form_on(mod)
         measured = bool(relativity.use_adaptive_tessellation and relativity.tessellation > 0)
         short = tessellation.edges_short(evaluated) if (closed or keyframed_on) and measured else None
+        short = expected[0] if expected[0] is not None and measured else short
         # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals
-        verdict = (short, keyframed.window_found(evaluated)) if keyframed_on else short
+        window = keyframed.window_found(evaluated) if expected[1] is None else expected[1]
+        verdict = (short, window) if keyframed_on else short
         if fingerprint is not None:
             pass
         elif (closed or keyframed_on) and (not measured or short):
@@ -188,7 +196,12 @@ def deferred() -> bool:
 
 
 def update_object(
-    scene: Scene, obj: Object, snap: Snapshot, depsgraph: Depsgraph | None = None, in_frame_change: bool = False
+    scene: Scene,
+    obj: Object,
+    snap: Snapshot,
+    depsgraph: Depsgraph | None = None,
+    in_frame_change: bool = False,
+    check_first: bool = False,
 ) -> int:
     """Recompute the cache of one object for the snapshot's frame. Raises RelativityError.
 
@@ -201,6 +214,7 @@ def update_object(
     _deferred.discard(obj.name)
     changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
+    checked = keyframed.verdicts_made(mod)  # none yet at Set Up: the update then expects its own
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     obj_eval = obj.evaluated_get(depsgraph)
@@ -208,7 +222,8 @@ def update_object(
     in_modifier = closed or keyframed.can_show(obj, scene)
     measure = tessellation.edge_measure_inputs(scene, obj, obj_eval, snap) if in_modifier else None
     try:
-        if measure is not None and (measure["Edges Proven Short"] or tessellation.edges_short(obj_eval)):
+        unchecked = check_first and not checked[0]  # Set Up: the modifier's check first (apply)
+        if measure is not None and (measure["Edges Proven Short"] or tessellation.edges_short(obj_eval) or unchecked):
             # the bound shows every edge's image short, or the modifier found them so at its last
             # evaluation and left the mesh whole; it checks again at the next (a longer edge shows
             # in the signature: decided then)
@@ -225,16 +240,23 @@ def update_object(
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
+    agrees = decision is not None and decision.level == 0 and decision.codes is None  # the check's verdict then
+    short = None if checked[0] or measure is None or decision is None else agrees
     if closed:
-        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
+        return _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short)
     obj_eval = obj.evaluated_get(depsgraph)
     if in_modifier and keyframed.update(obj, depsgraph, snap, scene, mod, cache, codes, measure):
-        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+        expected = (short, None if checked[1] or not keyframed.is_on(mod) else True)  # the window holds its bound
+        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=expected)
         for key in (names.ERROR_KEY, names.WARNING_KEY):
             if key in cache.data:
                 del cache.data[key]
         obj.update_tag()
         return len(obj_eval.data.vertices)
+    if measure is not None and unchecked:  # on the Python path: no check, decided after an evaluation
+        _deferred.add(obj.name)
+        cache.data[names.SIGNATURE_KEY] = ""
+        return 0
     changed = modifier.set_closed_form(mod, None)
     changed |= modifier.set_inputs(mod, {"Measure Edges": False, "Keyframed": False})
     if changed:  # the rest positions are stored before the closed form: they are current
@@ -264,7 +286,7 @@ def update_object(
     return len(local)
 
 
-def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure):
+def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure, short):
     """:func:`update_object` of a closed-form object (``motion.closed_form``): the modifier
     computes the positions and the velocity attribute; this sets its inputs (a few vectors), and
     reads and writes no vertex. The farthest seen depth comes from the evaluated bounds
@@ -280,7 +302,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure)
     if len(cache.data.vertices) != points:  # positions of an update on the cache's path
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         changed = True
-    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph)
+    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=(short, None))
     for key in (names.ERROR_KEY, names.WARNING_KEY):
         if key in cache.data:
             del cache.data[key]
@@ -462,10 +484,15 @@ def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None)
             for obj in objects:
                 modifier.ensure_modifier(obj)
             depsgraph = bpy.context.evaluated_depsgraph_get()
-            # as in a frame change: no evaluation per object (each costs a pass over the scene);
-            # the meshes whose positions need their new subdivision's are computed after one
+            # as in a frame change: no evaluation per object (each costs a pass over the scene); the
+            # modifiers check the edges first: after one evaluation, the meshes whose verdicts are not
+            # what their update expected are computed again, those needing a new subdivision after one more
             for obj in objects:
-                update_object(scene, obj, snap, depsgraph, in_frame_change=True)
+                update_object(scene, obj, snap, depsgraph, in_frame_change=True, check_first=True)
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            for obj in [obj for obj in objects if obj.name not in _deferred]:
+                if modifier.cache_data(obj).get(names.SIGNATURE_KEY) != object_signature(snap, obj, depsgraph):
+                    update_object(scene, obj, snap, depsgraph, in_frame_change=True)
             waiting = [obj for obj in objects if obj.name in _deferred]
             if waiting:
                 depsgraph = bpy.context.evaluated_depsgraph_get()

@@ -112,6 +112,15 @@ def is_on(mod: Modifier | None) -> bool:
     return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Keyframed")))
 
 
+def verdicts_made(mod: Modifier) -> tuple[bool, bool]:
+    """Whether the modifier's inputs make its verdicts: on the edges (``Measure Edges``, with the closed
+    form or keyframed motion on) and on the window (keyframed motion on). The inputs an update found
+    are those of the last evaluation: a new modifier (Set Up) has made none yet."""
+    group = mod.node_group
+    measured = bool(compat.modifier_input(mod, interface_identifier(group, "Measure Edges")))
+    return measured and modifier.closed_form_on(mod), is_on(mod)
+
+
 def window_found(obj_eval: Object) -> bool | None:
     """The modifier's verdict at its last evaluation: every retarded time inside its intervals (True),
     not (False), or None (it did not compute keyframed motion there)."""

@@ -243,3 +243,58 @@ def test_keyframed_meshes_solve_their_origin_from_the_knots(relativity_addon, mo
     for k in range(COUNT):
         assert np.abs(modifier_points[k] - python_points[k]).max() < 1e-5, f"Mover {k}"
         assert np.abs(python_points[k] - modifier_points[(k + 1) % COUNT]).max() > 1e-2  # meshes tell apart
+
+
+@pytest.mark.parametrize("interpolation", ["LINEAR", "BEZIER"], ids=["linear-keys", "eased-keys"])
+def test_set_up_computes_each_keyframed_mesh_once(relativity_addon, monkeypatch, interpolation):
+    """Issue 26, Set Up of many keyframed meshes: Set Up, the evaluation after it and the syncs that
+    follow compute each mesh's keyframed inputs once (``keyframed.update``; on main the first
+    evaluation's verdicts, which the signature stored at Set Up did not hold yet, made the next sync
+    compute every mesh again) and run no Python edge measure where the modifier's check finds every
+    edge short (``tessellation.decide``: on main once per mesh before the check), and the meshes are
+    where a recomputation from scratch puts them. Linear keys take the closed form, eased (Bezier)
+    keys the keyframed solve."""
+    import bpy
+
+    scene, movers = _keyframed_scene(bpy)
+    for obj in movers:
+        obj.relativity.tessellation_tolerance = 10.0  # every edge short, as the benchmark's grids at 64x48
+        for fcurve in gh.compat.action_fcurves(obj.animation_data):
+            for point in fcurve.keyframe_points:
+                point.interpolation = interpolation
+    keyframed = gh.addon_module("geometry.keyframed")
+    updates = Counter()
+    original = keyframed.update
+
+    def counted(obj, *args, **kwargs):
+        updates[obj.name] += 1
+        return original(obj, *args, **kwargs)
+
+    monkeypatch.setattr(keyframed, "update", counted)
+    tessellation = gh.addon_module("geometry.tessellation")
+    measured = []
+    decide = tessellation.decide
+    monkeypatch.setattr(tessellation, "decide", lambda *args: measured.append(args[1].name) or decide(*args))
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()  # the viewport's redraw: the verdicts
+    effect = gh.addon_module("pipeline.effect")
+    effect.sync(scene)
+    bpy.context.evaluated_depsgraph_get()
+    points = _points(bpy, movers)
+    on = [gh.addon_module("geometry.modifier").find_modifier(obj) for obj in movers]
+    assert all(keyframed.is_on(mod) for mod in on) == (interpolation == "BEZIER"), "not the expected path"
+    assert updates == Counter({f"Mover {k}": 1 for k in range(COUNT)}), dict(updates)
+    assert not measured, f"the Python edge measure ran for {measured}"
+    # no capture's anonymous attribute left on the evaluated meshes (Blender 4.5 kept the keyframed
+    # tree's three, 28 bytes per point in every evaluated mesh, the render's too)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    left = {a.name for obj in movers for a in obj.evaluated_get(depsgraph).data.attributes if a.name.startswith(".a_")}
+    assert not left, f"anonymous attributes on the evaluated meshes: {sorted(left)}"
+
+    for obj in movers:  # every mesh computed again from scratch, for the same frame and observer
+        gh.addon_module("geometry.modifier").cache_data(obj)[gh.addon_module("common.names").SIGNATURE_KEY] = ""
+    effect.sync(scene)
+    bpy.context.evaluated_depsgraph_get()
+    effect.sync(scene)
+    for k, again in enumerate(_points(bpy, movers)):
+        np.testing.assert_allclose(points[k], again, atol=1e-6)
