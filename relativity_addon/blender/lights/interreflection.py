@@ -69,12 +69,19 @@ def _moving_count(scene: Scene) -> int:
     return count
 
 
+def _with_material(scene: Scene) -> bool:
+    """Whether any set-up mesh has a material (the factor goes on materials: none, nothing to build)."""
+    return any(slot.material is not None for obj in modifier.applied_objects(scene) for slot in obj.material_slots)
+
+
 def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
     """The reasons that need no object's position (checked first: a sync pays nothing for them)."""
     if snap.method != "GEOMETRY" or scene.render.engine != "CYCLES":
         return "off the Apparent Geometry path"
     if _moving_count(scene) < 2:
         return "fewer than two moving objects"
+    if not _with_material(scene):
+        return "no moving object has a material"
     if snap.speed > 0.0:
         return "the observer moves"
     if not uses_osl(scene) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
@@ -356,7 +363,11 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
         ]
-    if reason is None or reason in ("off the Apparent Geometry path", "fewer than two moving objects"):
+    if reason is None or reason in (
+        "off the Apparent Geometry path",
+        "fewer than two moving objects",
+        "no moving object has a material",
+    ):
         return []
     return [
         f"Light bounced between moving objects is not corrected, up to {MEASURED_ERROR} off at 0.5c "

@@ -200,3 +200,23 @@ def test_one_moving_object_lighting_objects_at_rest_is_said(relativity_addon, fa
     assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
     assert not [line for line in effect.scene_warnings(scene) if "objects at rest" in line]
     effect.remove(scene)
+
+
+def test_no_group_for_moving_objects_without_materials(relativity_addon, factory_blender):
+    """The factor goes on materials: moving objects without any build no scene group (on main the
+    group was built with one receiver per moving object anyway, its values written at every sync:
+    most of Set Up and of each sync on a scene of many moving meshes)."""
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    for obj in scene.objects:
+        if obj.type == "MESH":
+            obj.data.materials.clear()
+    effect.apply(scene)
+    assert not any(g.name.startswith(names.BOUNCE_SCENE_GROUP) for g in bpy.data.node_groups)
+    bpy.data.objects["Panel"].data.materials.append(bpy.data.materials["White"])
+    effect.sync(scene)
+    assert any(g.name.startswith(names.BOUNCE_SCENE_GROUP) for g in bpy.data.node_groups)
+    assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
+    effect.remove(scene)
