@@ -71,9 +71,9 @@ def test_lean_group_while_the_bound_clears_and_the_full_group_after(relativity_a
     obj.relativity.use_adaptive_tessellation = False
     obj.relativity.tessellation = 1
     bpy.context.evaluated_depsgraph_get()
-    assert _group_name(modifier, obj) == names.GEOMETRY_GROUP
     # the new vertices (edge midpoints, face centres) moved by the closed form: the surface curves
     assert _check_positions(bpy, camera, obj, (0.5, 0.0, 0.0)) == (2 * SIDE - 1) ** 2
+    assert _group_name(modifier, obj) == names.GEOMETRY_GROUP
 
     # Adaptive on again: lean; Static keeps the closed form (lean), a motion bake takes the cache's path
     obj.relativity.use_adaptive_tessellation = True
