@@ -8,7 +8,10 @@ relative to the observer) for the Doppler shaders. ``geometry.update_object`` fi
 For the closed-form motions (``motion.closed_form``: Static, Constant Velocity without an animation
 of its own) the modifier computes the apparent positions itself (``Closed Form`` on, the inputs of
 ``motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
-step sets a few inputs and needs no cache and no pass over the vertices in Python.
+step sets a few inputs and needs no cache and no pass over the vertices in Python. Where the
+edges' bound clears such a mesh the modifier has the lean group instead (``node_group.LEAN_WHEN``,
+``names.LEAN_GEOMETRY_GROUP``): the same output from the closed form's nodes alone; :func:`set_inputs`
+gives each modifier the group its inputs call for.
 
 The cache object is not linked into any scene; the modifier holds its only user, so it is saved
 with the .blend and a render farm worker needs nothing else. Motion and deformation bakes are
