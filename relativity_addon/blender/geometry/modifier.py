@@ -224,7 +224,9 @@ def _give_group(mod: Modifier, group: NodeTree) -> None:
     """Give the modifier ``group`` (the full or the lean one), its inputs' values kept by name
     (the cache above all: the modifier is its only user)."""
     values = {
-        name: _plain(compat.modifier_input(mod, ident)) for name, ident in _input_identifiers(mod.node_group).items()
+        name: _plain(compat.modifier_input(mod, ident))
+        for name, ident in _input_identifiers(mod.node_group).items()
+        if name != "Geometry"  # no value (5.2: no such input property)
     }
     mod.node_group = group
     for name, identifier in _input_identifiers(group).items():
