@@ -438,8 +438,8 @@ LEAN_WHEN = {"Closed Form": True, "Keyframed": False, "Measure Edges": True, "Ed
 # The lean group's inputs: the full group's that it reads, and those it keeps for the full group
 # (the values go with a swap, by name): the cache, the tessellation's, the edge check's and
 # LEAN_WHEN's, which the add-on reads back. Not the keyframed solve's: they are set with Keyframed.
-_LEAN_INPUTS = ("Geometry", "Cache", "Tessellation", "Face Codes", "Weld Distance", *CLOSED_FORM_INPUTS)
-_LEAN_INPUTS += ("Inverse Gamma Squared", *EDGE_MEASURE_INPUTS, "Tolerance", *LEAN_WHEN)
+_LEAN_INPUTS: tuple[str, ...] = ("Geometry", "Cache", "Tessellation", "Face Codes", "Weld Distance")
+_LEAN_INPUTS += (*CLOSED_FORM_INPUTS, "Inverse Gamma Squared", *EDGE_MEASURE_INPUTS, "Tolerance", *LEAN_WHEN)
 
 
 def lean_node_group_spec() -> Group:
