@@ -20,6 +20,9 @@ GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (o
 # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form; 4: keyframed motion in
 # the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial)
 GEOMETRY_GROUP_VERSION = 7
+# the same modifier's group for meshes on the constant closed form whose edges' bound clears (node_group.LEAN_WHEN)
+LEAN_GEOMETRY_GROUP = "Relativity Apparent Geometry (Closed Form)"
+LEAN_GEOMETRY_GROUP_VERSION = 1
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)

@@ -8,7 +8,10 @@ relative to the observer) for the Doppler shaders. ``geometry.update_object`` fi
 For the closed-form motions (``motion.closed_form``: Static, Constant Velocity without an animation
 of its own) the modifier computes the apparent positions itself (``Closed Form`` on, the inputs of
 ``motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
-step sets a few inputs and needs no cache and no pass over the vertices in Python.
+step sets a few inputs and needs no cache and no pass over the vertices in Python. Where the
+edges' bound clears such a mesh the modifier has the lean group instead (``node_group.LEAN_WHEN``,
+``names.LEAN_GEOMETRY_GROUP``): the same output from the closed form's nodes alone; :func:`set_inputs`
+gives each modifier the group its inputs call for.
 
 The cache object is not linked into any scene; the modifier holds its only user, so it is saved
 with the .blend and a render farm worker needs nothing else. Motion and deformation bakes are
@@ -26,7 +29,7 @@ import numpy as np
 
 from ..common import compat, names
 from ..common.nodes import ensure_group, interface_identifier, remove_unused_groups
-from .node_group import node_group_spec
+from .node_group import LEAN_WHEN, lean_node_group_spec, node_group_spec
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -41,12 +44,24 @@ if TYPE_CHECKING:
 KEPT_INPUTS = ("Cache", "Tessellation", "Face Codes", "Weld Distance")
 
 
+GROUPS = (names.GEOMETRY_GROUP, names.LEAN_GEOMETRY_GROUP)
+
+
 def ensure_node_group() -> NodeTree:
     """The node group, rebuilt when a file holds another version of it. The rebuilt interface's
     sockets get new identifiers, so the modifiers' values (the cache, where the bakes live) are
     read by name before and set again after."""
-    tree = bpy.data.node_groups.get(names.GEOMETRY_GROUP)
-    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) == names.GEOMETRY_GROUP_VERSION:
+    return _ensure(names.GEOMETRY_GROUP, names.GEOMETRY_GROUP_VERSION)
+
+
+def ensure_lean_group() -> NodeTree:
+    """The lean group (``node_group.lean_node_group_spec``), rebuilt as :func:`ensure_node_group`."""
+    return _ensure(names.LEAN_GEOMETRY_GROUP, names.LEAN_GEOMETRY_GROUP_VERSION)
+
+
+def _ensure(name: str, version: int) -> NodeTree:
+    tree = bpy.data.node_groups.get(name)
+    if tree is not None and tree.get(names.GEOMETRY_GROUP_VERSION_KEY) == version:
         return tree  # current: the spec is not built (at every update it cost more than the rest of the check)
     kept = []
     rebuilt = tree is not None
@@ -57,7 +72,8 @@ def ensure_node_group() -> NodeTree:
                 if mod.type == "NODES" and mod.node_group == tree:
                     values = {name: compat.modifier_input(mod, old[name]) for name in KEPT_INPUTS if name in old}
                     kept.append((mod, values))
-    group = ensure_group(node_group_spec(), names.GEOMETRY_GROUP_VERSION_KEY, names.GEOMETRY_GROUP_VERSION)
+    spec = node_group_spec() if name == names.GEOMETRY_GROUP else lean_node_group_spec()
+    group = ensure_group(spec, names.GEOMETRY_GROUP_VERSION_KEY, version)
     if rebuilt:  # new socket identifiers; the signatures are deleted below: no object is current
         _identifiers.clear()
         _generation[0] += 1
@@ -82,11 +98,7 @@ def group_generation() -> int:
 
 def find_modifier(obj: Object) -> Modifier | None:
     for modifier in obj.modifiers:
-        if (
-            modifier.type == "NODES"
-            and modifier.node_group is not None
-            and modifier.node_group.name == names.GEOMETRY_GROUP
-        ):
+        if modifier.type == "NODES" and modifier.node_group is not None and modifier.node_group.name in GROUPS:
             return modifier
     return None
 
@@ -148,6 +160,10 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     if modifier is None:
         modifier = obj.modifiers.new(names.GEOMETRY_MODIFIER, "NODES")
         modifier.node_group = group
+    elif modifier.node_group != group:  # the lean group (set_inputs), at its version
+        group = ensure_lean_group()
+        if modifier.node_group != group:
+            _give_group(modifier, group)
     cache = cache_object(obj)
     if cache is not None and _shared_with_another_object(obj, cache):
         cache = None  # a duplicated object copied the modifier and its cache pointer: own one
@@ -192,9 +208,35 @@ def _input_identifiers(group: NodeTree) -> dict[str, str]:
             for item in group.interface.items_tree
             if item.item_type == "SOCKET" and item.in_out == "INPUT"
         }
-        _identifiers.clear()
+        if len(_identifiers) >= 4:  # the two groups of this file, at most an older version of each
+            _identifiers.clear()
         _identifiers[key] = known
     return known
+
+
+def _plain(value: object) -> object:
+    """A modifier input's value as Python data: 4.5's arrays are views into the modifier's
+    properties, which another group frees (reading one then crashed Blender)."""
+    return tuple(value) if hasattr(value, "__len__") and not isinstance(value, str) else value
+
+
+def _give_group(mod: Modifier, group: NodeTree) -> None:
+    """Give the modifier ``group`` (the full or the lean one), its inputs' values kept by name
+    (the cache above all: the modifier is its only user)."""
+    values = {
+        name: _plain(compat.modifier_input(mod, ident))
+        for name, ident in _input_identifiers(mod.node_group).items()
+        if name != "Geometry"  # no value (5.2: no such input property)
+    }
+    mod.node_group = group
+    for name, identifier in _input_identifiers(group).items():
+        if values.get(name) is not None:
+            compat.set_modifier_input(mod, identifier, values[name])
+
+
+def is_lean(mod: Modifier) -> bool:
+    """Whether the modifier has the lean group (``node_group.LEAN_WHEN``)."""
+    return mod.node_group is not None and mod.node_group.name == names.LEAN_GEOMETRY_GROUP
 
 
 def _identifier(group: NodeTree, name: str) -> str:
@@ -204,11 +246,21 @@ def _identifier(group: NodeTree, name: str) -> str:
 
 def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
     """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
-    whether any did."""
-    identifiers = _input_identifiers(mod.node_group)
+    whether any did (or the group changed).
+
+    The group follows the inputs: the lean one while they hold ``node_group.LEAN_WHEN`` (the full
+    group would run only the lean one's nodes), the full one as soon as one of those changes (a
+    setting, the bound failing, the keyframed solve, the cache's path). The lean group holds every
+    input but the keyframed solve's, which are set in the call that turns ``Keyframed`` on."""
     changed = False
+    if is_lean(mod) and any(name in LEAN_WHEN and bool(value) != LEAN_WHEN[name] for name, value in wanted.items()):
+        _give_group(mod, ensure_node_group())
+        changed = True
+    identifiers = _input_identifiers(mod.node_group)
     for name, value in wanted.items():
-        identifier = identifiers[name]
+        identifier = identifiers.get(name)
+        if identifier is None:
+            continue  # an input the lean group does not read
         current = compat.modifier_input(mod, identifier)
         if isinstance(value, bool):
             same = current is not None and bool(current) == value
@@ -219,6 +271,11 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
         if not same:
             compat.set_modifier_input(mod, identifier, value)
             changed = True
+    if not is_lean(mod) and all(
+        bool(compat.modifier_input(mod, identifiers[name])) == value for name, value in LEAN_WHEN.items()
+    ):
+        _give_group(mod, ensure_lean_group())
+        changed = True
     return changed
 
 
@@ -313,7 +370,7 @@ def remove_cache(cache: Object, with_bake: bool = True) -> None:
 
 
 def remove_unused_group() -> None:
-    remove_unused_groups((names.GEOMETRY_GROUP,))
+    remove_unused_groups(GROUPS)
 
 
 def evaluated_rest_positions(obj: Object, depsgraph: Depsgraph, dtype: type = np.float64) -> FloatArray | None:

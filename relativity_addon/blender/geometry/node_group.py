@@ -407,21 +407,72 @@ def node_group_spec() -> Group:
     return Group(
         names.GEOMETRY_GROUP,
         "GeometryNodeTree",
-        (
-            ("Geometry", "NodeSocketGeometry", None),
-            ("Tessellation", "NodeSocketInt", {"min_value": 0, "max_value": 6, "default_value": 1}),
-            ("Cache", "NodeSocketObject", None),
-            ("Face Codes", "NodeSocketInt", {"min_value": 0, "default_value": 0}),
-            ("Weld Distance", "NodeSocketFloat", {"min_value": 0.0, "default_value": 0.0}),
-            ("Closed Form", "NodeSocketBool", {"default_value": False}),
-            *((name, "NodeSocketVector", None) for name in CLOSED_FORM_INPUTS),
-            ("Inverse Gamma Squared", "NodeSocketFloat", {"default_value": 1.0}),
-            ("Measure Edges", "NodeSocketBool", {"default_value": False}),
-            *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
-            ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
-            *KEYFRAMED_INPUTS,
-            ("Edges Proven Short", "NodeSocketBool", {"default_value": False}),
-        ),
+        _INPUTS,
         (("Geometry", "NodeSocketGeometry", "store_window.Output"),),
+        nodes,
+    )
+
+
+_INPUTS = (
+    ("Geometry", "NodeSocketGeometry", None),
+    ("Tessellation", "NodeSocketInt", {"min_value": 0, "max_value": 6, "default_value": 1}),
+    ("Cache", "NodeSocketObject", None),
+    ("Face Codes", "NodeSocketInt", {"min_value": 0, "default_value": 0}),
+    ("Weld Distance", "NodeSocketFloat", {"min_value": 0.0, "default_value": 0.0}),
+    ("Closed Form", "NodeSocketBool", {"default_value": False}),
+    *((name, "NodeSocketVector", None) for name in CLOSED_FORM_INPUTS),
+    ("Inverse Gamma Squared", "NodeSocketFloat", {"default_value": 1.0}),
+    ("Measure Edges", "NodeSocketBool", {"default_value": False}),
+    *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
+    ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
+    *KEYFRAMED_INPUTS,
+    ("Edges Proven Short", "NodeSocketBool", {"default_value": False}),
+)
+
+# The full group runs only the closed form on the incoming mesh, stores the rest positions, the
+# velocity and the verdict "every edge short", and nothing else, when its inputs hold these values
+# (the edges' bound clears them: no edge visited, no subdivision, no cache read); then the modifier
+# gets the lean group instead (``modifier.set_inputs``). Its fixed cost per evaluation grows with the
+# group's nodes and inputs (benchmarks/lean_group.py: 323 nodes against 26, about 2.5x).
+LEAN_WHEN = {"Closed Form": True, "Keyframed": False, "Measure Edges": True, "Edges Proven Short": True}
+# The lean group's inputs: the full group's that it reads, and those it keeps for the full group
+# (the values go with a swap, by name): the cache, the tessellation's, the edge check's and
+# LEAN_WHEN's, which the add-on reads back. Not the keyframed solve's: they are set with Keyframed.
+_LEAN_INPUTS: tuple[str, ...] = ("Geometry", "Cache", "Tessellation", "Face Codes", "Weld Distance")
+_LEAN_INPUTS += (*CLOSED_FORM_INPUTS, "Inverse Gamma Squared", *EDGE_MEASURE_INPUTS, "Tolerance", *LEAN_WHEN)
+
+
+def lean_node_group_spec() -> Group:
+    """The lean group (``names.LEAN_GEOMETRY_GROUP``): what the full group computes with
+    ``LEAN_WHEN``'s inputs, with the same nodes on that path (the same output, attributes included)."""
+    vector = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
+    nodes = {
+        "position": Node("GeometryNodeInputPosition"),
+        "whole_rest": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "group.Geometry", "Name": Literal(names.REST_ATTRIBUTE), "Value": "position.Position"},
+            vector,
+        ),
+        **_closed_form_nodes(),
+        "whole_seen": Node(
+            "GeometryNodeSetPosition", {"Geometry": "whole_rest.Geometry", "Position": "apparent.Vector"}
+        ),
+        "store_beta": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "whole_seen.Geometry", "Name": Literal(names.BETA_ATTRIBUTE), "Value": "group.Seen Velocity"},
+            vector,
+        ),
+        "store_verdict": Node(
+            "GeometryNodeStoreNamedAttribute",
+            {"Geometry": "store_beta.Geometry", "Name": Literal(names.EDGES_SHORT_ATTRIBUTE), "Value": True},
+            {"data_type": "BOOLEAN", "domain": "FACE"},
+        ),
+    }
+    inputs = tuple(item for item in _INPUTS if item[0] in _LEAN_INPUTS)
+    return Group(
+        names.LEAN_GEOMETRY_GROUP,
+        "GeometryNodeTree",
+        inputs,
+        (("Geometry", "NodeSocketGeometry", "store_verdict.Geometry"),),
         nodes,
     )

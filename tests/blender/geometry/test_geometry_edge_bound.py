@@ -87,9 +87,15 @@ def test_velocity_change_on_a_fine_grid_visits_no_edge(relativity_addon, monkeyp
     assert verdict is True and vertices == SIDE * SIDE
     assert calls == {}, calls  # no measure, no read of the mesh
 
+    # the bound clears the grid: the modifier has the lean group (no edge check in it)
+    assert modifier.is_lean(mod)
     # the per-edge check is not run: a tolerance it would fail leaves the verdict as it is ...
     with _without_addon_handlers(bpy):  # the add-on's syncs would set its own inputs again
-        compat.set_modifier_input(*_input(mod, "Tolerance"), 1e-6)
+        assert modifier.set_inputs(mod, {"Tolerance": 1e-6}) and modifier.is_lean(mod)
+        obj.update_tag()
+        assert _verdict(bpy, obj)[0] is True
+        # ... in the full group too, given the same inputs (the lean group kept them) ...
+        modifier._give_group(mod, modifier.ensure_node_group())
         obj.update_tag()
         assert _verdict(bpy, obj)[0] is True
         # ... and fails it once the bound's input is off (the check runs again)
