@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from test_geometry_closed_form import _grid_mesh
 from test_geometry_keyframed_modifier import FPS, OBSERVER, OBSERVER_CHANGED, C, _count_passes, _seen
-from test_geometry_keyframed_uniform import _inputs
+from test_geometry_keyframed_uniform import _accelerating_cube, _inputs
 from test_object_type_sweep import _cube_mesh, _link
 
 import geometry_helpers as gh
@@ -101,17 +101,7 @@ def test_keys_whose_window_crosses_a_key_keep_the_general_solve(relativity_addon
     polynomial."""
     import bpy
 
-    scene, camera = gh.slow_light_scene(bpy, C, FPS)
-    obj = _link(bpy, scene, "Mover", _cube_mesh(bpy, "Mover", 0.3))
-    obj.location = (0.0, -0.4, -5.0)
-    for frame, x in ((-120, -3.2), (0, -1.6), (48, 2.2)):
-        obj.location.x = x
-        obj.keyframe_insert("location", index=0, frame=frame)
-    obj.relativity.motion = "ANIMATION"
-    obj.relativity.tessellation = 0
-    scene.frame_set(12)
-    gh.apply_geometry(scene)
-    bpy.context.evaluated_depsgraph_get()
+    scene, camera, obj = _accelerating_cube(bpy)
     assert _inputs(obj, MODES) == {"Keyframed": True, "Polynomial": True, "Closed Form": False}
     rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
     x_o = np.array(camera.matrix_world.translation)

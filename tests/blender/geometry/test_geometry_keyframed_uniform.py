@@ -89,14 +89,9 @@ def test_uniform_keyframed_motion_takes_the_closed_form(relativity_addon, monkey
     np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
 
 
-def test_accelerating_keys_keep_the_keyframed_solve_and_its_fallback(relativity_addon, monkeypatch):
-    """Bezier location keys alone (accelerating from about 0.1c to 0.8c, nothing turning): not a straight
-    line, so the modifier solves the keyframed motion; with its window made too narrow (the recorded
-    reach made tiny) the verdict sends the update to the Python path, where the relation puts the mesh."""
-    import bpy
-
-    keyframed = gh.addon_module("geometry.keyframed")
-    modifier = gh.addon_module("geometry.modifier")
+def _accelerating_cube(bpy):
+    """A 0.3 m cube on Bezier location keys alone (about 0.1c to 0.8c, a key at frame 0 where the
+    acceleration jumps), set up at frame 12 and evaluated: (scene, camera, cube)."""
     scene, camera = gh.slow_light_scene(bpy, C, FPS)
     obj = _link(bpy, scene, "Mover", _cube_mesh(bpy, "Mover", 0.3))
     obj.location = (0.0, -0.4, -5.0)
@@ -108,6 +103,18 @@ def test_accelerating_keys_keep_the_keyframed_solve_and_its_fallback(relativity_
     scene.frame_set(12)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
+    return scene, camera, obj
+
+
+def test_accelerating_keys_keep_the_keyframed_solve_and_its_fallback(relativity_addon, monkeypatch):
+    """Bezier location keys alone (accelerating from about 0.1c to 0.8c, nothing turning): not a straight
+    line, so the modifier solves the keyframed motion; with its window made too narrow (the recorded
+    reach made tiny) the verdict sends the update to the Python path, where the relation puts the mesh."""
+    import bpy
+
+    keyframed = gh.addon_module("geometry.keyframed")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, camera, obj = _accelerating_cube(bpy)
     assert _inputs(obj) == {"Closed Form": False, "Keyframed": True}
 
     modifier.cache_data(obj)[keyframed.REACH_KEY] = 1e-6
