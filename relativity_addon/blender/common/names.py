@@ -120,7 +120,7 @@ REST_NORMAL_MESH_KEY = (
 )
 REST_NORMAL_MATERIAL_KEY = "relativity_rest_normal_node"  # on materials: the inserted group node's name
 REST_NORMAL_GROUP = "Relativity Rest Normal"  # shader group: rest-frame normal in world axes
-REST_NORMAL_GROUP_VERSION = 1
+REST_NORMAL_GROUP_VERSION = 2
 BOUNCE_SHADER_TEXT = "relativistic_bounce.osl"  # text datablock of the bounce factor (lights/interreflection.py)
 BOUNCE_TEXT_KEY = "relativity_bounce_text"  # on scenes: the name of the scene's own bounce text datablock
 BOUNCE_MATERIAL_KEY = "relativity_bounce_node"  # on materials: the inserted script node and the old link

@@ -11,7 +11,8 @@ arrive from the object-frame direction; this stage gives the BSDFs the rest-fram
   modifier's subdivision interpolates it);
 - every material of those objects gets the group ``names.REST_NORMAL_GROUP`` (attribute -> world
   normal, or the geometry's own normal where the attribute is absent, e.g. a static object
-  sharing the material) linked into the Normal input of each BSDF whose Normal is not linked.
+  sharing the material: the transform then gets a unit stand-in, as the absent attribute's
+  ``(0, 0, 0)`` normalised to NaN, and the static mesh rendered black) linked into the Normal input of each BSDF whose Normal is not linked.
 
 Everything is recorded (the mesh names on the scene and a mark on each mesh, which follows a
 rename; the inserted node on each material) and :func:`remove` deletes exactly that.
@@ -49,13 +50,18 @@ def _group_spec():
             "rest": nodes.Node(
                 "ShaderNodeAttribute", props={"attribute_name": ATTRIBUTE, "attribute_type": "GEOMETRY"}
             ),
-            "world": nodes.Node(
-                "ShaderNodeVectorTransform",
-                {0: "rest.Vector"},
-                {"vector_type": "NORMAL", "convert_from": "OBJECT", "convert_to": "WORLD"},
-            ),
             "length": nodes.vmath("LENGTH", "rest.Vector"),
             "present": nodes.fmath("GREATER_THAN", "length.Value", 0.5),
+            # where the attribute is absent its (0, 0, 0) would normalise to NaN in the transform,
+            # and the mix's 0 x NaN is NaN: a mesh at rest sharing the material rendered black
+            "safe": nodes.Node(
+                "ShaderNodeMix", {"Factor": "present", 4: (0.0, 0.0, 1.0), 5: "rest.Vector"}, {"data_type": "VECTOR"}
+            ),
+            "world": nodes.Node(
+                "ShaderNodeVectorTransform",
+                {0: "safe.Result"},
+                {"vector_type": "NORMAL", "convert_from": "OBJECT", "convert_to": "WORLD"},
+            ),
             "geometry": nodes.Node("ShaderNodeNewGeometry"),
             "normal": nodes.Node(
                 "ShaderNodeMix", {"Factor": "present", 4: "geometry.Normal", 5: "world"}, {"data_type": "VECTOR"}
