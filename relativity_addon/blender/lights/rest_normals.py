@@ -12,7 +12,8 @@ arrive from the object-frame direction; this stage gives the BSDFs the rest-fram
 - every material of those objects gets the group ``names.REST_NORMAL_GROUP`` (attribute -> world
   normal, or the geometry's own normal where the attribute is absent, e.g. a static object
   sharing the material: the transform then gets a unit stand-in, as the absent attribute's
-  ``(0, 0, 0)`` normalised to NaN, and the static mesh rendered black) linked into the Normal input of each BSDF whose Normal is not linked.
+  ``(0, 0, 0)`` normalised to NaN, and the static mesh rendered black) linked into the Normal
+  input of each BSDF whose Normal is not linked.
 
 Everything is recorded (the mesh names on the scene and a mark on each mesh, which follows a
 rename; the inserted node on each material) and :func:`remove` deletes exactly that.

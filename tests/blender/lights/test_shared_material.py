@@ -94,5 +94,6 @@ def test_rest_mesh_sharing_a_moving_mesh_material(
     after = _render(bpy, scene, tmp_path / "after.exr")
     effect.remove(scene)
     b, a = float(before[seen].mean()), float(after[seen].mean())
-    print(f"{kind}, doppler {doppler}, keyframed {keyframed}: panel at rest {seen.sum()} px, before Set Up {b:.5f}, after {a:.5f}, ratio {a / b:.4f}")
+    label = f"{kind}, doppler {doppler}, keyframed {keyframed}"
+    print(f"{label}: panel at rest {seen.sum()} px, before Set Up {b:.5f}, after {a:.5f}, ratio {a / b:.4f}")
     assert a == pytest.approx(b, rel=0.05)
