@@ -36,41 +36,13 @@ import artist_chain  # noqa: E402
 
 
 def path_spec(name, interface):
-    """The nodes the constant closed form with a clearing bound runs, as the full group links them."""
-    from relativity_addon.blender.common import names
-    from relativity_addon.blender.common.nodes import Group, Literal, Node
+    """The nodes the constant closed form with a clearing bound runs: the add-on's lean group
+    (``node_group.lean_node_group_spec``) under another name and interface."""
+    import dataclasses
+
     from relativity_addon.blender.geometry import node_group
 
-    store = {"data_type": "FLOAT_VECTOR", "domain": "POINT"}
-    nodes = {
-        "position": Node("GeometryNodeInputPosition"),
-        "store_rest": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {"Geometry": "group.Geometry", "Name": Literal(names.REST_ATTRIBUTE), "Value": "position.Position"},
-            store,
-        ),
-        **node_group._closed_form_nodes(),
-        "set_position": Node(
-            "GeometryNodeSetPosition", {"Geometry": "store_rest.Geometry", "Position": "apparent.Vector"}
-        ),
-        "store_beta": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {
-                "Geometry": "set_position.Geometry",
-                "Name": Literal(names.BETA_ATTRIBUTE),
-                "Value": "group.Seen Velocity",
-            },
-            store,
-        ),
-        "store_verdict": Node(
-            "GeometryNodeStoreNamedAttribute",
-            {"Geometry": "store_beta.Geometry", "Name": Literal(names.EDGES_SHORT_ATTRIBUTE), "Value": True},
-            {"data_type": "BOOLEAN", "domain": "FACE"},
-        ),
-    }
-    return Group(
-        name, "GeometryNodeTree", interface, (("Geometry", "NodeSocketGeometry", "store_verdict.Geometry"),), nodes
-    )
+    return dataclasses.replace(node_group.lean_node_group_spec(), name=name, inputs=interface)
 
 
 def tiny_spec(name):
