@@ -56,6 +56,15 @@ def can_show(obj: Object, scene: Scene) -> bool:
     )
 
 
+def off_their_keys(scene: Scene) -> list[Object]:
+    """The scene's objects whose keyframed transform holds values their keys do not give at the
+    current frame (``animation.off_keys``: moved without a key). A render evaluates their keys
+    again, as does every frame change: what the add-on computed from the values shown is not what
+    would be rendered."""
+    frame = scene.frame_current + scene.frame_subframe
+    return [obj for obj in scene.objects if obj.animation_data is not None and animation.off_keys(obj, frame)]
+
+
 def _matrix_function(obj, scene, fps, step, c):
     """The world matrices at scene times (seconds) that the Python path samples: the keyframes, with
     the rotation and scale keys at the proper time when the object plays them there

@@ -7,8 +7,10 @@ evaluated meshes. ``depsgraph_update_post`` follows every edit. Only objects who
 changed are recomputed (the frame is one of them), and values are written only where they
 changed, so the handlers' own writes end the loop. ``render_pre`` runs before every render,
 attaching the Doppler colour to materials added since Set Up. ``render_init`` (once per still or
-animation render) puts an Apparent Geometry scene with a moving observer behind the exact camera
-for the render, ``render_complete``/``render_cancel`` take it back to the boosted-mesh preview
+animation render, on the main thread) first evaluates the frame again when a keyframed object was
+moved without a key (the render evaluates its keys: ``_keys_before_render``), then puts an
+Apparent Geometry scene with a moving observer behind the exact camera for the render;
+``render_complete``/``render_cancel`` take it back to the boosted-mesh preview
 (``effect.begin_final_render``). A handler never raises: a problem
 becomes the scene's warning and, for the exact camera, a black (never a wrong) image; a render of a
 set-up scene whose sync is refused is recorded in ``render_notice`` (the panel shows it, and a popup
@@ -25,7 +27,7 @@ from bpy.app.handlers import persistent
 
 from ..camera import exact_camera
 from ..common import busy
-from ..geometry import apparent_meshes
+from ..geometry import apparent_meshes, keyframed
 from . import effect, render_notice
 
 if TYPE_CHECKING:
@@ -99,9 +101,33 @@ def _tell_if_refused(scene):
 def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     busy.render_started()
     try:
+        _keys_before_render(scene)
+    except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
+        print(f"Relativity: {type(error).__name__}: {error}")
+    try:
         effect.begin_final_render(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
         print(f"Relativity: the final render stays the boosted-mesh preview: {error}")
+
+
+def _keys_before_render(scene):
+    """A set-up scene whose keyframed objects were moved without a key (``keyframed.off_their_keys``)
+    is evaluated at its frame again before the render, as the render evaluates it (its keys win):
+    otherwise the add-on's inputs, computed from the values the viewport shows, would not be those of
+    the object rendered (a silently wrong image). Said on the console and, with a window, in a popup."""
+    if effect.applied_method(scene) is None:
+        return
+    moved = keyframed.off_their_keys(scene)
+    if not moved:
+        return
+    scene.frame_set(scene.frame_current, subframe=scene.frame_subframe)
+    listed = ", ".join(repr(obj.name) for obj in moved[:3]) + (f" and {len(moved) - 3} more" if len(moved) > 3 else "")
+    reason = (
+        f"{listed} moved without a key: rendered where the keys put {'it' if len(moved) == 1 else 'them'} "
+        f"at frame {scene.frame_current}, as Blender renders (insert a key to keep a move)"
+    )
+    print(f"Relativity: {reason}")
+    render_notice.tell("Relativity: a change without a key is not rendered", reason)
 
 
 @persistent

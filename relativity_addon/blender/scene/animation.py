@@ -182,6 +182,23 @@ def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
     return tuple(parts)
 
 
+def off_keys(obj: Object, frame: float) -> bool:
+    """Whether a transform channel that a live F-curve of the object's action animates holds another
+    value than that F-curve at ``frame``: changed in the panel or the viewport without a key
+    (Blender keeps such a value until the frame changes; a render evaluates the keys again). False
+    for an object with NLA tracks or drivers on its transform (its values are not its action's)."""
+    animation_data = obj.animation_data
+    if animation_data is None or len(animation_data.nla_tracks):
+        return False
+    if any(driver.data_path in TRANSFORM_PATHS and not driver.mute for driver in animation_data.drivers):
+        return False
+    for (path, index), fcurve in _transform_fcurves(obj).items():
+        keyed = fcurve.evaluate(frame)
+        if abs(getattr(obj, path)[index] - keyed) > 1e-5 * (1.0 + abs(keyed)):  # float32 values
+            return True
+    return False
+
+
 def has_transform_keys(obj: Object) -> bool:
     """Whether live keyframes of the object's own action move, turn or scale it."""
     return bool(_transform_fcurves(obj))
