@@ -141,9 +141,12 @@ def world_matrices(
 
 def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
-    cache key; None when an F-curve has modifiers (their settings are not in the key)."""
+    cache key; None when an F-curve has modifiers (their settings are not in the key). A channel
+    an F-curve animates enters by its keys alone, not by its current value: that value changes at
+    every frame step, which changes no key (the evaluation reads the keys, :func:`basis_matrices`)."""
     parts = []
     while obj is not None:
+        animated = set(_transform_fcurves(obj))
         animation_data = obj.animation_data
         if animation_data is not None and animation_data.action is not None:
             for fcurve in compat.action_fcurves(animation_data):
@@ -175,7 +178,10 @@ def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
                 tuple(map(tuple, obj.matrix_parent_inverse)),
                 obj.rotation_mode,
                 obj.parent_type,
-                *(tuple(getattr(obj, path)) for path in sorted(TRANSFORM_PATHS)),
+                *(
+                    tuple(None if (path, i) in animated else value for i, value in enumerate(getattr(obj, path)))
+                    for path in sorted(TRANSFORM_PATHS)
+                ),
             )
         )
         obj = obj.parent
