@@ -65,7 +65,7 @@ def off_their_keys(scene: Scene) -> list[Object]:
     return [obj for obj in scene.objects if obj.animation_data is not None and animation.off_keys(obj, frame)]
 
 
-def _matrix_function(obj, scene, fps, step, c):
+def _matrix_function(obj, scene, fps, step, c, signature):
     """The world matrices at scene times (seconds) that the Python path samples: the keyframes, with
     the rotation and scale keys at the proper time when the object plays them there
     (``motion.proper_time_apparent_positions``)."""
@@ -73,8 +73,30 @@ def _matrix_function(obj, scene, fps, step, c):
         clock = motion.path_clock(obj, fps, step, c)
         return lambda times: animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
     function = lambda times: animation.world_matrices(obj, times * fps)  # noqa: E731
-    signature = animation.keyframes_signature(obj)
     return function if signature is None else _kept_samples(obj, (signature, fps, step), function, step)
+
+
+# Object session_uid -> (keyframes signature, {name: value}): what the keys alone decide (where they
+# hold the object still, whether they only move it, its held rotation and scale), kept while they
+# stay: a frame step or an observer change of 1,000 keyframed objects (issue 26) reads no key for it.
+_facts: dict[int, tuple[object, dict[str, object]]] = {}
+
+
+def _keyed_facts(obj: Object, signature: object) -> dict[str, object]:
+    """The object's kept facts (:data:`_facts`; a new dict for keys with F-curve modifiers, whose
+    ``signature`` is None: nothing kept)."""
+    known = _facts.get(obj.session_uid)
+    if signature is None or known is None or known[0] != signature:
+        known = (signature, {})
+        if signature is not None:
+            _facts[obj.session_uid] = known
+    return known[1]
+
+
+def _fact(facts, name, compute):
+    if name not in facts:
+        facts[name] = compute()
+    return facts[name]
 
 
 # Object session_uid -> (key, {grid index: world matrix}): the keyframes' world matrices at the sample
@@ -161,16 +183,18 @@ def modifier_inputs(
     motion.check_parent_motion(obj)
     fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
-    corners = _box_corners(obj)
+    signature = animation.keyframes_signature(obj)
+    facts = _keyed_facts(obj, signature)
+    corners = _box_corners(obj, facts)
     try:
-        function = _matrix_function(obj, scene, fps, step, c)
+        function = _matrix_function(obj, scene, fps, step, c, signature)
         guess = _last_tau.get(obj.session_uid)
         pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
     except ValueError as error:
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     if pieces is not None:
         _last_tau[obj.session_uid] = pieces.start_distance / c
-    held_before = animation.held_before_frame(obj)
+    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
     if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
         return None  # the Python path then (and its warning when a point is seen before the keys move it)
     beta_o = np.asarray(beta_o, dtype=np.float64)
@@ -183,7 +207,8 @@ def modifier_inputs(
     )
     if line is not None:
         start, per_frame = line
-        shape = animation.world_matrices(obj, [t_o * fps])[0, :3, :3]
+        # straight keys hold the rotation and scale (one value each): the shape at any frame
+        shape = _fact(facts, "held shape", lambda: animation.world_matrices(obj, [t_o * fps])[0, :3, :3])
         origin = start + per_frame * (t_o * fps)
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
@@ -237,11 +262,11 @@ def modifier_inputs(
 _polynomials: dict[int, polynomial_motion.WindowPolynomial] = {}
 
 
-def _box_corners(obj):
+def _box_corners(obj, facts):
     """The rest box's corners (object space) of an object whose keys only move it
     (``animation.translates_only``: the polynomial may serve it), else None."""
     bounds = tessellation.rest_bounds(obj)
-    if bounds is None or not animation.translates_only(obj):
+    if bounds is None or not _fact(facts, "translates only", lambda: animation.translates_only(obj)):
         return None
     return np.where(np.arange(8)[:, None] >> np.arange(3) & 1, bounds[1], bounds[0])
 

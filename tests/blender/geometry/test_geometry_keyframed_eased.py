@@ -78,7 +78,7 @@ def test_eased_keys_take_the_polynomial(relativity_addon, monkeypatch, adaptive)
     assert np.ptp(np.linalg.norm(beta_stepped, axis=1)) > 1e-4  # each vertex its own velocity
 
     # the general keyframed solve (the intervals read per point) on the same motion
-    monkeypatch.setattr(keyframed, "_box_corners", lambda obj: None)
+    monkeypatch.setattr(keyframed, "_box_corners", lambda obj, facts: None)
     scene.frame_set(12)
     scene.frame_set(13)
     assert _inputs(obj, MODES) == {"Keyframed": True, "Polynomial": False, "Closed Form": False}
