@@ -367,7 +367,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
         record = None
     lit = sorted({mover.name for _, mover in pairs} | set(moving_lit))
     if lit:
-        rest_normals.write(scene, [scene.objects[name] for name in lit])
+        rest_normals.write(scene, [scene.objects[name] for name in lit], snap)
     else:
         rest_normals.remove(scene)
     if not pairs:
