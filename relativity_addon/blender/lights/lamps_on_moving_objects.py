@@ -367,7 +367,9 @@ def write(scene: Scene, snap: Snapshot) -> int:
         if stand_ins is None:
             copy = copies[(lamp.name, mover.name, "0")]
             doppler_factor, turned = placement(matrix, lamp.data.type, mover)
-            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
+            k = incidence(matrix, lamp.data.type, mover)
+            angle = lamp_doppler.aberrated_disc_angle(k, mover.beta, float(lamp.data.angle))
+            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned, angle=angle)
             continue
         offsets, dopplers = stand_ins
         _write_stand_ins(
@@ -383,10 +385,19 @@ def write(scene: Scene, snap: Snapshot) -> int:
 
 
 def write_copy(
-    copy: Object, lamp: Object, colour: tuple[float, ...], matrix: FloatArray, power_factor: float | None = None
+    copy: Object,
+    lamp: Object,
+    colour: tuple[float, ...],
+    matrix: FloatArray,
+    power_factor: float | None = None,
+    angle: float | None = None,
 ) -> None:
-    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its energy)."""
-    _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
+    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its
+    energy; ``angle``: a sun's disc as the object sees it, ``lamp_doppler.aberrated_disc_angle``)."""
+    own = {"energy"} if power_factor is not None else set()
+    _follow(copy.data, lamp.data, frozenset(own | ({"angle"} if angle is not None else set())))
+    if angle is not None:
+        _set(copy.data, "angle", min(angle, math.pi))  # Blender's largest sun
     if power_factor is not None:
         _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
     _set(copy.data, "use_temperature", False)
