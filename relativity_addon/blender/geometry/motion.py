@@ -123,13 +123,25 @@ def apparent_world_positions(
     return (world, delay, beta_seen) if with_delay else (world, beta_seen)
 
 
+def turns(obj: Object, scene: Scene) -> bool:
+    """Whether the rigid object's orientation (rotation, scale) changes along its apparent
+    positions: rotation or scale keys (its own or an object parent's), or a motion bake; not a
+    deforming object (its normals are its own)."""
+    motion = obj.relativity.motion
+    if motion == "STATIC" or (motion == "ANIMATION" and obj.relativity.use_deformation):
+        return False
+    if motion == "ANIMATION" and modifier.motion_bake_range(obj) is not None:
+        return True
+    return animation.has_own_animation(obj, scene)
+
+
 def retarded_orientations(scene: Scene, obj: Object, obj_eval: Object, rest: FloatArray, snap: Snapshot) -> FloatArray:
     """The linear part (rotation and scale, ``(N, 3, 3)``) of the object's world matrix at the
     retarded time of each rest point (object space), on the clock its apparent positions use: what
     turns its rest-frame normals there. The current matrix for every point when the object does not
     turn (the closed form). A rigid object only (no deformation)."""
     now = matrix_array(obj_eval.matrix_world)[:3, :3]
-    if closed_form(obj, scene) or not len(rest):
+    if not turns(obj, scene) or not len(rest):
         return np.broadcast_to(now, (len(rest), 3, 3))
     t_o, c = snap.mesh_observer[0], snap.speed_of_light
     _, delay, _ = apparent_world_positions(scene, obj, obj_eval, rest, snap, shape_keys_too=False, with_delay=True)

@@ -92,8 +92,6 @@ def _turned_normals(scene, obj, snap, normals):
     mesh = obj.data  # the rest shape (the evaluated one is the apparent mesh)
     rest = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
     mesh.vertices.foreach_get("co", rest)
-    if motion.closed_form(obj, scene) or len(mesh.loops) * 3 != len(normals):
-        return normals
     # the original's matrix, as the lamp stage's centres: evaluating the depsgraph here would run
     # the handlers' sync inside this one
     orientations = motion.retarded_orientations(scene, obj, obj, rest.reshape(-1, 3), snap)
@@ -185,7 +183,7 @@ def write(scene: Scene, objects: Sequence[Object], snap: Snapshot) -> None:
             record["meshes"].append(mesh.name)
             scene[KEY] = record
         key = apparent_meshes.geometry_key(obj)
-        turns = not motion.closed_form(obj, scene)
+        turns = motion.turns(obj, scene)
         if key is not None and turns:
             t_o, x_o, beta_o = snap.mesh_observer
             key = (*key, t_o, tuple(x_o), tuple(beta_o), snap.speed_of_light)
