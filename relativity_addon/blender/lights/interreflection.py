@@ -13,8 +13,10 @@ Two forms, by the scene's shading system:
   receiver's velocity and rest normal from each moving object's rest box, the values node inputs
   the sync writes.
 
-A receiving point in no moving object's box is taken at rest (``beta_p = 0``). Observer at rest
-only; the node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
+A receiving point in no moving object's box is taken at rest (``beta_p = 0``). With a moving
+observer only in Apparent Geometry's final render through the exact camera, whose meshes are the
+scene frame's seen from a camera at rest at ``Snapshot.mesh_observer`` (the node form there:
+``trace()`` crashes behind Cycles' OSL camera; not on the boosted-mesh preview). The node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
 every shading point), beyond which the panel says the bounce is uncorrected. Everything is
 recorded (the inserted node and the old link on each material; the text datablock or node group
 on the scene) and :func:`remove` deletes exactly that.
@@ -28,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import bpy
 import numpy as np
 
+from ..camera import exact_camera
 from ..common import names, osl
 from ..common.nodes import build_group, detach_inserted, ensure_group, linked_surface, remove_unused_groups
 from ..geometry import modifier
@@ -82,9 +85,9 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
         return "fewer than two moving objects"
     if not _with_material(scene):
         return "no moving object has a material"
-    if snap.speed > 0.0:
-        return "the observer moves"
-    if not uses_osl(scene) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
+    if snap.speed > 0.0 and not snap.exact_camera:
+        return "the observer moves"  # the boosted-mesh preview (its meshes are the observer frame's)
+    if not _osl_form(scene, snap) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
         return (
             f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
             f"{NODE_COST_AT_MAX} slower; OSL shading corrects it)"
@@ -95,6 +98,17 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
 def uses_osl(scene: Scene) -> bool:
     """Whether the scene takes the OSL form (OSL shading on and available) or the node form."""
     return bool(scene.cycles.shading_system) and osl.unavailable_reason() is None
+
+
+def _osl_form(scene: Scene, snap: Snapshot) -> bool:
+    """The OSL form, except behind the exact camera (its ``trace()`` crashes Blender there)."""
+    return uses_osl(scene) and not snap.exact_camera
+
+
+def _camera(snap: Snapshot) -> tuple[float, ...]:
+    """Where the snapshot's meshes are seen from, at rest in the scene frame: the camera, or behind
+    the exact camera its aperture centre at the shutter time (``Snapshot.mesh_observer``)."""
+    return tuple(float(x) for x in snap.mesh_observer[1])
 
 
 def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
@@ -223,7 +237,7 @@ def _materials(scene: Scene, found: Sequence[Mover]) -> dict[str, Material]:
 
 def _write_osl(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
     _remove_group(scene)
-    text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
+    text, changed = _text(scene, shader_source(_camera(snap), found))
     materials = _materials(scene, found)
     for material in bpy.data.materials:  # no longer on one of this scene's moving objects
         if _carries(material, text.name) and material.name not in materials:
@@ -296,7 +310,7 @@ def attach_group(material: Material | None, group: NodeTree) -> bool:
 
 def _write_nodes(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
     _remove_text(scene)
-    group = _scene_group(scene, tuple(float(x) for x in snap.camera_position), found)
+    group = _scene_group(scene, _camera(snap), found)
     materials = _materials(scene, found)
     for material in bpy.data.materials:
         if _carries(material, group.name, "group") and material.name not in materials:
@@ -313,7 +327,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
     if cheap is not None or _reason(scene, snap, found) is not None:
         remove(scene)
         return 0
-    return _write_osl(scene, snap, found) if uses_osl(scene) else _write_nodes(scene, snap, found)
+    return _write_osl(scene, snap, found) if _osl_form(scene, snap) else _write_nodes(scene, snap, found)
 
 
 def apply(scene: Scene, snap: Snapshot) -> int:
@@ -363,6 +377,8 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
         ]
+    if reason == "the observer moves" and exact_camera.final_render_problem(scene, snap) is None:
+        return []  # the final render (through the exact camera) corrects it; the preview is a preview
     if reason is None or reason in (
         "off the Apparent Geometry path",
         "fewer than two moving objects",
