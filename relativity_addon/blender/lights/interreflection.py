@@ -16,14 +16,17 @@ Two forms, by the scene's shading system:
 A receiving point in no moving object's box is taken at rest (``beta_p = 0``). With a moving
 observer only in Apparent Geometry's final render through the exact camera, whose meshes are the
 scene frame's seen from a camera at rest at ``Snapshot.mesh_observer`` (the node form there:
-``trace()`` crashes behind Cycles' OSL camera; not on the boosted-mesh preview). The node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
-every shading point), beyond which the panel says the bounce is uncorrected. Everything is
+``trace()`` crashes behind Cycles' OSL camera; not on the boosted-mesh preview). The node form for
+at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on every shading point),
+beyond which the panel says the bounce is uncorrected; where it corrects the light a moving object
+with curved faces receives (its normal from its box), the panel says so. Everything is
 recorded (the inserted node and the old link on each material; the text datablock or node group
 on the scene) and :func:`remove` deletes exactly that.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from typing import TYPE_CHECKING, Any
 
@@ -39,7 +42,7 @@ from . import bounce_nodes, lamps_on_moving_objects
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
-    from bpy.types import Material, NodeTree, Scene, Text
+    from bpy.types import Material, Mesh, NodeTree, Object, Scene, Text
 
     from ..scene.snapshot import Snapshot
     from .lamps_on_moving_objects import Mover
@@ -58,18 +61,39 @@ NODE_COST_AT_MAX = "3x"  # the node form's render time over the uncorrected one 
 # docs/lamp-doppler.md, "Receivers at rest": a sphere alone at 0.5c lighting a panel at rest, the
 # snapshot's bounce 0.55x receding and 3.58x approaching (the stage is built for two or more movers)
 AT_REST_ERROR = "3.6x"
+# the node form takes a receiver's rest normal from its box: faces further off its local axes than
+# this are curved; docs/lamp-doppler.md, "The receiver's normal off": the bounce 0.69-1.57x of the
+# physics in the model where the normal is 45 degrees off
+CURVED_DEGREES = 5.0
+CURVED_ERROR = "0.69-1.57x"
+
+
+def _moving_objects(scene: Scene) -> list[Object]:
+    """The scene's set-up meshes that have a motion of their own (cheap: no positions)."""
+    found = []
+    for obj in modifier.applied_objects(scene):
+        settings = obj.relativity
+        if (settings.motion == "CONSTANT" and any(settings.beta)) or (
+            settings.motion == "ANIMATION" and not settings.use_deformation
+        ):
+            found.append(obj)
+    return found
 
 
 def _moving_count(scene: Scene) -> int:
-    """How many of the scene's set-up meshes have a motion of their own (cheap: no positions)."""
-    count = 0
-    for obj in modifier.applied_objects(scene):
-        settings = obj.relativity
-        if settings.motion == "CONSTANT" and any(settings.beta):
-            count += 1
-        elif settings.motion == "ANIMATION" and not settings.use_deformation:
-            count += 1
-    return count
+    return len(_moving_objects(scene))
+
+
+def off_axis_faces(mesh: Mesh) -> bool:
+    """Whether some face of ``mesh`` (object space) is more than :data:`CURVED_DEGREES` off every
+    local axis: the node form's receiver normal, its rest box's nearest face, is not its own there."""
+    count = len(mesh.polygons)
+    if count == 0:
+        return False
+    normals = np.empty(count * 3, dtype=np.float32)
+    mesh.polygon_normals.foreach_get("vector", normals)
+    largest = np.abs(normals.reshape(-1, 3)).max(axis=1)
+    return bool(np.any(largest < math.cos(math.radians(CURVED_DEGREES))))
 
 
 def _with_material(scene: Scene) -> bool:
@@ -377,15 +401,27 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
         ]
-    if reason == "the observer moves" and exact_camera.final_render_problem(scene, snap) is None:
-        return []  # the final render (through the exact camera) corrects it; the preview is a preview
-    if reason is None or reason in (
-        "off the Apparent Geometry path",
-        "fewer than two moving objects",
-        "no moving object has a material",
-    ):
+    # the final render (through the exact camera) corrects it with the node form; the preview is a preview
+    in_final = reason == "the observer moves" and exact_camera.final_render_problem(scene, snap) is None
+    if reason is None or in_final:
+        return [] if _osl_form(scene, snap) and not in_final else _curved_lines(scene, snap, in_final)
+    if reason in ("off the Apparent Geometry path", "fewer than two moving objects", "no moving object has a material"):
         return []
     return [
         f"Light bounced between moving objects is not corrected, up to {MEASURED_ERROR} off at 0.5c "
         f"(docs/lamp-doppler.md): {reason}"
+    ]
+
+
+def _curved_lines(scene: Scene, snap: Snapshot, in_final: bool) -> list[str]:
+    """One line naming the moving objects with curved faces, where the node form corrects the light
+    they receive from other moving objects with their box's face normals."""
+    curved = [obj.name for obj in _moving_objects(scene) if obj.type == "MESH" and off_axis_faces(obj.data)]
+    if not curved:
+        return []
+    where = "in the final render" if (in_final or snap.exact_camera) else "on SVM shading (OSL shading traces it)"
+    return [
+        f"Light other moving objects reflect onto {', '.join(repr(n) for n in sorted(curved))} is approximate "
+        f"{where}: faces more than {CURVED_DEGREES:g} degrees off the object's axes take its box's normal, "
+        f"{CURVED_ERROR} of the physics where 45 degrees off (docs/lamp-doppler.md)"
     ]
