@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import bpy
 import numpy as np
@@ -416,7 +416,9 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
 def _curved_lines(scene: Scene, snap: Snapshot, in_final: bool) -> list[str]:
     """One line naming the moving objects with curved faces, where the node form corrects the light
     they receive from other moving objects with their box's face normals."""
-    curved = [obj.name for obj in _moving_objects(scene) if obj.type == "MESH" and off_axis_faces(obj.data)]
+    curved = [
+        obj.name for obj in _moving_objects(scene) if obj.type == "MESH" and off_axis_faces(cast("Mesh", obj.data))
+    ]
     if not curved:
         return []
     where = "in the final render" if (in_final or snap.exact_camera) else "on SVM shading (OSL shading traces it)"
