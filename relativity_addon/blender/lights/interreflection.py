@@ -112,11 +112,16 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
     if snap.speed > 0.0 and not snap.exact_camera:
         return "the observer moves"  # the boosted-mesh preview (its meshes are the observer frame's)
     if not _osl_form(scene, snap) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
-        return (
-            f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
-            f"{NODE_COST_AT_MAX} slower; OSL shading corrects it)"
-        )
+        return _over_limit(count, snap.exact_camera)
     return None
+
+
+def _over_limit(count: int, exact: bool) -> str:
+    return (
+        f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
+        f"{NODE_COST_AT_MAX} slower; "
+        + ("a moving observer's final render takes the node form)" if exact else "OSL shading corrects it)")
+    )
 
 
 def uses_osl(scene: Scene) -> bool:
@@ -392,7 +397,8 @@ def remove(scene: Scene) -> None:
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """One line when two moving objects light each other uncorrected for a reason the user can change,
-    or when one moving object lights objects at rest uncorrected."""
+    or when one moving object lights objects at rest uncorrected; where the node form corrects it,
+    one line naming the moving meshes with curved faces (their normal is their box's)."""
     if snap.method != "GEOMETRY":
         return []
     reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
@@ -403,6 +409,8 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
         ]
     # the final render (through the exact camera) corrects it with the node form; the preview is a preview
     in_final = reason == "the observer moves" and exact_camera.final_render_problem(scene, snap) is None
+    if in_final and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
+        reason, in_final = _over_limit(count, exact=True), False  # the final render's reason, said now
     if reason is None or in_final:
         return [] if _osl_form(scene, snap) and not in_final else _curved_lines(scene, snap, in_final)
     if reason in ("off the Apparent Geometry path", "fewer than two moving objects", "no moving object has a material"):
