@@ -14,7 +14,10 @@ With ``--motion eased`` (Blender's default Bezier keys: the polynomial solve,
 ``geometry/polynomial_nodes.py``), the variants are ``built``, ``off``, ``onestep`` (``Polynomial One
 Step`` forced on, whether or not the window allows it: what the second Newton step costs) and
 ``transform`` (the polynomial's terms by Transform Points on matrices combined from the same inputs,
-as before issue 26's multiply-adds).
+as before issue 26's multiply-adds). With ``--motion constant`` (Constant Velocity 0.5c, the closed form
+on the lean group: the edges' bound clears the grid), ``folded`` and ``unfolded``: the modifier's
+``Folded`` on and off (``motion.FOLD_LIMIT``). Process CPU time (Blender's threads, not the wait for a
+core) is printed beside the wall time.
 Times are of the whole modifier (subdivision check, rest, solve, the velocity, the verdict). The
 grid's linear keys would get the closed form (``animation.straight_keys``): taken out here.
 """
@@ -114,11 +117,13 @@ def main():
     parser.add_argument("--size", default="2M")
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--variants", default=None)
-    parser.add_argument("--motion", default="keyframed", choices=("keyframed", "eased"))
+    parser.add_argument("--motion", default="keyframed", choices=("keyframed", "eased", "constant"))
     options = parser.parse_args()
     eased = options.motion == "eased"
+    constant = options.motion == "constant"
     if options.variants is None:
         options.variants = "built,off,onestep,transform" if eased else "built,off,steps1,steps2,single"
+        options.variants = "folded,unfolded" if constant else options.variants
     import bpy
 
     from relativity_addon import batch
@@ -139,7 +144,7 @@ def main():
     built = mod.node_group
     groups = {}
     for name in options.variants.split(","):
-        if name in ("built", "off"):
+        if name in ("built", "off", "folded", "unfolded"):
             groups[name] = built
         elif name.startswith("steps"):
             groups[name] = variant_group(bpy, f"profile {name}", steps=int(name[5:]))
@@ -150,8 +155,11 @@ def main():
         elif name in ("onestep", "transform"):
             groups[name] = variant_group(bpy, f"profile {name}", transform=name == "transform")
     times = {name: [] for name in groups}
+    cpu = {name: [] for name in groups}
 
     def keyframed_on(value):
+        if constant:
+            return
         identifier = next(i.identifier for i in mod.node_group.interface.items_tree if i.name == "Keyframed")
         compat.set_modifier_input(mod, identifier, value)
 
@@ -171,24 +179,31 @@ def main():
                 keyframed_on(name != "off")
                 if eased:
                     one_step(True if name == "onestep" else steps)
+                if constant:
+                    modifier.set_inputs(mod, {"Folded": name == "folded"})
                 obj.update_tag()
                 artist_chain.read_vertex(bpy, obj, depsgraph)  # settle the switch's evaluation
                 obj.update_tag()
-                start = time.perf_counter()
+                start, start_cpu = time.perf_counter(), time.process_time()
                 depsgraph.update()
                 artist_chain.read_vertex(bpy, obj, depsgraph)
                 if round_:  # the first round warms up
                     times[name].append(time.perf_counter() - start)
+                    cpu[name].append(time.process_time() - start_cpu)
                 keyframed_on(True)
         use_group(mod, built)
         if eased:
             one_step(steps)
     vertices = len(obj.evaluated_get(depsgraph).data.vertices)
     print(f"\nkeyframed modifier, {vertices:,} evaluated vertices, {options.rounds} rounds (load {os.getloadavg()})")
-    base, off = statistics.median(times.get("built", [1])), statistics.median(times.get("off", [1]))
+    first = next(iter(times))  # "as built": the first variant's
+    base, off = statistics.median(times.get("built", times[first])), statistics.median(times.get("off", [1]))
     for name, values in times.items():
-        median = statistics.median(values)
-        print(f"{name:>8} {median:8.3f}s  {median / base:5.2f}x as built  {median / off:6.2f}x off")
+        median, median_cpu = statistics.median(values), statistics.median(cpu[name])
+        print(
+            f"{name:>9} {median:8.3f}s  {median / base:5.2f}x as built  {median / off:6.2f}x off"
+            f"  CPU {median_cpu * 1000:7.1f} ms"
+        )
 
 
 if __name__ == "__main__":
