@@ -18,11 +18,12 @@ GEOMETRY_GROUP = "Relativity Apparent Geometry"  # geometry-nodes group
 GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
 GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
 # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form; 4: keyframed motion in
-# the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial)
-GEOMETRY_GROUP_VERSION = 7
+# the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial); 8: its
+# terms by multiply-adds, Polynomial One Step, the closed form's Folded
+GEOMETRY_GROUP_VERSION = 8
 # the same modifier's group for meshes on the constant closed form whose edges' bound clears (node_group.LEAN_WHEN)
 LEAN_GEOMETRY_GROUP = "Relativity Apparent Geometry (Closed Form)"
-LEAN_GEOMETRY_GROUP_VERSION = 1
+LEAN_GEOMETRY_GROUP_VERSION = 2  # 2: Folded
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)
