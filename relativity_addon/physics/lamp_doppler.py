@@ -81,6 +81,26 @@ def aberrated_direction(direction: ArrayLike, beta_object: ArrayLike) -> FloatAr
     return (k + along * beta - gamma * beta) / (gamma * (1.0 - bk))
 
 
+def aberrated_disc_angle(direction: ArrayLike, beta_object: ArrayLike, angle: float) -> float:
+    """The angular diameter (radians) in the object's frame of a disc of angular diameter
+    ``angle`` (a sun) whose centre's light travels along ``direction`` (scene frame), for an
+    object moving with ``beta_object``. Aberration maps circles on the sky to circles and is
+    conformal (``dOmega' = dOmega / D^2``, docs/physics.md), so the disc stays a disc, ``angle / D``
+    across when small; exactly, the angle between its two edges in the plane of ``k`` and ``beta``,
+    each aberrated (:func:`aberrated_direction`)."""
+    k = unit_vectors(direction, "direction")
+    beta = velocity_array(beta_object, "beta_object")
+    half = 0.5 * float(finite_array(angle, "angle"))
+    axis = np.cross(k, beta)
+    if np.linalg.norm(axis) < 1e-12:  # along the motion (or at rest): any axis across k
+        axis = np.cross(k, np.eye(3)[int(np.argmin(np.abs(k)))])
+    axis = axis / np.linalg.norm(axis)
+    across = np.cross(axis, k)
+    edges = [math.cos(half) * k + sign * math.sin(half) * across for sign in (1.0, -1.0)]
+    first, second = (aberrated_direction(edge, beta) for edge in edges)
+    return float(np.arccos(np.clip(first @ second / (np.linalg.norm(first) * np.linalg.norm(second)), -1.0, 1.0)))
+
+
 def aberrated_lamp_matrix(
     lamp_matrix: ArrayLike, centre: ArrayLike, direction: ArrayLike, beta_object: ArrayLike
 ) -> FloatArray:

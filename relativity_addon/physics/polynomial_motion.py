@@ -24,7 +24,7 @@ from .sampling import MotionIntervals
 
 DEGREE = 3  # cubic: Bezier segments with auto handles are cubic in time (the contraction is smooth)
 SAMPLES_PER_INTERVAL = 8  # where the fit is made and its residual measured
-NEWTON_STEPS = 2  # after the closed-form start (the modifier's count; checked on the rest box's corners)
+NEWTON_STEPS = 2  # after the closed-form start: the modifier's most (newton_steps picks 1 where that converges)
 FLOAT32_ROUNDING = 2.0**-24  # half an ulp, relative
 ABSOLUTE_FLOOR = 1e-6  # relative to the window's size: the tolerance where the samples round to nothing
 
@@ -113,11 +113,17 @@ def solve(polynomial: WindowPolynomial, points: FloatArray, steps: int = NEWTON_
     return sigma, (polynomial.centre - sigma) * rate
 
 
-def converges(polynomial: WindowPolynomial, corners: FloatArray) -> bool:
-    """Whether NEWTON_STEPS reach the root to a tenth of the tolerance at the rest box's corners
-    (the start's error, the departure from uniform motion, is affine in the point: largest at a
-    corner), each corner's retarded time inside the window."""
-    found, u = solve(polynomial, corners)
-    exact, _u = solve(polynomial, corners, steps=NEWTON_STEPS + 20)
-    inside = np.all(np.abs(u) <= 1.0)
-    return bool(inside and np.all(np.abs(found - exact) <= 0.1 * polynomial.tolerance))
+def newton_steps(polynomial: WindowPolynomial, corners: FloatArray) -> int | None:
+    """The fewest Newton steps (1 up to NEWTON_STEPS, the modifier's choices) that reach the root to a
+    tenth of the tolerance at the rest box's corners, each corner's retarded time inside the window;
+    None when NEWTON_STEPS do not. The start's error, the departure from uniform motion, is affine in
+    the point (largest at a corner), and a step's error grows with the error it starts from (Newton's
+    ``e' = f'' e^2 / (2 f')``): the corners bound the points."""
+    exact, u = solve(polynomial, corners, steps=NEWTON_STEPS + 20)
+    if not np.all(np.abs(u) <= 1.0):
+        return None
+    for steps in range(1, NEWTON_STEPS + 1):
+        found, _u = solve(polynomial, corners, steps=steps)
+        if np.all(np.abs(found - exact) <= 0.1 * polynomial.tolerance):
+            return steps
+    return None

@@ -190,3 +190,24 @@ def test_stand_ins_converge_to_eq_18_per_point():
     well_lit = exact > 0.2 * exact.max()
     np.testing.assert_allclose(rendered[well_lit], exact[well_lit], rtol=1e-9)
     assert np.sum(np.abs(one - exact)) / np.sum(exact) > 0.3
+
+
+@settings(max_examples=40, deadline=None)
+@given(directions, velocities(0.9), st.floats(0.001, 1.5))
+def test_sun_disc_is_seen_at_its_aberrated_size(k, beta, angle):
+    """A disc of angular diameter ``angle`` is seen by the moving object as the disc through its
+    edge directions boosted one by one (docs/physics.md, aberration): the diameter is the largest
+    angle between two of 720 boosted edge photons, and ``angle / D`` when small."""
+    k = np.asarray(k) / np.linalg.norm(k)
+    across = np.cross(k, np.eye(3)[int(np.argmin(np.abs(k)))])
+    across /= np.linalg.norm(across)
+    other = np.cross(k, across)
+    phi = np.linspace(0.0, 2.0 * math.pi, 720, endpoint=False)[:, None]
+    edge = math.cos(angle / 2) * k + math.sin(angle / 2) * (np.cos(phi) * across + np.sin(phi) * other)
+    seen = np.array([momentum / energy for energy, momentum in (_boost(1.0, e, np.asarray(beta)) for e in edge)])
+    widest = float(np.max(np.arccos(np.clip(seen @ seen.T, -1.0, 1.0))))
+    expected = lamp_doppler.aberrated_disc_angle(k, beta, angle)
+    assert expected == pytest.approx(widest, rel=1e-4, abs=1e-6)
+    if angle < 0.01:
+        doppler = float(lamp_doppler.lamp_to_object_doppler(k, beta))
+        assert expected == pytest.approx(angle / doppler, rel=0.01)

@@ -207,7 +207,9 @@ def doppler_colour_group() -> Group:
     On the exact-camera path the scene is at rest, so only camera rays are shifted: ordinary
     colours pass unchanged (the compositor shifts the pixel), blackbodies seen directly are shifted
     here and write the ``relativity_colour_done`` AOV so the compositor leaves them alone, and the
-    light every other ray carries (a lamp lighting the floor) stays the scene-frame light.
+    light every other ray carries (a lamp lighting the floor) stays the scene-frame light: a moving
+    emitter there (Apparent Geometry's final render) gets its ``D_s^4`` toward every ray, its colour
+    left unshifted on the rays that reach the camera through another surface.
     In a spectral pass (``spectral_nodes``) every colour becomes its spectral values instead.
     """
     nodes = {
@@ -256,9 +258,9 @@ def doppler_colour_group() -> Group:
         ),
         "spectral": group_node(spectral_nodes.SPECTRAL_COLOUR, spectral_nodes.COLOUR_LINKS),
         # A moving emitter behind the exact camera (Apparent Geometry's final render): the camera
-        # applies the observer's D_o^4 only, the compositor divides by the whole D^4; the rest, D_s^4
-        "emitter_power": fmath("MULTIPLY", "settings.Camera Power", "light_path.Is Camera Ray"),
-        "emitter_log": fmath("MULTIPLY", "emitter_power", "doppler.Log Emitter Doppler"),
+        # applies the observer's D_o^4 only, the compositor divides by the whole D^4; the rest, D_s^4,
+        # on every ray (toward the ray's direction): the scene-frame light it sends other surfaces too
+        "emitter_log": fmath("MULTIPLY", "settings.Camera Power", "doppler.Log Emitter Doppler"),
         "emitter_log_safe": fmath("MINIMUM", "emitter_log", EXP_LIMIT),
         "emitter_gain": fmath("EXPONENT", "emitter_log_safe"),
         "fast_gained": vmath("SCALE", "fast.Result", scale="emitter_gain"),

@@ -18,11 +18,12 @@ GEOMETRY_GROUP = "Relativity Apparent Geometry"  # geometry-nodes group
 GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
 GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
 # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form; 4: keyframed motion in
-# the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial)
-GEOMETRY_GROUP_VERSION = 7
+# the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial); 8: its
+# terms by multiply-adds, Polynomial One Step, the closed form's Folded
+GEOMETRY_GROUP_VERSION = 8
 # the same modifier's group for meshes on the constant closed form whose edges' bound clears (node_group.LEAN_WHEN)
 LEAN_GEOMETRY_GROUP = "Relativity Apparent Geometry (Closed Form)"
-LEAN_GEOMETRY_GROUP_VERSION = 1
+LEAN_GEOMETRY_GROUP_VERSION = 2  # 2: Folded
 REST_ATTRIBUTE = "relativity_rest"  # tessellated rest positions, stored by the modifier
 BETA_ATTRIBUTE = "relativity_beta"  # point velocity relative to the observer (fraction of c)
 FACE_CODE_ATTRIBUTE = "relativity_subdivide"  # per face: 1 subdivided, 2 across the seam (the cache's last points)
@@ -59,9 +60,9 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 8  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+SHADER_GROUPS_VERSION = 9  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
 # 5: volumes in spectral passes; 6: the coverage AOV; 7: temperature grids in the volume group;
-# 8: temperature grids in the spectral passes
+# 8: temperature grids in the spectral passes; 9: the emitter's D_s^4 on every ray behind the exact camera
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------

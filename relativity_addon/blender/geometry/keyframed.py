@@ -213,9 +213,10 @@ def modifier_inputs(
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
-    polynomial = None
+    polynomial, steps = None, None
     if corners is not None:
-        polynomial = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
+        found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
+        polynomial, steps = found if found is not None else (None, None)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -245,6 +246,7 @@ def modifier_inputs(
         return inputs, pieces.coefficients
     inputs.update(
         {
+            "Polynomial One Step": steps == 1,
             "Polynomial Centre": polynomial.centre,
             "Polynomial Rate": 1.0 / polynomial.half,
             **{
@@ -272,8 +274,9 @@ def _box_corners(obj, facts):
 
 
 def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c):
-    """One polynomial over the intervals (``physics/polynomial_motion.py``) where it follows them to
-    the samples' rounding and the modifier's steps converge on the rest box's ``corners``, else None
+    """One polynomial over the intervals (``physics/polynomial_motion.py``) and the modifier's Newton
+    steps, where it follows them to the samples' rounding and the steps converge on the rest box's
+    ``corners`` (``newton_steps``: one where one does), else None
     (the intervals then, read per point). No verdict is taken over the points: the window was bounded
     for every point within ``reach`` of the origin, and the rest box's farthest corner must lie
     within it (a box whose corners reach farther than its points, a sphere's, keeps the intervals)."""
@@ -281,9 +284,8 @@ def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach,
         return None  # the window holds only points within reach (a stale reach: the verdict says so)
     tolerance = polynomial_motion.rounding_tolerance(pieces, x_o, reach, step, c)
     polynomial = polynomial_motion.fit_window(pieces, grid_now, grid_per_distance, reach, tolerance)
-    if polynomial is None or not polynomial_motion.converges(polynomial, corners):
-        return None
-    return polynomial
+    steps = None if polynomial is None else polynomial_motion.newton_steps(polynomial, corners)
+    return None if steps is None else (polynomial, steps)
 
 
 def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray | None) -> None:

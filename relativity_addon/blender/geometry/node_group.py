@@ -57,9 +57,16 @@ def _closed_form_nodes() -> dict[str, Node]:
         "away": Node(
             "FunctionNodeCompare", {"A": "along.Value", "B": 0.0}, {"data_type": "FLOAT", "operation": "GREATER_THAN"}
         ),
-        "delay": Node(
+        "delay_per_point": Node(
             "GeometryNodeSwitch",
             {"Switch": "away.Result", "False": "delay_towards", "True": "delay_away"},
+            {"input_type": "FLOAT"},
+        ),
+        # Folded (a single value: only the side chosen is computed): the towards form on every point,
+        # its cancellation on receding points bounded by motion.FOLD_LIMIT
+        "delay": Node(
+            "GeometryNodeSwitch",
+            {"Switch": "group.Folded", "False": "delay_per_point.Output", "True": "delay_towards"},
             {"input_type": "FLOAT"},
         ),
         "local_x": _multiply_add("rest_split.X", "group.Local X", "group.Local Offset"),
@@ -422,6 +429,7 @@ _INPUTS = (
     ("Closed Form", "NodeSocketBool", {"default_value": False}),
     *((name, "NodeSocketVector", None) for name in CLOSED_FORM_INPUTS),
     ("Inverse Gamma Squared", "NodeSocketFloat", {"default_value": 1.0}),
+    ("Folded", "NodeSocketBool", {"default_value": False}),
     ("Measure Edges", "NodeSocketBool", {"default_value": False}),
     *((name, "NodeSocketVector", None) for name in EDGE_MEASURE_INPUTS),
     ("Tolerance", "NodeSocketFloat", {"default_value": 0.5}),
@@ -439,7 +447,7 @@ LEAN_WHEN = {"Closed Form": True, "Keyframed": False, "Measure Edges": True, "Ed
 # (the values go with a swap, by name): the cache, the tessellation's, the edge check's and
 # LEAN_WHEN's, which the add-on reads back. Not the keyframed solve's: they are set with Keyframed.
 _LEAN_INPUTS: tuple[str, ...] = ("Geometry", "Cache", "Tessellation", "Face Codes", "Weld Distance")
-_LEAN_INPUTS += (*CLOSED_FORM_INPUTS, "Inverse Gamma Squared", *EDGE_MEASURE_INPUTS, "Tolerance", *LEAN_WHEN)
+_LEAN_INPUTS += (*CLOSED_FORM_INPUTS, "Inverse Gamma Squared", "Folded", *EDGE_MEASURE_INPUTS, "Tolerance", *LEAN_WHEN)
 
 
 def lean_node_group_spec() -> Group:

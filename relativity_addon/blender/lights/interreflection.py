@@ -13,21 +13,27 @@ Two forms, by the scene's shading system:
   receiver's velocity and rest normal from each moving object's rest box, the values node inputs
   the sync writes.
 
-A receiving point in no moving object's box is taken at rest (``beta_p = 0``). Observer at rest
-only; the node form for at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on
-every shading point), beyond which the panel says the bounce is uncorrected. Everything is
+A receiving point in no moving object's box is taken at rest (``beta_p = 0``). With a moving
+observer only in Apparent Geometry's final render through the exact camera, whose meshes are the
+scene frame's seen from a camera at rest at ``Snapshot.mesh_observer`` (the node form there:
+``trace()`` crashes behind Cycles' OSL camera; not on the boosted-mesh preview). The node form for
+at most :data:`MAX_NODE_MOVERS` moving objects (its cost grows with them on every shading point),
+beyond which the panel says the bounce is uncorrected; where it corrects the light a moving object
+with curved faces receives (its normal from its box), the panel says so. Everything is
 recorded (the inserted node and the old link on each material; the text datablock or node group
 on the scene) and :func:`remove` deletes exactly that.
 """
 
 from __future__ import annotations
 
+import math
 import os
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import bpy
 import numpy as np
 
+from ..camera import exact_camera
 from ..common import names, osl
 from ..common.nodes import build_group, detach_inserted, ensure_group, linked_surface, remove_unused_groups
 from ..geometry import modifier
@@ -36,7 +42,7 @@ from . import bounce_nodes, lamps_on_moving_objects
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
-    from bpy.types import Material, NodeTree, Scene, Text
+    from bpy.types import Material, Mesh, NodeTree, Object, Scene, Text
 
     from ..scene.snapshot import Snapshot
     from .lamps_on_moving_objects import Mover
@@ -55,18 +61,39 @@ NODE_COST_AT_MAX = "3x"  # the node form's render time over the uncorrected one 
 # docs/lamp-doppler.md, "Receivers at rest": a sphere alone at 0.5c lighting a panel at rest, the
 # snapshot's bounce 0.55x receding and 3.58x approaching (the stage is built for two or more movers)
 AT_REST_ERROR = "3.6x"
+# the node form takes a receiver's rest normal from its box: faces further off its local axes than
+# this are curved; docs/lamp-doppler.md, "The receiver's normal off": the bounce 0.69-1.57x of the
+# physics in the model where the normal is 45 degrees off
+CURVED_DEGREES = 5.0
+CURVED_ERROR = "0.69-1.57x"
+
+
+def _moving_objects(scene: Scene) -> list[Object]:
+    """The scene's set-up meshes that have a motion of their own (cheap: no positions)."""
+    found = []
+    for obj in modifier.applied_objects(scene):
+        settings = obj.relativity
+        if (settings.motion == "CONSTANT" and any(settings.beta)) or (
+            settings.motion == "ANIMATION" and not settings.use_deformation
+        ):
+            found.append(obj)
+    return found
 
 
 def _moving_count(scene: Scene) -> int:
-    """How many of the scene's set-up meshes have a motion of their own (cheap: no positions)."""
-    count = 0
-    for obj in modifier.applied_objects(scene):
-        settings = obj.relativity
-        if settings.motion == "CONSTANT" and any(settings.beta):
-            count += 1
-        elif settings.motion == "ANIMATION" and not settings.use_deformation:
-            count += 1
-    return count
+    return len(_moving_objects(scene))
+
+
+def off_axis_faces(mesh: Mesh) -> bool:
+    """Whether some face of ``mesh`` (object space) is more than :data:`CURVED_DEGREES` off every
+    local axis: the node form's receiver normal, its rest box's nearest face, is not its own there."""
+    count = len(mesh.polygons)
+    if count == 0:
+        return False
+    normals = np.empty(count * 3, dtype=np.float32)
+    mesh.polygon_normals.foreach_get("vector", normals)
+    largest = np.abs(normals.reshape(-1, 3)).max(axis=1)
+    return bool(np.any(largest < math.cos(math.radians(CURVED_DEGREES))))
 
 
 def _with_material(scene: Scene) -> bool:
@@ -82,19 +109,35 @@ def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
         return "fewer than two moving objects"
     if not _with_material(scene):
         return "no moving object has a material"
-    if snap.speed > 0.0:
-        return "the observer moves"
-    if not uses_osl(scene) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
-        return (
-            f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
-            f"{NODE_COST_AT_MAX} slower; OSL shading corrects it)"
-        )
+    if snap.speed > 0.0 and not snap.exact_camera:
+        return "the observer moves"  # the boosted-mesh preview (its meshes are the observer frame's)
+    if not _osl_form(scene, snap) and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
+        return _over_limit(count, snap.exact_camera)
     return None
+
+
+def _over_limit(count: int, exact: bool) -> str:
+    return (
+        f"{count} moving objects, over the node form's {MAX_NODE_MOVERS} (it would render more than "
+        f"{NODE_COST_AT_MAX} slower; "
+        + ("a moving observer's final render takes the node form)" if exact else "OSL shading corrects it)")
+    )
 
 
 def uses_osl(scene: Scene) -> bool:
     """Whether the scene takes the OSL form (OSL shading on and available) or the node form."""
     return bool(scene.cycles.shading_system) and osl.unavailable_reason() is None
+
+
+def _osl_form(scene: Scene, snap: Snapshot) -> bool:
+    """The OSL form, except behind the exact camera (its ``trace()`` crashes Blender there)."""
+    return uses_osl(scene) and not snap.exact_camera
+
+
+def _camera(snap: Snapshot) -> tuple[float, ...]:
+    """Where the snapshot's meshes are seen from, at rest in the scene frame: the camera, or behind
+    the exact camera its aperture centre at the shutter time (``Snapshot.mesh_observer``)."""
+    return tuple(float(x) for x in snap.mesh_observer[1])
 
 
 def _reason(scene: Scene, snap: Snapshot, movers: Sequence[Mover] | None = None) -> str | None:
@@ -223,7 +266,7 @@ def _materials(scene: Scene, found: Sequence[Mover]) -> dict[str, Material]:
 
 def _write_osl(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
     _remove_group(scene)
-    text, changed = _text(scene, shader_source(tuple(float(x) for x in snap.camera_position), found))
+    text, changed = _text(scene, shader_source(_camera(snap), found))
     materials = _materials(scene, found)
     for material in bpy.data.materials:  # no longer on one of this scene's moving objects
         if _carries(material, text.name) and material.name not in materials:
@@ -296,7 +339,7 @@ def attach_group(material: Material | None, group: NodeTree) -> bool:
 
 def _write_nodes(scene: Scene, snap: Snapshot, found: Sequence[Mover]) -> int:
     _remove_text(scene)
-    group = _scene_group(scene, tuple(float(x) for x in snap.camera_position), found)
+    group = _scene_group(scene, _camera(snap), found)
     materials = _materials(scene, found)
     for material in bpy.data.materials:
         if _carries(material, group.name, "group") and material.name not in materials:
@@ -313,7 +356,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
     if cheap is not None or _reason(scene, snap, found) is not None:
         remove(scene)
         return 0
-    return _write_osl(scene, snap, found) if uses_osl(scene) else _write_nodes(scene, snap, found)
+    return _write_osl(scene, snap, found) if _osl_form(scene, snap) else _write_nodes(scene, snap, found)
 
 
 def apply(scene: Scene, snap: Snapshot) -> int:
@@ -354,7 +397,8 @@ def remove(scene: Scene) -> None:
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """One line when two moving objects light each other uncorrected for a reason the user can change,
-    or when one moving object lights objects at rest uncorrected."""
+    or when one moving object lights objects at rest uncorrected; where the node form corrects it,
+    one line naming the moving meshes with curved faces (their normal is their box's)."""
     if snap.method != "GEOMETRY":
         return []
     reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
@@ -363,13 +407,31 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
         ]
-    if reason is None or reason in (
-        "off the Apparent Geometry path",
-        "fewer than two moving objects",
-        "no moving object has a material",
-    ):
+    # the final render (through the exact camera) corrects it with the node form; the preview is a preview
+    in_final = reason == "the observer moves" and exact_camera.final_render_problem(scene, snap) is None
+    if in_final and (count := _moving_count(scene)) > MAX_NODE_MOVERS:
+        reason, in_final = _over_limit(count, exact=True), False  # the final render's reason, said now
+    if reason is None or in_final:
+        return [] if _osl_form(scene, snap) and not in_final else _curved_lines(scene, snap, in_final)
+    if reason in ("off the Apparent Geometry path", "fewer than two moving objects", "no moving object has a material"):
         return []
     return [
         f"Light bounced between moving objects is not corrected, up to {MEASURED_ERROR} off at 0.5c "
         f"(docs/lamp-doppler.md): {reason}"
+    ]
+
+
+def _curved_lines(scene: Scene, snap: Snapshot, in_final: bool) -> list[str]:
+    """One line naming the moving objects with curved faces, where the node form corrects the light
+    they receive from other moving objects with their box's face normals."""
+    curved = [
+        obj.name for obj in _moving_objects(scene) if obj.type == "MESH" and off_axis_faces(cast("Mesh", obj.data))
+    ]
+    if not curved:
+        return []
+    where = "in the final render" if (in_final or snap.exact_camera) else "on SVM shading (OSL shading traces it)"
+    return [
+        f"Light other moving objects reflect onto {', '.join(repr(n) for n in sorted(curved))} is approximate "
+        f"{where}: faces more than {CURVED_DEGREES:g} degrees off the object's axes take its box's normal, "
+        f"{CURVED_ERROR} of the physics where 45 degrees off (docs/lamp-doppler.md)"
     ]

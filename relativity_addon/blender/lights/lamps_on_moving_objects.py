@@ -38,11 +38,11 @@ import numpy as np
 from ...errors import RelativityError
 from ...physics import lamp_doppler
 from ..camera import exact_camera
-from ..common import busy, compat, names, nodes
+from ..common import busy, names, nodes
 from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
-from . import lamp_stand_ins, moving_lights, moving_pairs, rest_normals, stand_in_lamps
+from . import lamp_stand_ins, lamp_trees, moving_lights, moving_pairs, rest_normals, stand_in_lamps
 
 if TYPE_CHECKING:
     from bpy.types import Light, Object, Scene
@@ -219,32 +219,13 @@ def stand_in_placement(matrix: FloatArray, light: Light, mover: Mover) -> tuple[
     return stand_ins, (spread[0], centre, spread[1])
 
 
-def _tree_rest_colour(light):
-    """What the lamp's node tree multiplies its colour by, for the stand-ins (whose tree is the
-    add-on's): its Emission's unlinked Strength, and its unlinked Color or its blackbody (Blender's
-    luminance-1 colour at that temperature); 1 where the tree does something else."""
-    tree = compat.light_node_tree(light)
-    node = sources.light_emission_node(tree) if tree is not None else None
-    if node is None:
-        return np.ones(3)
-    strength = node.inputs["Strength"]
-    colour = node.inputs["Color"]
-    scale = float(strength.default_value) if not strength.is_linked else 1.0
-    if not colour.is_linked:
-        return scale * np.array(colour.default_value[:3], dtype=np.float64)
-    temperature = sources.light_blackbody(light)
-    if temperature is not None and not light.use_temperature:
-        return scale * lamp_doppler.blackbody_unit_rgb(temperature)
-    return np.full(3, scale)
-
-
 def copy_colour(lamp: Object, doppler_factor: float, snap: Snapshot) -> tuple[float, ...]:
     """The copy's colour: the lamp's colour with eq. 18's factor (its temperature folded in)."""
     light = lamp.data
     temperature = sources.light_blackbody(light)
     factor = lamp_doppler.lamp_rgb_factor(
         doppler_factor,
-        rgb=tuple(light.color),
+        rgb=lamp_trees.doppler_rgb(light),
         temperature_k=temperature,
         use_doppler=snap.use_doppler,
         use_searchlight=snap.use_searchlight,
@@ -367,7 +348,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
         record = None
     lit = sorted({mover.name for _, mover in pairs} | set(moving_lit))
     if lit:
-        rest_normals.write(scene, [scene.objects[name] for name in lit])
+        rest_normals.write(scene, [scene.objects[name] for name in lit], snap)
     else:
         rest_normals.remove(scene)
     if not pairs:
@@ -386,7 +367,9 @@ def write(scene: Scene, snap: Snapshot) -> int:
         if stand_ins is None:
             copy = copies[(lamp.name, mover.name, "0")]
             doppler_factor, turned = placement(matrix, lamp.data.type, mover)
-            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned)
+            k = incidence(matrix, lamp.data.type, mover)
+            angle = lamp_doppler.aberrated_disc_angle(k, mover.beta, float(lamp.data.angle))
+            write_copy(copy, lamp, copy_colour(lamp, doppler_factor, snap), turned, angle=angle)
             continue
         offsets, dopplers = stand_ins
         _write_stand_ins(
@@ -402,10 +385,19 @@ def write(scene: Scene, snap: Snapshot) -> int:
 
 
 def write_copy(
-    copy: Object, lamp: Object, colour: tuple[float, ...], matrix: FloatArray, power_factor: float | None = None
+    copy: Object,
+    lamp: Object,
+    colour: tuple[float, ...],
+    matrix: FloatArray,
+    power_factor: float | None = None,
+    angle: float | None = None,
 ) -> None:
-    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its energy)."""
-    _follow(copy.data, lamp.data, frozenset() if power_factor is None else {"energy"})
+    """The copy of ``lamp`` with its settings, ``colour`` and world ``matrix`` (``power_factor``: its
+    energy; ``angle``: a sun's disc as the object sees it, ``lamp_doppler.aberrated_disc_angle``)."""
+    own = {"energy"} if power_factor is not None else set()
+    _follow(copy.data, lamp.data, frozenset(own | ({"angle"} if angle is not None else set())))
+    if angle is not None:
+        _set(copy.data, "angle", min(angle, math.pi))  # Blender's largest sun
     if power_factor is not None:
         _set(copy.data, "energy", float(lamp.data.energy) * power_factor)
     _set(copy.data, "use_temperature", False)
@@ -421,7 +413,7 @@ def _write_stand_ins(lamp, mover, matrix, offsets, dopplers, snap, copies):
     speed = float(np.linalg.norm(beta))
     colours = [np.array(copy_colour(lamp, doppler, snap)) for doppler in dopplers]
     slope, curvature = lamp_stand_ins.colour_fit(dopplers, colours)
-    base = tuple(float(v) for v in colours[1] * _tree_rest_colour(lamp.data))
+    base = tuple(float(v) for v in colours[1] * lamp_trees.tree_colour(lamp.data))
     axis = -matrix[:3, 2] / max(float(np.linalg.norm(matrix[:3, 2])), 1e-12)
     cone, blend = -2.0, 1e-6
     if lamp.data.type == "SPOT":
@@ -530,6 +522,10 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             "Moving lights on moving objects: the render's material shader lights them as if at rest "
             "(docs/moving-lights.md); only the exact camera's final render (a moving observer) includes their motion"
         )
+    record = _record(scene)
+    found += (
+        lamp_trees.warnings(scene.objects[name] for name in record["lamps"] if name in scene.objects) if record else []
+    )
     used = light_linking_collections(scene)
     if used > MAX_LIGHT_LINKING and KEY in scene:
         found.append(

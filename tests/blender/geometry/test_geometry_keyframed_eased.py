@@ -19,17 +19,20 @@ from test_object_type_sweep import _cube_mesh, _link
 import geometry_helpers as gh
 
 MODES = ("Keyframed", "Polynomial", "Closed Form")
+ONE_STEP = (*MODES, "Polynomial One Step")
 
 
-def _eased_mover(bpy, scene, adaptive):
+def _eased_mover(bpy, scene, adaptive, slower=1):
     """Two Bezier keys on x and z (Blender's default: auto-clamped handles), 0.3c on average and
-    about 0.45c at the middle of the motion; rotation and scale held."""
+    about 0.45c at the middle of the motion (``slower`` times as far apart in time: that much
+    slower, the acceleration ``slower**2`` times less); rotation and scale held."""
+    slower = float(slower)
     mesh = _grid_mesh(bpy, "Mover", 60, 0.6) if adaptive else _cube_mesh(bpy, "Mover", 0.3)
     obj = _link(bpy, scene, "Mover", mesh)
     obj.scale = (1.0, 1.3, 0.8)
     obj.rotation_euler = (0.4, 0.0, -0.7)
     obj.location = (0.0, -0.4, -5.0)
-    for frame, x, z in ((-240, -12.0, -6.0), (480, 24.0, -3.0)):
+    for frame, x, z in ((round(-240 * slower), -12.0, -6.0), (round(480 * slower), 24.0, -3.0)):
         obj.location.x, obj.location.z = x, z
         obj.keyframe_insert("location", index=0, frame=frame)
         obj.keyframe_insert("location", index=2, frame=frame)
@@ -60,7 +63,8 @@ def test_eased_keys_take_the_polynomial(relativity_addon, monkeypatch, adaptive)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
     assert _intervals_written(obj) == 0  # (main: 128-156 intervals read per point)
-    assert _inputs(obj, MODES) == {"Keyframed": True, "Polynomial": True, "Closed Form": False}
+    # one Newton step reaches the rest box's corners' roots (polynomial_motion.newton_steps)
+    assert _inputs(obj, ONE_STEP) == {**dict.fromkeys(ONE_STEP, True), "Closed Form": False}
     calls = _count_passes(monkeypatch)
 
     scene.relativity.beta = OBSERVER_CHANGED  # as the panel does: the update callback runs
@@ -91,6 +95,37 @@ def test_eased_keys_take_the_polynomial(relativity_addon, monkeypatch, adaptive)
     # (measured: the general solve's velocities depart from the relation by up to 4.6e-4 on the grid,
     # the polynomial's by 7e-5; positions 1.5e-5 and 7e-6)
     np.testing.assert_allclose(beta_stepped, beta_general, atol=6e-4)
+
+
+def test_faster_eased_keys_take_two_newton_steps(relativity_addon):
+    """The keys of ``test_eased_keys_take_the_polynomial`` at half the time apart (twice the speed,
+    about 0.84c at frame 13, four times the acceleration): one Newton step from the closed-form start
+    leaves the rest box's corners' roots by more than a tenth of the tolerance, so the modifier takes
+    two (``Polynomial One Step`` off), and the mesh and its velocities are where docs/physics.md
+    puts them. The polynomial's terms are multiply-adds on the rest position's parts: no Transform
+    Point per point (main: four)."""
+    import bpy
+
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = OBSERVER
+    obj = _eased_mover(bpy, scene, False, slower=0.5)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    scene.frame_set(13)
+    assert _inputs(obj, ONE_STEP) == {
+        "Keyframed": True,
+        "Polynomial": True,
+        "Closed Form": False,
+        "Polynomial One Step": False,
+    }
+    stepped, beta_stepped = gh.evaluated_points(bpy, obj, "relativity_beta")
+    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+    expected, velocity = _seen(obj, rest, 13 / FPS, np.array(camera.matrix_world.translation), OBSERVER)
+    np.testing.assert_allclose(stepped, expected, atol=1e-4)
+    np.testing.assert_allclose(beta_stepped, velocity, atol=1e-4)
+    group = gh.addon_module("geometry.modifier").find_modifier(obj).node_group
+    solve = [node.bl_idname for node in group.nodes if node.name.startswith("kp")]
+    assert solve and "FunctionNodeTransformPoint" not in solve
 
 
 def test_keys_whose_window_crosses_a_key_keep_the_general_solve(relativity_addon):

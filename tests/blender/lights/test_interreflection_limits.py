@@ -220,3 +220,39 @@ def test_no_group_for_moving_objects_without_materials(relativity_addon, factory
     assert any(g.name.startswith(names.BOUNCE_SCENE_GROUP) for g in bpy.data.node_groups)
     assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
     effect.remove(scene)
+
+
+def _curved_lines(effect, scene):
+    return [line for line in effect.scene_warnings(scene) if "is approximate" in line and "reflect onto" in line]
+
+
+def test_curved_receivers_on_the_node_form_are_said(relativity_addon, factory_blender):
+    """The node form takes a receiver's rest normal from its box's nearest face: exact for the flat
+    panel, not for the sphere (its faces up to 90 degrees off its axes). The panel says so for the
+    curved one alone, on SVM and in a moving observer's final render (the node form there too);
+    OSL shading with the observer at rest (the normal traced) says nothing."""
+    from relativity_addon.blender.common import osl
+
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    beta = np.array([case.EACH, 0.0, 0.0])
+    scene, _ = case._scene(bpy, beta, -beta)
+    effect.apply(scene)
+    assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
+    line = (
+        "Light other moving objects reflect onto 'Sphere' is approximate {}: faces more than 5 degrees off "
+        "the object's axes take its box's normal, 0.69-1.57x of the physics where 45 degrees off "
+        "(docs/lamp-doppler.md)"
+    )
+    assert _curved_lines(effect, scene) == [line.format("on SVM shading (OSL shading traces it)")]
+    scene.relativity.beta = (0.0, -0.3, 0.0)  # the final render goes through the exact camera
+    effect.sync(scene)
+    expected = [] if osl.unavailable_reason() is not None else [line.format("in the final render")]
+    assert _curved_lines(effect, scene) == expected
+    scene.relativity.beta = (0.0, 0.0, 0.0)
+    if osl.unavailable_reason() is None:
+        scene.cycles.shading_system = True
+        effect.sync(scene)
+        assert "text" in bpy.data.materials["White"][names.BOUNCE_MATERIAL_KEY]
+        assert _curved_lines(effect, scene) == []
+    effect.remove(scene)
