@@ -111,12 +111,11 @@ def test_baked_apparent_geometry_renders_the_same_frames_without_the_add_on(
         "the bake's exact camera stays after a render and a frame change"
     )
     assert max(differences) < 0.1 * noise, f"baked frames differ from the add-on's: {differences} (noise {noise:.4g})"
-    if moving_light:  # a farm task whose chunk starts inside the range (frames 2-3), in a fresh process
-        chunk = render_plain_animation(
-            tmp_path / "baked.blend", tmp_path, FRAMES[1:], "chunk", chunk=(FRAMES[1], FRAMES[-1])
-        )
-        late = [float(np.abs(ch.read_exr(bpy, path) - o).mean()) for path, o in zip(chunk, own[1:], strict=True)]
-        assert max(late) < 0.1 * noise, f"frames 2-3 rendered alone differ from the add-on's: {late}"
+    if moving_light:  # a farm task whose chunk starts inside the range (frame 2), in a fresh process
+        # (frame 3 after frame 2 in one process is the animation's above: one OSL render less, 4-6 s)
+        chunk = render_plain_animation(tmp_path / "baked.blend", tmp_path, FRAMES[1:2], "chunk", chunk=FRAMES[1:2] * 2)
+        late = [float(np.abs(ch.read_exr(bpy, path) - o).mean()) for path, o in zip(chunk, own[1:2], strict=True)]
+        assert max(late) < 0.1 * noise, f"frame 2 rendered alone differs from the add-on's: {late}"
 
 
 @pytest.mark.parametrize(
