@@ -96,8 +96,6 @@ def test_accelerating_camera_lamp_follows_its_keyframed_path(relativity_addon, f
     scene.relativity.method = "CAMERA"
     scene.relativity.use_doppler = False
     mp._effect().apply(scene)
-    image = mp.ch.luminance(mp._render(bpy, scene, tmp_path / "accelerating.exr"))
-    assert np.all(np.isfinite(image)) and image.min() >= 0.0
     observer = np.array([kl.FAST, 0.0, 0.0])
     keyframed, uniform = [], []
     for offset in ((x, y) for y in SUBPIXELS for x in SUBPIXELS):
@@ -116,6 +114,9 @@ def test_accelerating_camera_lamp_follows_its_keyframed_path(relativity_addon, f
     away = (retarded_x < chord[0]) | (retarded_x > chord[-1])
     row = int(np.unravel_index(np.argmax(expected), expected.shape)[0])
     band = slice(row - mo.BAND // 2, row + mo.BAND - mo.BAND // 2)  # through the pool, along the motion
+    mp._render_rows(scene, band)  # the rows compared
+    image = mp.ch.luminance(mp._render(bpy, scene, tmp_path / "accelerating.exr"))
+    assert np.all(np.isfinite(image)) and image.min() >= 0.0
     peak = expected[band].mean(0).max()
     keep = away[band].all(axis=0)
     error = np.abs(image[band].mean(0) - expected[band].mean(0))[keep].max() / peak

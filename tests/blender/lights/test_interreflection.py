@@ -299,6 +299,18 @@ def _inner(model):
     return inner
 
 
+def _border(scene, sampled):
+    """Render only the box around the measured pixels (``sampled``, top row first) with a pixel to
+    spare: Cycles seeds each pixel by its own position, so those pixels come out the same."""
+    rows, columns = np.flatnonzero(sampled.any(1)), np.flatnonzero(sampled.any(0))
+    height, width = sampled.shape
+    top, bottom = max(rows[0] - 1, 0), min(rows[-1] + 2, height)
+    left, right = max(columns[0] - 1, 0), min(columns[-1] + 2, width)
+    scene.render.use_border, scene.render.use_crop_to_border = True, False
+    scene.render.border_min_y, scene.render.border_max_y = 1.0 - bottom / height, 1.0 - top / height
+    scene.render.border_min_x, scene.render.border_max_x = left / width, right / width
+
+
 def _save(bpy, path, image, model):
     """render | model, one brightness scale (the panel's model peak), as a PNG to look at."""
     peak = float(np.nanmax(model))
@@ -320,8 +332,9 @@ def _measure(bpy, tmp_path, beta_sphere, beta_panel, name):
     for material in bpy.data.materials:  # the snapshot's own error: the add-on's bounce factor muted
         if names.BOUNCE_MATERIAL_KEY in material:  # (test_interreflection_svm.py renders it)
             material.node_tree.nodes[material[names.BOUNCE_MATERIAL_KEY]["node"]].mute = True
-    image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"{name}.exr"))
     inner = _inner(_seen_panel(rotation, beta_sphere, beta_panel)[0])
+    _border(scene, inner)
+    image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"{name}.exr"))
     models = {"physics": _model(rotation, beta_sphere, beta_panel)}
     if np.any(beta_sphere) or np.any(beta_panel):
         models["receiver at rest"] = _model(rotation, beta_sphere, beta_panel, relative=False)
@@ -375,10 +388,12 @@ def _clamped_share(bpy, tmp_path, beta):
         scene.cycles.sample_clamp_indirect = clamp
         effect = _module("pipeline.effect")
         effect.apply(scene)
+        inner = _inner(_seen_panel(rotation, beta, -beta)[0])
+        _border(scene, inner)
         image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"clamp{clamp:g}.exr"))
         effect.remove(scene)
         assert scene.cycles.sample_clamp_indirect == pytest.approx(clamp)
-        means[clamp] = float(image[_inner(_seen_panel(rotation, beta, -beta)[0])].mean())
+        means[clamp] = float(image[inner].mean())
     return means[10.0] / means[0.0]
 
 

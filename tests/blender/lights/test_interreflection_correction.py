@@ -15,12 +15,21 @@ from relativity_addon.blender.common import names, osl
 UNCORRECTED = "Light bounced between moving objects is not corrected, up to 12 % off at 0.5c (docs/lamp-doppler.md)"
 
 
+def _sphere_pixels(beta):
+    """The sphere's inner pixels (at least two pixels from its outline)."""
+    rays = ch.pixel_rays(case.RESOLUTION, case.SENSOR, case.LENS)
+    sphere_path, _ = case._sphere_hit(case.CAMERA, 0.0, rays, beta)
+    return np.isfinite(sphere_path) & case._inner(np.where(np.isfinite(sphere_path), 1.0, np.nan))
+
+
 def _render(bpy, tmp_path, beta, name, use_osl=True):
     """The panel's (and the sphere's) pixels rendered through Set Up, and the panel's model."""
     scene, rotation = case._scene(bpy, beta, -beta)
     scene.cycles.shading_system = use_osl
     effect = case._module("pipeline.effect")
     effect.apply(scene)
+    panel = case._inner(case._seen_panel(rotation, beta, -beta)[0])
+    case._border(scene, panel | _sphere_pixels(beta))
     image = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"{name}.exr"))
     carrying = [m.name for m in bpy.data.materials if names.BOUNCE_MATERIAL_KEY in m]
     effect.remove(scene)
@@ -54,9 +63,7 @@ def test_set_up_corrects_the_bounce(relativity_addon, factory_blender, tmp_path,
     case._save(bpy, tmp_path / f"{name}_corrected_render_model.png", corrected, physics)
     ratio = float(corrected[sampled].mean() / physics[sampled].mean())
     svm = float(plain[sampled].mean() / physics[sampled].mean())
-    rays = ch.pixel_rays(case.RESOLUTION, case.SENSOR, case.LENS)
-    sphere_path, _ = case._sphere_hit(case.CAMERA, 0.0, rays, beta)
-    sphere = np.isfinite(sphere_path) & case._inner(np.where(np.isfinite(sphere_path), 1.0, np.nan))
+    sphere = _sphere_pixels(beta)
     direct = float(corrected[sphere].mean() / plain[sphere].mean())
     print(
         f"{name}: {sampled.sum()} panel px, rendered over physics: corrected {ratio:.4f}, "

@@ -74,16 +74,19 @@ def test_per_ray_factor_in_a_render(relativity_addon, factory_blender, tmp_path,
     beta = np.array([sphere_beta, 0.0, 0.0])
     monkeypatch.setattr(case._module("lights.interreflection"), "_reason", lambda *args: "the test's own shader")
     effect = case._module("pipeline.effect")
-    images = {}
+    images, sampled = {}, None
     variants = (("off", 0.0, 0.0), ("normal", 1.0, 1.0), ("traced normal", 1.0, 2.0), ("no normal", 1.0, 0.0))
     for key, use_factor, use_normal in variants:
         scene, rotation = case._scene(bpy, beta, -beta)
         effect.apply(scene)
         _insert_factor(bpy, scene, -beta, rotation[:, 2], use_factor, use_normal)
+        if sampled is None:  # the panel's inner pixels (where the sphere is not in front)
+            sampled = case._inner(case._seen_panel(rotation, beta, -beta)[0])
+        case._border(scene, sampled)
         images[key] = ch.luminance(ch.render_exr(bpy, scene, tmp_path / f"{name}_{key}.exr"))
         effect.remove(scene)
     physics = case._model(rotation, beta, -beta)
-    sampled = case._inner(case._seen_panel(rotation, beta, -beta)[0]) & np.isfinite(physics)
+    sampled &= np.isfinite(physics)
     case._save(bpy, tmp_path / f"{name}_factor_render_model.png", images["normal"], physics)
     ratios = {key: round(float(image[sampled].mean() / physics[sampled].mean()), 4) for key, image in images.items()}
     print(f"{name}, {sampled.sum()} px: rendered over physics {ratios}")

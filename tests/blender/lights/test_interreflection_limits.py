@@ -106,6 +106,7 @@ def test_bounce_onto_a_receiver_at_rest(relativity_addon, factory_blender, tmp_p
     effect = case._module("pipeline.effect")
     effect.apply(scene)
     assert sorted(m.name for m in bpy.data.materials if names.BOUNCE_MATERIAL_KEY in m) == ["Glow", "White"]
+    case._border(scene, case._inner(case._seen_panel(rotation, beta, np.zeros(3))[0]))
     corrected = _render(bpy, scene, tmp_path / f"{name}.exr")
     plain = _render(bpy, scene, tmp_path / f"{name}_muted.exr", muted=True)
     effect.remove(scene)
@@ -136,6 +137,7 @@ def test_bounce_onto_a_receiver_at_rest_on_osl(relativity_addon, factory_blender
     effect = case._module("pipeline.effect")
     effect.apply(scene)
     assert all("text" in m[names.BOUNCE_MATERIAL_KEY] for m in bpy.data.materials if names.BOUNCE_MATERIAL_KEY in m)
+    case._border(scene, case._inner(case._seen_panel(rotation, beta, np.zeros(3))[0]))
     image = _render(bpy, scene, tmp_path / f"{name}_osl.exr")
     effect.remove(scene)
     physics = _rest_panel_model(rotation, beta)

@@ -77,6 +77,7 @@ def test_floor_under_a_moving_rgb_lamp_gets_its_shifted_spectrum(relativity_addo
     bpy = factory_blender
     scene, camera, lamp = mp._floor_scene(bpy, samples=SAMPLES)
     scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
+    mp._render_rows(scene, ROWS)  # the rows _compare reads
     lamp.data.color = COLOUR
     mp._effect().apply(scene)
     points = mp._floor_points(bpy, scene, camera)
