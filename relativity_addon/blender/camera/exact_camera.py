@@ -342,9 +342,10 @@ def apply(scene: Scene, snap: Snapshot, render_only: bool = False) -> Object:
             raise RelativityError(f"{error}: the relativistic camera needs it") from error
         _save_state(camera_data, render_only)
         text = ensure_shader_text()
-        camera_data.type = "CUSTOM"
-        camera_data.custom_mode = "INTERNAL"
-        camera_data.custom_shader = text
+        with osl.compiling():
+            camera_data.type = "CUSTOM"
+            camera_data.custom_mode = "INTERNAL"
+            camera_data.custom_shader = text
     elif camera_data.type != "CUSTOM":
         raise RelativityError(type_changed(camera_object))  # the user's change stays until Remove
     try:
@@ -425,6 +426,13 @@ def remove_data(camera_data: Camera) -> bool:
         del custom[key]
     for key, value in saved.get("cycles_custom", {}).items():
         custom[key] = value
+    with osl.compiling():
+        _restore_shader(camera_data, saved)
+    camera_data.update_tag()
+    return True
+
+
+def _restore_shader(camera_data: Camera, saved: dict) -> None:
     camera_data.custom_mode = saved["custom_mode"]
     shader = bpy.data.texts.get(saved["custom_shader"]) if saved["custom_shader"] else None
     ours = bpy.data.texts.get(names.SHADER_TEXT)
@@ -444,5 +452,3 @@ def remove_data(camera_data: Camera) -> bool:
     text = bpy.data.texts.get(names.SHADER_TEXT)
     if text is not None and not any(cam.custom_shader == text for cam in bpy.data.cameras):
         bpy.data.texts.remove(text)
-    camera_data.update_tag()
-    return True

@@ -8,8 +8,11 @@ folder, and then compilation fails and the render silently uses an empty shader.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+import tempfile
+from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -75,6 +78,22 @@ def ensure_oslquery_importable() -> None:
         raise OSLUnavailableError(reason)
 
 
+@contextlib.contextmanager
+def compiling() -> Iterator[None]:
+    """Around anything that makes Cycles compile an OSL text datablock (assigning a script node's
+    or camera's shader, ``cycles.osl.update_*``): Cycles' own add-on compiles an in-memory text
+    to a temporary ``.oso`` file it never deletes (``osl_compile`` in ``cycles/osl.py``, 40-170 kB
+    a compile). The temporary files go to a private folder removed afterwards, so nothing is left
+    in the user's temporary folder."""
+    previous = tempfile.tempdir
+    with tempfile.TemporaryDirectory(prefix="relativity-osl-") as folder:
+        tempfile.tempdir = folder
+        try:
+            yield
+        finally:
+            tempfile.tempdir = previous
+
+
 def compile_custom_camera(camera_data: Camera) -> list[str]:
     """Compile the camera's OSL shader with Cycles; return the list of error messages.
 
@@ -95,7 +114,8 @@ def compile_custom_camera(camera_data: Camera) -> list[str]:
         if {"ERROR", "WARNING"} & set(kind):
             errors.append(str(message))
 
-    ok = osl.update_custom_camera_shader(camera_data, report)
+    with compiling():
+        ok = osl.update_custom_camera_shader(camera_data, report)
     if not ok and not errors:
         errors.append("Custom Camera shader compilation failed")
     return errors

@@ -212,7 +212,8 @@ def attach(material: Material | None, text: Text) -> bool:
     node = tree.nodes.new("ShaderNodeScript")
     node.name = node.label = NODE_NAME
     node.mode = "INTERNAL"
-    node.script = text  # compiles (oslquery importable: osl.unavailable_reason) and creates the sockets
+    with osl.compiling():
+        node.script = text  # compiles (oslquery importable: osl.unavailable_reason) and creates the sockets
     node.location = (output.location.x - 150.0, output.location.y - 250.0)
     node.hide = True
     material[MATERIAL_KEY] = {
@@ -252,7 +253,8 @@ def _recompile(materials: Sequence[Material]) -> None:
     for material in materials:
         node = material.node_tree.nodes.get(material[MATERIAL_KEY]["node"])
         if node is not None:
-            cycles_osl.update_script_node(node, report)
+            with osl.compiling():
+                cycles_osl.update_script_node(node, report)
 
 
 def _materials(scene: Scene, found: Sequence[Mover]) -> dict[str, Material]:

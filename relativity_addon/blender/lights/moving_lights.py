@@ -112,7 +112,8 @@ def ensure_group(light_names: Sequence[str]) -> NodeTree:
         node = group.nodes.new("ShaderNodeScript")
         node.name = node.label = f"light {name}"
         node.mode = "INTERNAL"
-        node.script = text  # compiles (oslquery must be importable) and creates the sockets
+        with osl.compiling():
+            node.script = text  # compiles (oslquery must be importable) and creates the sockets
         node.location = (200.0, -200.0 * index)
         if "Emission" not in node.outputs or "light_position" not in node.inputs:
             raise RelativityError("The moving-light OSL shader did not compile (no sockets on its script node)")

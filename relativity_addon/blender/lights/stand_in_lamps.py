@@ -42,7 +42,7 @@ from ...physics.moving_lights import (
 )
 from ..camera import cockpit
 from ..colour import light_groups, materials
-from ..common import busy, names
+from ..common import busy, names, osl
 from ..scene import animation, lens, sources
 from . import lamp_shader
 
@@ -178,7 +178,8 @@ def _new_lamp(scene, name, text, kind="POINT"):
     node = tree.nodes.new("ShaderNodeScript")
     node.name = node.label = names.MOVING_LAMP_PREFIX
     node.mode = "INTERNAL"
-    node.script = text
+    with osl.compiling():
+        node.script = text
     if "Emission" not in node.outputs or "lamp_time" not in node.inputs:
         bpy.data.lights.remove(light)
         raise RelativityError("The moving-lamp OSL shader did not compile (no sockets on its script node)")
