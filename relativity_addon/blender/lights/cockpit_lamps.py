@@ -9,7 +9,8 @@ same distance (with the searchlight; the shifted colour with the Doppler colour)
 copy in the cockpit scene, turned about the cockpit's centre so that its light arrives along ``k'``,
 with the colour and strength of ``lamps_on_moving_objects.copy_colour`` (one ``D`` and one direction
 for the whole cockpit, exact at its centre: the cockpit is small beside the distance to the lamps).
-A sun: its direction aberrated, ``D^2``. The copies are not seen by the camera (the film shows the
+A sun: its direction aberrated, ``D^2``, its disc as the cockpit sees it
+(``lamp_doppler.aberrated_disc_angle``). The copies are not seen by the camera (the film shows the
 relativistic render there); the scene's objects cast no shadow on the cockpit (they are not in
 its scene). Lamps with their own velocity (moving lights) and the add-on's own lamps are left out
 (docs/cockpit.md).
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING
 import bpy
 import numpy as np
 
+from ...physics import lamp_doppler
 from ..camera import cockpit
 from ..common import names
 from ..scene import cockpit as cockpit_reader
@@ -92,7 +94,11 @@ def write(scene: Scene, snap: Snapshot, structural: bool = True) -> None:
             continue
         matrix = eq18.lamp_matrix(scene, original, snap)
         doppler, turned = eq18.placement(matrix, original.data.type, mover)
-        eq18.write_copy(copied, original, eq18.copy_colour(original, doppler, snap), turned)
+        angle = None
+        if original.data.type == "SUN":  # the disc as the cockpit sees it (docs/physics.md)
+            k = eq18.incidence(matrix, "SUN", mover)
+            angle = lamp_doppler.aberrated_disc_angle(k, mover.beta, float(original.data.angle))
+        eq18.write_copy(copied, original, eq18.copy_colour(original, doppler, snap), turned, angle=angle)
 
 
 def apply(scene: Scene, snap: Snapshot) -> None:

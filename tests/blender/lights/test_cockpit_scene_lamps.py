@@ -120,3 +120,40 @@ def test_remove_gives_the_file_back_with_sky_and_lamps(relativity_addon, factory
     _effect().remove(scene)
     lines = scene_dump.differences(before, scene_dump.dump(bpy))
     assert not lines, "\n".join(lines[:20])
+
+
+def test_sun_copy_has_the_disc_the_cockpit_sees(relativity_addon, factory_blender):
+    """A sun of 20 degrees seen from the cockpit at 0.9c: its copy's disc is the angle between the
+    disc's two edges (in the plane of k and beta) each aberrated (docs/physics.md): 40.5 degrees
+    here (light from behind the motion, D = 0.51, the disc about 1/D as wide); before, the copy
+    kept the sun's 20."""
+    import math
+
+    bpy = factory_blender
+    scene, camera = ch.new_scene(bpy, resolution=(32, 24), samples=4)
+    mesh = bpy.data.meshes.new("Plate")
+    mesh.from_pydata([(-0.1, -0.1, 0.0), (0.1, -0.1, 0.0), (0.1, 0.1, 0.0), (-0.1, 0.1, 0.0)], [], [(0, 1, 2, 3)])
+    plate = bpy.data.objects.new("Plate", mesh)
+    scene.collection.objects.link(plate)
+    plate.parent = camera
+    plate.location = tuple(PLATE)
+    plate.relativity.moves_with_camera = True
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.angle = math.radians(20.0)
+    sun.rotation_euler = (0.0, math.radians(-60.0), 0.0)  # light along +x and down: from behind
+    scene.collection.objects.link(sun)
+    scene.relativity.method = "CAMERA"
+    scene.relativity.beta = tuple(BETA)
+    bpy.context.view_layer.update()
+    _effect().apply(scene)
+    copy = next(obj for obj in bpy.data.scenes[f"Relativity Cockpit {scene.name}"].objects if obj.type == "LIGHT")
+    k = -np.array(sun.matrix_world.col[2][:3])  # the sun's light travels along its -Z
+    across = np.cross(np.cross(k, BETA), k)
+    across /= np.linalg.norm(across)
+    half = 0.5 * sun.data.angle
+    edges = [ch.aberrate(math.cos(half) * k + sign * math.sin(half) * across, BETA) for sign in (1.0, -1.0)]
+    expected = math.acos(np.clip(edges[0] @ edges[1] / np.prod([np.linalg.norm(e) for e in edges]), -1.0, 1.0))
+    print(f"sun 20 deg, copy {math.degrees(copy.data.angle):.3f} deg, expected {math.degrees(expected):.3f} deg")
+    assert abs(expected - sun.data.angle) > 0.2 * sun.data.angle  # the case tells the two apart
+    assert copy.data.angle == pytest.approx(expected, rel=1e-4)
+    _effect().remove(scene)
