@@ -10,8 +10,8 @@ Building is slow for large groups: every node, link and value set from Python ma
 update the whole tree, so a build costs the square of its size (the Apparent Geometry group, 410
 nodes and 946 links: 1.9-3 s of every Set Up). :func:`ensure_group` therefore keeps each built
 group that refers to no other datablock in a small ``.blend`` in the extension's user folder
-(``bpy.utils.extension_path_user``), named by a fingerprint of the spec, the version stamp and
-the Blender build, and appends it from there the next time (15 ms).
+(``bpy.utils.extension_path_user``), named by a fingerprint of the spec, the version stamp, this
+builder's source and the Blender build, and appends it from there the next time (15 ms).
 """
 
 from __future__ import annotations
@@ -176,6 +176,19 @@ def ensure_group(spec: Group, version_key: str, version: int) -> NodeTree:
     return tree
 
 
+def _builder_fingerprint() -> str:
+    """This module's source: a change to how groups are built (not only to a spec) is not served
+    from groups kept by the old builder."""
+    try:
+        with open(__file__, "rb") as source:
+            return hashlib.sha256(source.read()).hexdigest()
+    except OSError:
+        return ""
+
+
+_BUILDER = _builder_fingerprint()
+
+
 def _canonical(value: object) -> object:
     """``value`` as nested tuples that tell apart what the builder tells apart (a
     :class:`Literal` from a reference, :class:`Links` from a tuple)."""
@@ -198,7 +211,7 @@ def _cache_path(spec: Group, version_key: str, version: int) -> str | None:
         folder = bpy.utils.extension_path_user(package, path="node_groups", create=True)
     except (ValueError, OSError):  # not installed as an extension; a read-only user folder
         return None
-    key = repr((_canonical(spec), version_key, version, bpy.app.version_string, bpy.app.build_hash))
+    key = repr((_canonical(spec), version_key, version, _BUILDER, bpy.app.version_string, bpy.app.build_hash))
     return os.path.join(folder, f"{hashlib.sha256(key.encode()).hexdigest()[:24]}.blend")
 
 
