@@ -10,8 +10,9 @@ Building is slow for large groups: every node, link and value set from Python ma
 update the whole tree, so a build costs the square of its size (the Apparent Geometry group, 410
 nodes and 946 links: 1.9-3 s of every Set Up). :func:`ensure_group` therefore keeps each built
 group that refers to no other datablock in a small ``.blend`` in the extension's user folder
-(``bpy.utils.extension_path_user``), named by a fingerprint of the spec, the version stamp, this
-builder's source and the Blender build, and appends it from there the next time (15 ms).
+(``bpy.utils.extension_path_user``; run from the source tree, Blender's user data folder),
+named by a fingerprint of the spec, the version stamp, this builder's source and the Blender
+build, and appends it from there the next time (15 ms).
 """
 
 from __future__ import annotations
@@ -203,13 +204,18 @@ def _canonical(value: object) -> object:
 
 def _cache_path(spec: Group, version_key: str, version: int) -> str | None:
     """Where the built group of ``spec`` is kept, or None: a group naming other datablocks (a
-    nested group, an image) is not kept, nor anything when the add-on runs outside an extension."""
+    nested group, an image) is not kept, nor anything when the user folder cannot be written."""
     if any(prop in ("node_tree", "image") for node in spec.nodes.values() for prop in node.props):
         return None
     package = (__package__ or "").rsplit(".blender", 1)[0]
     try:
-        folder = bpy.utils.extension_path_user(package, path="node_groups", create=True)
-    except (ValueError, OSError):  # not installed as an extension; a read-only user folder
+        if package.startswith("bl_ext."):
+            folder = bpy.utils.extension_path_user(package, path="node_groups", create=True)
+        else:  # run from the source tree (examples/render.py, benchmarks): Blender's user data folder
+            folder = bpy.utils.user_resource("DATAFILES", path=os.path.join(package, "node_groups"), create=True)
+    except (ValueError, OSError):  # a read-only user folder
+        return None
+    if not folder:
         return None
     key = repr((_canonical(spec), version_key, version, _BUILDER, bpy.app.version_string, bpy.app.build_hash))
     return os.path.join(folder, f"{hashlib.sha256(key.encode()).hexdigest()[:24]}.blend")
