@@ -198,11 +198,12 @@ def test_moving_blackbody_lamp_bounce_light_is_approximate(relativity_addon, fac
     """What is left (docs/moving-lights.md): the stand-ins' shader shifts their light by the ``D_o``
     of the lit point, so light reaching the camera by a second bounce carries the wrong one. A white
     slope turned away from the lamp (lit only by the floor) and the floor in its shadow (lit only
-    by bounces), observer at 0.5c, 256 samples: the fast mode against the spectral render there,
-    printed and held to its documented size (Delta E 1.3, luminance 0.64)."""
+    by bounces), observer at 0.5c, 128 samples: the fast mode against the spectral render there,
+    printed and held to its documented size (measured: Delta E 0.95 on Blender 5.2 and 0.98 on
+    4.5, luminance 0.94 and 0.93 of the spectral render's; at 256 samples 0.93 and 0.94 on both)."""
     bpy = factory_blender
     scene, _camera, _lamp = _scene(bpy, rows_only=False)  # the slope and its shadow: every row
-    scene.cycles.samples = 256
+    scene.cycles.samples = 128
     mesh = bpy.data.meshes.new("Slope")  # facing +x and up: away from the lamp's retarded positions
     mesh.from_pydata([(0.0, -1.0, 1.0), (1.0, -1.0, 0.0), (1.0, 1.0, 0.0), (0.0, 1.0, 1.0)], [], [(0, 1, 2, 3)])
     mesh.materials.append(bpy.data.materials["White"])
@@ -215,6 +216,7 @@ def test_moving_blackbody_lamp_bounce_light_is_approximate(relativity_addon, fac
     spectral = dh.linear_rec709_to_xyz(pixels[::-1, :, :3].astype(float).reshape(-1, 3)).reshape(-1, RESOLUTION[0], 3)
     fast = dh.linear_rec709_to_xyz(mp._render(bpy, scene, tmp_path / "fast.exr").reshape(-1, 3)).reshape(spectral.shape)
     slope.hide_render = True  # where the slope changes the picture: itself and its shadow
+    scene.cycles.samples = 64  # this render only picks the pixels (a change of half or more), not compared
     floor_only = mp._render(bpy, scene, tmp_path / "floor.exr")
     without = dh.linear_rec709_to_xyz(floor_only.reshape(-1, 3))[:, 1].reshape(spectral.shape[:2])
     bounce_only = np.abs(fast[..., 1] - without) > 0.5 * np.abs(without) + 1e-3
