@@ -38,7 +38,8 @@ def _insert_factor(bpy, scene, beta_receiver, receiver_normal, use_factor, use_n
     text.from_string(SHADER.read_text())
     script = tree.nodes.new("ShaderNodeScript")
     script.mode = "INTERNAL"
-    script.script = text
+    with osl.compiling():  # Cycles' compile leaves its .oso behind otherwise (common/osl.py)
+        script.script = text
     assert "Out" in script.outputs, "the OSL shader did not compile"
     beta = tree.nodes.new("ShaderNodeAttribute")
     beta.attribute_type = "GEOMETRY"
