@@ -82,7 +82,7 @@ setup() {  # setup X.Y: create .venv-X.Y and install requirements/blender-X.Y.tx
 run_tests() {  # run_tests X.Y [pytest arguments]
     local version=$1 status=0
     shift
-    ".venv-$version/bin/python" -m pytest -n 2 tests --ignore=tests/gui "$@" || status=$?
+    ".venv-$version/bin/python" -m pytest -n 2 --dist worksteal tests --ignore=tests/gui "$@" || status=$?
     if [ "$status" -eq 5 ]; then
         echo "error: pytest collected no tests (Blender $version)" >&2
         return 1
