@@ -27,6 +27,18 @@ def _effect():
     return importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
 
 
+def _cockpit_plate(bpy, scene, camera):
+    """A 0.2 m plate parented to the camera at PLATE, moving with it (the cockpit)."""
+    mesh = bpy.data.meshes.new("Plate")
+    mesh.from_pydata([(-0.1, -0.1, 0.0), (0.1, -0.1, 0.0), (0.1, 0.1, 0.0), (-0.1, 0.1, 0.0)], [], [(0, 1, 2, 3)])
+    plate = bpy.data.objects.new("Plate", mesh)
+    scene.collection.objects.link(plate)
+    plate.parent = camera
+    plate.location = tuple(PLATE)
+    plate.relativity.moves_with_camera = True
+    return plate
+
+
 def expected_ratio(lamp=LAMP, plate=PLATE, beta=BETA, normal=NORMAL):
     """``D^2 cos(alpha') / cos(alpha)`` at the plate's centre, ``alpha`` the angle of incidence
     (scene frame, the lamp at rest) and ``alpha'`` the plate's frame one (aberrated ``k'``)."""
@@ -96,13 +108,7 @@ def test_remove_gives_the_file_back_with_sky_and_lamps(relativity_addon, factory
     gradient = tree.nodes.new("ShaderNodeTexGradient")
     tree.links.new(gradient.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     tree.nodes["Background"].inputs["Strength"].default_value = 1.0
-    mesh = bpy.data.meshes.new("Plate")
-    mesh.from_pydata([(-0.1, -0.1, 0.0), (0.1, -0.1, 0.0), (0.1, 0.1, 0.0), (-0.1, 0.1, 0.0)], [], [(0, 1, 2, 3)])
-    plate = bpy.data.objects.new("Plate", mesh)
-    scene.collection.objects.link(plate)
-    plate.parent = camera
-    plate.location = tuple(PLATE)
-    plate.relativity.moves_with_camera = True
+    _cockpit_plate(bpy, scene, camera)
     for kind, location in (("POINT", LAMP), ("SUN", (0.0, 5.0, 5.0))):
         lamp = bpy.data.objects.new(kind.title(), bpy.data.lights.new(kind.title(), kind))
         lamp.location = tuple(location)
@@ -131,13 +137,7 @@ def test_sun_copy_has_the_disc_the_cockpit_sees(relativity_addon, factory_blende
 
     bpy = factory_blender
     scene, camera = ch.new_scene(bpy, resolution=(32, 24), samples=4)
-    mesh = bpy.data.meshes.new("Plate")
-    mesh.from_pydata([(-0.1, -0.1, 0.0), (0.1, -0.1, 0.0), (0.1, 0.1, 0.0), (-0.1, 0.1, 0.0)], [], [(0, 1, 2, 3)])
-    plate = bpy.data.objects.new("Plate", mesh)
-    scene.collection.objects.link(plate)
-    plate.parent = camera
-    plate.location = tuple(PLATE)
-    plate.relativity.moves_with_camera = True
+    _cockpit_plate(bpy, scene, camera)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.angle = math.radians(20.0)
     sun.rotation_euler = (0.0, math.radians(-60.0), 0.0)  # light along +x and down: from behind
