@@ -46,12 +46,25 @@ def problem(light: Light) -> str | None:
     return None
 
 
-def tree_colour(light: Light) -> FloatArray:
-    """What the lamp's tree multiplies its Color by (linear RGB): its Emission's Strength times its
-    unlinked Color, or its blackbody (Blender's luminance-1 colour, times its constant); ones
-    without a tree, the Strength alone where the tree is not carried (:func:`problem`)."""
+def _emission(light):
     tree = compat.light_node_tree(light)
-    node = sources.light_emission_node(tree) if tree is not None else None
+    return sources.light_emission_node(tree) if tree is not None else None
+
+
+def _tree_blackbody(light):
+    """The Blackbody (``sources.Blackbody``) on the Emission Color that is the lamp's blackbody
+    (``sources.light_blackbody``, its own temperature off), or None."""
+    node = _emission(light)
+    if node is None or not node.inputs["Color"].is_linked or light.use_temperature:
+        return None
+    return sources.blackbody_source(node.inputs["Color"]) if sources.light_blackbody(light) is not None else None
+
+
+def tree_factor(light: Light) -> FloatArray:
+    """What the lamp's tree multiplies its Color by, a Blackbody in it left out (linear RGB): its
+    Emission's Strength times its unlinked Color, or times the Blackbody's constant; ones without a
+    tree, the Strength alone where the tree is not carried (:func:`problem`)."""
+    node = _emission(light)
     if node is None:
         return np.ones(3)
     strength = node.inputs["Strength"]
@@ -59,20 +72,33 @@ def tree_colour(light: Light) -> FloatArray:
     colour = node.inputs["Color"]
     if not colour.is_linked:
         return scale * np.array(colour.default_value[:3], dtype=np.float64)
-    temperature = sources.light_blackbody(light)
-    source = sources.blackbody_source(colour)
-    if temperature is not None and not light.use_temperature and source is not None:
-        factor = source.scale if isinstance(source.scale, float) else 1.0
-        return scale * factor * lamp_doppler.blackbody_unit_rgb(temperature)
+    blackbody = _tree_blackbody(light)
+    if blackbody is not None and isinstance(blackbody.scale, float):
+        scale *= blackbody.scale
     return np.full(3, scale)
+
+
+def tree_colour(light: Light) -> FloatArray:
+    """What the lamp's tree multiplies its Color by (linear RGB): :func:`tree_factor`, times a
+    Blackbody in it (Blender's luminance-1 colour)."""
+    temperature = sources.light_blackbody(light)
+    if temperature is not None and _tree_blackbody(light) is not None:
+        return tree_factor(light) * lamp_doppler.blackbody_unit_rgb(temperature)
+    return tree_factor(light)
+
+
+def rest_emission(light: Light) -> tuple[FloatArray, float | None]:
+    """``(colour, temperature or None)``: the lamp as a copy without its tree emits it (a moving
+    sun's stand-in): its Color times :func:`tree_factor`, and the temperature of its blackbody, its
+    own or a Blackbody in its tree (``sources.light_blackbody``)."""
+    return np.array(light.color[:3], dtype=np.float64) * tree_factor(light), sources.light_blackbody(light)
 
 
 def doppler_rgb(light: Light) -> tuple[float, float, float]:
     """The colour eq. 18's factor is taken for: the lamp's Color times its tree's unlinked Emission
     Color (the factor is per channel, so a red tree under a white lamp is shifted as red)."""
     colour = np.array(light.color, dtype=np.float64)
-    tree = compat.light_node_tree(light)
-    node = sources.light_emission_node(tree) if tree is not None else None
+    node = _emission(light)
     if node is not None and not node.inputs["Color"].is_linked:
         colour = colour * np.array(node.inputs["Color"].default_value[:3], dtype=np.float64)
     return (float(colour[0]), float(colour[1]), float(colour[2]))

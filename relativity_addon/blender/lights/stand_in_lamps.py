@@ -43,8 +43,8 @@ from ...physics.moving_lights import (
 from ..camera import cockpit
 from ..colour import light_groups, materials
 from ..common import busy, names, osl
-from ..scene import animation, lens, sources
-from . import lamp_shader
+from ..scene import animation, lens
+from . import lamp_shader, lamp_trees
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping, Sequence
@@ -495,13 +495,12 @@ def fast_sun(user: Light, doppler: float) -> tuple[tuple[float, ...], float | No
     sun is the blackbody at ``D T`` with ``D^-2 Y(D T)/Y(T)`` its strength (the spectral passes'
     brightness); an RGB sun keeps the ``D^2`` of its total with the colour of its shifted spectrum
     (``M(D) c`` at ``c``'s luminance), as moving RGB lamps keep eq. 19's ``D^4``."""
-    colour = np.array(user.color[:3], dtype=np.float64)
-    temperature = sources.light_blackbody(user) if user.use_temperature else None
+    colour, temperature = lamp_trees.rest_emission(user)  # its tree's Blackbody or Strength too
     if temperature is not None:
         log_ratio = spectral_render.log_blackbody_luminance(
             doppler * temperature
         ) - spectral_render.log_blackbody_luminance(temperature)
-        return tuple(colour), doppler * temperature, float(np.exp(log_ratio)) / doppler**2
+        return tuple(float(v) for v in colour), doppler * temperature, float(np.exp(log_ratio)) / doppler**2
     if user.use_temperature:  # a tinted blackbody: an RGB colour
         colour = colour * np.array(user.temperature_color[:3])
     shifted = spectral_render.gamut_map(spectral_render.doppler_rgb_matrix(doppler) @ colour)
@@ -522,10 +521,11 @@ def _write_sun(scene, light, obj):
         stand_in[names.SUN_DOPPLER_KEY] = float(doppler)
     _set(stand_in, "angle", min(float(user.angle) / doppler, math.pi))
     if materials.spectral_pass_wavelengths() is None:  # in a pass (the user's sun spectral too): they stay
+        rest_colour, rest_temperature = lamp_trees.rest_emission(user)
         rest = {
-            "color": [float(v) for v in user.color[:3]],
-            "use_temperature": bool(user.use_temperature),
-            "temperature": float(user.temperature),
+            "color": [float(v) for v in rest_colour],
+            "use_temperature": rest_temperature is not None or bool(user.use_temperature),
+            "temperature": float(user.temperature if rest_temperature is None else rest_temperature),
         }
         saved = stand_in.get(names.SUN_REST_KEY)
         if saved is None or saved.to_dict() != rest:  # the spectrum the passes shift

@@ -13,6 +13,7 @@ test_moving_point_light.py, against relations written out here in numpy (docs/ph
 
 import math
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -157,6 +158,48 @@ def test_moving_blackbody_sun_in_spectral_mode_is_the_blackbody_at_d_t(relativit
     print(f"fast mode: Delta E {fast_delta_e:.3f}, Y / expected {fast_xyz[1] / expected_y:.4f}")
     assert fast_delta_e < 1.0
     assert fast_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
+
+
+def test_moving_sun_with_a_blackbody_in_its_tree_is_the_blackbody_at_d_t(relativity_addon, factory_blender, tmp_path):
+    """A 4000 K Blackbody node on the moving sun's Emission Color, Strength 2 (its own temperature
+    off): the floor is the blackbody at ``D T`` with ``a / pi E cos D^-2 Y(D T) / Y(T)``, ``E`` the
+    sun's strength times 2, in the fast mode and in spectral mode. Before, the stand-in sun (which
+    has no tree) was white at the sun's own strength: Delta E 24, luminance 0.38 of the physics."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "colour"))
+    import colour_helpers as dh
+
+    bpy = factory_blender
+    temperature, strength = 4000.0, 2.0
+    scene, _camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, kind="SUN", samples=8)
+    scene.render.resolution_x, scene.render.resolution_y = 40, 30
+    sun.data.energy = SUN_STRENGTH / strength
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        sun.data.use_nodes = True  # 4.5: the tree is used only then; 5.x: always on
+    tree = sun.data.node_tree
+    emission = next(node for node in tree.nodes if node.bl_idname == "ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = strength
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    blackbody.inputs["Temperature"].default_value = temperature
+    tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+    floor._effect().apply(scene)
+    k = ch.aberrate(np.array([0.0, 0.0, -1.0]), -SUN_BETA)
+    d = 1.0 / (ch.gamma_of(SUN_BETA) * (1.0 - SUN_BETA @ k))
+    shifted = dh.blackbody_xyz_colour_science(d * temperature)
+    y_ratio = shifted[1] / dh.blackbody_xyz_colour_science(temperature)[1]
+    expected_y = floor.ALBEDO / math.pi * SUN_STRENGTH * (-k[2]) * y_ratio / (d * d)
+    fast = floor._render(bpy, scene, tmp_path / "fast.exr")[..., :3]
+    spectral_render = dh.addon_module(relativity_addon, "pipeline.spectral_render")
+    spectral, _info = spectral_render.render(scene, 3)
+    for mode, pixels in (("fast", fast), ("spectral", spectral[:, :, :3])):
+        floor_xyz = dh.linear_rec709_to_xyz(pixels.reshape(-1, 3).astype(float)).mean(axis=0)
+        delta_e = dh.delta_e_2000_normalised(floor_xyz, shifted)
+        print(
+            f"{mode}: D = {d:.4f}, Delta E {delta_e:.3f} from the blackbody at D T, "
+            f"Y / expected {floor_xyz[1] / expected_y:.4f}"
+        )
+        assert delta_e < 1.0
+        assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
 
 
 def test_keyframed_sun_moves_with_its_keyframes_velocity(relativity_addon, factory_blender):
