@@ -35,7 +35,7 @@ from ..colour import materials
 from ..common import busy, names, osl
 from ..common.nodes import detach_inserted, linked_surface
 from ..scene import emitting_meshes, sources
-from . import stand_in_lamps
+from . import lamp_trees, stand_in_lamps
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -454,6 +454,14 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             "Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
             "between neighbouring lamps (docs/moving-lights.md)"
         )
+        for light in supported(snap):  # a stand-in sun has no node tree: what of the sun's it carries
+            obj = scene.objects.get(light.name)
+            reason = lamp_trees.problem(obj.data) if light.kind == "SUN" and obj is not None else None
+            if reason is not None:
+                found.append(
+                    f"Light {light.name!r}: its node tree ({reason}) is left out of the moving sun "
+                    "(its stand-in emits the Color, Emission Strength and a Blackbody only)"
+                )
     if supported(snap) and scene.render.engine != "CYCLES":
         found.append("Moving lights need Cycles (OSL)")
     return found

@@ -202,6 +202,31 @@ def test_moving_sun_with_a_blackbody_in_its_tree_is_the_blackbody_at_d_t(relativ
         assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
 
 
+def test_moving_sun_tree_left_out_is_said(relativity_addon, factory_blender):
+    """A texture on the moving sun's Emission Color is not carried to its stand-in sun: one panel
+    line (none before); a Blackbody there is carried (above): no line."""
+    bpy = factory_blender
+    scene, _camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, kind="SUN", samples=8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        sun.data.use_nodes = True  # 4.5: the tree is used only then; 5.x: always on
+    tree = sun.data.node_tree
+    emission = next(node for node in tree.nodes if node.bl_idname == "ShaderNodeEmission")
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+    floor._effect().apply(scene)
+    assert not [line for line in floor._effect().scene_warnings(scene) if "node tree" in line]
+    floor._effect().remove(scene)
+    checker = tree.nodes.new("ShaderNodeTexChecker")
+    tree.links.new(checker.outputs["Color"], emission.inputs["Color"])
+    floor._effect().apply(scene)
+    lines = [line for line in floor._effect().scene_warnings(scene) if "node tree" in line]
+    assert lines == [
+        "Light 'Lamp': its node tree (an Emission Color made by nodes other than one Blackbody) is left out "
+        "of the moving sun (its stand-in emits the Color, Emission Strength and a Blackbody only)"
+    ]
+
+
 def test_keyframed_sun_moves_with_its_keyframes_velocity(relativity_addon, factory_blender):
     """A sun keyframed to move at 0.5c along x gets, at the frame, the stand-in of a sun moving at
     that velocity: the photon direction aberrated and the strength ``D^2`` written out here."""
