@@ -51,38 +51,18 @@ def _emission(light):
     return sources.light_emission_node(tree) if tree is not None else None
 
 
-def _tree_blackbody(light):
-    """The Blackbody (``sources.Blackbody``) on the Emission Color that is the lamp's blackbody
-    (``sources.light_blackbody``, its own temperature off), or None."""
-    node = _emission(light)
-    if node is None or not node.inputs["Color"].is_linked or light.use_temperature:
-        return None
-    return sources.blackbody_source(node.inputs["Color"]) if sources.light_blackbody(light) is not None else None
-
-
 def tree_factor(light: Light) -> FloatArray:
-    """What the lamp's tree multiplies its Color by, a Blackbody in it left out (linear RGB): its
-    Emission's Strength times its unlinked Color, or times the Blackbody's constant; ones without a
-    tree, the Strength alone where the tree is not carried (:func:`problem`)."""
-    node = _emission(light)
-    if node is None:
-        return np.ones(3)
-    strength = node.inputs["Strength"]
-    scale = float(strength.default_value) if not strength.is_linked else 1.0
-    colour = node.inputs["Color"]
-    if not colour.is_linked:
-        return scale * np.array(colour.default_value[:3], dtype=np.float64)
-    blackbody = _tree_blackbody(light)
-    if blackbody is not None and isinstance(blackbody.scale, float):
-        scale *= blackbody.scale
-    return np.full(3, scale)
+    """``sources.light_tree_factor``: the tree's Strength times its unlinked Color or a Blackbody's
+    constant (linear RGB); ones without a tree, the Strength alone where the tree is not carried
+    (:func:`problem`)."""
+    return np.array(sources.light_tree_factor(light), dtype=np.float64)
 
 
 def tree_colour(light: Light) -> FloatArray:
     """What the lamp's tree multiplies its Color by (linear RGB): :func:`tree_factor`, times a
     Blackbody in it (Blender's luminance-1 colour)."""
     temperature = sources.light_blackbody(light)
-    if temperature is not None and _tree_blackbody(light) is not None:
+    if temperature is not None and sources.light_tree_blackbody(light) is not None:
         return tree_factor(light) * lamp_doppler.blackbody_unit_rgb(temperature)
     return tree_factor(light)
 

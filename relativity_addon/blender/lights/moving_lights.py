@@ -454,14 +454,14 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             "Moving lights with the exact camera: stand-in lamps on the light's path, shadows blended "
             "between neighbouring lamps (docs/moving-lights.md)"
         )
-        for light in supported(snap):  # a stand-in sun has no node tree: what of the sun's it carries
-            obj = scene.objects.get(light.name)
-            reason = lamp_trees.problem(obj.data) if light.kind == "SUN" and obj is not None else None
-            if reason is not None:
-                found.append(
-                    f"Light {light.name!r}: its node tree ({reason}) is left out of the moving sun "
-                    "(its stand-in emits the Color, Emission Strength and a Blackbody only)"
-                )
+    for light in supported(snap):  # rendered without its tree: what of the tree is carried
+        obj = scene.objects.get(light.name)
+        reason = lamp_trees.problem(obj.data) if obj is not None and obj.type == "LIGHT" else None
+        if reason is not None:
+            found.append(
+                f"Light {light.name!r}: its node tree ({reason}) is left out of the moving light "
+                "(it carries the Color, Emission Strength and a Blackbody only)"
+            )
     if supported(snap) and scene.render.engine != "CYCLES":
         found.append("Moving lights need Cycles (OSL)")
     return found

@@ -363,9 +363,10 @@ def moving_lights(
         light = obj.data
         power = float(light.energy) / (4.0 * math.pi)
         spot = light.type == "SPOT"
-        colour = np.array(light.color, float) * (
-            np.array(light.temperature_color, float) if light.use_temperature else 1.0
-        )
+        # its Color times its tree's constant (the stand-ins do not render its tree) and its temperature's
+        colour = np.array(light.color, float) * np.array(sources.light_tree_factor(light), float)
+        if light.use_temperature:
+            colour = colour * np.array(light.temperature_color, float)
         found.append(
             MovingLight(
                 name=obj.name,

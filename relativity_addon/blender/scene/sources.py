@@ -313,6 +313,36 @@ def light_blackbody(light: Light) -> float | None:
     return source.temperature
 
 
+def light_tree_blackbody(light: Light) -> Blackbody | None:
+    """The Blackbody on the Emission Color of the light's tree that is its blackbody
+    (:func:`light_blackbody`, its own temperature off), or None."""
+    tree = compat.light_node_tree(light)
+    node = light_emission_node(tree) if tree is not None else None
+    if node is None or not node.inputs["Color"].is_linked or light.use_temperature or light_blackbody(light) is None:
+        return None
+    return blackbody_source(node.inputs["Color"])
+
+
+def light_tree_factor(light: Light) -> tuple[float, float, float]:
+    """What the light's node tree multiplies its Color by (linear RGB), a Blackbody in it left out
+    (that is :func:`light_blackbody`'s): its Emission's Strength times its unlinked Color, or times
+    the Blackbody's constant; ones without a tree, the Strength alone for any other Color."""
+    tree = compat.light_node_tree(light)
+    node = light_emission_node(tree) if tree is not None else None
+    if node is None:
+        return (1.0, 1.0, 1.0)
+    strength = node.inputs["Strength"]
+    scale = float(strength.default_value) if not strength.is_linked else 1.0
+    colour = node.inputs["Color"]
+    if not colour.is_linked:
+        r, g, b = (scale * float(v) for v in colour.default_value[:3])
+        return (r, g, b)
+    blackbody = light_tree_blackbody(light)
+    if blackbody is not None and isinstance(blackbody.scale, float):
+        scale *= blackbody.scale
+    return (scale, scale, scale)
+
+
 def scene_blackbody_lights(scene: Scene) -> dict[str, float]:
     """``{light object name: temperature}`` for every light of ``scene`` that is a blackbody."""
     found = {}

@@ -202,11 +202,12 @@ def test_moving_sun_with_a_blackbody_in_its_tree_is_the_blackbody_at_d_t(relativ
         assert floor_xyz[1] / expected_y == pytest.approx(1.0, abs=0.03)
 
 
-def test_moving_sun_tree_left_out_is_said(relativity_addon, factory_blender):
-    """A texture on the moving sun's Emission Color is not carried to its stand-in sun: one panel
-    line (none before); a Blackbody there is carried (above): no line."""
+@pytest.mark.parametrize("kind", ["SUN", "POINT"])
+def test_moving_light_tree_left_out_is_said(relativity_addon, factory_blender, kind):
+    """A texture on a moving sun's (or point lamp's) Emission Color is not carried to its stand-in:
+    one panel line (none before); a Blackbody there is carried (above): no line."""
     bpy = factory_blender
-    scene, _camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, kind="SUN", samples=8)
+    scene, _camera, sun = floor._floor_scene(bpy, beta=SUN_BETA, kind=kind, samples=8)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         sun.data.use_nodes = True  # 4.5: the tree is used only then; 5.x: always on
@@ -223,7 +224,7 @@ def test_moving_sun_tree_left_out_is_said(relativity_addon, factory_blender):
     lines = [line for line in floor._effect().scene_warnings(scene) if "node tree" in line]
     assert lines == [
         "Light 'Lamp': its node tree (an Emission Color made by nodes other than one Blackbody) is left out "
-        "of the moving sun (its stand-in emits the Color, Emission Strength and a Blackbody only)"
+        "of the moving light (it carries the Color, Emission Strength and a Blackbody only)"
     ]
 
 
