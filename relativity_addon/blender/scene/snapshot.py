@@ -364,9 +364,9 @@ def moving_lights(
         power = float(light.energy) / (4.0 * math.pi)
         spot = light.type == "SPOT"
         # its Color times its tree's constant (the stand-ins do not render its tree) and its temperature's
-        colour = np.array(light.color, float) * np.array(sources.light_tree_factor(light), float)
+        colour = np.array(light.color, dtype=np.float64) * np.array(sources.light_tree_factor(light))
         if light.use_temperature:
-            colour = colour * np.array(light.temperature_color, float)
+            colour = colour * np.array(light.temperature_color, dtype=np.float64)
         found.append(
             MovingLight(
                 name=obj.name,
