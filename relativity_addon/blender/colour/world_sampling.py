@@ -18,27 +18,30 @@ from typing import TYPE_CHECKING
 from ..common import names
 
 if TYPE_CHECKING:
-    from bpy.types import World
+    from bpy.types import Node, World
 
 MAP_RESOLUTION = 16
 SAVED = names.WORLD_SAMPLING_SAVED_KEY
 
 
-def _constant(world):
-    """Whether the world's surface is one Background of unlinked colour and strength."""
+def constant_background(world: World) -> Node | None:
+    """The world's one Background of unlinked colour and strength that its surface is, or None."""
     tree = world.node_tree
     if tree is None:
-        return False
+        return None
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputWorld" and node.is_active_output]
-    if len(outputs) != 1 or outputs[0].inputs["Volume"].is_linked or not outputs[0].inputs["Surface"].is_linked:
-        return False
-    background = outputs[0].inputs["Surface"].links[0].from_node
-    return background.bl_idname == "ShaderNodeBackground" and not any(socket.is_linked for socket in background.inputs)
+    links = outputs[0].inputs["Surface"].links if len(outputs) == 1 else None
+    if not links or outputs[0].inputs["Volume"].is_linked:
+        return None
+    background = links[0].from_node
+    if background.bl_idname != "ShaderNodeBackground" or any(socket.is_linked for socket in background.inputs):
+        return None
+    return background
 
 
 def hold(world: World | None) -> None:
     """Before the Doppler groups go into ``world``: a uniform map if the world is constant."""
-    if world is None or SAVED in world or not _constant(world):
+    if world is None or SAVED in world or constant_background(world) is None:
         return
     settings = world.cycles
     world[SAVED] = {

@@ -90,14 +90,20 @@ def material_node_tree(material: Material) -> ShaderNodeTree:
     return _node_tree(material)
 
 
-def light_node_tree(light: Light) -> ShaderNodeTree | None:
-    """The node tree a light renders with, or None. 5.x: lights always have one and always use
-    it (``use_nodes`` is deprecated and stays on); 4.5: only while ``use_nodes`` is on."""
-    if light.node_tree is None:
+def rendered_node_tree(owner: Light | Material | World) -> ShaderNodeTree | None:
+    """The node tree ``owner`` renders with, or None: 5.x always uses its tree (``use_nodes`` is
+    deprecated and stays on), 4.5 only while ``use_nodes`` is on (else its plain colour)."""
+    if owner.node_tree is None:
         return None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
-        return light.node_tree if getattr(light, "use_nodes", True) else None
+        return owner.node_tree if getattr(owner, "use_nodes", True) else None
+
+
+def light_node_tree(light: Light) -> ShaderNodeTree | None:
+    """The node tree a light renders with, or None. 5.x: lights always have one and always use
+    it (``use_nodes`` is deprecated and stays on); 4.5: only while ``use_nodes`` is on."""
+    return rendered_node_tree(light)
 
 
 def eevee_engine() -> str:

@@ -139,6 +139,18 @@ def applied_objects(scene: Scene) -> list[Object]:
     return found
 
 
+def moving_objects(scene: Scene) -> list[Object]:
+    """The scene's set-up meshes that have a motion of their own (cheap: no positions)."""
+    found = []
+    for obj in applied_objects(scene):
+        settings = obj.relativity
+        if (settings.motion == "CONSTANT" and any(settings.beta)) or (
+            settings.motion == "ANIMATION" and not settings.use_deformation
+        ):
+            found.append(obj)
+    return found
+
+
 def cache_object(obj: Object) -> Object | None:
     modifier = find_modifier(obj)
     if modifier is None:

@@ -42,7 +42,7 @@ from . import bounce_nodes, lamps_on_moving_objects
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
-    from bpy.types import Material, Mesh, NodeTree, Object, Scene, Text
+    from bpy.types import Material, Mesh, NodeTree, Scene, Text
 
     from ..scene.snapshot import Snapshot
     from .lamps_on_moving_objects import Mover
@@ -68,20 +68,8 @@ CURVED_DEGREES = 5.0
 CURVED_ERROR = "0.69-1.57x"
 
 
-def _moving_objects(scene: Scene) -> list[Object]:
-    """The scene's set-up meshes that have a motion of their own (cheap: no positions)."""
-    found = []
-    for obj in modifier.applied_objects(scene):
-        settings = obj.relativity
-        if (settings.motion == "CONSTANT" and any(settings.beta)) or (
-            settings.motion == "ANIMATION" and not settings.use_deformation
-        ):
-            found.append(obj)
-    return found
-
-
 def _moving_count(scene: Scene) -> int:
-    return len(_moving_objects(scene))
+    return len(modifier.moving_objects(scene))
 
 
 def off_axis_faces(mesh: Mesh) -> bool:
@@ -427,7 +415,9 @@ def _curved_lines(scene: Scene, snap: Snapshot, in_final: bool) -> list[str]:
     """One line naming the moving objects with curved faces, where the node form corrects the light
     they receive from other moving objects with their box's face normals."""
     curved = [
-        obj.name for obj in _moving_objects(scene) if obj.type == "MESH" and off_axis_faces(cast("Mesh", obj.data))
+        obj.name
+        for obj in modifier.moving_objects(scene)
+        if obj.type == "MESH" and off_axis_faces(cast("Mesh", obj.data))
     ]
     if not curved:
         return []

@@ -42,7 +42,7 @@ from ..common import busy, names, nodes
 from ..geometry import apparent_meshes, modifier
 from ..geometry import motion as world_lines
 from ..scene import snapshot, sources
-from . import lamp_stand_ins, lamp_trees, moving_lights, moving_pairs, rest_normals, stand_in_lamps
+from . import lamp_stand_ins, lamp_trees, moving_lights, moving_pairs, rest_normals, stand_in_lamps, unshifted_light
 
 if TYPE_CHECKING:
     from bpy.types import Light, Object, Scene
@@ -526,6 +526,12 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     found += (
         lamp_trees.warnings(scene.objects[name] for name in record["lamps"] if name in scene.objects) if record else []
     )
+    unshifted = unshifted_light.sources(scene)
+    if unshifted and modifier.moving_objects(scene):
+        found.append(
+            f"Light from {unshifted} reaches moving objects unshifted (eq. 18 not applied: 0.86x of it across "
+            "the motion at 0.5c, far more off along it; docs/lamp-doppler.md)"
+        )
     used = light_linking_collections(scene)
     if used > MAX_LIGHT_LINKING and KEY in scene:
         found.append(

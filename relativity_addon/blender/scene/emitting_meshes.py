@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..common import names, visibility
+from ..common import compat, names, visibility
 from . import sources
 
 if TYPE_CHECKING:
     import numpy.typing as npt
-    from bpy.types import Object
+    from bpy.types import Material, Object
     from mathutils import Matrix
 
 RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
@@ -52,6 +52,28 @@ def emission_radiance(obj: Object) -> tuple[float, ...] | None:
             if max(radiance) > 0.0:
                 return radiance
     return None
+
+
+def emits(material: Material) -> bool:
+    """Whether ``material`` emits light at all (an Emission or Principled emission in use, its
+    strength and colour not zero where unlinked)."""
+    tree = compat.rendered_node_tree(material)
+    if tree is None:
+        return False
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeEmission":
+            colour, strength = node.inputs["Color"], node.inputs["Strength"]
+        elif node.bl_idname == "ShaderNodeBsdfPrincipled":
+            colour, strength = node.inputs["Emission Color"], node.inputs["Emission Strength"]
+        else:
+            continue
+        if node.mute or not node.outputs[0].is_linked:
+            continue
+        if (strength.is_linked or strength.default_value > 0.0) and (
+            colour.is_linked or max(colour.default_value[:3]) > 0.0
+        ):
+            return True
+    return False
 
 
 def _rest_colour(socket):

@@ -191,3 +191,32 @@ def test_light_no_lamp_carries_on_a_moving_plate(relativity_addon, factory_blend
     assert lit.sum() >= 150
     assert over_cycles == pytest.approx(1.0, abs=0.03)
     assert over_physics == pytest.approx(MEASURED[source], abs=0.02)
+
+
+def _unshifted_lines(scene):
+    return [line for line in _effect().scene_warnings(scene) if "reaches moving objects unshifted" in line]
+
+
+@pytest.mark.parametrize("source", ["panel", "world", "neither"])
+def test_light_no_lamp_carries_is_said_in_the_panel(relativity_addon, factory_blender, source):
+    """The approximation above is said in one panel line naming its source (the world, emitting
+    meshes), from Set Up on and after a change in the panel; none without such light or without a
+    moving object."""
+    bpy = factory_blender
+    scene, _ = _scene(bpy, "panel" if source == "panel" else "world")
+    background = compat.world_node_tree(scene.world).nodes["Background"]
+    if source != "world":
+        background.inputs["Strength"].default_value = 0.0
+    scene.relativity.enabled = True
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    lines = _unshifted_lines(scene)
+    print(source, lines)
+    if source == "neither":
+        assert lines == []
+        return
+    assert len(lines) == 1 and "\n" not in lines[0]
+    assert ("the world" in lines[0]) == (source == "world")
+    assert ("emitting meshes" in lines[0]) == (source == "panel")
+    bpy.data.objects["Plate"].relativity.beta = (0.0, 0.0, 0.0)  # changed in the panel: nothing moves
+    bpy.context.view_layer.update()
+    assert _unshifted_lines(scene) == [], _effect().scene_warnings(scene)
