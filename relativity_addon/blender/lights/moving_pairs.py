@@ -247,7 +247,7 @@ def write(scene: Scene, snap: Snapshot, movers: Sequence[Any]) -> list[str]:
         shared = {
             socket.name: socket.default_value
             for socket in first.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs
-            if socket.name not in _OWN
+            if socket.name not in _OWN and not socket.is_linked  # linked: the stand-in's own (PER_LAMP)
         }
         values = moving_lights.shader_parameters(light, snap)
         reception_time = moving_lights.reception_event(snap)[0]
