@@ -15,9 +15,11 @@ half-shadow where each point's own retarded position does (docs/moving-lights.md
 
 The lamps are placed from ``scene.ray_cast`` over the camera's view (a grid of its rays, 5 %
 wider, from its reception event): the hit points that get at least 1 % of the brightest one's irradiance set the
-span of retarded times (``physics.moving_lights.lamp_times``). Everything made here (objects,
-lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the scene and deleted by
-:func:`remove`; the user's light is hidden by ``moving_lights.py``.
+span of retarded times (``physics.moving_lights.lamp_times``). A light's lamps share one light
+datablock (Cycles compiles one OSL shader per datablock at every render): what differs between them
+(:data:`PER_LAMP`) is on each lamp object, read by Attribute nodes. Everything made here (objects,
+the light, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the scene and deleted
+by :func:`remove`; the user's light is hidden by ``moving_lights.py``.
 """
 
 from __future__ import annotations
