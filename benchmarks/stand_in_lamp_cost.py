@@ -8,10 +8,10 @@ The floor of benchmarks/moving_light_shadows.py (white, a point lamp 1 above it 
 above at rest, the black square 0.5 above the floor): 16 lamps drawn out into lines, 48 area lights.
 Cycles JIT-compiles every distinct OSL light shader at every render, and a light datablock is one
 shader: one per stand-in cost about 3 s a render whatever the samples (docs/performance.md). The
-stand-ins' own datablocks are made here from the shared one (``obj.data = obj.data.copy()``: the
-same node tree, the lamps' own inputs still read from their objects, so the image is the same; it
-is checked), with the add-on's handlers held off while they render (its sync would share them
-again); so that the cases compare alike, every case renders with the handlers held off. The cases
+stand-ins' own datablocks are made here as before from the shared one: a copy per stand-in, its
+Attribute nodes replaced by the object's values on the script node (the image is the same; it is
+checked), with the add-on's handlers held off while they render (its sync would share them again);
+so that the cases compare alike, every case renders with the handlers held off. The cases
 are set up and rendered alternately, after one warm-up round, and the median wall-clock and CPU
 times (range) are printed with the load average.
 """
@@ -55,6 +55,23 @@ def handlers_held(bpy):
             getattr(bpy.app.handlers, name).extend(handlers)
 
 
+def own_light(obj, shared):
+    """A copy of the stand-ins' ``shared`` light holding ``obj``'s own inputs on its script node, as
+    before (no Attribute nodes: the values are constants of the shader, as they were)."""
+    from relativity_addon.blender.common import names
+    from relativity_addon.blender.lights import stand_in_lamps
+
+    light = shared.copy()
+    tree = light.node_tree
+    node = tree.nodes[names.MOVING_LAMP_PREFIX]
+    for key in stand_in_lamps.PER_LAMP:
+        tree.nodes.remove(tree.nodes[key])
+        value = obj.get(stand_in_lamps.lamp_key(key))
+        if value is not None:
+            node.inputs[key].default_value = value
+    return light
+
+
 def render_case(bpy, scene, case, path):
     """Set up ``case``, render it (handlers held off) and remove it: (wall, CPU seconds, lights, image)."""
     from relativity_addon.blender.common import names
@@ -69,7 +86,7 @@ def render_case(bpy, scene, case, path):
         shared = stand_ins[0].data if stand_ins else None
         if case == "OWN":
             for obj in stand_ins:
-                obj.data = shared.copy()
+                obj.data = own_light(obj, shared)
         lights = len({obj.data for obj in stand_ins})
         wall, cpu, image = render(bpy, scene, path, 1)
         if case == "OWN":  # the copies go with their objects; the shared light is removed by effect.remove
