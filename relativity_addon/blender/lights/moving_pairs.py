@@ -11,7 +11,10 @@ object's bounding box sees the light in its own frame: ``x - D_R r k' = x_L(t_e)
 (``lamp_doppler.apparent_lamp_offset`` with the emission point for the lamp), which lies on the path
 when the two motions are parallel (exact there; otherwise its place along the path). The shader's
 linear weights between them then sum Cycles' ``cos / t^2`` to eq. 18's ``cos(alpha') / r'^2``. Each
-lamp is a sphere far too small to show (:func:`lamp_radius`), for Cycles' light tree.
+lamp is a sphere far too small to show (:func:`lamp_radius`), for Cycles' light tree. Unlike the
+stand-ins, each lamp keeps its own light datablock (one OSL shader each at a render): its power is
+its share of the light, which Cycles' light tree samples by, and a light's power is the
+datablock's (an object's scale does not change a point light's).
 
 A fixed number of lamps per pair, so an animation render or a bake keeps the same datablocks from
 frame to frame. Everything made is recorded on the scene (``names.MOVING_PAIR_KEY``) and deleted by
@@ -247,7 +250,7 @@ def write(scene: Scene, snap: Snapshot, movers: Sequence[Any]) -> list[str]:
         shared = {
             socket.name: socket.default_value
             for socket in first.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs
-            if socket.name not in _OWN
+            if socket.name not in _OWN and not socket.is_linked  # linked: the stand-in's own (PER_LAMP)
         }
         values = moving_lights.shader_parameters(light, snap)
         reception_time = moving_lights.reception_event(snap)[0]

@@ -15,9 +15,11 @@ half-shadow where each point's own retarded position does (docs/moving-lights.md
 
 The lamps are placed from ``scene.ray_cast`` over the camera's view (a grid of its rays, 5 %
 wider, from its reception event): the hit points that get at least 1 % of the brightest one's irradiance set the
-span of retarded times (``physics.moving_lights.lamp_times``). Everything made here (objects,
-lights, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the scene and deleted by
-:func:`remove`; the user's light is hidden by ``moving_lights.py``.
+span of retarded times (``physics.moving_lights.lamp_times``). A light's lamps share one light
+datablock (Cycles compiles one OSL shader per datablock at every render): what differs between them
+(:data:`PER_LAMP`) is on each lamp object, read by Attribute nodes. Everything made here (objects,
+the light, the shader text) is named ``names.MOVING_LAMP_PREFIX``, listed on the scene and deleted
+by :func:`remove`; the user's light is hidden by ``moving_lights.py``.
 """
 
 from __future__ import annotations
@@ -157,17 +159,32 @@ def lamp_path(
 # --- the stand-in lamps ---------------------------------------------------------------------
 
 
-def _new_lamp(scene, name, text, kind="POINT"):
+# the shader's inputs that differ between the lamps of one light: each lamp object's own custom
+# properties (names.MOVING_LAMP_INPUT_KEY + input), read by Attribute nodes in the light's one node
+# tree; the rest are the script node's values. Cycles compiles (JIT) one OSL shader per light
+# datablock at every render, so one datablock for all of a light's lamps (docs/performance.md).
+PER_LAMP = (
+    *("lamp_time", "lamp_position", "previous_time", "previous_position", "next_time", "next_position"),
+    *("after_time", "after_position", "strip_normal", "strip_length"),
+)
+
+
+def lamp_key(name: str) -> str:
+    """The custom property of a stand-in object holding its shader input ``name`` (PER_LAMP)."""
+    return names.MOVING_LAMP_INPUT_KEY + name
+
+
+def _new_light(name, text, kind="POINT", per_lamp=()):
+    """A light with the moving-lamp shader; its inputs ``per_lamp`` linked from Attribute nodes
+    reading the lamp object's custom properties (:func:`lamp_key`)."""
     light = bpy.data.lights.new(name, kind)
     if kind == "SUN":  # direction, strength and angle are written by _write_sun; no shader
-        obj = bpy.data.objects.new(name, light)
-        obj.rotation_mode = "QUATERNION"
-        scene.collection.objects.link(obj)
-        return obj
+        return light
     light.energy = 4.0 * math.pi  # 1 W/sr: the shader's Emission carries the intensity
     light.color = (1.0, 1.0, 1.0)
-    if kind == "AREA":  # a strip along a piece of the path: write() sets its length and width
+    if kind == "AREA":  # a strip along a piece of the path: the object's scale gives its length (_place_strip)
         light.shape = "RECTANGLE"
+        light.size, light.size_y = 1.0, STRIP_WIDTH
     else:
         light.shadow_soft_size = 0.0
     with warnings.catch_warnings():  # 5.x: use_nodes is deprecated (always on)
@@ -183,19 +200,42 @@ def _new_lamp(scene, name, text, kind="POINT"):
     if "Emission" not in node.outputs or "lamp_time" not in node.inputs:
         bpy.data.lights.remove(light)
         raise RelativityError("The moving-lamp OSL shader did not compile (no sockets on its script node)")
+    for index, key in enumerate(per_lamp):
+        attribute = tree.nodes.new("ShaderNodeAttribute")
+        attribute.name = attribute.label = key
+        attribute.attribute_type = "OBJECT"
+        attribute.attribute_name = lamp_key(key)
+        attribute.location = (-300.0, -60.0 * index)
+        socket = node.inputs[key]
+        tree.links.new(attribute.outputs["Fac" if socket.type == "VALUE" else "Vector"], socket)
     output = tree.nodes.new("ShaderNodeOutputLight")
     output.location = (300.0, 0.0)
     tree.links.new(node.outputs["Emission"], output.inputs["Surface"])
+    return light
+
+
+def _new_object(scene, name, light):
     obj = bpy.data.objects.new(name, light)
     obj.rotation_mode = "QUATERNION"
-    obj.visible_camera = False  # a strip is no surface the camera sees
+    if light.type != "SUN":
+        obj.visible_camera = False  # a strip is no surface the camera sees
     scene.collection.objects.link(obj)
     return obj
 
 
+def _is_shared(light):
+    """Whether ``light`` is a stand-in light that reads its lamps' own inputs from the objects."""
+    if light.type == "SUN":
+        return True
+    tree = light.node_tree
+    node = tree.nodes.get(names.MOVING_LAMP_PREFIX) if tree is not None else None
+    return node is not None and all(node.inputs[key].is_linked for key in PER_LAMP)
+
+
 def new_point_lamp(scene: Scene, name: str) -> Object:
-    """A point lamp (radius 0, power 4 pi) with the moving-lamp shader, its inputs unset."""
-    return _new_lamp(scene, name, lamp_shader.shader_text())
+    """A point lamp (radius 0, power 4 pi) with its own light and moving-lamp shader, its inputs
+    unset (:func:`write_inputs`)."""
+    return _new_object(scene, name, _new_light(name, lamp_shader.shader_text()))
 
 
 def stand_in_names(scene: Scene) -> dict[str, list[str]]:
@@ -236,19 +276,25 @@ def _record(scene):
 
 
 def _lamps_for(scene, light_name, count, text, kind="POINT"):
-    """The light's first ``count`` lamps; while a bake steps frames (``busy.keeps_stand_ins``) the
-    others are kept, hidden from renders, and more are added under the next names when needed."""
+    """The light's first ``count`` lamps, sharing one light datablock; while a bake steps frames
+    (``busy.keeps_stand_ins``) the others are kept, hidden from renders, and more are added under
+    the next names when needed."""
     record = _record(scene)
     existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
-    same_kind = all(bpy.data.objects[name].data.type == kind for name in existing)
+    lights = {bpy.data.objects[name].data for name in existing}
+    same_kind = len(lights) <= 1 and all(light.type == kind and _is_shared(light) for light in lights)
     kept = busy.keeps_stand_ins() and same_kind
     if len(existing) < count or (not kept and (len(existing) != count or not same_kind)):
         if not kept:
             for name in existing:
                 delete_lamp(name)
             existing = []
+        if existing:
+            light = bpy.data.objects[existing[0]].data
+        else:
+            light = _new_light(f"{names.MOVING_LAMP_PREFIX} {light_name}", text, kind, PER_LAMP)
         existing += [
-            _new_lamp(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", text, kind).name
+            _new_object(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", light).name
             for index in range(len(existing), count)
         ]
         record[light_name] = existing
@@ -270,20 +316,20 @@ def hide(scene: Scene) -> None:
 
 
 def _stored_times(scene, light_name):
-    """The stand-ins' times of the last placement (their shaders' inputs), or None."""
+    """The stand-ins' times of the last placement (their own inputs), or None."""
     objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
     if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
         return None
     objects = [obj for obj in objects if not obj.hide_render]  # a bake's unused lamps are hidden
-    if not objects:
+    if not objects or any(lamp_key("lamp_time") not in obj for obj in objects):
         return None
-    inputs = [obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs for obj in objects]
-    times = [node_inputs["lamp_time"].default_value for node_inputs in inputs]
+    times = [float(obj[lamp_key("lamp_time")]) for obj in objects]
     if objects[0].data.type == "AREA":  # LINE_SIDES strips per lamp (lines) or STRIP_SIDES per piece
-        if inputs[0]["strip"].default_value == 1:  # the pieces' starts and the last end
-            times = times[::STRIP_SIDES] + [inputs[-1]["next_time"].default_value]
+        inputs = objects[0].data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs
+        if inputs["strip"].default_value == 1:  # the pieces' starts and the last end
+            times = times[::STRIP_SIDES] + [float(objects[-1].get(lamp_key("next_time"), times[-1]))]
         else:
-            times = times[:: inputs[0]["strip_sides"].default_value]
+            times = times[:: inputs["strip_sides"].default_value]
     return np.array(times, float)
 
 
@@ -398,17 +444,41 @@ def write(
             _write_strips(scene, light, text, shared, times, positions, camera_position)
 
 
+def _set_own(obj, key, value):
+    """Write the custom property ``key`` of ``obj`` if it changed; whether it did."""
+    current = obj.get(key)
+    if isinstance(value, tuple):
+        if hasattr(current, "__len__") and len(current) == len(value) and all(map(_same, current, value)):
+            return False
+        obj[key] = list(value)
+    elif current is not None and not hasattr(current, "__len__") and _same(current, value):
+        return False
+    else:
+        obj[key] = value
+    return True
+
+
 def write_inputs(obj: Object, inputs: Mapping[str, Any]) -> None:
-    """Set the moving-lamp shader's inputs of lamp ``obj`` (only changed values)."""
+    """Set the moving-lamp shader's inputs of lamp ``obj`` (only changed values): those its light
+    reads from the object (Attribute nodes, :data:`PER_LAMP`) as the object's custom properties, the
+    others on the script node (shared by the lamps of one light)."""
     node = obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX]
+    changed = False
     for key, value in inputs.items():
-        _set(node.inputs[key], "default_value", tuple(map(float, value)) if isinstance(value, tuple) else value)
+        value = tuple(map(float, value)) if isinstance(value, tuple) else value
+        socket = node.inputs[key]
+        if socket.is_linked:
+            changed = _set_own(obj, lamp_key(key), value) or changed
+        else:
+            _set(socket, "default_value", value)
+    if changed:  # an ID property written from Python tags nothing: the viewport's render would not see it
+        obj.update_tag()
 
 
 def _place_strip(obj, centre, axis, length, side, camera_position, sides=STRIP_SIDES):
-    """Set strip ``obj`` (an area light) ``length`` long along ``axis`` at ``centre``, side ``side`` of
-    ``sides`` facing 360 / ``sides`` degrees apart about the axis (the first toward the camera);
-    returns its normal (it emits along it)."""
+    """Set strip ``obj`` (an area light, 1 by STRIP_WIDTH) ``length`` long along ``axis`` at
+    ``centre``, side ``side`` of ``sides`` facing 360 / ``sides`` degrees apart about the axis (the
+    first toward the camera); returns its normal (it emits along it)."""
     first = camera_position - centre
     first = first - (first @ axis) * axis
     if not np.linalg.norm(first) > 1e-9 * max(length, 1.0):
@@ -419,8 +489,8 @@ def _place_strip(obj, centre, axis, length, side, camera_position, sides=STRIP_S
     rotation = np.column_stack([axis, np.cross(-normal, axis), -normal])  # emits along its local -Z
     _set(obj, "location", tuple(float(v) for v in centre))
     _set(obj, "rotation_quaternion", tuple(Matrix(rotation.tolist()).to_quaternion()))
-    _set(obj.data, "size", max(length, 1e-6))
-    _set(obj.data, "size_y", STRIP_WIDTH * max(length, 1e-6))
+    # the light (1 x STRIP_WIDTH) is shared by the light's strips: the scale sets the length and width
+    _set(obj, "scale", (max(length, 1e-6), max(length, 1e-6), 1.0))
     return normal
 
 

@@ -380,3 +380,65 @@ def test_moving_light_tree_strength_and_colour_are_carried(relativity_addon, fac
     in_lamp = _render(bpy, scene, tmp_path / "lamp.exr")[..., :3].reshape(-1, 3).sum(axis=0)
     print(f"tree over lamp settings per channel: {in_tree / in_lamp}")
     assert in_tree / in_lamp == pytest.approx(np.ones(3), abs=0.01)
+
+
+def _stand_ins(bpy, scene):
+    names = importlib.import_module(f"{ADDON_MODULE}.blender.common.names")
+    record = scene[names.MOVING_LAMPS_KEY].to_dict()
+    return [bpy.data.objects[name] for name in record["Lamp"]]
+
+
+def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory_blender, tmp_path):
+    """The stand-in lamps of one moving light share one light datablock, so Cycles compiles one OSL
+    light shader for them at a render instead of one per lamp (docs/performance.md); each lamp's
+    own inputs live on its object. A change after set-up (the shutter time: the camera receives the
+    light later) reaches every lamp's evaluated object (what the viewport's render reads) and the
+    render follows eq. 19 for the new reception time."""
+    stand_in_lamps = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lamps")
+    bpy = factory_blender
+    scene, camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
+    _effect().apply(scene)
+    stand_ins = _stand_ins(bpy, scene)
+    assert len(stand_ins) > 2
+    assert len({obj.data.name for obj in stand_ins}) == 1, "one light datablock for the light's stand-ins"
+    assert len({obj.data.node_tree.name_full for obj in stand_ins}) == 1
+    scripts = [node for light in bpy.data.lights if light.node_tree for node in light.node_tree.nodes]
+    assert sum(node.bl_idname == "ShaderNodeScript" for node in scripts) == 1
+    key = stand_in_lamps.lamp_key("lamp_time")
+    before = [float(obj[key]) for obj in stand_ins]
+    assert len(set(before)) == len(before) // stand_in_lamps.LINE_SIDES  # one time per line, its strips alike
+
+    scene.relativity.shutter_time = 0.15  # after set-up: the sync of the depsgraph update moves the lamps on
+    bpy.context.view_layer.update()
+    stand_ins = _stand_ins(bpy, scene)
+    assert [float(obj[key]) for obj in stand_ins] != before
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for obj in stand_ins:
+        evaluated = obj.evaluated_get(depsgraph)
+        for name in stand_in_lamps.PER_LAMP:
+            if stand_in_lamps.lamp_key(name) in obj:
+                assert np.allclose(evaluated[stand_in_lamps.lamp_key(name)], obj[stand_in_lamps.lamp_key(name)]), (
+                    f"{obj.name}: {name} not seen by the depsgraph"
+                )
+    # an own input written alone (the lamp not moved: no transform update tags it) reaches it too;
+    # the add-on's sync is held off, which would write the placed value back
+    handlers = list(bpy.app.handlers.depsgraph_update_post)
+    bpy.app.handlers.depsgraph_update_post.clear()
+    try:
+        placed = float(stand_ins[0][key])
+        stand_in_lamps.write_inputs(stand_ins[0], {"lamp_time": placed + 0.5})
+        evaluated = stand_ins[0].evaluated_get(bpy.context.evaluated_depsgraph_get())
+        assert evaluated[key] == pytest.approx(placed + 0.5)
+        stand_in_lamps.write_inputs(stand_ins[0], {"lamp_time": placed})
+    finally:
+        bpy.app.handlers.depsgraph_update_post.extend(handlers)
+
+    _render_rows(scene, ROWS)
+    image = _render(bpy, scene, tmp_path / "shared.exr")[..., 1]
+    expected, _, _ = _expected_radiance(_floor_points(bpy, scene, camera), BETA, reception_time=0.15)
+    measured, later = image[ROWS].mean(0), expected[ROWS].mean(0)
+    print(
+        f"{len(stand_ins)} stand-ins, 1 light; shutter time set after set-up: peak at {np.argmax(measured)} "
+        f"(expected {np.argmax(later)}); max error {np.abs(measured - later).max() / later.max():.4f} of the peak"
+    )
+    assert np.abs(measured - later).max() < 0.05 * later.max()
