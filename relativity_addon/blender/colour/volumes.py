@@ -171,7 +171,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         tree.links.new(attribute.outputs["Alpha"], group.inputs["Grid Alpha"])
         group.inputs["Bolometric"].default_value = 1.0
         created.append(attribute)
-    tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+    temperature_source = _link_emission_inputs(tree, node, group)
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
     tree.links.new(group.outputs["Color"], emission.inputs["Color"])
@@ -204,6 +204,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         "object_temperature": records[0]["object_temperature"] if records else 0.0,
     }
     records += [{**blank, "group_node": new_node.name} for new_node in created if new_node is not add]
+    records += [{**blank, **temperature_source, "group_node": group.name}]
     records += [
         {
             **blank,
@@ -216,6 +217,26 @@ def attach(material: Material, grids: bool = False) -> bool:
     ]
     material[materials.ATTACHED_KEY] = records
     return True
+
+
+def _link_emission_inputs(tree, node, group):
+    """Feed the Principled Volume ``node``'s Blackbody Intensity, Temperature and Blackbody Tint from
+    the volume blackbody ``group`` (the bolometric rule shifts Cycles' own emission through them),
+    and return the record fields that give the Temperature input its own link back on detach
+    (``materials.resolve_record``; none where it was a constant, which stays in the socket)."""
+    temperature = node.inputs["Temperature"]
+    source = temperature.links[0].from_socket if temperature.is_linked else None
+    tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+    tree.links.new(group.outputs["Temperature"], temperature)
+    tree.links.new(group.outputs["Tint"], node.inputs["Blackbody Tint"])
+    if source is None:
+        return {}
+    return {
+        "target": node.name,
+        "socket": temperature.identifier,
+        "source_node": source.node.name,
+        "source_socket": source.identifier,
+    }
 
 
 def _reads_grids(obj):
@@ -270,12 +291,6 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
         return False
     did = False
     for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
-        blackbody = sources.volume_blackbody(node)
-        if blackbody is None:
-            continue
-        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
-        if intensity is None or not node.outputs[0].is_linked:
-            continue
         existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
         if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
             if existing is not None:  # put in for another material, which may not carry grids
@@ -286,6 +301,12 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
                 inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
                 did = did or bool(reader)
             continue
+        blackbody = sources.volume_blackbody(node)
+        if blackbody is None:
+            continue
+        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+        if intensity is None or not node.outputs[0].is_linked:
+            continue
         group = _blackbody_group(inner, node, blackbody, intensity)
         group.inputs["Fast Part"].default_value = 0.0  # on where every user takes the boundary (grouped_volumes)
         created = [group, *_grid_reader(inner, node, group, grids)]
@@ -294,12 +315,13 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
         add = inner.nodes.new("ShaderNodeAddShader")
         add.name = add.label = f"{NODE_PREFIX} Add {node.name}"
         targets = [link.to_socket for link in node.outputs[0].links]
-        inner.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+        temperature_source = _link_emission_inputs(inner, node, group)
         inner.links.new(group.outputs["Color"], emission.inputs["Color"])
         inner.links.new(node.outputs[0], add.inputs[0])
         inner.links.new(emission.outputs[0], add.inputs[1])
         blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
         records = [{**blank, "group_node": new.name} for new in (*created, emission)]
+        records.append({**blank, **temperature_source, "group_node": group.name})
         for target in targets:
             inner.links.new(add.outputs[0], target)
             relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}
