@@ -54,9 +54,11 @@ the **bolometric rule**: Cycles' emission ``sigma T^4`` times a unit-luminance b
 read as a blackbody of total ``sigma T^4``, seen at ``D T`` with total ``sigma (D T)^4``, i.e.
 Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; the visible rule's
 ``Y(D T) / Y(T)`` explodes in the cool gas where every grid fades to 0 K (docs/spectral-model.md,
-"Temperature grids"). For camera rays Cycles' own blackbody is switched off and the group emits
-the shifted light alone (Blender 5.2's Principled Volume reads a grid otherwise than an Attribute
-node, so ``X - E`` would leave the difference unshifted). A Volume object renders no surface
+"Temperature grids"). For camera rays the Principled Volume itself emits the shifted light: the
+group feeds its Temperature (times ``D``) and Blackbody Tint (times the rule's gain), so Cycles
+reads the grid as it does at rest (Blender 5.2's Principled Volume reads a grid 2.9 % brighter
+than an Attribute node does) and the majorant grid of 5.x's null scattering evaluates no second
+grid read and Blackbody node (docs/performance.md, "What is left"). A Volume object renders no surface
 closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
 there too (measured: with the link to it cut the compositor shifts those pixels again). In a
 spectral pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, the scene-frame spectrum whose
