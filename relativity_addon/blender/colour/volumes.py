@@ -154,6 +154,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         return False
     records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
     if any(record["group_node"].startswith(NODE_PREFIX) for record in records):
+        _upgrade(material, material.node_tree, records)
         return False
     found = _correctable(material)
     if found is None:
@@ -241,6 +242,25 @@ def _link_emission_inputs(tree, node, group):
     }
 
 
+def _upgrade(owner, tree, records):
+    """A correction put in before the group fed the Principled Volume's Temperature and Tint (group
+    version 10; a file set up with an earlier add-on): link them, so that the bolometric rule, which
+    the group no longer emits itself, reaches the gas; recorded on ``owner`` (material or group)."""
+    for record in list(records):
+        group = tree.nodes.get(record["group_node"])
+        if group is None or group.bl_idname != "ShaderNodeGroup" or "Tint" not in group.outputs:
+            continue
+        node = tree.nodes.get(group.name.removeprefix(f"{NODE_PREFIX} "))
+        if node is None or node.bl_idname != "ShaderNodeVolumePrincipled":
+            continue
+        temperature = node.inputs["Temperature"]
+        if temperature.is_linked and temperature.links[0].from_node == group:
+            continue
+        blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
+        records.append({**blank, **record, **_link_emission_inputs(tree, node, group), "group_node": group.name})
+        owner[materials.ATTACHED_KEY] = records
+
+
 def _reads_grids(obj):
     """Whether Cycles may multiply ``obj``'s volume Temperature by a temperature grid: a Volume
     object (OpenVDB grids) or a fluid domain (smoke and fire)."""
@@ -295,6 +315,7 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
     for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
         existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
         if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
+            _upgrade(inner, inner, [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])])
             if existing is not None:  # put in for another material, which may not carry grids
                 reader = [
                     {"group_node": new.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}

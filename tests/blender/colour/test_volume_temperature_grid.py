@@ -177,3 +177,27 @@ def test_temperature_grid_in_spectral_mode_is_seen_at_d_t_with_d4_luminance(rela
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
     assert len(material.node_tree.nodes) == nodes_before
+
+
+def test_a_grid_set_up_by_an_earlier_version_gets_the_principled_volume_fed(relativity_addon, tmp_path):
+    """Group version 10 shifts grid gas through the Principled Volume's own Temperature and Tint; a
+    file set up before (the group's outputs not linked there) gets them linked at the next attach
+    (every render attaches), and Remove still gives the links back. No render."""
+    bpy = __import__("bpy")
+    volumes = dh.addon_module(relativity_addon, "colour.volumes")
+    scene, _camera, material = grid_scene(bpy, tmp_path)
+    tree = material.node_tree
+    links_before = sorted((link.from_node.name, link.to_node.name) for link in tree.links)
+    observe(scene)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    principled = tree.nodes["Principled Volume"]
+    group = tree.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
+    for name in ("Temperature", "Blackbody Tint"):
+        assert principled.inputs[name].links[0].from_node == group, name
+        tree.links.remove(principled.inputs[name].links[0])  # the wiring of version 9
+    volumes.attach_scene(scene)
+    for name in ("Temperature", "Blackbody Tint"):
+        assert principled.inputs[name].is_linked and principled.inputs[name].links[0].from_node == group, name
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted((link.from_node.name, link.to_node.name) for link in tree.links) == links_before
+    assert principled.inputs["Temperature"].default_value == BASE_TEMPERATURE
