@@ -222,14 +222,23 @@ def attach(material: Material, grids: bool = False) -> bool:
     return True
 
 
+def _bolometric(group):
+    """Whether the volume blackbody ``group`` node may shift by the bolometric rule (a grid read)."""
+    bolometric = group.inputs["Bolometric"]
+    return bolometric.is_linked or bolometric.default_value > 0.0
+
+
 def _link_emission_inputs(tree, node, group):
-    """Feed the Principled Volume ``node``'s Blackbody Intensity, Temperature and Blackbody Tint from
-    the volume blackbody ``group`` (the bolometric rule shifts Cycles' own emission through them),
-    and return the record fields that give the Temperature input its own link back on detach
-    (``materials.resolve_record``; none where it was a constant, which stays in the socket)."""
-    temperature = node.inputs["Temperature"]
-    source = temperature.links[0].from_socket if temperature.is_linked else None
+    """Feed the Principled Volume ``node``'s Blackbody Intensity from the volume blackbody ``group``,
+    and where the group may take the bolometric rule (:func:`_bolometric`) its Temperature and
+    Blackbody Tint too (the rule shifts Cycles' own emission through them; the visible rule leaves
+    them as they were). Returns the record fields that give the Temperature input its own link back
+    on detach (``materials.resolve_record``; none where it was a constant, which stays in the socket)."""
     tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+    temperature = node.inputs["Temperature"]
+    if not _bolometric(group):
+        return {}
+    source = temperature.links[0].from_socket if temperature.is_linked else None
     tree.links.new(group.outputs["Temperature"], temperature)
     tree.links.new(group.outputs["Tint"], node.inputs["Blackbody Tint"])
     if source is None:
@@ -254,7 +263,7 @@ def _upgrade(owner, tree, records):
         if node is None or node.bl_idname != "ShaderNodeVolumePrincipled":
             continue
         temperature = node.inputs["Temperature"]
-        if temperature.is_linked and temperature.links[0].from_node == group:
+        if not _bolometric(group) or (temperature.is_linked and temperature.links[0].from_node == group):
             continue
         blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
         records.append({**blank, **record, **_link_emission_inputs(tree, node, group), "group_node": group.name})
@@ -315,7 +324,6 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
     for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
         existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
         if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
-            _upgrade(inner, inner, [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])])
             if existing is not None:  # put in for another material, which may not carry grids
                 reader = [
                     {"group_node": new.name, "target": "", "socket": "", "source_node": "", "source_socket": ""}
@@ -323,6 +331,8 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
                 ]
                 inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
                 did = did or bool(reader)
+            # the reader's rule reaches the Principled Volume (also a group set up by an earlier version)
+            _upgrade(inner, inner, [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])])
             continue
         blackbody = sources.volume_blackbody(node)
         if blackbody is None:
