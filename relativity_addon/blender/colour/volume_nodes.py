@@ -15,9 +15,11 @@ SIGMA = 5.670373e-8 * 1e-6 / math.pi  # Cycles' Stefan-Boltzmann factor for the 
 
 def volume_blackbody_group() -> Group:
     """``Color``: the emission to add to the volume (``X - E`` for camera rays on the exact camera's
-    path, 0 otherwise; in a spectral pass ``E``'s spectral values); ``Done``: 1 where the boundary
-    marks the pixel as shifted; ``Intensity``: the Principled Volume's Blackbody Intensity (0 in a
-    spectral pass)."""
+    path under the visible rule, 0 otherwise; in a spectral pass ``E``'s spectral values); ``Done``:
+    1 where the boundary marks the pixel as shifted; ``Intensity``, ``Temperature`` and ``Tint``:
+    the Principled Volume's Blackbody Intensity (0 in a spectral pass), Temperature and Blackbody
+    Tint, which for camera rays under the bolometric rule (temperature grids) make Cycles' own
+    emission the shifted one: its Temperature times ``D``, its tint times the rule's gain."""
     nodes = {
         "settings": group_node(materials.SETTINGS),
         # Cycles' T: the Temperature input times max(grid, 0) where the object has the grid
@@ -70,36 +72,38 @@ def volume_blackbody_group() -> Group:
         "dt4": fmath("POWER", "dt", 4.0),
         "dt4m1": fmath("SUBTRACT", "dt4", 1.0),
         "dt_mixed": fmath("MULTIPLY_ADD", "group.Intensity", "dt4m1", 1.0),
-        "dt_sigma": fmath("MULTIPLY", "dt_mixed", SIGMA),
-        "dt_strength": fmath("MULTIPLY", "dt_sigma", "group.Tint"),
-        "dt_planck": Node("ShaderNodeBlackbody", {"Temperature": "dt"}),
-        "bolometric_base": vmath("SCALE", "dt_planck.Color", scale="dt_strength"),
         "ss4": fmath("MULTIPLY", "settings.Spectral Searchlight", 4.0),
         "bolometric_power": fmath("ADD", "ss4", "power"),
         "bolometric_exponent": fmath("MULTIPLY_ADD", "settings.Use Doppler", -4.0, "bolometric_power"),
-        "bolometric_log": fmath("MULTIPLY", "bolometric_exponent", "ln_d"),
-        "bolometric_safe": fmath("MINIMUM", "bolometric_log", materials.EXP_LIMIT),
-        "bolometric_gain": fmath("EXPONENT", "bolometric_safe"),
-        "bolometric_emitter": vmath("SCALE", "bolometric_base", scale="bolometric_gain"),
-        "emitter": Node(
-            "ShaderNodeMix",
-            {"Factor": "group.Bolometric", 4: "visible_emitter", 5: "bolometric_emitter"},
-            {"data_type": "VECTOR"},
-        ),
         # only camera rays on the exact camera's path, never in a spectral pass
         "light_path": Node("ShaderNodeLightPath"),
         "fast": fmath("SUBTRACT", 1.0, "settings.Spectral Pass"),
         "camera_ray": fmath("MULTIPLY", "light_path.Is Camera Ray", "settings.Camera Path"),
         "fast_camera_ray": fmath("MULTIPLY", "camera_ray", "fast"),
         "switch": fmath("MULTIPLY", "fast_camera_ray", "group.Fast Part"),  # 0: inside a node group
-        # X - E added to Cycles' own E (which the group's E matches to 2e-4 for a constant or
-        # node-driven T); with a grid (Bolometric 1) Cycles' E is switched off for camera rays and
-        # X emitted alone: Blender 5.2 reads a grid in the Principled Volume otherwise than an
-        # Attribute node does (sigma T^4 2.4-2.9 % apart), and the difference would leak unshifted
-        "rest_kept": fmath("SUBTRACT", 1.0, "group.Bolometric"),
-        "rest_taken": vmath("SCALE", "rest", scale="rest_kept"),
-        "difference": vmath("SUBTRACT", "emitter.Result", "rest_taken"),
-        "fast_out": vmath("SCALE", "difference", scale="switch"),
+        # the visible rule: X - E added to Cycles' own E (which the group's E matches to 2e-4 for
+        # a constant or node-driven T). The bolometric rule (a grid, Bolometric 1) is Cycles' own
+        # emission at D T: the Principled Volume itself shifts it (the Temperature and Tint outputs),
+        # reading the grid as it does at rest (Blender 5.2 reads a grid in the Principled Volume
+        # otherwise than an Attribute node does, sigma T^4 2.4-2.9 % apart), and under 5.x's null
+        # scattering Cycles evaluates the volume shader at 128^3 x 16 points per render for its
+        # majorant grid: no second grid read and Blackbody node there (docs/performance.md)
+        "visible_part": fmath("SUBTRACT", 1.0, "group.Bolometric"),
+        "visible_switch": fmath("MULTIPLY", "switch", "visible_part"),
+        "difference": vmath("SUBTRACT", "visible_emitter", "rest"),
+        "fast_out": vmath("SCALE", "difference", scale="visible_switch"),
+        # per point as few nodes as Cycles leaves after folding the settings' constants: D as
+        # gamma (1 - beta_o . k), raised to the switch (D or 1), to Use Doppler and to the gain's
+        # exponent (4 SS + p - p_cam - 4 Use Doppler; 0 with the searchlight on: no node)
+        "gamma_o": fmath("POWER", "one_bo2", -0.5),
+        "d_direct": fmath("MULTIPLY", "ns_bo_k", "gamma_o"),
+        "bolometric_switch": fmath("MULTIPLY", "switch", "group.Bolometric"),
+        "d_switched": fmath("POWER", "d_direct", "bolometric_switch"),
+        "d_shifted": fmath("POWER", "d_switched", "settings.Use Doppler"),
+        "camera_temperature": fmath("MULTIPLY", "group.Temperature", "d_shifted"),
+        "tint_gain": fmath("POWER", "d_switched", "bolometric_exponent"),
+        "safe_tint_gain": fmath("MINIMUM", "tint_gain", math.exp(materials.EXP_LIMIT)),
+        "camera_tint": fmath("MULTIPLY", "group.Tint", "safe_tint_gain"),
         # a spectral pass, every ray: E's spectral values (the blackbody at T with E's luminance, as
         # a surface blackbody's) instead of Cycles' RGB E, which the Intensity output switches off
         # (adding the difference instead loses the Wien tail: E's RGB is ~1e3 times its values there)
@@ -125,10 +129,8 @@ def volume_blackbody_group() -> Group:
         "spectral_scale": fmath("MULTIPLY", "spectral_gain", "settings.Spectral Pass"),
         "spectral_out": vmath("SCALE", "spectral", scale="spectral_scale"),
         "out": vmath("ADD", "fast_out", "spectral_out"),
-        # Cycles' own blackbody off in a spectral pass, and for camera rays with a grid (above)
-        "switched_off": fmath("MULTIPLY", "switch", "group.Bolometric"),
-        "kept": fmath("SUBTRACT", "fast", "switched_off"),
-        "intensity": fmath("MULTIPLY", "group.Intensity", "kept"),
+        # Cycles' own blackbody off in a spectral pass
+        "intensity": fmath("MULTIPLY", "group.Intensity", "fast"),
         # the boundary where a camera ray enters the volume
         "front": fmath("SUBTRACT", 1.0, "geometry.Backfacing"),
         "done": fmath("MULTIPLY", "switch", "front"),
@@ -149,6 +151,8 @@ def volume_blackbody_group() -> Group:
             ("Color", "NodeSocketColor", "out"),
             ("Done", "NodeSocketFloat", "done"),
             ("Intensity", "NodeSocketFloat", "intensity"),
+            ("Temperature", "NodeSocketFloat", "camera_temperature"),
+            ("Tint", "NodeSocketFloat", "camera_tint"),
         ),
         nodes,
     )

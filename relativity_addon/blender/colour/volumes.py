@@ -54,9 +54,11 @@ the **bolometric rule**: Cycles' emission ``sigma T^4`` times a unit-luminance b
 read as a blackbody of total ``sigma T^4``, seen at ``D T`` with total ``sigma (D T)^4``, i.e.
 Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; the visible rule's
 ``Y(D T) / Y(T)`` explodes in the cool gas where every grid fades to 0 K (docs/spectral-model.md,
-"Temperature grids"). For camera rays Cycles' own blackbody is switched off and the group emits
-the shifted light alone (Blender 5.2's Principled Volume reads a grid otherwise than an Attribute
-node, so ``X - E`` would leave the difference unshifted). A Volume object renders no surface
+"Temperature grids"). For camera rays the Principled Volume itself emits the shifted light: the
+group feeds its Temperature (times ``D``) and Blackbody Tint (times the rule's gain), so Cycles
+reads the grid as it does at rest (Blender 5.2's Principled Volume reads a grid 2.9 % brighter
+than an Attribute node does) and the majorant grid of 5.x's null scattering evaluates no second
+grid read and Blackbody node (docs/performance.md, "What is left"). A Volume object renders no surface
 closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
 there too (measured: with the link to it cut the compositor shifts those pixels again). In a
 spectral pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, the scene-frame spectrum whose
@@ -152,6 +154,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         return False
     records = [record.to_dict() for record in material[materials.ATTACHED_KEY]]
     if any(record["group_node"].startswith(NODE_PREFIX) for record in records):
+        _upgrade(material, material.node_tree, records)
         return False
     found = _correctable(material)
     if found is None:
@@ -171,7 +174,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         tree.links.new(attribute.outputs["Alpha"], group.inputs["Grid Alpha"])
         group.inputs["Bolometric"].default_value = 1.0
         created.append(attribute)
-    tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+    temperature_source = _link_emission_inputs(tree, node, group)
     emission = tree.nodes.new("ShaderNodeEmission")
     emission.name = emission.label = f"{NODE_PREFIX} Emission {node.name}"
     tree.links.new(group.outputs["Color"], emission.inputs["Color"])
@@ -204,6 +207,7 @@ def attach(material: Material, grids: bool = False) -> bool:
         "object_temperature": records[0]["object_temperature"] if records else 0.0,
     }
     records += [{**blank, "group_node": new_node.name} for new_node in created if new_node is not add]
+    records += [{**blank, **temperature_source, "group_node": group.name}]
     records += [
         {
             **blank,
@@ -216,6 +220,54 @@ def attach(material: Material, grids: bool = False) -> bool:
     ]
     material[materials.ATTACHED_KEY] = records
     return True
+
+
+def _bolometric(group):
+    """Whether the volume blackbody ``group`` node may shift by the bolometric rule (a grid read)."""
+    bolometric = group.inputs["Bolometric"]
+    return bolometric.is_linked or bolometric.default_value > 0.0
+
+
+def _link_emission_inputs(tree, node, group):
+    """Feed the Principled Volume ``node``'s Blackbody Intensity from the volume blackbody ``group``,
+    and where the group may take the bolometric rule (:func:`_bolometric`) its Temperature and
+    Blackbody Tint too (the rule shifts Cycles' own emission through them; the visible rule leaves
+    them as they were). Returns the record fields that give the Temperature input its own link back
+    on detach (``materials.resolve_record``; none where it was a constant, which stays in the socket)."""
+    tree.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+    temperature = node.inputs["Temperature"]
+    if not _bolometric(group):
+        return {}
+    source = temperature.links[0].from_socket if temperature.is_linked else None
+    tree.links.new(group.outputs["Temperature"], temperature)
+    tree.links.new(group.outputs["Tint"], node.inputs["Blackbody Tint"])
+    if source is None:
+        return {}
+    return {
+        "target": node.name,
+        "socket": temperature.identifier,
+        "source_node": source.node.name,
+        "source_socket": source.identifier,
+    }
+
+
+def _upgrade(owner, tree, records):
+    """A correction put in before the group fed the Principled Volume's Temperature and Tint (group
+    version 10; a file set up with an earlier add-on): link them, so that the bolometric rule, which
+    the group no longer emits itself, reaches the gas; recorded on ``owner`` (material or group)."""
+    for record in list(records):
+        group = tree.nodes.get(record["group_node"])
+        if group is None or group.bl_idname != "ShaderNodeGroup" or "Tint" not in group.outputs:
+            continue
+        node = tree.nodes.get(group.name.removeprefix(f"{NODE_PREFIX} "))
+        if node is None or node.bl_idname != "ShaderNodeVolumePrincipled":
+            continue
+        temperature = node.inputs["Temperature"]
+        if not _bolometric(group) or (temperature.is_linked and temperature.links[0].from_node == group):
+            continue
+        blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
+        records.append({**blank, **record, **_link_emission_inputs(tree, node, group), "group_node": group.name})
+        owner[materials.ATTACHED_KEY] = records
 
 
 def _reads_grids(obj):
@@ -270,12 +322,6 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
         return False
     did = False
     for _group, inner, node in list(grouped_volume_nodes(material.node_tree)):
-        blackbody = sources.volume_blackbody(node)
-        if blackbody is None:
-            continue
-        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
-        if intensity is None or not node.outputs[0].is_linked:
-            continue
         existing = inner.nodes.get(f"{NODE_PREFIX} {node.name}")
         if inner.nodes.get(f"{NODE_PREFIX} Add {node.name}") is not None:
             if existing is not None:  # put in for another material, which may not carry grids
@@ -285,6 +331,14 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
                 ]
                 inner[materials.ATTACHED_KEY] = [r.to_dict() for r in inner[materials.ATTACHED_KEY]] + reader
                 did = did or bool(reader)
+            # the reader's rule reaches the Principled Volume (also a group set up by an earlier version)
+            _upgrade(inner, inner, [record.to_dict() for record in inner.get(materials.ATTACHED_KEY, [])])
+            continue
+        blackbody = sources.volume_blackbody(node)
+        if blackbody is None:
+            continue
+        intensity = sources.constant_value(node.inputs["Blackbody Intensity"])
+        if intensity is None or not node.outputs[0].is_linked:
             continue
         group = _blackbody_group(inner, node, blackbody, intensity)
         group.inputs["Fast Part"].default_value = 0.0  # on where every user takes the boundary (grouped_volumes)
@@ -294,12 +348,13 @@ def attach_grouped(material: Material, grids: bool = False) -> bool:
         add = inner.nodes.new("ShaderNodeAddShader")
         add.name = add.label = f"{NODE_PREFIX} Add {node.name}"
         targets = [link.to_socket for link in node.outputs[0].links]
-        inner.links.new(group.outputs["Intensity"], node.inputs["Blackbody Intensity"])  # 0 in spectral passes
+        temperature_source = _link_emission_inputs(inner, node, group)
         inner.links.new(group.outputs["Color"], emission.inputs["Color"])
         inner.links.new(node.outputs[0], add.inputs[0])
         inner.links.new(emission.outputs[0], add.inputs[1])
         blank = {"target": "", "socket": "", "source_node": "", "source_socket": ""}
         records = [{**blank, "group_node": new.name} for new in (*created, emission)]
+        records.append({**blank, **temperature_source, "group_node": group.name})
         for target in targets:
             inner.links.new(add.outputs[0], target)
             relink = {"target": target.node.name, "socket": target.identifier, "source_node": node.name}

@@ -60,9 +60,10 @@ BLACKBODY_SHIFT_GROUP = "Relativity Blackbody Shift"
 DOPPLER_COLOUR_GROUP = "Relativity Doppler Colour"
 DOPPLER_AOV_GROUP = "Relativity Doppler AOV"
 SPECTRAL_COLOUR_GROUP = "Relativity Spectral Colour"
-SHADER_GROUPS_VERSION = 9  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
+SHADER_GROUPS_VERSION = 10  # 3: spectral passes, blackbodies shifted for camera rays only; 4: emitter D_s^4;
 # 5: volumes in spectral passes; 6: the coverage AOV; 7: temperature grids in the volume group;
-# 8: temperature grids in the spectral passes; 9: the emitter's D_s^4 on every ray behind the exact camera
+# 8: temperature grids in the spectral passes; 9: the emitter's D_s^4 on every ray behind the exact camera;
+# 10: the bolometric rule through the Principled Volume's own Temperature and Tint
 GROUP_VERSION_KEY = "relativity_group_version"  # on shader and compositor groups
 
 # --- Doppler colour: compositor (exact camera) ----------------------------------------------

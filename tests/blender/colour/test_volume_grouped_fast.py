@@ -160,8 +160,8 @@ def test_grouped_temperature_grid_is_seen_at_d_t_with_d4_luminance(relativity_ad
     """The two-temperature VDB of ``test_volume_temperature_grid.py`` (2500 K and 4000 K halves) with
     its Principled Volume inside a node group that a second material, on a mesh (out of view), uses
     too: each half must be colour-science's blackbody at ``D T`` (Delta E 2000 <= 1) with its rest
-    luminance times ``D^4`` (eq. 15) and the slab's path-length change, within 5 % as ungrouped
-    (Blender 5.2 reads the grid 3 % brighter in the Principled Volume than in an Attribute node).
+    luminance times ``D^4`` (eq. 15) and the slab's path-length change, within 2 % as ungrouped
+    (the Principled Volume's own emission shifted: it reads the grid as at rest).
     Before: the RGB shift (the group could not read the grid)."""
     bpy = __import__("bpy")
     import test_volume_temperature_grid as tg
@@ -206,5 +206,5 @@ def test_grouped_temperature_grid_in_spectral_mode_is_seen_at_d_t_with_d4_lumina
     spectral = pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
 
-    assert not tg.halves_off(bpy, scene, camera, spectral, y_rest, label="spectral grouped grid ")
+    assert not tg.halves_off(bpy, scene, camera, spectral, y_rest, label="spectral grouped grid ", luminance=0.05)
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}

@@ -93,10 +93,15 @@ def observe(scene):
     scene.relativity.speed_of_light = 1.0
 
 
-def halves_off(bpy, scene, camera, image, y_rest, power=4, label=""):
+def halves_off(bpy, scene, camera, image, y_rest, power=4, label="", luminance=0.02):
     """The halves of ``image`` (rows top first) not seen as colour-science's blackbody at ``D T``
     (Delta E 2000 <= 1) with their rest luminance ``y_rest`` times ``D^power`` and the slab's
-    path-length change (within 5 %), ``D`` from each pixel's viewing direction."""
+    path-length change (within ``luminance``), ``D`` from each pixel's viewing direction.
+
+    The fast mode shifts Cycles' own emission (the Principled Volume reads the grid as at rest): 2 %
+    (16 samples: 0.9955 / 1.0015 on Blender 5.2, 0.9993 / 1.0001 on 4.5; 0.966 / 0.971 on 5.2 when
+    the group rebuilt the emission from an Attribute node). The spectral passes rebuild it from the
+    Attribute node, which Blender 5.2 reads 2.9 % dimmer than the Principled Volume: 5 % there."""
     doppler = dh.pixel_doppler(bpy, scene, camera, BETA)
     path = _slab_path_ratio(bpy, scene, camera)
     failures = []
@@ -111,7 +116,7 @@ def halves_off(bpy, scene, camera, image, y_rest, power=4, label=""):
             f"{label}{name} ({temperature:.0f} K): D {d.mean():.3f}, Delta E {delta_e:.3f}, "
             f"Y / D^{power} Y_rest {ratio:.4f}"
         )
-        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=0.05)):
+        if not (delta_e <= 1.0 and ratio == pytest.approx(1.0, abs=luminance)):
             failures.append(name)
     return failures
 
@@ -167,8 +172,32 @@ def test_temperature_grid_in_spectral_mode_is_seen_at_d_t_with_d4_luminance(rela
     pixels, _info = spectral_render.render(scene, 3)
     spectral = pixels[::-1, :, :3].astype(float)  # top row first, like the EXR reader
     assert np.all(np.isfinite(spectral)) and spectral.min() >= 0.0
-    assert not halves_off(bpy, scene, camera, spectral, y_rest, label="spectral ")
+    assert not halves_off(bpy, scene, camera, spectral, y_rest, label="spectral ", luminance=0.05)
 
     assert bpy.ops.relativity.remove_all() == {"FINISHED"}
     assert sorted((link.from_node.name, link.to_node.name) for link in material.node_tree.links) == links_before
     assert len(material.node_tree.nodes) == nodes_before
+
+
+def test_a_grid_set_up_by_an_earlier_version_gets_the_principled_volume_fed(relativity_addon, tmp_path):
+    """Group version 10 shifts grid gas through the Principled Volume's own Temperature and Tint; a
+    file set up before (the group's outputs not linked there) gets them linked at the next attach
+    (every render attaches), and Remove still gives the links back. No render."""
+    bpy = __import__("bpy")
+    volumes = dh.addon_module(relativity_addon, "colour.volumes")
+    scene, _camera, material = grid_scene(bpy, tmp_path)
+    tree = material.node_tree
+    links_before = sorted((link.from_node.name, link.to_node.name) for link in tree.links)
+    observe(scene)
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    principled = tree.nodes["Principled Volume"]
+    group = tree.nodes[f"{volumes.NODE_PREFIX} Principled Volume"]
+    for name in ("Temperature", "Blackbody Tint"):
+        assert principled.inputs[name].links[0].from_node == group, name
+        tree.links.remove(principled.inputs[name].links[0])  # the wiring of version 9
+    volumes.attach_scene(scene)
+    for name in ("Temperature", "Blackbody Tint"):
+        assert principled.inputs[name].is_linked and principled.inputs[name].links[0].from_node == group, name
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    assert sorted((link.from_node.name, link.to_node.name) for link in tree.links) == links_before
+    assert principled.inputs["Temperature"].default_value == BASE_TEMPERATURE
