@@ -32,21 +32,28 @@ if TYPE_CHECKING:
 RAYS = ("visible_diffuse", "visible_glossy", "visible_transmission", "visible_volume_scatter")
 
 
+def _emissions(tree):
+    """``(colour, strength)`` input sockets of the tree's Emission and Principled BSDF nodes in use."""
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeEmission":
+            sockets = node.inputs["Color"], node.inputs["Strength"]
+        elif node.bl_idname == "ShaderNodeBsdfPrincipled":
+            sockets = node.inputs["Emission Color"], node.inputs["Emission Strength"]
+        else:
+            continue
+        if not node.mute and node.outputs[0].is_linked:
+            yield sockets
+
+
 def emission_radiance(obj: Object) -> tuple[float, ...] | None:
     """``(r, g, b)`` radiance of the emitter's first constant emission, or None."""
     for slot in obj.material_slots:
         material = slot.material
         if material is None or material.node_tree is None:
             continue
-        for node in material.node_tree.nodes:
-            if node.bl_idname == "ShaderNodeEmission":
-                colour, strength = node.inputs["Color"], node.inputs["Strength"]
-            elif node.bl_idname == "ShaderNodeBsdfPrincipled":
-                colour, strength = node.inputs["Emission Color"], node.inputs["Emission Strength"]
-            else:
-                continue
+        for colour, strength in _emissions(material.node_tree):
             colour = _rest_colour(colour)
-            if colour is None or strength.is_linked or not node.outputs[0].is_linked:
+            if colour is None or strength.is_linked:
                 continue
             radiance = tuple(float(strength.default_value) * float(v) for v in tuple(colour.default_value)[:3])
             if max(radiance) > 0.0:
@@ -58,22 +65,11 @@ def emits(material: Material) -> bool:
     """Whether ``material`` emits light at all (an Emission or Principled emission in use, its
     strength and colour not zero where unlinked)."""
     tree = compat.rendered_node_tree(material)
-    if tree is None:
-        return False
-    for node in tree.nodes:
-        if node.bl_idname == "ShaderNodeEmission":
-            colour, strength = node.inputs["Color"], node.inputs["Strength"]
-        elif node.bl_idname == "ShaderNodeBsdfPrincipled":
-            colour, strength = node.inputs["Emission Color"], node.inputs["Emission Strength"]
-        else:
-            continue
-        if node.mute or not node.outputs[0].is_linked:
-            continue
-        if (strength.is_linked or strength.default_value > 0.0) and (
-            colour.is_linked or max(colour.default_value[:3]) > 0.0
-        ):
-            return True
-    return False
+    return tree is not None and any(
+        (strength.is_linked or strength.default_value > 0.0)
+        and (colour.is_linked or max(colour.default_value[:3]) > 0.0)
+        for colour, strength in _emissions(tree)
+    )
 
 
 def _rest_colour(socket):
