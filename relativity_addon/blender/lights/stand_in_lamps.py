@@ -475,6 +475,10 @@ def write(
                 "basis_weights",
             )
         }
+        if light.motion == "ANIMATION" and len(times) < 2:
+            # one lamp: its keyframed path where the surfaces see it is at rest (lamp_path), where
+            # the shader would carry it on at the frame's velocity (a light starting to move there)
+            shared["light_beta"] = (0.0, 0.0, 0.0)
         shared["spectral"] = int(values["spectral"])
         shared["lambert"] = int(values["lambert"])
         # the fast mode's observed light group (light_groups.OBSERVED): the observer's shift too

@@ -6,7 +6,8 @@ The light is keyframed (Motion: Animation), at rest at x = 0 until frame 1, then
 that to reach the floor and the camera), frame 4 already moving. Found: Render Animation kept the
 stand-in lamps' count of its first frame (none are made between its frames: Blender 5.2 crashed),
 here one lamp, which drew frames 2 to 4 wrong (the pool at pixel 76 where the frame's F12 render
-has it at 40)."""
+has it at 40); and a lone stand-in carried the light on at the frame's velocity where its path is
+at rest (frame 1: the pool 13 px behind Blender's own lamp at rest)."""
 
 import importlib
 import sys
@@ -95,3 +96,20 @@ def test_render_animation_frames_are_their_own_frames(relativity_addon, factory_
         assert difference < 0.02, f"frame {frame} of Render Animation is not that frame's image"
     assert _centroid_x(animated[3]) > _centroid_x(animated[0]) + 5.0
 
+
+def test_keyframed_light_at_rest_until_the_frame_lights_as_a_lamp_at_rest(relativity_addon, factory_blender, tmp_path):
+    """Frame 1: the light has been at rest at x = 0 over all the time its light takes to reach the
+    floor and the camera, so the floor is lit as by Blender's own lamp at rest there (the same light
+    with Motion Static): the pool within 1 px of it and the total light within 3 %."""
+    bpy = factory_blender
+    scene = _scene(bpy, motion="STATIC")
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    at_rest = _still(bpy, scene, tmp_path / "rest.exr")
+    assert bpy.ops.relativity.remove_all() == {"FINISHED"}
+    bpy.data.objects["Lamp"].relativity.motion = "ANIMATION"
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    keyed = _still(bpy, scene, tmp_path / "keyed.exr")
+    ratio = ch.luminance(keyed).sum() / ch.luminance(at_rest).sum()
+    print(f"pool at {_centroid_x(keyed):.1f} px (lamp at rest: {_centroid_x(at_rest):.1f}); total light {ratio:.4f}")
+    assert abs(_centroid_x(keyed) - _centroid_x(at_rest)) < 1.0
+    assert abs(ratio - 1.0) < 0.03
