@@ -275,15 +275,15 @@ def _record(scene):
     return {} if stored is None else {key: list(value) for key, value in stored.to_dict().items()}
 
 
-def _lamps_for(scene, light_name, count, text, kind="POINT"):
+def _lamps_for(scene, light_name, count, text, kind="POINT", keep=False):
     """The light's first ``count`` lamps, sharing one light datablock; while a bake steps frames
-    (``busy.keeps_stand_ins``) the others are kept, hidden from renders, and more are added under
-    the next names when needed."""
+    (``busy.keeps_stand_ins``) or ``keep`` (a render runs: :func:`reserve`) the others are kept,
+    hidden from renders, and more are added under the next names when needed."""
     record = _record(scene)
     existing = [name for name in record.get(light_name, []) if bpy.data.objects.get(name) is not None]
     lights = {bpy.data.objects[name].data for name in existing}
     same_kind = len(lights) <= 1 and all(light.type == kind and _is_shared(light) for light in lights)
-    kept = busy.keeps_stand_ins() and same_kind
+    kept = (busy.keeps_stand_ins() or keep) and same_kind
     if len(existing) < count or (not kept and (len(existing) != count or not same_kind)):
         if not kept:
             for name in existing:
@@ -303,6 +303,52 @@ def _lamps_for(scene, light_name, count, text, kind="POINT"):
     for index, obj in enumerate(lamps):
         _set(obj, "hide_render", index >= count)
     return lamps[:count]
+
+
+def _capacity(obj):
+    """``(lamps the stand-ins of this kind can hold at most, strips or lamps per lamp)`` for a
+    light's stand-in ``obj``: MAX_LAMPS points or lines, or MAX_LAMPS - 1 pieces of strips."""
+    if obj.data.type == "POINT":
+        return MAX_LAMPS, 1
+    if obj.data.node_tree.nodes[names.MOVING_LAMP_PREFIX].inputs["strip"].default_value == 1:
+        return MAX_LAMPS - 1, STRIP_SIDES
+    return MAX_LAMPS, LINE_SIDES
+
+
+def reserve(scene: Scene) -> None:
+    """Before a render (``render_init``): give every moving light as many stand-ins as it can use,
+    those not in use hidden from renders. Between Render Animation's frames none are made or deleted
+    (Blender 5.2 crashed, :func:`write`), so a frame that needs more lamps than the first (a keyframed
+    light at rest before the first frame has one) takes them from these instead of making do with
+    the first frame's count. Not for the cockpit: made in its render (its Render Layers node), they
+    crashed Blender 5.2 (``test_cockpit_lamp.py``)."""
+    if cockpit.is_applied(scene):
+        return
+    record = _record(scene)
+    for light_name, existing in record.items():
+        objects = [bpy.data.objects.get(name) for name in existing]
+        if not objects or any(obj is None for obj in objects) or objects[0].data.type == "SUN":
+            continue
+        lights = {obj.data for obj in objects}
+        if len(lights) != 1 or not _is_shared(objects[0].data):
+            continue
+        lamps, sides = _capacity(objects[0])
+        for index in range(len(existing), lamps * sides):
+            obj = _new_object(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", objects[0].data)
+            obj.hide_render = True
+            existing.append(obj.name)
+        record[light_name] = existing
+    if record:
+        scene[names.MOVING_LAMPS_KEY] = record
+
+
+def _held(scene, light_name):
+    """How many lamps (times) the light's stand-ins, hidden ones included, hold (0: none)."""
+    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
+    if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
+        return 0
+    lamps, sides = _capacity(objects[0])
+    return len(objects) // sides + (lamps == MAX_LAMPS - 1)  # Continuous: pieces, one time more
 
 
 def hide(scene: Scene) -> None:
@@ -394,19 +440,21 @@ def write(
         stored = _stored_times(scene, light.name)
         times = None if depsgraph is not None else stored
         lines = _stored_lines(scene, light.name)
+        keep = busy.rendering() or cockpit.is_applied(scene)
         if times is None:  # place them (the camera's view is ray-cast)
             if points is None:
                 points = visible_points(scene, snap, depsgraph, values["camera_position"])
             times, positions = lamp_path(scene, snap, light, values, reception_time, points)
-            keep = busy.rendering() or cockpit.is_applied(scene)
             if not (keep and stored is not None):  # while rendering the lamps stay what they are (below)
                 lines = _use_lines(points, camera_position, times, positions)
-            if keep and stored is not None and len(stored) != len(times):
-                # as many as there are: stand-ins made and deleted between Render Animation's
-                # frames (frame_change_post) crashed Blender 5.2's render of the next frame, and
-                # at a frame change with the cockpit's Render Layers node (docs/cockpit.md)
+            held = max(_held(scene, light.name), len(stored)) if stored is not None else 0
+            if keep and stored is not None and len(times) > held:
+                # no more than there are (hidden ones too, :func:`reserve`): stand-ins made and
+                # deleted between Render Animation's frames (frame_change_post) crashed Blender
+                # 5.2's render of the next frame, and at a frame change with the cockpit's Render
+                # Layers node (docs/cockpit.md)
                 ends = np.linspace(0.0, 1.0, len(times))
-                times = np.interp(np.linspace(0.0, 1.0, len(stored)), ends, times)
+                times = np.interp(np.linspace(0.0, 1.0, held), ends, times)
                 positions = path_positions(scene, snap, light, values, reception_time, times)
         else:  # no depsgraph (frame_change_pre, render_pre): the times of the last placement, moved on
             positions = path_positions(scene, snap, light, values, reception_time, times)
@@ -427,6 +475,10 @@ def write(
                 "basis_weights",
             )
         }
+        if light.motion == "ANIMATION" and len(times) < 2:
+            # one lamp: its keyframed path where the surfaces see it is at rest (lamp_path), where
+            # the shader would carry it on at the frame's velocity (a light starting to move there)
+            shared["light_beta"] = (0.0, 0.0, 0.0)
         shared["spectral"] = int(values["spectral"])
         shared["lambert"] = int(values["lambert"])
         # the fast mode's observed light group (light_groups.OBSERVED): the observer's shift too
@@ -439,9 +491,9 @@ def write(
             camera_power=float(colour.camera_power),
         )
         if len(times) < 2 or snap.moving_light_shadows != "CONTINUOUS":
-            _write_points(scene, light, text, shared, times, positions, camera_position, lines)
+            _write_points(scene, light, text, shared, times, positions, camera_position, lines, keep)
         else:
-            _write_strips(scene, light, text, shared, times, positions, camera_position)
+            _write_strips(scene, light, text, shared, times, positions, camera_position, keep)
 
 
 def _set_own(obj, key, value):
@@ -494,13 +546,13 @@ def _place_strip(obj, centre, axis, length, side, camera_position, sides=STRIP_S
     return normal
 
 
-def _write_points(scene, light, text, shared, times, positions, camera_position, lines):
+def _write_points(scene, light, text, shared, times, positions, camera_position, lines, keep=False):
     """A lamp at each time, lighting the points whose retarded times lie next to it: a point lamp,
     or (``lines``, two lamps or more) LINE_SIDES strips LINE lamp spacings long along the path."""
     last = len(times) - 1
     lines = lines and last > 0
     sides = LINE_SIDES if lines else 1
-    lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT")
+    lamps = _lamps_for(scene, light.name, sides * len(times), text, "AREA" if lines else "POINT", keep)
     for number, obj in enumerate(lamps):
         index, side = divmod(number, sides)
         before, after = max(index - 1, 0), min(index + 1, last)
@@ -525,13 +577,13 @@ def _write_points(scene, light, text, shared, times, positions, camera_position,
         write_inputs(obj, inputs)
 
 
-def _write_strips(scene, light, text, shared, times, positions, camera_position):
+def _write_strips(scene, light, text, shared, times, positions, camera_position, keep=False):
     """STRIP_SIDES one-sided strips (thin area lights facing 120 degrees apart about the path) along
     each piece between the times: each point gets its light, and its shadow rays, from the path
     within KERNEL / 2 of the piece's duration around its own retarded time (the shader's box)."""
     pieces = len(times) - 1
     width = KERNEL  # in units of the piece's duration
-    for index, obj in enumerate(_lamps_for(scene, light.name, STRIP_SIDES * pieces, text, "AREA")):
+    for index, obj in enumerate(_lamps_for(scene, light.name, STRIP_SIDES * pieces, text, "AREA", keep)):
         piece, side = divmod(index, STRIP_SIDES)
         start, end = positions[piece], positions[piece + 1]
         along = end - start

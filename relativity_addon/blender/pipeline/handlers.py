@@ -28,6 +28,7 @@ from bpy.app.handlers import persistent
 from ..camera import exact_camera
 from ..common import busy
 from ..geometry import apparent_meshes, keyframed
+from ..lights import stand_in_lamps
 from . import effect, render_notice
 
 if TYPE_CHECKING:
@@ -108,6 +109,10 @@ def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
         effect.begin_final_render(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
         print(f"Relativity: the final render stays the boosted-mesh preview: {error}")
+    try:
+        stand_in_lamps.reserve(scene)  # none are made between Render Animation's frames
+    except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
+        print(f"Relativity: {type(error).__name__}: {error}")
 
 
 def _keys_before_render(scene):
