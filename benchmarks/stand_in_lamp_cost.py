@@ -59,14 +59,14 @@ def own_light(obj, shared):
     """A copy of the stand-ins' ``shared`` light holding ``obj``'s own inputs on its script node, as
     before (no Attribute nodes: the values are constants of the shader, as they were)."""
     from relativity_addon.blender.common import names
-    from relativity_addon.blender.lights import stand_in_lamps
+    from relativity_addon.blender.lights import stand_in_lights
 
     light = shared.copy()
     tree = light.node_tree
     node = tree.nodes[names.MOVING_LAMP_PREFIX]
-    for key in stand_in_lamps.PER_LAMP:
+    for key in stand_in_lights.PER_LAMP:
         tree.nodes.remove(tree.nodes[key])
-        value = obj.get(stand_in_lamps.lamp_key(key))
+        value = obj.get(stand_in_lights.lamp_key(key))
         if value is not None:
             node.inputs[key].default_value = value
     return light

@@ -27,43 +27,28 @@ scene frame).
 
 **Spectral mode** (``spectral_render``): the passes carry volumes like surfaces, so nothing above is
 needed and what is seen through a volume is right too. In a pass the group's fast part and done
-mask are 0 (the compositor passes through), its ``Intensity`` output (linked into the Principled
-Volume's Blackbody Intensity) switches Cycles' RGB blackbody off, and its ``Color`` is ``E``'s
-spectral values: the blackbody at ``T`` with ``E``'s luminance (``spectral_nodes``, the surfaces'
-group; adding the spectral-minus-RGB difference instead was tried: 18 % off at 400 nm, where ``E``'s
-RGB is ~1e3 times the Planck value). :func:`attach_colours` puts ``spectral_nodes.volume_colour_group``
-(the colour unchanged outside the passes) in front of the volume colours (:data:`VOLUME_COLOURS`):
-Principled Volume Color and Absorption Color and the Volume Absorption / Scatter colours up-sampled
-as reflectances, which Cycles' per-channel formulas (``sigma_a = density max(1 - C, 0)
-max(1 - sqrt(A), 0)``, Volume Absorption ``density (1 - C)``) then apply per wavelength; the
-Principled Volume's Emission Color as an emitted colour (a Blackbody node's as a blackbody). An
-Emission node in a volume has the materials' own group already. A Principled Volume blackbody
-inside a node group gets the group's spectral part in the group's tree (:func:`attach_grouped`; the
-fast part there is switched on, and the boundary put into each material using the group, by
-``grouped_volumes.py``). What cannot be made spectral is refused in one line
-(:func:`spectral_problem`).
+mask are 0, its ``Intensity`` output switches Cycles' RGB blackbody off, and its ``Color`` is
+``E``'s spectral values (the blackbody at ``T`` with ``E``'s luminance; ``spectral_nodes``).
+:func:`attach_colours` puts ``spectral_nodes.volume_colour_group`` in front of the volume colours
+(:data:`VOLUME_COLOURS`: absorption and scatter colours up-sampled as reflectances, which Cycles'
+per-channel formulas then apply per wavelength; emission colours as emitted colours;
+docs/spectral-model.md). A Principled Volume blackbody inside a node group gets the group's
+spectral part in the group's tree (:func:`attach_grouped`; ``grouped_volumes.py`` for the fast
+part). What cannot be made spectral is refused in one line (:func:`spectral_problem`).
 
 Recognised (``sources.volume_blackbody``): a Principled Volume feeding the active Material
 Output's Volume input directly, the Surface input unlinked, a grey Blackbody Tint, a constant
 Blackbody Intensity and a constant or linked Temperature (a node field is followed per point).
 
-**Temperature grids** (a Volume object or fluid domain whose Temperature Attribute names a grid,
-e.g. a fire simulation; :func:`grid_materials`): Cycles' ``T`` is the Temperature input times
-``max(grid, 0)``, which an Attribute node reading the grid gives the group. Such gas is shifted by
-the **bolometric rule**: Cycles' emission ``sigma T^4`` times a unit-luminance blackbody colour is
-read as a blackbody of total ``sigma T^4``, seen at ``D T`` with total ``sigma (D T)^4``, i.e.
-Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite for every ``T``; the visible rule's
-``Y(D T) / Y(T)`` explodes in the cool gas where every grid fades to 0 K (docs/spectral-model.md,
-"Temperature grids"). For camera rays the Principled Volume itself emits the shifted light: the
-group feeds its Temperature (times ``D``) and Blackbody Tint (times the rule's gain), so Cycles
-reads the grid as it does at rest (Blender 5.2's Principled Volume reads a grid 2.9 % brighter
-than an Attribute node does) and the majorant grid of 5.x's null scattering evaluates no second
-grid read and Blackbody node (docs/performance.md, "What is left"). A Volume object renders no surface
-closures, but Cycles runs its surface shader's AOV Output nodes, so the boundary's done mask holds
-there too (measured: with the link to it cut the compositor shifts those pixels again). In a
-spectral pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, the scene-frame spectrum whose
-shift is that rule (``D`` of the ray: it depends on the direction), other rays ``E`` up-sampled as
-an RGB emitter. Not covered: a Principled Volume behind a Mix or Add shader or with a surface
+**Temperature grids** (a Volume object or fluid domain whose Temperature Attribute names a grid;
+:func:`grid_materials`) follow the **bolometric rule** (docs/spectral-model.md, "Temperature
+grids"): Cycles' own emission at ``D T`` (times ``D^(p - 4)``), finite where the gas fades to 0 K.
+For camera rays the group feeds the Principled Volume's Temperature (times ``D``) and Blackbody Tint
+(times the rule's gain), so Cycles reads the grid as at rest (docs/performance.md, "What is left":
+5.2's Attribute node reads it 2.9 % dimmer, and 5.x's majorant grid evaluates no second read). The
+boundary's AOV holds on Volume objects too (Cycles runs their surface AOV nodes). In a spectral
+pass camera rays get ``E_bol(D T) B(mu, T) / Y_B(D T)``, other rays ``E`` up-sampled as RGB.
+Not covered: a Principled Volume behind a Mix or Add shader or with a surface
 shader (also refused by the spectral mode when it emits a blackbody; on an object with grids a
 panel warning names it), and Apparent Geometry's boosted meshes.
 """

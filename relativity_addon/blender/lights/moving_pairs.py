@@ -33,7 +33,7 @@ from ...physics import lamp_doppler
 from ...physics.moving_lights import retarded_times, retarded_times_on_path
 from ..common import busy, names
 from ..geometry import motion as world_lines
-from . import moving_lights, stand_in_lamps
+from . import moving_lights, stand_in_lamps, stand_in_paths
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -82,7 +82,7 @@ def _path_times(scene, snap, light, values, reception_time, points):
         return times, origin + times[:, None] * beta, np.broadcast_to(beta, points.shape)
 
     def where(at):
-        return stand_in_lamps.path_positions(scene, snap, light, values, reception_time, np.asarray(at, float))
+        return stand_in_paths.path_positions(scene, snap, light, values, reception_time, np.asarray(at, float))
 
     here = where([0.0])[0]
     reach = float(np.max(np.linalg.norm(points - camera, axis=-1) + np.linalg.norm(points - here, axis=-1)))
@@ -257,7 +257,7 @@ def write(scene: Scene, snap: Snapshot, movers: Sequence[Any]) -> list[str]:
         for mover in movers:
             points, normals = surfaces[mover.name]
             times, shares = pair_times(scene, snap, light, points, normals, mover.beta)
-            positions = stand_in_lamps.path_positions(scene, snap, light, values, reception_time, times)
+            positions = stand_in_paths.path_positions(scene, snap, light, values, reception_time, times)
             radius = lamp_radius(points, positions)
             for index in range(len(times), COUNT):
                 copy = copies[(light.name, mover.name, str(index))]

@@ -395,6 +395,7 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     light later) reaches every lamp's evaluated object (what the viewport's render reads) and the
     render follows eq. 19 for the new reception time."""
     stand_in_lamps = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lamps")
+    stand_in_lights = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lights")
     bpy = factory_blender
     scene, camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
     _effect().apply(scene)
@@ -415,7 +416,7 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     depsgraph = bpy.context.evaluated_depsgraph_get()
     for obj in stand_ins:
         evaluated = obj.evaluated_get(depsgraph)
-        for name in stand_in_lamps.PER_LAMP:
+        for name in stand_in_lights.PER_LAMP:
             if stand_in_lamps.lamp_key(name) in obj:
                 assert np.allclose(evaluated[stand_in_lamps.lamp_key(name)], obj[stand_in_lamps.lamp_key(name)]), (
                     f"{obj.name}: {name} not seen by the depsgraph"
