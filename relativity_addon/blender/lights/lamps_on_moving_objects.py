@@ -526,8 +526,9 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     found += (
         lamp_trees.warnings(scene.objects[name] for name in record["lamps"] if name in scene.objects) if record else []
     )
-    unshifted = unshifted_light.sources(scene)
-    if unshifted and modifier.moving_objects(scene):
+    moving = modifier.moving_objects(scene)
+    unshifted = unshifted_light.sources(scene, moving) if moving else None
+    if unshifted:
         found.append(
             f"Light from {unshifted} reaches moving objects unshifted (eq. 18 not applied: 0.86x of it across "
             "the motion at 0.5c, far more off along it; docs/lamp-doppler.md)"

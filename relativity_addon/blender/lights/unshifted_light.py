@@ -19,19 +19,22 @@ from ..common import compat
 from ..scene import emitting_meshes
 
 if TYPE_CHECKING:
-    from bpy.types import Scene, World
+    from collections.abc import Sequence
+
+    from bpy.types import Object, Scene, World
 
 
-def sources(scene: Scene) -> str | None:
-    """What lights the scene besides its lamps, with no Doppler factor on moving receivers: "the
-    world", "emitting meshes" (at rest, or moving without Lights Scene), both, or None."""
+def sources(scene: Scene, moving: Sequence[Object]) -> str | None:
+    """What lights the ``moving`` objects besides the lamps, with no Doppler factor: "the world",
+    "emitting meshes" (at rest, or moving without Lights Scene; a moving object's own emission does
+    not count for itself), both, or None."""
     world = scene.world is not None and world_lights(scene.world)
     emitting = {material for material in bpy.data.materials if emitting_meshes.emits(material)}
+    receivers = {obj.name for obj in moving}
     meshes = bool(emitting) and any(
-        slot.material in emitting
+        any(slot.material in emitting for slot in obj.material_slots)
         for obj in scene.objects
-        if not obj.hide_render and not emitting_meshes.is_emitter_light(obj)
-        for slot in obj.material_slots
+        if receivers - {obj.name} and not obj.hide_render and not emitting_meshes.is_emitter_light(obj)
     )
     parts = [part for part, used in (("the world", world), ("emitting meshes", meshes)) if used]
     return " and ".join(parts) or None

@@ -197,21 +197,23 @@ def _unshifted_lines(scene):
     return [line for line in _effect().scene_warnings(scene) if "reaches moving objects unshifted" in line]
 
 
-@pytest.mark.parametrize("source", ["panel", "world", "neither"])
+@pytest.mark.parametrize("source", ["panel", "world", "neither", "itself"])
 def test_light_no_lamp_carries_is_said_in_the_panel(relativity_addon, factory_blender, source):
     """The approximation above is said in one panel line naming its source (the world, emitting
-    meshes), from Set Up on and after a change in the panel; none without such light or without a
-    moving object."""
+    meshes), from Set Up on and after a change in the panel; none without such light, without a
+    moving object, or where the only emitting mesh is the one moving object itself."""
     bpy = factory_blender
     scene, _ = _scene(bpy, "panel" if source == "panel" else "world")
     background = compat.world_node_tree(scene.world).nodes["Background"]
     if source != "world":
         background.inputs["Strength"].default_value = 0.0
+    if source == "itself":
+        bpy.data.objects["Plate"].data.materials[0] = ch.emission_material(bpy)
     scene.relativity.enabled = True
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
     lines = _unshifted_lines(scene)
     print(source, lines)
-    if source == "neither":
+    if source in ("neither", "itself"):
         assert lines == []
         return
     assert len(lines) == 1 and "\n" not in lines[0]
