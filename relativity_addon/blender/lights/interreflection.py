@@ -89,6 +89,18 @@ def _with_material(scene: Scene) -> bool:
     return any(slot.material is not None for obj in modifier.applied_objects(scene) for slot in obj.material_slots)
 
 
+GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD", "VOLUME"}
+
+
+def _lit_at_rest(scene: Scene) -> bool:
+    """Whether the scene renders anything at rest that a moving object could light."""
+    moving = {obj.name for obj in modifier.moving_objects(scene)}
+    return any(
+        obj.type in GEOMETRY_TYPES and obj.name not in moving and not obj.hide_render and not modifier.is_cache(obj)
+        for obj in scene.objects
+    )
+
+
 def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:
     """The reasons that need no object's position (checked first: a sync pays nothing for them)."""
     if snap.method != "GEOMETRY" or scene.render.engine != "CYCLES":
@@ -392,7 +404,7 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if snap.method != "GEOMETRY":
         return []
     reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
-    if reason == "fewer than two moving objects" and _moving_count(scene) == 1:
+    if reason == "fewer than two moving objects" and _moving_count(scene) == 1 and _lit_at_rest(scene):
         return [
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"

@@ -204,6 +204,20 @@ def test_one_moving_object_lighting_objects_at_rest_is_said(relativity_addon, fa
     effect.remove(scene)
 
 
+def test_one_moving_object_alone_is_not_said_to_light_objects_at_rest(relativity_addon, factory_blender):
+    """With nothing at rest to light (the one moving object, a camera and lamps), no such line."""
+    bpy = factory_blender
+    effect = case._module("pipeline.effect")
+    scene, _ = case._scene(bpy, np.array([case.EACH, 0.0, 0.0]), np.zeros(3))
+    moving = [obj for obj in scene.objects if obj.type == "MESH" and any(obj.relativity.beta)]
+    for obj in [obj for obj in scene.objects if obj.type == "MESH" and obj not in moving]:
+        bpy.data.objects.remove(obj)
+    effect.apply(scene)
+    warnings = effect.scene_warnings(scene)
+    assert len(moving) == 1 and not [line for line in warnings if "objects at rest" in line], warnings
+    effect.remove(scene)
+
+
 def test_no_group_for_moving_objects_without_materials(relativity_addon, factory_blender):
     """The factor goes on materials: moving objects without any build no scene group (on main the
     group was built with one receiver per moving object anyway, its values written at every sync:
