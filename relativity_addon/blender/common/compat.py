@@ -100,6 +100,16 @@ def rendered_node_tree(owner: Light | Material | World) -> ShaderNodeTree | None
         return owner.node_tree if getattr(owner, "use_nodes", True) else None
 
 
+def empty_light_tree(light: Light) -> ShaderNodeTree:
+    """``light``'s node tree, in use and emptied (5.x: ``use_nodes`` is deprecated and always on)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        light.use_nodes = True
+    tree = light.node_tree
+    tree.nodes.clear()
+    return tree
+
+
 def light_node_tree(light: Light) -> ShaderNodeTree | None:
     """The node tree a light renders with, or None. 5.x: lights always have one and always use
     it (``use_nodes`` is deprecated and stays on); 4.5: only while ``use_nodes`` is on."""

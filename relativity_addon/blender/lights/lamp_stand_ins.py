@@ -28,10 +28,9 @@ per receiving point (Cycles' SVM nodes, no OSL):
 from __future__ import annotations
 
 import math
-import warnings
 from typing import TYPE_CHECKING
 
-from ..common import names, nodes
+from ..common import compat, names, nodes
 
 if TYPE_CHECKING:
     from bpy.types import Light, NodeTree
@@ -139,11 +138,7 @@ def group() -> NodeTree:
 
 def make_tree(light: Light) -> None:
     """Replace ``light``'s node tree by the group -> Emission -> Light Output."""
-    with warnings.catch_warnings():  # 5.x: use_nodes is deprecated (always on)
-        warnings.simplefilter("ignore", DeprecationWarning)
-        light.use_nodes = True
-    tree = light.node_tree
-    tree.nodes.clear()
+    tree = compat.empty_light_tree(light)
     node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = group()
     node.name = node.label = NODE

@@ -11,13 +11,12 @@ and length) is each lamp object's custom properties, read by Attribute nodes of 
 from __future__ import annotations
 
 import math
-import warnings
 from typing import TYPE_CHECKING, Any, Literal
 
 import bpy
 
 from ...errors import RelativityError
-from ..common import names, osl
+from ..common import compat, names, osl
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
@@ -57,11 +56,7 @@ def new_light(name: str, text: Text, kind: LightKind = "POINT", per_lamp: Sequen
         light.size, light.size_y = 1.0, STRIP_WIDTH
     else:
         light.shadow_soft_size = 0.0
-    with warnings.catch_warnings():  # 5.x: use_nodes is deprecated (always on)
-        warnings.simplefilter("ignore", DeprecationWarning)
-        light.use_nodes = True
-    tree = light.node_tree
-    tree.nodes.clear()
+    tree = compat.empty_light_tree(light)
     node = tree.nodes.new("ShaderNodeScript")
     node.name = node.label = names.MOVING_LAMP_PREFIX
     node.mode = "INTERNAL"
