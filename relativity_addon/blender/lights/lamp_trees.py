@@ -46,11 +46,6 @@ def problem(light: Light) -> str | None:
     return None
 
 
-def _emission(light):
-    tree = compat.light_node_tree(light)
-    return sources.light_emission_node(tree) if tree is not None else None
-
-
 def tree_factor(light: Light) -> FloatArray:
     """``sources.light_tree_factor``: the tree's Strength times its unlinked Color or a Blackbody's
     constant (linear RGB); ones without a tree, the Strength alone where the tree is not carried
@@ -78,7 +73,7 @@ def doppler_rgb(light: Light) -> tuple[float, float, float]:
     """The colour eq. 18's factor is taken for: the lamp's Color times its tree's unlinked Emission
     Color (the factor is per channel, so a red tree under a white lamp is shifted as red)."""
     colour = np.array(light.color, dtype=np.float64)
-    node = _emission(light)
+    node = sources.light_tree_emission(light)
     if node is not None and not node.inputs["Color"].is_linked:
         colour = colour * np.array(node.inputs["Color"].default_value[:3], dtype=np.float64)
     return (float(colour[0]), float(colour[1]), float(colour[2]))

@@ -281,6 +281,13 @@ def light_emission_node(tree: NodeTree | None) -> Node | None:
     return found[0].node
 
 
+def light_tree_emission(light: Light) -> Node | None:
+    """The Emission node of the tree ``light`` renders with (:func:`light_emission_node`), or None
+    (no tree in use, or none shown)."""
+    tree = compat.light_node_tree(light)
+    return light_emission_node(tree) if tree is not None else None
+
+
 def _light_emission_colour(tree):
     """The Color input of the Emission node that a light's active Light Output shows, or None."""
     node = light_emission_node(tree)
@@ -316,8 +323,7 @@ def light_blackbody(light: Light) -> float | None:
 def light_tree_blackbody(light: Light) -> Blackbody | None:
     """The Blackbody on the Emission Color of the light's tree that is its blackbody
     (:func:`light_blackbody`, its own temperature off), or None."""
-    tree = compat.light_node_tree(light)
-    node = light_emission_node(tree) if tree is not None else None
+    node = light_tree_emission(light)
     if node is None or not node.inputs["Color"].is_linked or light.use_temperature or light_blackbody(light) is None:
         return None
     return blackbody_source(node.inputs["Color"])
@@ -327,8 +333,7 @@ def light_tree_factor(light: Light) -> tuple[float, float, float]:
     """What the light's node tree multiplies its Color by (linear RGB), a Blackbody in it left out
     (that is :func:`light_blackbody`'s): its Emission's Strength times its unlinked Color, or times
     the Blackbody's constant; ones without a tree, the Strength alone for any other Color."""
-    tree = compat.light_node_tree(light)
-    node = light_emission_node(tree) if tree is not None else None
+    node = light_tree_emission(light)
     if node is None:
         return (1.0, 1.0, 1.0)
     strength = node.inputs["Strength"]
