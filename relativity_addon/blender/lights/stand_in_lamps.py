@@ -78,6 +78,22 @@ def _record(scene):
     return {} if stored is None else {key: list(value) for key, value in stored.to_dict().items()}
 
 
+def _shader_lamps(lamp_names):
+    """The stand-in objects named when all are there and are shader lamps (point or area), else []."""
+    objects = [bpy.data.objects.get(name) for name in lamp_names]
+    if any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
+        return []
+    return objects
+
+
+def _new_lamps(scene, light_name, light, start, stop):
+    """Names of new stand-in objects ``start`` .. ``stop - 1`` of the light, sharing ``light``."""
+    return [
+        stand_in_lights.new_object(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", light).name
+        for index in range(start, stop)
+    ]
+
+
 def _lamps_for(scene, light_name, count, text, kind="POINT", keep=False):
     """The light's first ``count`` lamps, sharing one light datablock; while a bake steps frames
     (``busy.keeps_stand_ins``) or ``keep`` (a render runs: :func:`reserve`) the others are kept,
@@ -98,10 +114,7 @@ def _lamps_for(scene, light_name, count, text, kind="POINT", keep=False):
             light = stand_in_lights.new_light(
                 f"{names.MOVING_LAMP_PREFIX} {light_name}", text, kind, stand_in_lights.PER_LAMP
             )
-        existing += [
-            stand_in_lights.new_object(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", light).name
-            for index in range(len(existing), count)
-        ]
+        existing += _new_lamps(scene, light_name, light, len(existing), count)
         record[light_name] = existing
         scene[names.MOVING_LAMPS_KEY] = record
     lamps = [bpy.data.objects[name] for name in existing]
@@ -131,26 +144,22 @@ def reserve(scene: Scene) -> None:
         return
     record = _record(scene)
     for light_name, existing in record.items():
-        objects = [bpy.data.objects.get(name) for name in existing]
-        if not objects or any(obj is None for obj in objects) or objects[0].data.type == "SUN":
-            continue
-        lights = {obj.data for obj in objects}
-        if len(lights) != 1 or not stand_in_lights.is_shared(objects[0].data):
+        objects = _shader_lamps(existing)
+        if not objects or len({obj.data for obj in objects}) != 1 or not stand_in_lights.is_shared(objects[0].data):
             continue
         lamps, sides = _capacity(objects[0])
-        for index in range(len(existing), lamps * sides):
-            obj = stand_in_lights.new_object(scene, f"{names.MOVING_LAMP_PREFIX} {light_name} {index}", objects[0].data)
-            obj.hide_render = True
-            existing.append(obj.name)
-        record[light_name] = existing
+        added = _new_lamps(scene, light_name, objects[0].data, len(existing), lamps * sides)
+        for name in added:
+            bpy.data.objects[name].hide_render = True
+        record[light_name] = existing + added
     if record:
         scene[names.MOVING_LAMPS_KEY] = record
 
 
 def _held(scene, light_name):
     """How many lamps (times) the light's stand-ins, hidden ones included, hold (0: none)."""
-    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
-    if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
+    objects = _shader_lamps(_record(scene).get(light_name, []))
+    if not objects:
         return 0
     lamps, sides = _capacity(objects[0])
     return len(objects) // sides + (lamps == MAX_LAMPS - 1)  # Continuous: pieces, one time more
@@ -168,8 +177,8 @@ def hide(scene: Scene) -> None:
 
 def _stored_times(scene, light_name):
     """The stand-ins' times of the last placement (their own inputs), or None."""
-    objects = [bpy.data.objects.get(name) for name in _record(scene).get(light_name, [])]
-    if not objects or any(obj is None or obj.data.type not in {"POINT", "AREA"} for obj in objects):
+    objects = _shader_lamps(_record(scene).get(light_name, []))
+    if not objects:
         return None
     objects = [obj for obj in objects if not obj.hide_render]  # a bake's unused lamps are hidden
     if not objects or any(lamp_key("lamp_time") not in obj for obj in objects):
