@@ -42,7 +42,7 @@ from . import bounce_nodes, lamps_on_moving_objects
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
-    from bpy.types import Material, Mesh, NodeTree, Scene, Text
+    from bpy.types import Material, Mesh, NodeTree, Object, Scene, Text
 
     from ..scene.snapshot import Snapshot
     from .lamps_on_moving_objects import Mover
@@ -92,11 +92,14 @@ def _with_material(scene: Scene) -> bool:
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD", "VOLUME"}
 
 
-def _lit_at_rest(scene: Scene) -> bool:
-    """Whether the scene renders anything at rest that a moving object could light."""
-    moving = {obj.name for obj in modifier.moving_objects(scene)}
+def _lit_at_rest(scene: Scene, moving: Sequence[Object]) -> bool:
+    """Whether the scene renders anything at rest (not in ``moving``) that a moving object could light."""
+    moving_names = {obj.name for obj in moving}
     return any(
-        obj.type in GEOMETRY_TYPES and obj.name not in moving and not obj.hide_render and not modifier.is_cache(obj)
+        obj.type in GEOMETRY_TYPES
+        and obj.name not in moving_names
+        and not obj.hide_render
+        and not modifier.is_cache(obj)
         for obj in scene.objects
     )
 
@@ -404,7 +407,8 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if snap.method != "GEOMETRY":
         return []
     reason = _cheap_reason(scene, snap)  # (no positions: the panel is drawn often)
-    if reason == "fewer than two moving objects" and _moving_count(scene) == 1 and _lit_at_rest(scene):
+    moving = modifier.moving_objects(scene) if reason == "fewer than two moving objects" else []
+    if len(moving) == 1 and _lit_at_rest(scene, moving):
         return [
             f"Light the moving object sends onto objects at rest is not corrected, up to {AT_REST_ERROR} off "
             "at 0.5c (docs/lamp-doppler.md): the correction is built for two or more moving objects"
