@@ -28,8 +28,7 @@ from bpy.app.handlers import persistent
 from ..camera import exact_camera
 from ..common import busy
 from ..geometry import apparent_meshes, keyframed
-from ..lights import stand_in_lamps
-from . import effect, render_notice
+from . import effect, render_notice, stages
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Scene
@@ -110,7 +109,7 @@ def render_init(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
         print(f"Relativity: the final render stays the boosted-mesh preview: {error}")
     try:
-        stand_in_lamps.reserve(scene)  # none are made between Render Animation's frames
+        stages.render_init(scene)
     except Exception as error:  # noqa: BLE001 - a handler must never stop Blender or the render
         print(f"Relativity: {type(error).__name__}: {error}")
 

@@ -12,7 +12,10 @@ Remove (or a failed Set Up) removes them in reverse. Every stage answers the sam
 ``remove(scene)``
     gives back everything the stage added or changed; safe when nothing was applied;
 ``warnings(scene, snap)``
-    one-line problems for the panel (computed at sync, shown by the panel).
+    one-line problems for the panel (computed at sync, shown by the panel);
+``render_init(scene)`` (optional)
+    once when a render job starts (F12 or Render Animation), before its first frame's sync: what
+    the job's frames need that must not be made between them (:func:`render_init`).
 
 ``docs/architecture.md`` lists the same stages in the same order (a test checks it).
 """
@@ -25,7 +28,14 @@ from typing import TYPE_CHECKING, Any
 
 from ..camera import clamping, cockpit
 from ..colour import cockpit_sky, doppler_colour, light_groups, volumes, world_doppler
-from ..lights import cockpit_lamps, interreflection, lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..lights import (
+    cockpit_lamps,
+    interreflection,
+    lamps_on_moving_objects,
+    lamps_seen_directly,
+    moving_lights,
+    stand_in_lamps,
+)
 from . import metadata
 
 if TYPE_CHECKING:
@@ -47,6 +57,10 @@ def _none(scene: Scene, snap: Snapshot) -> list[str]:
     return []
 
 
+def _no_render_init(scene: Scene) -> None:
+    """Most stages need nothing before a render job beyond the syncs of its frames."""
+
+
 @dataclass(frozen=True)
 class Stage:
     """One stage: its name in the docs, the module that holds it, and its four verbs."""
@@ -57,6 +71,7 @@ class Stage:
     write: Callable[[Scene, Snapshot, Sync], object]
     remove: Callable[[Scene], object]
     warnings: Callable[[Scene, Snapshot], list[str]] = _none
+    render_init: Callable[[Scene], object] = _no_render_init
 
 
 def _colour_warnings(scene: Scene, snap: Snapshot) -> list[str]:
@@ -82,6 +97,7 @@ STAGES: tuple[Stage, ...] = (
         write=lambda scene, snap, sync: moving_lights.write(scene, snap, sync.attach_new_materials, sync.depsgraph),
         remove=moving_lights.remove,
         warnings=moving_lights.warnings,
+        render_init=stand_in_lamps.reserve,  # no stand-ins are made between Render Animation's frames
     ),
     Stage(
         "Doppler colour",
@@ -159,3 +175,9 @@ STAGES: tuple[Stage, ...] = (
         remove=cockpit_lamps.remove,
     ),
 )
+
+
+def render_init(scene: Scene) -> None:
+    """Every stage's ``render_init``, in order (the ``render_init`` handler, once per render job)."""
+    for stage in STAGES:
+        stage.render_init(scene)

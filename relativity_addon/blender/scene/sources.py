@@ -269,7 +269,7 @@ def _grey(colour):
     return r == g == b
 
 
-def light_emission_node(tree: NodeTree | None) -> Node | None:
+def light_emission_node(tree: NodeTree) -> Node | None:
     """The Emission node that a light's active Light Output shows, or None."""
     outputs = [node for node in tree.nodes if node.bl_idname == "ShaderNodeOutputLight"]
     output = next((node for node in outputs if node.is_active_output), outputs[0] if outputs else None)
