@@ -28,7 +28,7 @@ from ..camera import cockpit
 from ..common import names
 from ..scene import cockpit as cockpit_reader
 from . import lamps_on_moving_objects as eq18
-from . import stand_in_lamps
+from . import stand_in_lights
 
 if TYPE_CHECKING:
     from bpy.types import Object, Scene
@@ -78,7 +78,7 @@ def write(scene: Scene, snap: Snapshot, structural: bool = True) -> None:
         for name in list(record):
             copy = bpy.data.objects.get(record[name])
             if name not in wanted or copy is None or copy.type != "LIGHT" or copy.data.type != wanted[name].data.type:
-                stand_in_lamps.delete_lamp(record.pop(name))
+                stand_in_lights.delete_lamp(record.pop(name))
         for name, lamp in wanted.items():
             if name not in record:
                 copy = bpy.data.objects.new(f"{PREFIX} {name}", lamp.data.copy())
@@ -110,5 +110,5 @@ def remove(scene: Scene) -> None:
     if KEY not in scene:
         return
     for copy_name in scene[KEY].to_dict().values():
-        stand_in_lamps.delete_lamp(copy_name)
+        stand_in_lights.delete_lamp(copy_name)
     del scene[KEY]

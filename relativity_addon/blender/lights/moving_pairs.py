@@ -33,7 +33,7 @@ from ...physics import lamp_doppler
 from ...physics.moving_lights import retarded_times, retarded_times_on_path
 from ..common import busy, names
 from ..geometry import motion as world_lines
-from . import moving_lights, stand_in_lamps, stand_in_paths
+from . import moving_lights, stand_in_lamps, stand_in_lights, stand_in_paths
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -282,7 +282,7 @@ def write(scene: Scene, snap: Snapshot, movers: Sequence[Any]) -> list[str]:
                     copy.data.energy = energy
                 if not math.isclose(copy.data.shadow_soft_size, radius, rel_tol=1e-4):
                     copy.data.shadow_soft_size = radius
-                stand_in_lamps.write_inputs(copy, {k: _value(v) for k, v in inputs.items()})
+                stand_in_lights.write_inputs(copy, {k: _value(v) for k, v in inputs.items()})
                 location = tuple(float(v) for v in positions[index])
                 if not np.allclose(tuple(copy.location), location, rtol=1e-7, atol=1e-9):
                     copy.location = location
@@ -311,7 +311,7 @@ def remove(scene: Scene) -> int:
     copies = [bpy.data.objects.get(name) for name in record["copies"]]
     for obj in copies:
         if obj is not None:
-            stand_in_lamps.delete_lamp(obj.name)
+            stand_in_lights.delete_lamp(obj.name)
     for name in record["lights"]:
         light = bpy.data.lights.get(name)
         if light is not None and light.users == 0:

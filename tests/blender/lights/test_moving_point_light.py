@@ -396,6 +396,7 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     render follows eq. 19 for the new reception time."""
     stand_in_lamps = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lamps")
     stand_in_lights = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lights")
+    stand_in_lights = importlib.import_module(f"{ADDON_MODULE}.blender.lights.stand_in_lights")
     bpy = factory_blender
     scene, camera, _lamp = _floor_scene(bpy, samples=SAMPLES_LAMPS)
     _effect().apply(scene)
@@ -405,7 +406,7 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     assert len({obj.data.node_tree.name_full for obj in stand_ins}) == 1
     scripts = [node for light in bpy.data.lights if light.node_tree for node in light.node_tree.nodes]
     assert sum(node.bl_idname == "ShaderNodeScript" for node in scripts) == 1
-    key = stand_in_lamps.lamp_key("lamp_time")
+    key = stand_in_lights.lamp_key("lamp_time")
     before = [float(obj[key]) for obj in stand_ins]
     assert len(set(before)) == len(before) // stand_in_lamps.LINE_SIDES  # one time per line, its strips alike
 
@@ -417,8 +418,8 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     for obj in stand_ins:
         evaluated = obj.evaluated_get(depsgraph)
         for name in stand_in_lights.PER_LAMP:
-            if stand_in_lamps.lamp_key(name) in obj:
-                assert np.allclose(evaluated[stand_in_lamps.lamp_key(name)], obj[stand_in_lamps.lamp_key(name)]), (
+            if stand_in_lights.lamp_key(name) in obj:
+                assert np.allclose(evaluated[stand_in_lights.lamp_key(name)], obj[stand_in_lights.lamp_key(name)]), (
                     f"{obj.name}: {name} not seen by the depsgraph"
                 )
     # an own input written alone (the lamp not moved: no transform update tags it) reaches it too;
@@ -427,10 +428,10 @@ def test_stand_ins_share_one_light_and_follow_a_change(relativity_addon, factory
     bpy.app.handlers.depsgraph_update_post.clear()
     try:
         placed = float(stand_ins[0][key])
-        stand_in_lamps.write_inputs(stand_ins[0], {"lamp_time": placed + 0.5})
+        stand_in_lights.write_inputs(stand_ins[0], {"lamp_time": placed + 0.5})
         evaluated = stand_ins[0].evaluated_get(bpy.context.evaluated_depsgraph_get())
         assert evaluated[key] == pytest.approx(placed + 0.5)
-        stand_in_lamps.write_inputs(stand_ins[0], {"lamp_time": placed})
+        stand_in_lights.write_inputs(stand_ins[0], {"lamp_time": placed})
     finally:
         bpy.app.handlers.depsgraph_update_post.extend(handlers)
 
