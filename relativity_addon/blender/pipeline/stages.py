@@ -25,7 +25,14 @@ from typing import TYPE_CHECKING, Any
 
 from ..camera import clamping, cockpit
 from ..colour import cockpit_sky, doppler_colour, light_groups, volumes, world_doppler
-from ..lights import cockpit_lamps, interreflection, lamps_on_moving_objects, lamps_seen_directly, moving_lights
+from ..lights import (
+    cockpit_lamps,
+    interreflection,
+    lamps_on_moving_objects,
+    lamps_seen_directly,
+    moving_lights,
+    turning_receivers,
+)
 from . import metadata
 
 if TYPE_CHECKING:
@@ -63,6 +70,10 @@ def _colour_warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if not snap.exact_camera:
         return []
     return volumes.warnings(scene) + light_groups.warnings(scene, snap)
+
+
+def _lamp_warnings(scene: Scene, snap: Snapshot) -> list[str]:
+    return lamps_on_moving_objects.warnings(scene, snap) + turning_receivers.warnings(scene, snap)
 
 
 def _world_pixels(scene: Scene, snap: Snapshot, pixels: bool = True) -> None:
@@ -118,7 +129,7 @@ STAGES: tuple[Stage, ...] = (
         apply=lamps_on_moving_objects.apply,
         write=lambda scene, snap, sync: lamps_on_moving_objects.write(scene, snap),
         remove=lamps_on_moving_objects.remove,
-        warnings=lamps_on_moving_objects.warnings,
+        warnings=_lamp_warnings,
     ),
     Stage(
         "light bounced between moving objects",
