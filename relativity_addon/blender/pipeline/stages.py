@@ -35,6 +35,7 @@ from ..lights import (
     lamps_seen_directly,
     moving_lights,
     stand_in_lamps,
+    turning_receivers,
 )
 from . import metadata
 
@@ -78,6 +79,10 @@ def _colour_warnings(scene: Scene, snap: Snapshot) -> list[str]:
     if not snap.exact_camera:
         return []
     return volumes.warnings(scene) + light_groups.warnings(scene, snap)
+
+
+def _lamp_warnings(scene: Scene, snap: Snapshot) -> list[str]:
+    return lamps_on_moving_objects.warnings(scene, snap) + turning_receivers.warnings(scene, snap)
 
 
 def _world_pixels(scene: Scene, snap: Snapshot, pixels: bool = True) -> None:
@@ -134,7 +139,7 @@ STAGES: tuple[Stage, ...] = (
         apply=lamps_on_moving_objects.apply,
         write=lambda scene, snap, sync: lamps_on_moving_objects.write(scene, snap),
         remove=lamps_on_moving_objects.remove,
-        warnings=lamps_on_moving_objects.warnings,
+        warnings=_lamp_warnings,
     ),
     Stage(
         "light bounced between moving objects",
