@@ -276,7 +276,7 @@ def keyframed_nodes() -> dict[str, Node]:
         }
     )
     local, beta = _seen(nodes, "kf", x, sigma, f"{tag}_w.Vector")
-    polynomial, kp_x, kp_sigma, kp_w = polynomial_nodes(_step)
+    polynomial, kp_x, kp_sigma, kp_w = polynomial_nodes()
     nodes.update(polynomial)
     kp_local, kp_beta = _seen(nodes, "kp", kp_x, kp_sigma, kp_w)
     items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"), ("FLOAT", "Inside"))}
