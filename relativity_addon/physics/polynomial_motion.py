@@ -20,6 +20,7 @@ cone's curvature).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -78,13 +79,11 @@ def fit_window(
     fractions = np.arange(SAMPLES_PER_INTERVAL) / SAMPLES_PER_INTERVAL
     powers = fractions[:, None] ** np.arange(4)  # (S, 4)
     maps = np.einsum("si,kiab->ksab", powers, pieces).reshape(-1, 12)
-    s = (np.arange(count)[:, None] + fractions).ravel()
     end = np.einsum("i,iab->ab", np.ones(4), pieces[-1]).reshape(1, 12)  # f = 1 of the last interval
-    maps, s = np.concatenate([maps, end]), np.append(s, float(count))
+    maps = np.concatenate([maps, end])  # at _least_squares' samples
     half_grid = 0.5 * count
-    u = (s - half_grid) / half_grid
-    vandermonde = u[:, None] ** np.arange(DEGREE + 1)
-    solution, *_ = np.linalg.lstsq(vandermonde, maps, rcond=None)
+    vandermonde, inverse = _least_squares(count)
+    solution = inverse @ maps
     departure = (maps - vandermonde @ solution).reshape(-1, 3, 4)
     residual = float(
         np.max(np.linalg.norm(departure[:, :, 3], axis=1) + reach * np.linalg.norm(departure[:, :, :3], axis=(1, 2)))
@@ -95,6 +94,16 @@ def fit_window(
     return WindowPolynomial(
         centre, half_grid / grid_per_distance, solution.reshape(DEGREE + 1, 3, 4), residual, tolerance
     )
+
+
+@functools.lru_cache(maxsize=16)
+def _least_squares(count: int) -> tuple[FloatArray, FloatArray]:
+    """The fit's Vandermonde matrix over ``count`` intervals' samples and its pseudo-inverse (the
+    least-squares solve), kept per count: a frame step or an observer change fits the same count."""
+    s = np.append((np.arange(count)[:, None] + np.arange(SAMPLES_PER_INTERVAL) / SAMPLES_PER_INTERVAL).ravel(), count)
+    u = (s - 0.5 * count) / (0.5 * count)
+    vandermonde = u[:, None] ** np.arange(DEGREE + 1)
+    return vandermonde, np.linalg.pinv(vandermonde)
 
 
 def solve(polynomial: WindowPolynomial, points: FloatArray, steps: int = 24) -> tuple[FloatArray, FloatArray]:
