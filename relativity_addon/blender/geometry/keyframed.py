@@ -241,6 +241,7 @@ def modifier_inputs(
         "Observer Velocity": vector(-beta_o),
         "Observer Inverse Gamma": 1.0 / gamma,
         "Observer Factor": gamma / (gamma + 1.0),
+        "Observer Moving": bool(np.any(beta_o != 0.0)),
     }
     if polynomial is None or form is None:
         return inputs, pieces.coefficients
