@@ -186,25 +186,14 @@ def modifier_inputs(
     signature = animation.keyframes_signature(obj)
     facts = _keyed_facts(obj, signature)
     corners = _box_corners(obj, facts)
-    try:
-        function = _matrix_function(obj, scene, fps, step, c, signature)
-        guess = _last_tau.get(obj.session_uid)
-        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
-    except ValueError as error:
-        raise RelativityError(f"Object {obj.name!r}: {error}") from None
-    if pieces is not None:
-        _last_tau[obj.session_uid] = pieces.start_distance / c
-    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
-    if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
+    window = _window(obj, scene, signature, facts, corners, (fps, step, t_o, x_o, c, reach))
+    if window is None:
         return None  # the Python path then (and its warning when a point is seen before the keys move it)
+    pieces, line, found = window
     beta_o = np.asarray(beta_o, dtype=np.float64)
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     inverse = motion.affine_inverse(matrix)[:3, :3]
-    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
-    line = animation.straight_keys(
-        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
-    )
     if line is not None:
         start, per_frame = line
         # straight keys hold the rotation and scale (one value each): the shape at any frame
@@ -213,10 +202,7 @@ def modifier_inputs(
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
-    polynomial, form, steps = None, None, None
-    if corners is not None:
-        found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
-        polynomial, form, steps = found if found is not None else (None, None, None)
+    polynomial, form, steps = found if found is not None else (None, None, None)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -262,6 +248,52 @@ def modifier_inputs(
     )
     _polynomials[obj.session_uid] = polynomial
     return inputs, None  # no interval read: the cache holds the face codes alone
+
+
+# Object session_uid -> (key, (intervals, straight line, polynomial found)) of the last update: the
+# window depends on the observer's event, not on its velocity, so an observer's velocity change (the
+# same event, keys, step, reach and rest box) samples, contracts and fits nothing again.
+_windows: dict[int, tuple[object, tuple[object, object, object]]] = {}
+
+
+def _window(obj, scene, signature, facts, corners, event):
+    """The intervals of the observer ``event`` (``(fps, step, t_o, x_o, c, reach)``), the keys' straight
+    line over them (``animation.straight_keys``) and else the polynomial found (``_window_polynomial``:
+    None where there is none or no rest box); None for the Python path (too many intervals, or
+    intervals before the keys start moving the object). Raises RelativityError."""
+    fps, step, t_o, x_o, c, reach = event
+    key = None
+    if signature is not None:  # keys with F-curve modifiers: nothing kept
+        box = None if corners is None else tuple(float(v) for v in np.ravel(corners))
+        proper = bool(obj.relativity.use_proper_time)
+        event_key = (fps, step, float(t_o), tuple(float(v) for v in x_o), float(c), float(reach))
+        key = (signature, proper, *event_key, box, MAX_INTERVALS)
+        kept = _windows.get(obj.session_uid)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+    try:
+        function = _matrix_function(obj, scene, fps, step, c, signature)
+        guess = _last_tau.get(obj.session_uid)
+        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
+    except ValueError as error:
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    if pieces is not None:
+        _last_tau[obj.session_uid] = pieces.start_distance / c
+    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
+    if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
+        return None
+    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
+    line = animation.straight_keys(
+        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
+    )
+    found = None
+    if line is None and corners is not None:
+        grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
+        x_o = np.asarray(x_o, dtype=np.float64)
+        found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
+    if key is not None:
+        _windows[obj.session_uid] = (key, (pieces, line, found))
+    return pieces, line, found
 
 
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).

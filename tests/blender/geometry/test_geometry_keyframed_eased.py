@@ -42,6 +42,20 @@ def _eased_mover(bpy, scene, adaptive, slower=1):
     return obj
 
 
+def _count_windows(monkeypatch):
+    """A one-item list counting the windows of retarded times sampled (``sampling.motion_intervals``)."""
+    sampling = gh.addon_module("geometry.keyframed").sampling
+    count = [0]
+    original = sampling.motion_intervals
+
+    def counted(*args, **kwargs):
+        count[0] += 1
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(sampling, "motion_intervals", counted)
+    return count
+
+
 def _intervals_written(obj):
     """How many sample intervals the cache holds for the modifier to read per point (its points
     before the face codes)."""
@@ -66,16 +80,23 @@ def test_eased_keys_take_the_polynomial(relativity_addon, monkeypatch, adaptive)
     # one closed-form step reaches the roots at the rest box's check points (polynomial_motion.choose_steps)
     assert _inputs(obj, ONE_STEP) == {**dict.fromkeys(ONE_STEP, True), "Closed Form": False}
     calls = _count_passes(monkeypatch)
+    windows = _count_windows(monkeypatch)
 
     scene.relativity.beta = OBSERVER_CHANGED  # as the panel does: the update callback runs
-    gh.evaluated_points(bpy, obj)
+    changed, beta_changed = gh.evaluated_points(bpy, obj, "relativity_beta")
+    # the window depends on the observer's event, not on its velocity: kept (main: sampled again)
+    assert windows == [0]
+    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+    x_o = np.array(camera.matrix_world.translation)
+    expected, velocity = _seen(obj, rest, 12 / FPS, x_o, OBSERVER_CHANGED)
+    np.testing.assert_allclose(changed, expected, atol=1e-4)
+    np.testing.assert_allclose(beta_changed, velocity, atol=1e-4)
     scene.frame_set(13)
+    assert windows == [1]  # a new event: a new window
     stepped, beta_stepped = gh.evaluated_points(bpy, obj, "relativity_beta")
     assert calls == dict.fromkeys(calls, 0), calls
     assert _inputs(obj, MODES) == {"Keyframed": True, "Polynomial": True, "Closed Form": False}
-    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
     assert len(rest) == len(obj.data.vertices)  # the grid left whole: the edges' bound cleared it
-    x_o = np.array(camera.matrix_world.translation)
     expected, velocity = _seen(obj, rest, 13 / FPS, x_o, OBSERVER_CHANGED)
     np.testing.assert_allclose(stepped, expected, atol=1e-4)
     np.testing.assert_allclose(beta_stepped, velocity, atol=1e-4)
