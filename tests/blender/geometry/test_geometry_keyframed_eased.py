@@ -198,3 +198,29 @@ def test_observer_at_rest_skips_the_boost(relativity_addon):
         np.testing.assert_allclose(seen, expected, atol=1e-4)
         np.testing.assert_allclose(beta_seen, velocity, atol=1e-4)
         assert np.ptp(np.linalg.norm(beta_seen, axis=1)) > 1e-4  # each vertex its own velocity
+
+
+def test_unfolded_closed_forms(relativity_addon, monkeypatch):
+    """With ``Folded`` off (a window too fast for the towards form on every point: here forced by a
+    fold limit of 1), each of the polynomial's closed forms picks its form per point, and the mesh
+    and its velocities are still where docs/physics.md puts them."""
+    import bpy
+
+    monkeypatch.setattr(gh.addon_module("geometry.motion"), "FOLD_LIMIT", 1.0)
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = OBSERVER
+    obj = _eased_mover(bpy, scene, False)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    scene.frame_set(13)
+    assert _inputs(obj, (*MODES, "Folded")) == {
+        "Keyframed": True,
+        "Polynomial": True,
+        "Closed Form": False,
+        "Folded": False,
+    }
+    seen, beta_seen = gh.evaluated_points(bpy, obj, "relativity_beta")
+    rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+    expected, velocity = _seen(obj, rest, 13 / FPS, np.array(camera.matrix_world.translation), OBSERVER)
+    np.testing.assert_allclose(seen, expected, atol=1e-4)
+    np.testing.assert_allclose(beta_seen, velocity, atol=1e-4)
