@@ -109,7 +109,8 @@ def _least_squares(count: int) -> tuple[FloatArray, FloatArray]:
 def solve(polynomial: WindowPolynomial, points: FloatArray, steps: int = 24) -> tuple[FloatArray, FloatArray]:
     """The root in float64 for object-space ``points`` ``(N, 3)`` (the reference the modifier's solve is
     checked against): the light-travel distances ``sigma`` ``(N,)`` after the closed-form start at the
-    window's centre velocity and ``steps`` Newton steps on ``|x|^2 - sigma^2``, and ``u`` there."""
+    window's centre velocity and up to ``steps`` Newton steps on ``|x|^2 - sigma^2`` (fewer where the
+    last moved no ``sigma`` by more than 1e-13 of the largest), and ``u`` there."""
     affine = np.column_stack((np.asarray(points, dtype=np.float64), np.ones(len(points))))
     terms = np.einsum("iab,nb->ina", polynomial.coefficients, affine)  # P_i per point
     rate = 1.0 / polynomial.half
@@ -121,6 +122,8 @@ def solve(polynomial: WindowPolynomial, points: FloatArray, steps: int = 24) -> 
         value, slope = _horner(terms, u)
         m = (sigma * sigma - np.einsum("ij,ij->i", value, value)) / (np.einsum("ij,ij->i", value, slope) * rate + sigma)
         sigma = sigma - 0.5 * m
+        if not np.max(np.abs(m), initial=0.0) > 2e-13 * np.max(np.abs(sigma), initial=1.0):
+            break  # converged (or NaN, which more steps would keep)
     return sigma, (polynomial.centre - sigma) * rate
 
 
