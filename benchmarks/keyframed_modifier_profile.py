@@ -11,8 +11,9 @@ points to the Python path, more cost more), ``single`` (every step reads the fir
 interval: the cost without per-point Sample Index, not the right positions), ``off`` (Keyframed
 off), ``capture`` (the captures of the rest positions, nothing solved).
 With ``--motion eased`` (Blender's default Bezier keys: the polynomial solve,
-``geometry/polynomial_nodes.py``), the variants are ``built``, ``off``, ``onestep`` (``Polynomial One
-Step`` forced on, whether or not the window allows it: what the second Newton step costs) and
+``geometry/polynomial_nodes.py``), the variants are ``built``, ``off``, ``onestep`` / ``twosteps``
+(``Polynomial One Step`` forced on / off, whether or not the window allows one: what the second
+closed-form step costs) and
 ``transform`` (the polynomial's terms by Transform Points on matrices combined from the same inputs,
 as before issue 26's multiply-adds). With ``--motion constant`` (Constant Velocity 0.5c, the closed form
 on the lean group: the edges' bound clears the grid), ``folded`` and ``unfolded``: the modifier's
@@ -122,7 +123,7 @@ def main():
     eased = options.motion == "eased"
     constant = options.motion == "constant"
     if options.variants is None:
-        options.variants = "built,off,onestep,transform" if eased else "built,off,steps1,steps2,single"
+        options.variants = "built,off,twosteps,transform" if eased else "built,off,steps1,steps2,single"
         options.variants = "folded,unfolded" if constant else options.variants
     import bpy
 
@@ -152,7 +153,7 @@ def main():
             groups[name] = variant_group(bpy, "profile capture", capture_only=True)
         elif name == "single":
             groups[name] = variant_group(bpy, "profile single", single=True)
-        elif name in ("onestep", "transform"):
+        elif name in ("onestep", "twosteps", "transform"):
             groups[name] = variant_group(bpy, f"profile {name}", transform=name == "transform")
     times = {name: [] for name in groups}
     cpu = {name: [] for name in groups}
@@ -178,7 +179,7 @@ def main():
                 use_group(mod, group)
                 keyframed_on(name != "off")
                 if eased:
-                    one_step(True if name == "onestep" else steps)
+                    one_step({"onestep": True, "twosteps": False}.get(name, steps))
                 if constant:
                     modifier.set_inputs(mod, {"Folded": name == "folded"})
                 obj.update_tag()

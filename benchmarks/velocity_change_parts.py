@@ -1,10 +1,11 @@
-"""A constant-velocity change on artist_chain.py's grid, its parts timed apart in one process.
+"""A velocity change on artist_chain.py's grid, its parts timed apart in one process.
 
-    python benchmarks/velocity_change_parts.py [--size 2M] [--rounds 15]
+    python benchmarks/velocity_change_parts.py [--size 2M] [--rounds 15] [--motion constant|eased]
 
-The grid of ``artist_chain.py`` (one mesh, Constant Velocity 0.5c, tessellation at its default) is
-set up; each round rewrites the plain scene's positions (``artist_chain.plain_rewrite``, handlers
-out), then changes the grid's velocity the panel's way and reads a vertex after
+The grid of ``artist_chain.py`` (one mesh, Constant Velocity 0.5c, or ``eased``: its Bezier location
+keys, tessellation at its default) is set up; each round rewrites the plain scene's positions
+(``artist_chain.plain_rewrite``, handlers out), then changes the grid's velocity (eased: the
+observer's, as ``artist_chain.py`` does) the panel's way and reads a vertex after
 ``evaluated_depsgraph_get``. Printed, medians of the rounds: the whole change (wall), the update
 callback (wall, and the main thread's CPU time: Python, which waiting for a core does not count),
 the evaluation (wall, the handler's sync taken out), the ``depsgraph_update_post`` sync (wall and
@@ -31,6 +32,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="2M")
     parser.add_argument("--rounds", type=int, default=15)
+    parser.add_argument("--motion", default="constant", choices=("constant", "eased"))
     options = parser.parse_args()
 
     import bpy
@@ -43,7 +45,7 @@ def main():
     load = os.getloadavg()
     print(f"Blender {bpy.app.version_string}, load average at start: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
     size = artist_chain.parse_size(options.size)
-    _scene, plain_scene, movers, plain = artist_chain.build(bpy, "grid", size, "constant", None, (64, 48), 4)
+    scene, plain_scene, movers, plain = artist_chain.build(bpy, "grid", size, options.motion, None, (64, 48), 4)
     assert bpy.ops.relativity.setup_scene() == {"FINISHED"}, "Set Up failed"
     grid = movers[0]
     grid.relativity.beta = (artist_chain.BETA + 0.02, 0.0, 0.0)
@@ -67,7 +69,10 @@ def main():
                 plain_time = artist_chain.timed(artist_chain.plain_rewrite, bpy, plain_scene, plain, 1e-3)
             syncs.clear()
             start, start_cpu = time.perf_counter(), time.thread_time()
-            grid.relativity.beta = (artist_chain.BETA + 0.01 * (round_ % 2 + 1), 0.0, 0.0)
+            if options.motion == "constant":
+                grid.relativity.beta = (artist_chain.BETA + 0.01 * (round_ % 2 + 1), 0.0, 0.0)
+            else:
+                scene.relativity.beta = (0.0, 0.0, 0.01 * (round_ % 2 + 1))
             called, called_cpu = time.perf_counter(), time.thread_time()
             artist_chain.read_vertex(bpy, grid, bpy.context.evaluated_depsgraph_get())
             end = time.perf_counter()

@@ -38,39 +38,62 @@ def _eased(kink=None, duration=30.0):
     return origin, matrices
 
 
-def _window(matrices, t_o):
-    pieces = sampling.motion_intervals(matrices, STEP, t_o, X_O, C, REACH, 1024)
+def _window(matrices, t_o, reach=REACH):
+    pieces = sampling.motion_intervals(matrices, STEP, t_o, X_O, C, reach, 1024)
     grid_now, per_distance = t_o / STEP - pieces.first, 1.0 / (C * STEP)
-    tolerance = polynomial_motion.rounding_tolerance(pieces, X_O, REACH, STEP, C)
+    tolerance = polynomial_motion.rounding_tolerance(pieces, X_O, reach, STEP, C)
     return pieces, grid_now, per_distance, tolerance
 
 
-def _light_cone_departure(origin, t_o, sigma):
-    """``|x_e(t_o - sigma / c) - x_o| - sigma`` of the exact motion (scene units)."""
-    t_e = t_o - sigma / C
+def _emitted(origin, t_e, points):
+    """The points at times ``t_e`` (one each): the origin there plus the point contracted along the
+    origin's velocity there."""
     h = 1e-4  # the origin's velocity at each retarded time, for the contraction
     velocity = (origin(t_e + h) - origin(t_e - h)) / (2.0 * h * C)
-    emitted = origin(t_e) + contract(POINTS, velocity)
-    return np.linalg.norm(emitted - X_O, axis=1) - sigma
+    return origin(t_e) + contract(points, velocity)
 
 
-@pytest.mark.parametrize(("duration", "steps"), [(30.0, 2), (60.0, 1)])
-def test_eased_motion_meets_the_light_cone(duration, steps):
-    """The modifier's steps (``newton_steps``): two for the 30 s motion, where one step alone leaves
-    the root by more than a tenth of the tolerance (about 0.85 of it), one for the gentler 60 s motion."""
+def _light_cone_departure(origin, t_o, sigma, points=POINTS):
+    """``|x_e(t_o - sigma / c) - x_o| - sigma`` of the exact motion (scene units)."""
+    return np.linalg.norm(_emitted(origin, t_o - sigma / C, points) - X_O, axis=1) - sigma
+
+
+@pytest.mark.parametrize(("duration", "size", "steps"), [(30.0, 2.0, 1), (60.0, 2.0, 1), (30.0, 4.0, 2)])
+def test_eased_motion_meets_the_light_cone(duration, size, steps):
+    """The modifier's solve (``modifier_solve``, the steps ``choose_steps`` picks, checked at
+    ``box_points``) on a flat square ``2 size`` wide: one closed-form step after the start's line for
+    the 4 m square (the 30 s motion took two Newton steps before: one left the root by about 0.85 of
+    the tolerance) and for the gentler 60 s motion; two for the 8 m square at 30 s, whose points'
+    retarded times spread twice as far, where one step alone leaves the light cone by more than the
+    check allows. The light-travel distances, emission points and velocities are checked against the
+    exact motion on a 9 x 9 grid of the square (its points between the check points)."""
+    points = np.array([[x, y, 0.0] for x in np.linspace(-size, size, 9) for y in np.linspace(-size, size, 9)])
+    reach = float(np.max(np.linalg.norm(points, axis=1)))
     origin, matrices = _eased(duration=duration)
     t_o = 0.5
-    pieces, grid_now, per_distance, tolerance = _window(matrices, t_o)
-    polynomial = polynomial_motion.fit_window(pieces, grid_now, per_distance, REACH, tolerance)
-    # the exact motion (no float32 samples here): the cubic follows it far inside the tolerance
-    assert polynomial is not None and polynomial.residual <= 1e-5 < tolerance
-    assert polynomial_motion.newton_steps(polynomial, POINTS) == steps
-    sigma, u = polynomial_motion.solve(polynomial, POINTS, steps=steps)
-    assert np.all(np.abs(u) <= 1.0)
-    np.testing.assert_allclose(_light_cone_departure(origin, t_o, sigma), 0.0, atol=2e-5)
-    if steps > 1:  # one step is not enough there: the light cone missed by more than the bound allows
-        one, _u = polynomial_motion.solve(polynomial, POINTS, steps=1)
-        assert np.max(np.abs(_light_cone_departure(origin, t_o, one))) > 0.1 * tolerance
+    pieces, grid_now, per_distance, tolerance = _window(matrices, t_o, reach)
+    polynomial = polynomial_motion.fit_window(pieces, grid_now, per_distance, reach, tolerance)
+    # the exact motion (no float32 samples here): the cubic follows it inside the tolerance (1.5e-6 for
+    # the 4 m square, 7.7e-5 for the 8 m one: a window twice as long)
+    assert polynomial is not None and polynomial.residual <= 0.2 * tolerance
+    low, high = np.array([-size, -size, 0.0]), np.array([size, size, 0.0])
+    form, found = polynomial_motion.choose_steps(polynomial, polynomial_motion.box_points(low, high, polynomial))
+    assert found == steps
+    sigma, emission, velocity = polynomial_motion.modifier_solve(form, points, steps)
+    # the solve within CHECK_SHARE of the tolerance of the polynomial's root, the polynomial within its residual
+    allowed = polynomial_motion.CHECK_SHARE * tolerance + polynomial.residual
+    np.testing.assert_allclose(_light_cone_departure(origin, t_o, sigma, points), 0.0, atol=allowed)
+    t_e = t_o - sigma / C
+    np.testing.assert_allclose(emission, _emitted(origin, t_e, points) - X_O, atol=allowed)
+    # the points' own velocities: the origin's plus the contraction's rate (up to 0.007c here)
+    h = 1e-3
+    exact_velocity = (_emitted(origin, t_e + h, points) - _emitted(origin, t_e - h, points)) / (2.0 * h * C)
+    np.testing.assert_allclose(velocity, exact_velocity, atol=allowed / polynomial.half)
+    if steps > 1:  # one step is not enough there: it leaves the polynomial's root (Newton's, to
+        # convergence) by more than the check allows (2.8e-4 against 7.1e-5)
+        one, _emission, _velocity = polynomial_motion.modifier_solve(form, points, 1)
+        root, _u = polynomial_motion.solve(polynomial, points)
+        assert np.max(np.abs(one - root)) > 2.0 * polynomial_motion.CHECK_SHARE * tolerance
 
 
 def test_a_jump_of_acceleration_in_the_window_is_refused():

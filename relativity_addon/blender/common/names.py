@@ -19,8 +19,9 @@ GEOMETRY_MODIFIER = "Relativity Apparent Geometry"
 GEOMETRY_GROUP_VERSION_KEY = "relativity_version"  # the geometry group's own (older) stamp key
 # 2: adaptive tessellation (face codes at the end of the cache); 3: the closed form; 4: keyframed motion in
 # the modifier; 5: Edges Proven Short; 7: one polynomial over the keyframed window (Polynomial); 8: its
-# terms by multiply-adds, Polynomial One Step, the closed form's Folded
-GEOMETRY_GROUP_VERSION = 8
+# terms by multiply-adds, Polynomial One Step, the closed form's Folded; 9: the polynomial's start line and
+# closed-form steps (Polynomial Start Offset/Slope, no Polynomial Rate), Observer Moving
+GEOMETRY_GROUP_VERSION = 9
 # the same modifier's group for meshes on the constant closed form whose edges' bound clears (node_group.LEAN_WHEN)
 LEAN_GEOMETRY_GROUP = "Relativity Apparent Geometry (Closed Form)"
 LEAN_GEOMETRY_GROUP_VERSION = 2  # 2: Folded

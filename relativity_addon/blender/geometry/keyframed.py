@@ -186,25 +186,14 @@ def modifier_inputs(
     signature = animation.keyframes_signature(obj)
     facts = _keyed_facts(obj, signature)
     corners = _box_corners(obj, facts)
-    try:
-        function = _matrix_function(obj, scene, fps, step, c, signature)
-        guess = _last_tau.get(obj.session_uid)
-        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
-    except ValueError as error:
-        raise RelativityError(f"Object {obj.name!r}: {error}") from None
-    if pieces is not None:
-        _last_tau[obj.session_uid] = pieces.start_distance / c
-    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
-    if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
+    window = _window(obj, scene, signature, facts, corners, (fps, step, t_o, x_o, c, reach))
+    if window is None:
         return None  # the Python path then (and its warning when a point is seen before the keys move it)
+    pieces, line, found = window
     beta_o = np.asarray(beta_o, dtype=np.float64)
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     inverse = motion.affine_inverse(matrix)[:3, :3]
-    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
-    line = animation.straight_keys(
-        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
-    )
     if line is not None:
         start, per_frame = line
         # straight keys hold the rotation and scale (one value each): the shape at any frame
@@ -213,10 +202,7 @@ def modifier_inputs(
         closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
-    polynomial, steps = None, None
-    if corners is not None:
-        found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
-        polynomial, steps = found if found is not None else (None, None)
+    polynomial, form, steps = found if found is not None else (None, None, None)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     # e' = B e + gamma sigma beta_o (the boost of the emission event relative to the observer)
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -241,16 +227,20 @@ def modifier_inputs(
         "Observer Velocity": vector(-beta_o),
         "Observer Inverse Gamma": 1.0 / gamma,
         "Observer Factor": gamma / (gamma + 1.0),
+        "Observer Moving": bool(np.any(beta_o != 0.0)),
     }
-    if polynomial is None:
+    if polynomial is None or form is None:
         return inputs, pieces.coefficients
     inputs.update(
         {
             "Polynomial One Step": steps == 1,
-            "Polynomial Centre": polynomial.centre,
-            "Polynomial Rate": 1.0 / polynomial.half,
+            "Polynomial Centre": form.centre,
+            "Polynomial Start Offset": form.start_offset,
+            "Polynomial Start Slope": form.start_slope,
+            # the closed forms' towards form on every point (as the closed form's, motion.FOLD_LIMIT)
+            "Folded": 1.0 / (1.0 - pieces.fastest) <= motion.FOLD_LIMIT,
             **{
-                f"Polynomial {power} {part}": vector(polynomial.coefficients[power][:, column])
+                f"Polynomial {power} {part}": vector(form.coefficients[power][:, column])
                 for power in range(polynomial_motion.DEGREE + 1)
                 for column, part in enumerate(("X", "Y", "Z", "Offset"))
             },
@@ -260,32 +250,81 @@ def modifier_inputs(
     return inputs, None  # no interval read: the cache holds the face codes alone
 
 
+# Object session_uid -> (key, (intervals, straight line, polynomial found)) of the last update: the
+# window depends on the observer's event, not on its velocity, so an observer's velocity change (the
+# same event, keys, step, reach and rest box) samples, contracts and fits nothing again.
+_windows: dict[int, tuple[object, tuple[object, object, object]]] = {}
+
+
+def _window(obj, scene, signature, facts, corners, event):
+    """The intervals of the observer ``event`` (``(fps, step, t_o, x_o, c, reach)``), the keys' straight
+    line over them (``animation.straight_keys``) and else the polynomial found (``_window_polynomial``:
+    None where there is none or no rest box); None for the Python path (too many intervals, or
+    intervals before the keys start moving the object). Raises RelativityError."""
+    fps, step, t_o, x_o, c, reach = event
+    key = None
+    if signature is not None:  # keys with F-curve modifiers: nothing kept
+        box = None if corners is None else tuple(float(v) for v in np.ravel(corners))
+        proper = bool(obj.relativity.use_proper_time)
+        event_key = (fps, step, float(t_o), tuple(float(v) for v in x_o), float(c), float(reach))
+        key = (signature, proper, *event_key, box, MAX_INTERVALS)
+        kept = _windows.get(obj.session_uid)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+    try:
+        function = _matrix_function(obj, scene, fps, step, c, signature)
+        guess = _last_tau.get(obj.session_uid)
+        pieces = sampling.motion_intervals(function, step, t_o, x_o, c, reach, MAX_INTERVALS, guess)
+    except ValueError as error:
+        raise RelativityError(f"Object {obj.name!r}: {error}") from None
+    if pieces is not None:
+        _last_tau[obj.session_uid] = pieces.start_distance / c
+    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
+    if pieces is None or (held_before is not None and pieces.first * step * fps < held_before):
+        return None
+    # keys drawing a straight line over every knot the intervals use: uniform motion, the closed form
+    line = animation.straight_keys(
+        obj, (pieces.first - 1) * step * fps, (pieces.first + len(pieces.coefficients) + 1) * step * fps
+    )
+    found = None
+    if line is None and corners is not None:
+        grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
+        x_o = np.asarray(x_o, dtype=np.float64)
+        found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
+    if key is not None:
+        _windows[obj.session_uid] = (key, (pieces, line, found))
+    return pieces, line, found
+
+
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
 _polynomials: dict[int, polynomial_motion.WindowPolynomial] = {}
 
 
 def _box_corners(obj, facts):
-    """The rest box's corners (object space) of an object whose keys only move it
+    """The rest box (object space: its low and high corners) of an object whose keys only move it
     (``animation.translates_only``: the polynomial may serve it), else None."""
     bounds = tessellation.rest_bounds(obj)
     if bounds is None or not _fact(facts, "translates only", lambda: animation.translates_only(obj)):
         return None
-    return np.where(np.arange(8)[:, None] >> np.arange(3) & 1, bounds[1], bounds[0])
+    return np.asarray(bounds[0], dtype=np.float64), np.asarray(bounds[1], dtype=np.float64)
 
 
-def _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c):
-    """One polynomial over the intervals (``physics/polynomial_motion.py``) and the modifier's Newton
-    steps, where it follows them to the samples' rounding and the steps converge on the rest box's
-    ``corners`` (``newton_steps``: one where one does), else None
+def _window_polynomial(pieces, box, grid_now, grid_per_distance, x_o, reach, step, c):
+    """One polynomial over the intervals (``physics/polynomial_motion.py``), the modifier's form of it
+    and its closed-form steps, where it follows them to the samples' rounding and the steps converge
+    at the rest ``box``'s check points (``choose_steps``: one where one does), else None
     (the intervals then, read per point). No verdict is taken over the points: the window was bounded
     for every point within ``reach`` of the origin, and the rest box's farthest corner must lie
     within it (a box whose corners reach farther than its points, a sphere's, keeps the intervals)."""
+    corners = np.where(np.arange(8)[:, None] >> np.arange(3) & 1, box[1], box[0])
     if float(np.max(np.linalg.norm(corners, axis=1))) > reach * (1.0 + 1e-6):  # (float32 reads)
         return None  # the window holds only points within reach (a stale reach: the verdict says so)
     tolerance = polynomial_motion.rounding_tolerance(pieces, x_o, reach, step, c)
     polynomial = polynomial_motion.fit_window(pieces, grid_now, grid_per_distance, reach, tolerance)
-    steps = None if polynomial is None else polynomial_motion.newton_steps(polynomial, corners)
-    return None if steps is None else (polynomial, steps)
+    if polynomial is None:
+        return None
+    found = polynomial_motion.choose_steps(polynomial, polynomial_motion.box_points(*box, polynomial))
+    return None if found is None else (polynomial, *found)
 
 
 def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray | None) -> None:

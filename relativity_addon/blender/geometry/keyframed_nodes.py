@@ -49,6 +49,7 @@ KEYFRAMED_INPUTS = (
     ),
     ("Observer Inverse Gamma", "NodeSocketFloat", {"default_value": 1.0}),
     ("Observer Factor", "NodeSocketFloat", {"default_value": 0.5}),
+    ("Observer Moving", "NodeSocketBool", {"default_value": True}),
     *POLYNOMIAL_INPUTS,
 )
 
@@ -212,9 +213,21 @@ def _seen(nodes: dict[str, Node], tag: str, x: str, sigma: object, w: str) -> tu
             f"{tag}_denominator": fmath("ADD", f"{tag}_vu.Value", 1.0),
             f"{tag}_inverse": fmath("DIVIDE", 1.0, f"{tag}_denominator"),
             f"{tag}_beta_seen": vmath("SCALE", f"{tag}_sum.Vector", scale=f"{tag}_inverse"),
+            # an observer at rest (a single value: only the side chosen is computed): no delay term
+            # (Emission Delay is zero) and no addition of velocities (the boost is the identity)
+            f"{tag}_local_moving": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Observer Moving", "False": f"{tag}_lz.Vector", "True": f"{tag}_local.Vector"},
+                {"input_type": "VECTOR"},
+            ),
+            f"{tag}_beta_moving": Node(
+                "GeometryNodeSwitch",
+                {"Switch": "group.Observer Moving", "False": w, "True": f"{tag}_beta_seen.Vector"},
+                {"input_type": "VECTOR"},
+            ),
         }
     )
-    return f"{tag}_local.Vector", f"{tag}_beta_seen.Vector"
+    return f"{tag}_local_moving.Output", f"{tag}_beta_moving.Output"
 
 
 def keyframed_nodes() -> dict[str, Node]:
@@ -276,7 +289,7 @@ def keyframed_nodes() -> dict[str, Node]:
         }
     )
     local, beta = _seen(nodes, "kf", x, sigma, f"{tag}_w.Vector")
-    polynomial, kp_x, kp_sigma, kp_w = polynomial_nodes(_step)
+    polynomial, kp_x, kp_sigma, kp_w = polynomial_nodes()
     nodes.update(polynomial)
     kp_local, kp_beta = _seen(nodes, "kp", kp_x, kp_sigma, kp_w)
     items = {"capture_items": (("VECTOR", "Seen"), ("VECTOR", "Beta"), ("FLOAT", "Inside"))}
