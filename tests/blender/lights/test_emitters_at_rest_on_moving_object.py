@@ -274,3 +274,42 @@ def test_light_no_lamp_carries_is_said_in_the_panel(relativity_addon, factory_bl
     bpy.data.objects["Plate"].relativity.beta = (0.0, 0.0, 0.0)  # changed in the panel: nothing moves
     bpy.context.view_layer.update()
     assert _unshifted_lines(scene) == [], _effect().scene_warnings(scene)
+
+
+@pytest.mark.parametrize("case", ["floor", "floor and world", "no bounces", "nothing at rest", "emitting floor"])
+def test_light_bounced_off_objects_at_rest_is_said_in_the_panel(relativity_addon, factory_blender, case):
+    """A lit floor at rest under a moving sphere reflects the lamp's light onto it unshifted (the
+    "bounce" case above, measured): the unshifted-light line names it, in the same one line as the
+    world's; not where Cycles bounces no light (Max Bounces 0), nothing renders at rest, or the
+    only thing at rest emits and reflects nothing (then it is an emitting mesh)."""
+    bpy = factory_blender
+    scene, camera = ch.new_scene(bpy, resolution=RESOLUTION, samples=1, location=(0.0, -10.0, 3.0))
+    camera.rotation_euler = (math.radians(75.0), 0.0, 0.0)
+    sphere = ch.add_sphere(bpy, scene, (0.0, 0.0, 1.0), 1.0, ch.diffuse_material(bpy, "White", (0.8,) * 3), "Sphere")
+    sphere.relativity.enabled = True
+    sphere.relativity.motion = "CONSTANT"
+    sphere.relativity.beta = tuple(BETA)
+    floor = ch.emission_material(bpy) if case == "emitting floor" else ch.diffuse_material(bpy, "Grey", (0.5,) * 3)
+    _quad(bpy, scene, "Floor", 10.0, (0.0, 0.0, 0.0), floor)
+    lamp = bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", "POINT"))
+    lamp.location = (2.0, -2.0, 5.0)
+    scene.collection.objects.link(lamp)
+    if case == "nothing at rest":
+        bpy.data.objects.remove(bpy.data.objects["Floor"])
+    if case == "no bounces":
+        scene.cycles.max_bounces = 0
+    if case == "floor and world":
+        background = compat.world_node_tree(scene.world).nodes["Background"]
+        background.inputs["Color"].default_value, background.inputs["Strength"].default_value = (1, 1, 1, 1), 1.0
+    scene.relativity.method = "GEOMETRY"
+    scene.relativity.enabled = True
+    assert bpy.ops.relativity.setup_scene() == {"FINISHED"}
+    lines = _unshifted_lines(scene)
+    print(case, lines)
+    if case in ("no bounces", "nothing at rest"):
+        assert lines == []
+        return
+    assert len(lines) == 1 and "\n" not in lines[0]
+    assert ("bounced off objects at rest" in lines[0]) == (case != "emitting floor")
+    assert ("the world" in lines[0]) == (case == "floor and world")
+    assert "0.86x" in lines[0] and "docs/lamp-doppler.md" in lines[0]
