@@ -37,7 +37,7 @@ from ..camera import exact_camera
 from ..common import names, osl
 from ..common.nodes import build_group, detach_inserted, ensure_group, linked_surface, remove_unused_groups
 from ..geometry import modifier
-from . import bounce_nodes, lamps_on_moving_objects
+from . import bounce_nodes, lamps_on_moving_objects, unshifted_light
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
@@ -89,19 +89,9 @@ def _with_material(scene: Scene) -> bool:
     return any(slot.material is not None for obj in modifier.applied_objects(scene) for slot in obj.material_slots)
 
 
-GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD", "VOLUME"}
-
-
 def _lit_at_rest(scene: Scene, moving: Sequence[Object]) -> bool:
     """Whether the scene renders anything at rest (not in ``moving``) that a moving object could light."""
-    moving_names = {obj.name for obj in moving}
-    return any(
-        obj.type in GEOMETRY_TYPES
-        and obj.name not in moving_names
-        and not obj.hide_render
-        and not modifier.is_cache(obj)
-        for obj in scene.objects
-    )
+    return any(True for _ in unshifted_light.objects_at_rest(scene, moving))
 
 
 def _cheap_reason(scene: Scene, snap: Snapshot) -> str | None:

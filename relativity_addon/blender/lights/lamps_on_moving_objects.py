@@ -530,7 +530,7 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     unshifted = unshifted_light.sources(scene, moving) if moving else None
     if unshifted:
         found.append(
-            f"Light from {unshifted} reaches moving objects unshifted (eq. 18 not applied: 0.86x of it across "
+            f"Light {unshifted} reaches moving objects unshifted (eq. 18 not applied: 0.86x of it across "
             "the motion at 0.5c, far more off along it; docs/lamp-doppler.md)"
         )
     used = light_linking_collections(scene)

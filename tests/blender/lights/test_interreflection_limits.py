@@ -191,7 +191,7 @@ def test_one_moving_object_lighting_objects_at_rest_is_said(relativity_addon, fa
     beta = np.array([case.EACH, 0.0, 0.0])
     scene, _ = case._scene(bpy, beta, np.zeros(3))
     effect.apply(scene)
-    lines = [line for line in effect.scene_warnings(scene) if "objects at rest" in line]
+    lines = [line for line in effect.scene_warnings(scene) if "sends onto objects at rest" in line]
     assert lines == [
         "Light the moving object sends onto objects at rest is not corrected, up to 3.6x off at 0.5c "
         "(docs/lamp-doppler.md): the correction is built for two or more moving objects"
@@ -200,7 +200,7 @@ def test_one_moving_object_lighting_objects_at_rest_is_said(relativity_addon, fa
     _extra_movers(bpy, scene, 1)
     effect.apply(scene)
     assert names.BOUNCE_MATERIAL_KEY in bpy.data.materials["White"]
-    assert not [line for line in effect.scene_warnings(scene) if "objects at rest" in line]
+    assert not [line for line in effect.scene_warnings(scene) if "sends onto objects at rest" in line]
     effect.remove(scene)
 
 
@@ -214,7 +214,7 @@ def test_one_moving_object_alone_is_not_said_to_light_objects_at_rest(relativity
         bpy.data.objects.remove(obj)
     effect.apply(scene)
     warnings = effect.scene_warnings(scene)
-    assert len(moving) == 1 and not [line for line in warnings if "objects at rest" in line], warnings
+    assert len(moving) == 1 and not [line for line in warnings if "sends onto objects at rest" in line], warnings
     effect.remove(scene)
 
 
