@@ -293,6 +293,20 @@ def apply_effect(scene: Scene, options: argparse.Namespace, first: float, last: 
         raise BatchError(str(error)) from None
 
 
+def _say_notes(scene: Scene, said: set[str], log: Callable[..., object]) -> None:
+    """The panel's lines for ``scene`` as of its last sync (what is approximate or left out: the
+    scene's, then each set-up object's), each printed once per run as ``render.py: note: ...``: a
+    pipeline user sees what an artist sees in the N-panel."""
+    effect = addon_module("pipeline.effect")
+    lines = list(effect.scene_warnings(scene))
+    for obj in scene.objects:
+        lines += [line if obj.name in line else f"{obj.name!r}: {line}" for line in effect.object_warnings(scene, obj)]
+    for line in lines:
+        if line not in said:
+            said.add(line)
+            log(f"render.py: note: {line}", flush=True)
+
+
 def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     import time
 
@@ -305,6 +319,9 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     frames = bake_to.frames(scene, options) or _frames(scene, options)
     scene_frames = scene_frames_of(scene, options, frames)
     apply_effect(scene, options, scene_frames[0], scene_frames[-1])
+    said: set[str] = set()
+    if relativistic:
+        _say_notes(scene, said, log)
     if options.bake_to is not None:
         return [bake_to.bake(bpy, scene, addon_module("pipeline.effect"), options.bake_to, frames, log)]
     several = len(frames) > 1
@@ -324,6 +341,8 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     for done, (frame, scene_frame, path) in enumerate(zip(frames, scene_frames, paths, strict=True), start=1):
         frame_started = time.monotonic()
         _render_frame(bpy, scene, frame, path, relativistic, options.spectral, scene_frame)
+        if relativistic:
+            _say_notes(scene, said, log)  # a frame may bring its own (a light that starts to move)
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import pipeline_helpers as wh
+from relativity_addon.blender.common import compat
 
 C_SLOW = 10.0  # scene units per second for the animated tests (fps 24)
 
@@ -258,3 +259,32 @@ def test_frame_whose_geometry_update_fails_is_not_rendered(relativity_addon, fac
     assert 3 <= failed_frame <= 5
     rendered = sorted(path.name for path in tmp_path.glob("fast_object*.png"))
     assert rendered == [f"fast_object_{frame:04d}.png" for frame in range(1, failed_frame)]
+
+
+def test_panel_lines_are_printed_once_as_notes(relativity_addon, factory_blender, tmp_path):
+    """What the N-panel says of a set-up scene reaches a pipeline user too: a moving sphere under a
+    lit world (the world's light reaches it unshifted: docs/lamp-doppler.md) gets the panel's line as
+    one ``render.py: note:`` line, once for two frames; the same file with a black world gets none of it."""
+    bpy = factory_blender
+    scene, _, sphere = wh.new_scene(bpy)
+    scene.frame_start, scene.frame_end = 1, 2
+    sphere.relativity.enabled = True
+    sphere.relativity.motion = "CONSTANT"
+    sphere.relativity.beta = (0.5, 0.0, 0.0)
+    black = wh.save_blend(bpy, tmp_path / "black_world.blend")
+    scene.world.color = (0.2, 0.2, 0.2)  # Blender 4.5 without world nodes, and the tree's Background
+    background = compat.world_node_tree(scene.world).nodes["Background"]
+    background.inputs["Color"].default_value = (0.2, 0.2, 0.2, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    lit = wh.save_blend(bpy, tmp_path / "lit_world.blend")
+    common = ("--method=geometry", "--beta=0,0,0", "--speed-of-light=10", "--frames=1-2", "--samples=1")
+    notes = {}
+    for name, blend in (("lit", lit), ("black", black)):
+        result = wh.run_render_script(blend, *common, f"--out={tmp_path / name / 'shot.png'}")
+        assert result.returncode == 0, result.stderr[-2000:]
+        notes[name] = [line for line in result.stdout.splitlines() if line.startswith("render.py: note: ")]
+    print(notes)
+    world_lines = [line for line in notes["lit"] if "the world" in line and "unshifted" in line]
+    assert len(world_lines) == 1, notes["lit"]
+    assert len(notes["lit"]) == len(set(notes["lit"]))  # each line once over the two frames
+    assert not [line for line in notes["black"] if "the world" in line], notes["black"]
