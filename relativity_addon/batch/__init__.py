@@ -15,7 +15,7 @@ import sys
 from typing import TYPE_CHECKING, NoReturn
 
 from ..errors import BatchError, RelativityError
-from . import bake_to
+from . import bake_to, notes
 from .frame_files import format_seconds, frame_output_path, partial_path
 from .options import (
     LENS_CHOICES,
@@ -293,18 +293,14 @@ def apply_effect(scene: Scene, options: argparse.Namespace, first: float, last: 
         raise BatchError(str(error)) from None
 
 
-def _say_notes(scene: Scene, said: set[str], log: Callable[..., object]) -> None:
-    """The panel's lines for ``scene`` as of its last sync (what is approximate or left out: the
-    scene's, then each set-up object's), each printed once per run as ``render.py: note: ...``: a
-    pipeline user sees what an artist sees in the N-panel."""
+def panel_lines(scene: Scene) -> list[str]:
+    """The N-panel's lines for set-up ``scene`` as of its last sync (what it leaves approximate or
+    out): the scene's, then each set-up object's, named."""
     effect = addon_module("pipeline.effect")
     lines = list(effect.scene_warnings(scene))
     for obj in scene.objects:
         lines += [line if obj.name in line else f"{obj.name!r}: {line}" for line in effect.object_warnings(scene, obj)]
-    for line in lines:
-        if line not in said:
-            said.add(line)
-            log(f"render.py: note: {line}", flush=True)
+    return lines
 
 
 def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
@@ -321,7 +317,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
     apply_effect(scene, options, scene_frames[0], scene_frames[-1])
     said: set[str] = set()
     if relativistic:
-        _say_notes(scene, said, log)
+        notes.say(panel_lines(scene), said, log)
     if options.bake_to is not None:
         return [bake_to.bake(bpy, scene, addon_module("pipeline.effect"), options.bake_to, frames, log)]
     several = len(frames) > 1
@@ -342,7 +338,7 @@ def run(argv: Sequence[str], log: Callable[..., object] = print) -> list[str]:
         frame_started = time.monotonic()
         _render_frame(bpy, scene, frame, path, relativistic, options.spectral, scene_frame)
         if relativistic:
-            _say_notes(scene, said, log)  # a frame may bring its own (a light that starts to move)
+            notes.say(panel_lines(scene), said, log)  # a frame may bring its own (a light that starts to move)
         now = time.monotonic()
         left = (now - started) / done * (len(frames) - done)
         log(

@@ -23,7 +23,7 @@ import time
 from typing import TYPE_CHECKING
 
 from ..errors import BatchError
-from . import frame_files
+from . import frame_files, notes
 from .options import check_blend_file, check_out_suffix
 
 if TYPE_CHECKING:
@@ -201,6 +201,7 @@ class _Job:
         self.paths, self.log = paths, log
         self.total, self.skipped = len(paths), len(skipped)
         self.rendered, self.failed = [], {}
+        self.said: set[str] = set()  # the N-panel's lines printed as notes, once per job
         self.started = time.monotonic()
         # A frame counts as rendered only if its file was replaced during the job (the rename
         # gives it a new inode): an old output of a frame a failed chunk never reached is no result.
@@ -214,6 +215,7 @@ class _Job:
             frame, reason = result["frame"], result["reason"]
             if result.get("lost"):
                 self.log(f"render.py: on {worker}: {result['lost']}; frame {frame} rendered again", flush=True)
+            notes.say(result.get("notes") or (), self.said, self.log)
             path = self.paths[frame]
             problem = frame_files.problem(path)
             if problem is None and _identity(path) == self.before[frame]:

@@ -83,6 +83,16 @@ class _Frames:
         self.applied = True
         return frame
 
+    def notes(self):
+        """The N-panel's lines after the last frame (``batch.panel_lines``); none before Set Up or
+        when they cannot be read (the frame's own reason says what failed)."""
+        if not self.applied or self.options.reference:
+            return []
+        try:
+            return self.batch.panel_lines(self.scene)
+        except Exception:  # noqa: BLE001 - notes are extra: never cost a frame
+            return []
+
     def render(self, frame):
         """(reason or None, clean): render output ``frame`` to its file."""
         import bpy
@@ -149,7 +159,7 @@ def serve(argv: Sequence[str], reply_fd: int, setup_frame: int | None = None) ->
         started = time.monotonic()
         reason, clean = frames.render(frame)
         seconds = time.monotonic() - started
-        _reply(channel, frame=frame, reason=reason, clean=clean, seconds=seconds, pid=os.getpid())
+        _reply(channel, frame=frame, reason=reason, clean=clean, seconds=seconds, pid=os.getpid(), notes=frames.notes())
         print(
             f"render.py: frame {frame} {'done' if reason is None else 'failed: ' + reason} in {seconds:.2f} s",
             flush=True,

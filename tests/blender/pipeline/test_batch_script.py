@@ -264,7 +264,8 @@ def test_frame_whose_geometry_update_fails_is_not_rendered(relativity_addon, fac
 def test_panel_lines_are_printed_once_as_notes(relativity_addon, factory_blender, tmp_path):
     """What the N-panel says of a set-up scene reaches a pipeline user too: a moving sphere under a
     lit world (the world's light reaches it unshifted: docs/lamp-doppler.md) gets the panel's line as
-    one ``render.py: note:`` line, once for two frames; the same file with a black world gets none of it."""
+    one ``render.py: note:`` line, once for two frames, in one process and on a Dask farm; the same
+    file with a black world gets none of it."""
     bpy = factory_blender
     scene, _, sphere = wh.new_scene(bpy)
     scene.frame_start, scene.frame_end = 1, 2
@@ -288,3 +289,12 @@ def test_panel_lines_are_printed_once_as_notes(relativity_addon, factory_blender
     assert len(world_lines) == 1, notes["lit"]
     assert len(notes["lit"]) == len(set(notes["lit"]))  # each line once over the two frames
     assert not [line for line in notes["black"] if "the world" in line], notes["black"]
+
+    # On a Dask farm (two workers, a frame each): the workers' Blender processes send the lines with
+    # each frame's reply; the coordinator prints each once.
+    result = wh.run_render_script(lit, *common, f"--out={tmp_path / 'farm' / 'shot.png'}", "--workers=2", "--threads=1")
+    assert result.returncode == 0, result.stderr[-2000:]
+    farm_notes = [line for line in result.stdout.splitlines() if line.startswith("render.py: note: ")]
+    print(farm_notes)
+    assert "Dask cluster" in result.stdout and "2 rendered" in result.stdout, result.stdout[-3000:]
+    assert farm_notes == notes["lit"], result.stdout[-3000:]
