@@ -185,6 +185,9 @@ def modifier_inputs(
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
     signature = animation.keyframes_signature(obj)
     facts = _keyed_facts(obj, signature)
+    uniform = _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach)
+    if uniform is not None:
+        return uniform, None
     corners = _box_corners(obj, facts)
     try:
         function = _matrix_function(obj, scene, fps, step, c, signature)
@@ -258,6 +261,40 @@ def modifier_inputs(
     )
     _polynomials[obj.session_uid] = polynomial
     return inputs, None  # no interval read: the cache holds the face codes alone
+
+
+def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
+    """The closed form's inputs where the keys draw one straight line over every sample
+    ``sampling.motion_intervals`` would read (``sampling.uniform_motion_window``: found from the
+    line alone, no key evaluated, no window solved), else None (the intervals decide then). The
+    same inputs as the intervals' straight-keys case below: the same line, shape and observer."""
+    if not _fact(facts, "translates only", lambda: animation.translates_only(obj)):
+        return None  # a rotation or scale keyed anywhere: the shape is not one matrix
+    t_o, x_o, beta_o = snap.mesh_observer
+    c = snap.speed_of_light
+    guess = t_o - _last_tau.get(obj.session_uid, 0.0)
+    line = animation.straight_keys(obj, guess * fps, guess * fps)
+    if line is None:
+        return None
+    start, per_frame = line
+    shape = _fact(facts, "held shape", lambda: animation.world_matrices(obj, [t_o * fps])[0, :3, :3])
+    size = _fact(facts, "held size", lambda: float(np.linalg.svd(shape, compute_uv=False)[0]))
+    window = sampling.uniform_motion_window(start, per_frame * fps, size, step, t_o, x_o, c, reach, MAX_INTERVALS)
+    if window is None:
+        return None
+    low, high, tau = window
+    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
+    if held_before is not None and low * fps < held_before:
+        return None  # the intervals decide (the Python path, and its warning, before the keys move it)
+    over = animation.straight_keys(obj, low * fps, high * fps)
+    if over is None or not (np.array_equal(over[0], start) and np.array_equal(over[1], per_frame)):
+        return None
+    _last_tau[obj.session_uid] = tau
+    matrix = motion.matrix_array(obj_eval.matrix_world)
+    origin = start + per_frame * (t_o * fps)
+    beta_o, x_o = np.asarray(beta_o, dtype=np.float64), np.asarray(x_o, dtype=np.float64)
+    closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
+    return {"Keyframed": False, "Closed Form": True, **closed}
 
 
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
