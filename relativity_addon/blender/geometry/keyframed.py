@@ -23,8 +23,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ...physics import polynomial_motion, sampling
-from ..common import compat, names
-from ..common.nodes import interface_identifier
+from ..common import names
 from ..scene import animation
 from . import modifier, motion, shape_keys, tessellation
 
@@ -140,15 +139,14 @@ def is_on(mod: Modifier | None) -> bool:
     """Whether the modifier computes keyframed motion itself."""
     if mod is None:
         return False
-    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Keyframed")))
+    return bool(modifier.input_value(mod, "Keyframed"))
 
 
 def verdicts_made(mod: Modifier) -> tuple[bool, bool]:
     """Whether the modifier's inputs make its verdicts: on the edges (``Measure Edges``, with the closed
     form or keyframed motion on) and on the window (keyframed motion on). The inputs an update found
     are those of the last evaluation: a new modifier (Set Up) has made none yet."""
-    group = mod.node_group
-    measured = bool(compat.modifier_input(mod, interface_identifier(group, "Measure Edges")))
+    measured = bool(modifier.input_value(mod, "Measure Edges"))
     return measured and modifier.closed_form_on(mod), is_on(mod)
 
 

@@ -189,7 +189,7 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     # modifier starts with none, so Set Up never subdivides a large mesh it may not need to
     adaptive = bool(obj.relativity.use_adaptive_tessellation)
     if created or not adaptive:
-        identifier = interface_identifier(group, "Tessellation")
+        identifier = _identifier(group, "Tessellation")
         level = 0 if adaptive else int(obj.relativity.tessellation)
         if compat.modifier_input(modifier, identifier) != level:
             compat.set_modifier_input(modifier, identifier, level)
@@ -254,6 +254,16 @@ def is_lean(mod: Modifier) -> bool:
 def _identifier(group: NodeTree, name: str) -> str:
     identifier = _input_identifiers(group).get(name)
     return identifier if identifier is not None else interface_identifier(group, name)
+
+
+def input_identifier(group: NodeTree, name: str) -> str:
+    """The identifier of the group's input ``name`` (read once per group and version)."""
+    return _identifier(group, name)
+
+
+def input_value(mod: Modifier, name: str) -> object:
+    """The modifier's input ``name`` (by interface name; identifiers read once per group)."""
+    return compat.modifier_input(mod, _identifier(mod.node_group, name))
 
 
 def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
