@@ -406,8 +406,8 @@ def update(
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
             bound = _edge_bound(obj, obj_eval, snap, scene, inputs)
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
-    modifier.set_inputs(mod, inputs)
-    modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    # one call: the group (full or lean) is chosen once, on every input's new value
+    modifier.set_inputs(mod, {**inputs, "Measure Edges": measure is not None, **(measure or {})})
     if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays
         tessellation.announce(obj)
     return True
