@@ -301,13 +301,15 @@ def uniform_motion_window(
     The bound is :func:`motion_intervals`' own, ``reach size / (c (1 - v))`` widened by 5% and two
     steps, with the largest speed ``v`` its knots may show (the line's, plus the rounding over two
     steps, plus its tenth of room) and its ``tau`` moved by the rounding over ``c (1 - v)``."""
-    c = speed_of_light(c)
-    step = float(positive_array(step, "step"))
-    origin, velocity, x_o = (
-        vector_array(v, name) for v, name in ((origin, "origin"), (velocity, "velocity"), (x_o, "x_o"))
+    # in float scalars: called per keyframed object and update (issue 26: 1,000 objects)
+    origin, velocity, x_o = _vector3(origin, "origin"), _vector3(velocity, "velocity"), _vector3(x_o, "x_o")
+    c, step, t_o = float(c), float(step), float(t_o)
+    if not (0.0 < c < math.inf and 0.0 < step < math.inf and math.isfinite(t_o)):
+        raise ValueError("c and step must be positive and finite, t_o finite")
+    d = [o + u * t_o - x for o, u, x in zip(origin, velocity, x_o, strict=True)]
+    u2, du, d2 = (
+        math.fsum(a * b for a, b in zip(p, q, strict=True)) for p, q in ((velocity, velocity), (d, velocity), (d, d))
     )
-    d = origin + velocity * float(t_o) - x_o
-    u2, du, d2 = float(velocity @ velocity), float(d @ velocity), float(d @ d)
     speed = math.sqrt(u2) / c
     if speed >= 1.0:
         return None
@@ -316,7 +318,7 @@ def uniform_motion_window(
     tau = d2 / (root + du) if du > 0.0 else (root - du) / (c * c - u2)
     extent = 0.0  # the window's largest |t - t_o|: the samples' size, so their rounding, grows with it
     for _ in range(2):
-        size_there = float(np.max(np.abs(origin))) + math.sqrt(u2) * (abs(float(t_o)) + tau + extent)
+        size_there = max(map(abs, origin)) + math.sqrt(u2) * (abs(t_o) + tau + extent)
         rounding = SAMPLE_ROUNDING * (1.0 + size_there)
         fastest = speed + rounding / (step * c)
         room = fastest + 0.1 * (1.0 - fastest)
@@ -330,3 +332,10 @@ def uniform_motion_window(
     if last - first - 8 > max_intervals:
         return None
     return first * step, last * step, tau
+
+
+def _vector3(value: ArrayLike, name: str) -> list[float]:
+    values = [float(v) for v in np.asarray(value, dtype=np.float64).reshape(-1)]
+    if len(values) != 3 or not all(map(math.isfinite, values)):
+        raise ValueError(f"{name} must be a finite 3-vector")
+    return values

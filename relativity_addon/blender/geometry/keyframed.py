@@ -17,6 +17,7 @@ path (its verdict is in the object's signature).
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
@@ -270,11 +271,13 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
         return None  # a rotation or scale keyed anywhere: the shape is not one matrix
     t_o, x_o, beta_o = snap.mesh_observer
     c = snap.speed_of_light
-    guess = t_o - _last_tau.get(obj.session_uid, 0.0)
-    line = animation.straight_keys(obj, guess * fps, guess * fps)
-    if line is None:
+    guess = (t_o - _last_tau.get(obj.session_uid, 0.0)) * fps
+    span = facts.get("straight span")
+    if span is None or not span[2] <= guess <= span[3]:  # the line the keys draw around the guess
+        span = facts["straight span"] = animation.straight_span(obj, guess) or (None, None, math.inf, -math.inf)
+    start, per_frame, first_frame, last_frame = span
+    if start is None:
         return None
-    start, per_frame = line
     shape = _fact(facts, "held shape", lambda: animation.world_matrices(obj, [t_o * fps])[0, :3, :3])
     size = _fact(facts, "held size", lambda: float(np.linalg.svd(shape, compute_uv=False)[0]))
     window = sampling.uniform_motion_window(start, per_frame * fps, size, step, t_o, x_o, c, reach, MAX_INTERVALS)
@@ -284,9 +287,8 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
     held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
     if held_before is not None and low * fps < held_before:
         return None  # the intervals decide (the Python path, and its warning, before the keys move it)
-    over = animation.straight_keys(obj, low * fps, high * fps)
-    if over is None or not (np.array_equal(over[0], start) and np.array_equal(over[1], per_frame)):
-        return None
+    if not (first_frame <= low * fps and high * fps <= last_frame):
+        return None  # the window reaches past the line (the intervals decide: a change of velocity in it)
     _last_tau[obj.session_uid] = tau
     matrix = motion.matrix_array(obj_eval.matrix_world)
     origin = start + per_frame * (t_o * fps)
