@@ -135,8 +135,10 @@ def _all_inputs(obj):
     mod = modifier.find_modifier(obj)
     values = {}
     for name, identifier in modifier._input_identifiers(mod.node_group).items():
+        if name in ("Geometry", "Cache"):  # (5.2: the geometry input has no value)
+            continue
         value = gh.compat.modifier_input(mod, identifier)
-        if name not in ("Geometry", "Cache") and value is not None:
+        if value is not None:
             values[name] = tuple(value) if hasattr(value, "__len__") else value
     return mod.node_group.name, values
 
