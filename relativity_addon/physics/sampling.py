@@ -268,3 +268,74 @@ def origin_light_travel_time(
     if not np.all(speeds < c):
         return None
     return tau, near
+
+
+# The relative rounding of a sampled motion's translations the window of :func:`uniform_motion_window`
+# allows for (Blender evaluates F-curves in float32: about four ulps of 2**-23).
+SAMPLE_ROUNDING = 5e-7
+
+
+def uniform_motion_window(
+    origin: ArrayLike,
+    velocity: ArrayLike,
+    size: float,
+    step: float,
+    t_o: float,
+    x_o: ArrayLike,
+    c: float,
+    reach: float,
+    max_intervals: int,
+) -> tuple[float, float, float] | None:
+    """For a motion whose origin is ``origin + velocity t`` (scene units, seconds) and whose 3x3 is
+    one matrix of largest singular value ``size``: ``(low, high, tau)`` with ``tau`` the origin's
+    light-travel time seen from ``(t_o, x_o)`` (docs/physics.md, "Light-travel time (retarded
+    positions)": ``c tau = |d - velocity tau|``, ``d`` the origin at ``t_o`` relative to ``x_o``,
+    the root of a quadratic), and ``[low, high]`` (seconds) a span that holds every sample
+    :func:`motion_intervals` reads for this motion sampled on the grid ``k step`` with each sample's
+    translation off the line by at most :data:`SAMPLE_ROUNDING` of its size (float32 keys): its
+    intervals' knots with their neighbours, four steps to spare. None where those samples might not
+    give intervals (the speed within that rounding of c, or more than ``max_intervals`` intervals):
+    without sampling, a caller can tell that the motion over every knot of the window is this line
+    (the keys draw it over ``[low, high]``) and take its closed form.
+
+    The bound is :func:`motion_intervals`' own, ``reach size / (c (1 - v))`` widened by 5% and two
+    steps, with the largest speed ``v`` its knots may show (the line's, plus the rounding over two
+    steps, plus its tenth of room) and its ``tau`` moved by the rounding over ``c (1 - v)``."""
+    # in float scalars: called per keyframed object and update (issue 26: 1,000 objects)
+    origin, velocity, x_o = _vector3(origin, "origin"), _vector3(velocity, "velocity"), _vector3(x_o, "x_o")
+    c, step, t_o = float(c), float(step), float(t_o)
+    if not (0.0 < c < math.inf and 0.0 < step < math.inf and math.isfinite(t_o)):
+        raise ValueError("c and step must be positive and finite, t_o finite")
+    d = [o + u * t_o - x for o, u, x in zip(origin, velocity, x_o, strict=True)]
+    u2, du, d2 = (
+        math.fsum(a * b for a, b in zip(p, q, strict=True)) for p, q in ((velocity, velocity), (d, velocity), (d, d))
+    )
+    speed = math.sqrt(u2) / c
+    if speed >= 1.0:
+        return None
+    # (c^2 - u^2) tau^2 + 2 (d.u) tau - d^2 = 0, the positive root in the form without cancellation
+    root = math.sqrt(du * du + (c * c - u2) * d2)
+    tau = d2 / (root + du) if du > 0.0 else (root - du) / (c * c - u2)
+    extent = 0.0  # the window's largest |t - t_o|: the samples' size, so their rounding, grows with it
+    for _ in range(2):
+        size_there = max(map(abs, origin)) + math.sqrt(u2) * (abs(t_o) + tau + extent)
+        rounding = SAMPLE_ROUNDING * (1.0 + size_there)
+        fastest = speed + rounding / (step * c)
+        room = fastest + 0.1 * (1.0 - fastest)
+        if room >= 1.0 - 1e-9:
+            return None
+        half = 1.05 * reach * 1.25 * size * (1.0 + 1e-6) / (c * (1.0 - room)) + 2.0 * step
+        shift = 2.0 * rounding / (c * (1.0 - fastest))
+        extent = 2.0 * (half + shift + 8.0 * step)  # twice: the second pass's rounding covers its own window
+    first = math.floor((t_o - tau - shift - half) / step) - 4
+    last = math.ceil((t_o - tau + shift + half) / step) + 4
+    if last - first - 8 > max_intervals:
+        return None
+    return first * step, last * step, tau
+
+
+def _vector3(value: ArrayLike, name: str) -> list[float]:
+    values = [float(v) for v in np.asarray(value, dtype=np.float64).reshape(-1)]
+    if len(values) != 3 or not all(map(math.isfinite, values)):
+        raise ValueError(f"{name} must be a finite 3-vector")
+    return values

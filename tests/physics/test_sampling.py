@@ -180,3 +180,38 @@ def test_origin_light_travel_time_gives_way_near_light_speed():
     assert sampling.origin_light_travel_time(matrices, 0.05, 5.0, np.zeros(3), c) is None
     with pytest.raises(ValueError, match="slower than light"):
         sampling.motion_intervals(matrices, 0.05, 5.0, np.zeros(3), c, 0.5, 1024)
+
+
+@pytest.mark.parametrize("seed", range(18))
+def test_uniform_motion_window_holds_every_sample_the_intervals_read(seed):
+    """``uniform_motion_window`` (issue 26: the window of straight keys without sampling them) against
+    :func:`motion_intervals` on the same line sampled in float32 (as Blender evaluates keys): every
+    sample the intervals read (their knots, the neighbours, the contraction's neighbours) lies inside
+    the span, the span is at most three times as wide and a few steps, and its ``tau`` is the closed form's
+    (docs/physics.md: ``c tau = |x_o - O(t_o - tau)|``)."""
+    rng = np.random.default_rng(seed)
+    c, step = 10.0, 1.0 / 192.0
+    speed = [0.0, 0.3, 0.5, 0.8, 0.9, 0.95][seed % 6]
+    direction = rng.normal(size=3)
+    velocity = speed * c * direction / np.linalg.norm(direction)
+    start = rng.uniform(-1.0, 1.0, 3) * [5.0, 50.0, 500.0][seed // 6]  # large values: coarse float32 samples
+    angle, scale = rng.uniform(0.0, 6.0), rng.uniform(0.5, 2.0)
+    shape = scale * np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0, 0, 1]])
+
+    def matrices(times):
+        m = np.zeros((len(times), 4, 4))
+        m[:, :3, :3] = shape
+        m[:, :3, 3] = (start + np.multiply.outer(np.asarray(times), velocity)).astype(np.float32)
+        m[:, 3, 3] = 1.0
+        return m
+
+    t_o, x_o, reach = rng.uniform(-2.0, 2.0), rng.uniform(-3.0, 3.0, 3), rng.uniform(0.1, 3.0)
+    low, high, tau = sampling.uniform_motion_window(start, velocity, scale, step, t_o, x_o, c, reach, 4096)
+    d = start + velocity * t_o - x_o
+    expected = apparent.apparent_positions_uniform(t_o, x_o, d[None] + x_o, velocity / c, c, np.zeros(3))[1][0]
+    assert tau == pytest.approx(expected, rel=1e-12)
+    pieces = sampling.motion_intervals(matrices, step, t_o, x_o, c, reach, 4096)
+    assert pieces.start_distance / c == pytest.approx(tau, rel=1e-5, abs=1e-6)
+    read_low, read_high = (pieces.first - 3) * step, (pieces.first + len(pieces.coefficients) + 3) * step
+    assert low <= read_low + 1e-9 and read_high <= high + 1e-9
+    assert high - low <= 3.0 * (read_high - read_low) + 20 * step  # wide where the samples round coarsely

@@ -17,14 +17,14 @@ path (its verdict is in the object's signature).
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from ...errors import RelativityError
 from ...physics import polynomial_motion, sampling
-from ..common import compat, names
-from ..common.nodes import interface_identifier
+from ..common import names
 from ..scene import animation
 from . import modifier, motion, shape_keys, tessellation
 
@@ -140,15 +140,14 @@ def is_on(mod: Modifier | None) -> bool:
     """Whether the modifier computes keyframed motion itself."""
     if mod is None:
         return False
-    return bool(compat.modifier_input(mod, interface_identifier(mod.node_group, "Keyframed")))
+    return bool(modifier.input_value(mod, "Keyframed"))
 
 
 def verdicts_made(mod: Modifier) -> tuple[bool, bool]:
     """Whether the modifier's inputs make its verdicts: on the edges (``Measure Edges``, with the closed
     form or keyframed motion on) and on the window (keyframed motion on). The inputs an update found
     are those of the last evaluation: a new modifier (Set Up) has made none yet."""
-    group = mod.node_group
-    measured = bool(compat.modifier_input(mod, interface_identifier(group, "Measure Edges")))
+    measured = bool(modifier.input_value(mod, "Measure Edges"))
     return measured and modifier.closed_form_on(mod), is_on(mod)
 
 
@@ -185,6 +184,9 @@ def modifier_inputs(
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
     signature = animation.keyframes_signature(obj)
     facts = _keyed_facts(obj, signature)
+    uniform = _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach)
+    if uniform is not None:
+        return uniform, None
     corners = _box_corners(obj, facts)
     window = _window(obj, scene, signature, facts, corners, (fps, step, t_o, x_o, c, reach))
     if window is None:
@@ -294,6 +296,41 @@ def _window(obj, scene, signature, facts, corners, event):
     if key is not None:
         _windows[obj.session_uid] = (key, (pieces, line, found))
     return pieces, line, found
+
+
+def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
+    """The closed form's inputs where the keys draw one straight line over every sample
+    ``sampling.motion_intervals`` would read (``sampling.uniform_motion_window``: found from the
+    line alone, no key evaluated, no window solved), else None (the intervals decide then). The
+    same inputs as the intervals' straight-keys case below: the same line, shape and observer."""
+    if not _fact(facts, "translates only", lambda: animation.translates_only(obj)):
+        return None  # a rotation or scale keyed anywhere: the shape is not one matrix
+    t_o, x_o, beta_o = snap.mesh_observer
+    c = snap.speed_of_light
+    guess = (t_o - _last_tau.get(obj.session_uid, 0.0)) * fps
+    span = facts.get("straight span")
+    if span is None or not span[2] <= guess <= span[3]:  # the line the keys draw around the guess
+        span = facts["straight span"] = animation.straight_span(obj, guess) or (None, None, math.inf, -math.inf)
+    start, per_frame, first_frame, last_frame = span
+    if start is None:
+        return None
+    shape = _fact(facts, "held shape", lambda: animation.world_matrices(obj, [t_o * fps])[0, :3, :3])
+    size = _fact(facts, "held size", lambda: float(np.linalg.svd(shape, compute_uv=False)[0]))
+    window = sampling.uniform_motion_window(start, per_frame * fps, size, step, t_o, x_o, c, reach, MAX_INTERVALS)
+    if window is None:
+        return None
+    low, high, tau = window
+    held_before = _fact(facts, "held before", lambda: animation.held_before_frame(obj))
+    if held_before is not None and low * fps < held_before:
+        return None  # the intervals decide (the Python path, and its warning, before the keys move it)
+    if not (first_frame <= low * fps and high * fps <= last_frame):
+        return None  # the window reaches past the line (the intervals decide: a change of velocity in it)
+    _last_tau[obj.session_uid] = tau
+    matrix = motion.matrix_array(obj_eval.matrix_world)
+    origin = start + per_frame * (t_o * fps)
+    beta_o, x_o = np.asarray(beta_o, dtype=np.float64), np.asarray(x_o, dtype=np.float64)
+    closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
+    return {"Keyframed": False, "Closed Form": True, **closed}
 
 
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
@@ -410,8 +447,8 @@ def update(
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
             bound = _edge_bound(obj, obj_eval, snap, scene, inputs)
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
-    modifier.set_inputs(mod, inputs)
-    modifier.set_inputs(mod, {"Measure Edges": measure is not None, **(measure or {})})
+    # one call: the group (full or lean) is chosen once, on every input's new value
+    modifier.set_inputs(mod, {**inputs, "Measure Edges": measure is not None, **(measure or {})})
     if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays
         tessellation.announce(obj)
     return True

@@ -21,8 +21,9 @@ kept on the cache mesh too (``bakes.py``), so they go with the effect when it is
 from __future__ import annotations
 
 import threading
+from array import array
 from contextlib import contextmanager
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import bpy
 import numpy as np
@@ -32,7 +33,7 @@ from ..common.nodes import ensure_group, interface_identifier, remove_unused_gro
 from .node_group import LEAN_WHEN, lean_node_group_spec, node_group_spec
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from collections.abc import Iterable, Iterator
 
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
 
@@ -189,7 +190,7 @@ def ensure_modifier(obj: Object) -> tuple[Modifier, Object]:
     # modifier starts with none, so Set Up never subdivides a large mesh it may not need to
     adaptive = bool(obj.relativity.use_adaptive_tessellation)
     if created or not adaptive:
-        identifier = interface_identifier(group, "Tessellation")
+        identifier = _identifier(group, "Tessellation")
         level = 0 if adaptive else int(obj.relativity.tessellation)
         if compat.modifier_input(modifier, identifier) != level:
             compat.set_modifier_input(modifier, identifier, level)
@@ -256,6 +257,16 @@ def _identifier(group: NodeTree, name: str) -> str:
     return identifier if identifier is not None else interface_identifier(group, name)
 
 
+def input_identifier(group: NodeTree, name: str) -> str:
+    """The identifier of the group's input ``name`` (read once per group and version)."""
+    return _identifier(group, name)
+
+
+def input_value(mod: Modifier, name: str) -> object:
+    """The modifier's input ``name`` (by interface name; identifiers read once per group)."""
+    return compat.modifier_input(mod, _identifier(mod.node_group, name))
+
+
 def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
     """Set the modifier's inputs (by interface name) that differ after rounding to float32; returns
     whether any did (or the group changed).
@@ -277,9 +288,13 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
         if isinstance(value, bool):
             same = current is not None and bool(current) == value
         else:
-            new = np.asarray(value, dtype=np.float32)
-            same = current is not None and np.array_equal(np.asarray(current, dtype=np.float32), new)
-            value = float(new) if new.ndim == 0 else tuple(map(float, new))
+            new = _float32s(value)
+            same = (
+                current is not None
+                and hasattr(current, "__len__") == hasattr(value, "__len__")
+                and _float32s(current) == new
+            )
+            value = tuple(new) if hasattr(value, "__len__") else new[0]
         if not same:
             compat.set_modifier_input(mod, identifier, value)
             changed = True
@@ -289,6 +304,14 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
         _give_group(mod, ensure_lean_group())
         changed = True
     return changed
+
+
+def _float32s(value: object) -> list[float]:
+    """A number or a sequence of numbers rounded to float32 (the sockets' precision), as a list of
+    Python floats: compared and written without a numpy array per input (some twenty inputs per
+    object and update)."""
+    values = cast("Iterable[float]", value if hasattr(value, "__len__") else (value,))
+    return array("f", values).tolist()
 
 
 def closed_form_on(mod: Modifier) -> bool:

@@ -212,9 +212,37 @@ def uniform_motion_inputs(
     the observer at ``x_o`` moving with ``beta_o``, in the object space of the world ``matrix``."""
     beta_o = np.asarray(beta_o, dtype=np.float64)
     x_o = np.asarray(x_o, dtype=np.float64)
-    # r = A x_rest + k: the point at the observer's time, relative to the observer
-    scene = apparent.lorentz_contraction_matrix(w) @ np.asarray(shape, dtype=np.float64)
+    matrix = np.asarray(matrix, dtype=np.float64)
+    shape, w = np.asarray(shape, dtype=np.float64), np.asarray(w, dtype=np.float64)
+    key = b"".join(np.ascontiguousarray(a).tobytes() for a in (shape, w, beta_o, matrix[:3, :3]))
+    known = _uniform_parts.get(key)
+    if known is None:
+        known = _uniform_parts[key] = _uniform_motion_parts(shape, w, beta_o, matrix)
+        if len(_uniform_parts) > 4096:  # more objects, or velocities, than a sync passes over
+            _uniform_parts.clear()
+    inverse, to_local, fixed = known
     offset = np.asarray(origin, dtype=np.float64) - x_o
+    return {
+        **fixed,
+        "Scene Offset": _vector(offset),
+        "Local Offset": _vector(to_local @ offset + inverse @ (x_o - matrix[:3, 3])),
+    }
+
+
+def _vector(values):
+    return tuple(float(v) for v in values)
+
+
+# (shape, w, beta_o, the object's 3x3) -> what uniform_motion_inputs computes from them alone: a frame
+# step of keyframed motion on straight keys (issue 26: 1,000 objects) changes the two offsets only.
+_uniform_parts: dict[bytes, tuple[FloatArray, FloatArray, dict[str, tuple[float, ...] | float]]] = {}
+
+
+def _uniform_motion_parts(shape, w, beta_o, matrix):
+    """``(the inverse of the object's 3x3, its product with the boost, the inputs that do not
+    depend on the origin or the observer's place)`` of :func:`uniform_motion_inputs`."""
+    # r = A x_rest + k: the point at the observer's time, relative to the observer
+    scene = apparent.lorentz_contraction_matrix(w) @ shape
     # the emission event (-s, e = r - s w) boosted: e' = B e + gamma s beta_o (Lorentz boost)
     gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
     boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
@@ -223,26 +251,21 @@ def uniform_motion_inputs(
     to_local = inverse @ boost
     local = to_local @ scene
     seen = apparent.velocity_seen_by_observer(w, beta_o).reshape(-1, 3)[0]
-
-    def vector(values):
-        return tuple(float(v) for v in values)
-
-    return {
-        "Scene X": vector(scene[:, 0]),
-        "Scene Y": vector(scene[:, 1]),
-        "Scene Z": vector(scene[:, 2]),
-        "Scene Offset": vector(offset),
-        "Velocity": vector(w),
+    fixed = {
+        "Scene X": _vector(scene[:, 0]),
+        "Scene Y": _vector(scene[:, 1]),
+        "Scene Z": _vector(scene[:, 2]),
+        "Velocity": _vector(w),
         "Inverse Gamma Squared": 1.0 - float(w @ w),
         # one form for every point: no per-point choice (4 of the closed form's 19 nodes per point)
         "Folded": 1.0 / (1.0 - float(np.sqrt(w @ w))) <= FOLD_LIMIT,
-        "Local X": vector(local[:, 0]),
-        "Local Y": vector(local[:, 1]),
-        "Local Z": vector(local[:, 2]),
-        "Local Offset": vector(to_local @ offset + inverse @ (x_o - matrix[:3, 3])),
-        "Delay Direction": vector(gamma * (inverse @ beta_o) - to_local @ w),
-        "Seen Velocity": vector(seen),
+        "Local X": _vector(local[:, 0]),
+        "Local Y": _vector(local[:, 1]),
+        "Local Z": _vector(local[:, 2]),
+        "Delay Direction": _vector(gamma * (inverse @ beta_o) - to_local @ w),
+        "Seen Velocity": _vector(seen),
     }
+    return inverse, to_local, fixed
 
 
 def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:

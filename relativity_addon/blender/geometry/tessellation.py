@@ -29,7 +29,6 @@ import numpy as np
 
 from ...physics import tessellation
 from ..common import busy, compat, names
-from ..common.nodes import interface_identifier
 from . import modifier, motion
 
 if TYPE_CHECKING:
@@ -330,7 +329,7 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
     wanted = {"Tessellation": decision.level, "Face Codes": count, "Weld Distance": decision.weld}
     changed = data.get(names.TESSELLATION_KEY) != decision.key()
     for name, value in wanted.items():
-        identifier = interface_identifier(group, name)
+        identifier = modifier.input_identifier(group, name)
         current = compat.modifier_input(mod, identifier)
         # a float socket may hold the value in single precision: equal within its rounding
         if current is None or not math.isclose(float(current), float(value), rel_tol=1e-6, abs_tol=0.0):
@@ -350,7 +349,7 @@ def apply(obj: Object, mod: Modifier, cache: Object, decision: Decision) -> bool
 
 def face_codes(cache: Object, mod: Modifier) -> np.ndarray | None:
     """The face codes the cache holds for the modifier (kept when the decision is), or None."""
-    count = compat.modifier_input(mod, interface_identifier(mod.node_group, "Face Codes"))
+    count = modifier.input_value(mod, "Face Codes")
     attribute = cache.data.attributes.get(names.FACE_CODE_ATTRIBUTE) if count else None
     if attribute is None or len(attribute.data) < count:
         return None

@@ -14,6 +14,7 @@ camera's local axes (Blender convention: the camera looks down its local -Z).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -131,8 +132,9 @@ class Snapshot:
 
     @property
     def world_to_camera(self) -> np.ndarray:
-        """Rotation ``(3, 3)`` taking world vectors to camera axes (scale and shear removed)."""
-        return world_to_camera(np.array(self.camera_matrix, dtype=np.float64))
+        """Rotation ``(3, 3)`` taking world vectors to camera axes (scale and shear removed): one SVD
+        per camera matrix, not per call (the meshes' updates ask for it a few times an object)."""
+        return _world_to_camera_of(self.camera_matrix).copy()
 
     @property
     def beta_camera(self) -> np.ndarray:
@@ -426,6 +428,11 @@ def end_final_render(scene: Scene) -> None:
 
 def in_final_render(scene: Scene) -> bool:
     return scene.name in _final_renders
+
+
+@functools.lru_cache(maxsize=8)
+def _world_to_camera_of(camera_matrix: tuple) -> npt.NDArray[np.float64]:
+    return world_to_camera(np.array(camera_matrix, dtype=np.float64))
 
 
 def world_to_camera(camera_matrix: npt.ArrayLike) -> npt.NDArray[np.float64]:

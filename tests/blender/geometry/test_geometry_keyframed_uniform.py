@@ -127,3 +127,65 @@ def test_accelerating_keys_keep_the_keyframed_solve_and_its_fallback(relativity_
     rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
     expected, _velocity = _seen(obj, rest, 12 / FPS, np.array(camera.matrix_world.translation), OBSERVER_CHANGED)
     np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], expected, atol=1e-4)
+
+
+def _all_inputs(obj):
+    """Every input value of the object's modifier but the geometry and the cache, as Python data."""
+    modifier = gh.addon_module("geometry.modifier")
+    mod = modifier.find_modifier(obj)
+    values = {}
+    for name, identifier in modifier._input_identifiers(mod.node_group).items():
+        if name in ("Geometry", "Cache"):  # (5.2: the geometry input has no value)
+            continue
+        value = gh.compat.modifier_input(mod, identifier)
+        if value is not None:
+            values[name] = tuple(value) if hasattr(value, "__len__") else value
+    return mod.node_group.name, values
+
+
+def test_straight_keys_found_without_sampling_give_the_intervals_inputs(relativity_addon, monkeypatch):
+    """Issue 26 (the 1,000-object keyframed scene): straight keys take the closed form from the line
+    alone (``keyframed._uniform_over_window``, ``sampling.uniform_motion_window``: no key evaluated,
+    no window solved) wherever the intervals would have found the keys straight, with the very inputs
+    the intervals' path sets, frame after frame across a change of velocity (frame 40) and back."""
+    import bpy
+
+    keyframed = gh.addon_module("geometry.keyframed")
+    sampling = keyframed.sampling
+    animation = gh.addon_module("scene.animation")
+    scene, _camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = OBSERVER
+    obj = _uniform_mover(bpy, scene, adaptive=True)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    frames = (12, 13, 14, 20, 30, 60, 75, 90, 13)
+    calls = {"motion_intervals": 0, "world_matrices": 0}
+    for module, name in ((sampling, "motion_intervals"), (animation, "world_matrices")):
+        original = getattr(module, name)
+
+        def counted(*args, _original=original, _name=name, **kwargs):
+            calls[_name] += _name != "world_matrices" or args[0] == obj  # (the camera's are read at every sync)
+            return _original(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, counted)
+
+    def run():
+        found = []
+        for frame in frames:
+            scene.frame_set(frame)
+            bpy.context.evaluated_depsgraph_get()
+            found.append((dict(calls), _all_inputs(obj)))
+        return found
+
+    found = run()
+    closed = [frame for frame, (_calls, (_group, values)) in zip(frames, found, strict=True) if values["Closed Form"]]
+    assert 12 in closed and 75 not in closed  # 75: the window holds the kink at frame 40
+    # frames 13 and 14 after 12: each step is taken from the line alone
+    assert found[1][0] == found[0][0] and found[2][0] == found[1][0]
+    monkeypatch.setattr(keyframed, "_uniform_over_window", lambda *args: None)
+    scene.frame_set(1)  # every frame below is a change again
+    bpy.context.evaluated_depsgraph_get()
+    intervals = run()
+    assert intervals[2][0]["motion_intervals"] > intervals[1][0]["motion_intervals"]
+    assert [inputs for _calls, inputs in found] == [inputs for _calls, inputs in intervals]
