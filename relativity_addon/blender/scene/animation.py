@@ -304,6 +304,30 @@ def _straight_channel(fcurve: FCurve, low: float, high: float) -> tuple[float, f
     return None
 
 
+def _keyed_line(obj, channel):
+    """``(translation at frame 0, its change per frame, the channels' lines)`` summed from what
+    ``channel(fcurve)`` gives each transform F-curve (a tuple starting ``(value at frame 0, change per
+    frame)``, or None), the channels no F-curve animates taken at the object's own values; None when
+    the object has a parent, a channel gives None, or a channel other than a location changes."""
+    if obj.parent is not None:
+        return None
+    curves = _transform_fcurves(obj)
+    start, rate, lines = np.zeros(3), np.zeros(3), []
+    for (path, index), fcurve in curves.items():
+        line = channel(fcurve)
+        if line is None or (path not in LOCATION_PATHS and line[1] != 0.0):
+            return None
+        lines.append(line)
+        if path in LOCATION_PATHS:
+            start[index] += line[0]
+            rate[index] += line[1]
+    for path in LOCATION_PATHS:  # the channels no F-curve animates: the object's own values
+        for index in range(3):
+            if (path, index) not in curves:
+                start[index] += float(getattr(obj, path)[index])
+    return start, rate, lines
+
+
 def straight_keys(
     obj: Object, low: float, high: float
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
@@ -313,22 +337,8 @@ def straight_keys(
     other transform channel one value, no parent), else None. In float64 from the keys themselves:
     the line the keys draw, without the float32 rounding of Blender's evaluation
     (:func:`world_matrices`)."""
-    if obj.parent is not None:
-        return None
-    curves = _transform_fcurves(obj)
-    start, rate = np.zeros(3), np.zeros(3)
-    for (path, index), fcurve in curves.items():
-        line = _straight_channel(fcurve, low, high)
-        if line is None or (path not in LOCATION_PATHS and line[1] != 0.0):
-            return None
-        if path in LOCATION_PATHS:
-            start[index] += line[0]
-            rate[index] += line[1]
-    for path in LOCATION_PATHS:  # the channels no F-curve animates: the object's own values
-        for index in range(3):
-            if (path, index) not in curves:
-                start[index] += float(getattr(obj, path)[index])
-    return start, rate
+    found = _keyed_line(obj, lambda fcurve: _straight_channel(fcurve, low, high))
+    return None if found is None else found[:2]
 
 
 def _channel_span(fcurve: FCurve, frame: float) -> tuple[float, float, float, float] | None:
@@ -362,22 +372,12 @@ def straight_span(
     over which the keys draw that one line), or None where it gives None around ``frame``. Read once,
     it answers :func:`straight_keys` for any window inside the span without reading a key (issue 26:
     a frame step of 1,000 keyframed objects)."""
-    if obj.parent is not None:
+    found = _keyed_line(obj, lambda fcurve: _channel_span(fcurve, frame))
+    if found is None:
         return None
-    curves = _transform_fcurves(obj)
-    start, rate, low, high = np.zeros(3), np.zeros(3), -math.inf, math.inf
-    for (path, index), fcurve in curves.items():
-        line = _channel_span(fcurve, frame)
-        if line is None or (path not in LOCATION_PATHS and line[1] != 0.0):
-            return None
-        low, high = max(low, line[2]), min(high, line[3])
-        if path in LOCATION_PATHS:
-            start[index] += line[0]
-            rate[index] += line[1]
-    for path in LOCATION_PATHS:  # the channels no F-curve animates: the object's own values
-        for index in range(3):
-            if (path, index) not in curves:
-                start[index] += float(getattr(obj, path)[index])
+    start, rate, lines = found
+    low = max((line[2] for line in lines), default=-math.inf)
+    high = min((line[3] for line in lines), default=math.inf)
     return start, rate, low, high
 
 
