@@ -210,3 +210,30 @@ def test_turning_sphere_lamp_doppler_with_each_points_velocity(relativity_addon,
         assert named == pytest.approx(_rim(turn, axis), abs=0.015)
     if turn < TURN / 5.0:
         assert lines == []
+
+
+@pytest.mark.parametrize("spin", ["about X", "about Z", "slow", "at rest"])
+def test_spin_left_rigid_in_scene_time_is_said(relativity_addon, factory_blender, spin):
+    """The own animation of a moving body is drawn at the origin's clock for every vertex, so the
+    relativity of simultaneity across it is left out (docs/proper-time.md): a point a rest distance
+    ``x`` ahead of the origin is drawn ``omega beta x / c`` radians late, ``beta beta_rim`` at the
+    rim (0.5c, rim 0.31c: 0.157 rad, 9.0 degrees). One panel line names the sphere with about that
+    angle (the speeds it reads are the drawn ones: 0.31c about X, up to 0.38c about Z); none for
+    the slow spin (0.9 degrees, under the one-degree bar) or a spinning sphere at rest."""
+    bpy = factory_blender
+    turn = TURN / 10.0 if spin == "slow" else TURN
+    scene, _ = _turning_sphere(bpy, "CONSTANT", 1, False, turn, 2 if spin == "about Z" else 0)
+    if spin == "at rest":
+        scene.objects["Sphere"].relativity.beta = (0.0, 0.0, 0.0)
+    effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+    effect.apply(scene)
+    lines = [line for line in effect.scene_warnings(scene) if "'Sphere' spins while it moves" in line]
+    print(spin, lines)
+    if spin in ("slow", "at rest"):
+        assert lines == []
+        return
+    assert len(lines) == 1 and "docs/proper-time.md" in lines[0]
+    named = float(lines[0].split("up to about ")[1].split(" degrees")[0])
+    expected = math.degrees(per_point.BETA * turn * 1.0 / per_point.C)  # beta beta_rim, the keys' rim
+    assert expected == pytest.approx(9.0, abs=0.1)
+    assert named == pytest.approx(expected, rel=0.25)
