@@ -30,6 +30,7 @@ from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
 from ..geometry import apparent_meshes, changes, clip_end, instancing, modifier, shape_keys, tessellation
+from ..lights import turning_receivers
 from ..scene import animation, moving_objects, snapshot, traveller
 from . import bake, render_notice
 from .stages import STAGES, Sync
@@ -446,13 +447,15 @@ def _record(scene, snap, depsgraph=None):
                 known = _object_warnings.get(obj.name)
                 if known is not None and known[0][0] == eye and changes.is_current(scene.name, obj.session_uid):
                     continue  # an applied mesh Blender did not update since its warnings were made
-                _object_warnings[obj.name] = _mesh_warnings(obj, snap)
+                _object_warnings[obj.name] = _mesh_warnings(scene, obj, snap)
 
 
-def _mesh_warnings(obj, snap):
+def _mesh_warnings(scene, obj, snap):
     """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change."""
     inputs = (
         tuple(snap.camera_position),
+        obj.relativity.motion,
+        tuple(obj.relativity.beta),
         tuple(map(tuple, obj.matrix_world)),
         obj.data.name,
         len(obj.data.edges),
@@ -464,7 +467,8 @@ def _mesh_warnings(obj, snap):
     if known is not None and known[0] == inputs:
         return known
     coarse = tessellation.coarse_mesh_warning(obj, snap.camera_position)
-    return inputs, [coarse] if coarse else []
+    spin = turning_receivers.spin_warning(obj, scene, snap.speed_of_light)
+    return inputs, [line for line in (coarse, spin) if line]
 
 
 def _shape_key_warnings(obj):

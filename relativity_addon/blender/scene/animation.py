@@ -242,6 +242,48 @@ def has_own_animation(obj: Object, scene: Scene | None = None) -> bool:
     return False
 
 
+EULER_PATHS = frozenset(("rotation_euler", "delta_rotation_euler"))
+
+
+def fastest_key_rates(obj: Object) -> tuple[float, float] | None:
+    """``(location speed, turn rate)`` per frame at most, that the object's own location and Euler
+    rotation keys draw (scene units and radians per frame; each channel's steepest slope, its Bezier
+    segments bounded by their control polygons, summed over the channels), or None where another
+    channel turns it (quaternion, axis-angle) or an F-curve has modifiers: no bound read off the keys."""
+    location, turn = np.zeros(3), 0.0
+    for (path, index), fcurve in _transform_fcurves(obj).items():
+        steepest = None if len(fcurve.modifiers) else _steepest(fcurve)
+        if path in LOCATION_PATHS | EULER_PATHS and steepest is None:
+            return None
+        if path in LOCATION_PATHS:
+            location[index] += steepest
+        elif path in EULER_PATHS:
+            turn += steepest
+        elif path.startswith(("rotation", "delta_rotation")):
+            return None
+    return float(np.linalg.norm(location)), turn
+
+
+def _steepest(fcurve: FCurve) -> float | None:
+    """The largest slope (value per frame) of an F-curve between its keys: a Bezier segment's
+    derivative lies within its control polygon's slopes (the hodograph's convex hull); None where a
+    segment eases otherwise (Sine, Elastic...: no bound kept here)."""
+    points = sorted(fcurve.keyframe_points, key=lambda point: point.co[0])
+    steepest = 0.0
+    for left, right in zip(points, points[1:], strict=False):
+        polygon = [left.co, right.co]
+        if left.interpolation == "BEZIER":
+            polygon = [left.co, left.handle_right, right.handle_left, right.co]
+        elif left.interpolation == "CONSTANT":
+            continue
+        elif left.interpolation != "LINEAR":
+            return None
+        for a, b in zip(polygon, polygon[1:], strict=False):
+            if b[0] - a[0] > 1e-9:
+                steepest = max(steepest, abs(float(b[1]) - float(a[1])) / (float(b[0]) - float(a[0])))
+    return steepest
+
+
 def world_matrix_at(obj: Object, frame: float) -> Matrix:
     """``matrix_world`` at ``frame`` from keyframes alone (object parents; no constraints)."""
     return Matrix(world_matrices(obj, [frame])[0].tolist())
