@@ -56,7 +56,7 @@ def _count_work(monkeypatch):
     hook(meshes, "update_object", "update", lambda args: args[1])
     hook(compat, "set_modifier_input", "input written", lambda args: args[0].id_data)
     hook(clip_end, "bounds_depth", "depth", lambda args: args[1])
-    hook(effect, "_mesh_warnings", "warnings", lambda args: args[0])
+    hook(effect, "_mesh_warnings", "warnings", lambda args: args[1])
     return work
 
 
