@@ -14,6 +14,7 @@ of arrays of points, so this module knows no camera model and no motion.
 
 import math
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
@@ -206,6 +207,95 @@ _EYE3 = np.eye(3)
 _EYE3.flags.writeable = False
 
 
+class _BoxView(NamedTuple):
+    """What both edge bounds need of a mesh in uniform motion over rest boxes (one value per box
+    where an array): the pixels per unit of ``|v| / d`` (``scale``), the largest distance and least
+    depth of the apparent points (``distance``, ``depth``; ``depth <= 0``: not every point is in
+    front), the least light-travel distance ``s_low``, a lower bound on ``1 + n.w`` (``approach``,
+    ``n`` the unit vector from the observer to the emission), the motion's ``speed`` and ``gamma``,
+    ``h`` (``e' = B r + s h``), the norms of ``B A`` and of the object's 3x3 matrix and the
+    observer's ``gamma_o``."""
+
+    scale: float
+    distance: FloatArray
+    depth: FloatArray
+    s_low: FloatArray
+    approach: FloatArray
+    speed: float
+    gamma: float
+    h: FloatArray
+    norm_ba: float
+    norm_m: float
+    gamma_o: float
+
+
+def _box_view(
+    rest_low: ArrayLike,
+    rest_high: ArrayLike,
+    object_matrix: ArrayLike,
+    object_beta: ArrayLike,
+    observer_position: ArrayLike,
+    observer_beta: ArrayLike,
+    world_to_camera: ArrayLike,
+    window: tuple[float, float, float, float],
+    resolution: tuple[float, float],
+) -> _BoxView:
+    """Rest boxes (``rest_low``/``rest_high``: ``(3,)`` or ``(K, 3)``) seen through the closed form
+    (docs/performance.md, "A bound on the edges' images", steps 1-6, and "A bound on the edges'
+    bends")."""
+    low = np.asarray(rest_low, dtype=np.float64).reshape(-1, 1, 3)
+    high = np.asarray(rest_high, dtype=np.float64).reshape(-1, 1, 3)
+    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
+    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
+    beta_o = np.asarray(observer_beta, dtype=np.float64).reshape(3)
+    speed, speed_o = math.sqrt(float(w @ w)), math.sqrt(float(beta_o @ beta_o))
+    if not (speed < 1.0 and speed_o < 1.0):
+        raise ValueError("velocities must be below the speed of light")
+    gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
+    # r = A x + k: the rest point at the observer's time, relative to the observer
+    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
+    a = contraction @ matrix[:3, :3]
+    k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
+    r = np.where(_CORNER_BITS, high, low) @ a.T + k  # (K, 8, 3)
+    # s = c tau from |r - s w| = s (docs/physics.md with Delta = -r): convex in r, so largest at a
+    # corner of the box's image
+    along = r @ w
+    s = (np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=-1)) - along) / (1.0 - speed * speed)
+    s_high = s.max(axis=1)
+    centre = r.sum(axis=1)
+    toward = centre / np.maximum(np.linalg.norm(centre, axis=1), 1e-300)[:, None]
+    s_low = np.maximum(0.0, np.einsum("kcj,kj->kc", r, toward).min(axis=1)) / (1.0 + speed)  # |r| <= (1 + |w|) s
+    # convex: at least its tangent plane at the box's centre, least at a corner (grad s = n / (1 + n.w))
+    mid = centre / 8.0
+    mid_along = mid @ w
+    s_mid = (np.sqrt(mid_along * mid_along + (1.0 - speed * speed) * (mid * mid).sum(axis=-1)) - mid_along) / (
+        1.0 - speed * speed
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        n_mid = (mid - s_mid[:, None] * w) / s_mid[:, None]
+        grad = n_mid / (1.0 + n_mid @ w)[:, None]
+        tangent = s_mid + np.einsum("kcj,kj->kc", r - mid[:, None, :], grad).min(axis=1)
+    s_low = np.where(np.isfinite(tangent), np.maximum(s_low, tangent), s_low)
+    # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
+    boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
+    h = gamma_o * beta_o - boost @ w
+    forward = -np.asarray(world_to_camera, dtype=np.float64).reshape(3, 3)[2]
+    ahead, ahead_s = r @ (boost @ forward), float(forward @ h)
+    # depth f.e': concave in r when f.h <= 0 (least at a corner), else at least its linear part's least
+    depth = (ahead + s * ahead_s).min(axis=1) if ahead_s <= 0.0 else ahead.min(axis=1) + s_low * ahead_s
+    distance = gamma_o * (1.0 + speed_o) * s_high
+    left, right, bottom, top = window
+    width, height = resolution
+    scale = max(width / (right - left), height / (top - bottom))
+    norms = np.linalg.svd(np.stack((boost @ a, matrix[:3, :3])), compute_uv=False)[:, 0]
+    # 1 + n.w = 1 - w.w + r.w / s (n = (r - s w) / s): r.w linear, least at a corner; s_low <= s <= s_high
+    least_along = along.min(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        least_ratio = np.where(least_along < 0.0, least_along / s_low, least_along / s_high)
+        approach = np.maximum(1.0 - speed, np.where(s_low > 0.0, 1.0 - speed * speed + least_ratio, 0.0))
+    return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h, float(norms[0]), float(norms[1]), gamma_o)
+
+
 def edge_image_bound(
     rest_low: ArrayLike,
     rest_high: ArrayLike,
@@ -228,41 +318,88 @@ def edge_image_bound(
     The object is drawn with ``object_matrix`` (4, 4) at the observer's time, its rest shape
     contracted along ``object_beta`` (fraction of c) about its origin; the observer moves with
     ``observer_beta``; docs/physics.md, "Light-travel time" and "Lorentz boost of an event"."""
-    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
-    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
-    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
-    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
-    beta_o = np.asarray(observer_beta, dtype=np.float64).reshape(3)
-    speed, speed_o = math.sqrt(float(w @ w)), math.sqrt(float(beta_o @ beta_o))
-    if not (speed < 1.0 and speed_o < 1.0):
-        raise ValueError("velocities must be below the speed of light")
-    gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
-    # r = A x + k: the rest point at the observer's time, relative to the observer
-    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
-    a = contraction @ matrix[:3, :3]
-    k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
-    r = np.where(_CORNER_BITS, high, low) @ a.T + k
-    # s = c tau from |r - s w| = s: convex in r, so largest at a corner of the box's image
-    along = r @ w
-    s = (along + np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=1))) / (1.0 - speed * speed)
-    s_high = float(s.max())
-    centre = r.sum(axis=0)
-    toward = centre / max(math.sqrt(float(centre @ centre)), 1e-300)
-    s_low = max(0.0, float((r @ toward).min())) / (1.0 + speed)  # |r| <= (1 + |w|) s
-    # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
-    boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
-    h = gamma_o * beta_o - boost @ w
-    forward = -np.asarray(world_to_camera, dtype=np.float64).reshape(3, 3)[2]
-    ahead, ahead_s = r @ (boost @ forward), float(forward @ h)
-    # depth f.e': concave in r when f.h <= 0 (least at a corner), else at least its linear part's least
-    depth = float((ahead + s * ahead_s).min()) if ahead_s <= 0.0 else float(ahead.min()) + s_low * ahead_s
-    distance = gamma_o * (1.0 + speed_o) * s_high
+    view = _box_view(
+        rest_low,
+        rest_high,
+        object_matrix,
+        object_beta,
+        observer_position,
+        observer_beta,
+        world_to_camera,
+        window,
+        resolution,
+    )
+    distance, depth = float(view.distance[0]), float(view.depth[0])
     if not depth > 1e-9 * distance:
         return float("inf")
-    left, right, bottom, top = window
-    width, height = resolution
-    scale = max(width / (right - left), height / (top - bottom))
     # |d pixels| <= scale |v| / depth^2 |dv|;  De' = B A + h (A^T n)^T / (1 + n.w), n = e / s
-    norms = np.linalg.svd(np.stack((boost @ a, matrix[:3, :3])), compute_uv=False)[:, 0]
-    stretch = float(norms[0]) + math.sqrt(float(h @ h)) * float(norms[1]) * gamma * (1.0 + speed)
-    return scale * distance / (depth * depth) * stretch * float(longest_edge)
+    stretch = view.norm_ba + math.sqrt(float(view.h @ view.h)) * view.norm_m * view.gamma * (1.0 + view.speed)
+    return view.scale * distance / (depth * depth) * stretch * float(longest_edge)
+
+
+# The bend bound splits the rest box into up to this many parts along each of its axes (each part
+# widened by the longest edge, so that it holds every edge that starts in it): the farthest and the
+# nearest apparent points, and the points that recede fastest, are then no longer taken together.
+BEND_PARTS = 4
+
+
+def _parts(low: FloatArray, high: FloatArray, longest: float) -> tuple[FloatArray, FloatArray]:
+    """The rest box's parts (``(K, 3)`` lows and highs): an axis is split where it is longer than
+    ``BEND_PARTS`` edges."""
+    cuts = []
+    for axis in range(3):
+        extent = high[axis] - low[axis]
+        count = BEND_PARTS if extent > BEND_PARTS * longest else 1
+        edges = low[axis] + extent * np.arange(count + 1) / count
+        cuts.append((np.maximum(edges[:-1] - longest, low[axis]), np.minimum(edges[1:] + longest, high[axis])))
+    grid = np.stack(np.meshgrid(*[np.arange(len(c[0])) for c in cuts], indexing="ij"), axis=-1).reshape(-1, 3)
+    lows = np.stack([cuts[axis][0][grid[:, axis]] for axis in range(3)], axis=1)
+    highs = np.stack([cuts[axis][1][grid[:, axis]] for axis in range(3)], axis=1)
+    return lows, highs
+
+
+def edge_bend_bound(
+    rest_low: ArrayLike,
+    rest_high: ArrayLike,
+    longest_edge: float,
+    object_matrix: ArrayLike,
+    object_beta: ArrayLike,
+    observer_position: ArrayLike,
+    observer_beta: ArrayLike,
+    world_to_camera: ArrayLike,
+    window: tuple[float, float, float, float],
+    resolution: tuple[float, float],
+    acceleration: float = 0.0,
+) -> float:
+    """An upper bound, in pixels, on the bend :func:`edge_levels` measures on every edge left whole
+    (:func:`segment_bends` with one piece: the image of the apparent midpoint against the image of
+    the drawn segment's middle), for the mesh of :func:`edge_image_bound`; infinite where it cannot
+    show every apparent point in front of the camera. It falls with the square of ``longest_edge``
+    (the length bound with its first power): a dense mesh seen at a large render size clears it where
+    its edges' images are pixels long (docs/performance.md, "A bound on the edges' bends").
+
+    ``acceleration``: where the origin's world line is not straight, a bound on ``|d^2 x / d(ct)^2|``
+    (per unit length) over the light-travel times the edges span, ``object_beta`` the velocity the
+    line is measured from (keyframed motion over its window)."""
+    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
+    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
+    lows, highs = _parts(low, high, float(longest_edge))
+    view = _box_view(
+        lows, highs, object_matrix, object_beta, observer_position, observer_beta, world_to_camera, window, resolution
+    )
+    if not np.all(view.depth > 1e-9 * view.distance) or not np.all(view.s_low > 0.0):
+        return float("inf")
+    # along an edge r(t) = r_a + t u, |u| <= ||M|| L (the contraction shortens): the apparent
+    # point e'(t) = B r(t) + s(t) h, so e'(1/2) - (e'(0) + e'(1)) / 2 = h (s(1/2) - (s(0) + s(1)) / 2),
+    # at most |h| max|s''| / 8; s'' = (|u - s' w|^2 - s'^2) / (s (1 + n.w)) <= gamma_w^2 |u|^2 / (s (1 + n.w))
+    u2 = (view.norm_m * float(longest_edge)) ** 2
+    s_second = view.gamma * view.gamma * u2 / (view.s_low * view.approach)
+    spatial: FloatArray | float = 0.0
+    if acceleration > 0.0:
+        # a world line bent by a: e'' = B x'' s'^2 + h s'', |s'| <= |u| / (1 + n.w), and s'' gains
+        # a |s'|^2 / (1 + n.w) (docs/performance.md)
+        s_second = s_second + acceleration * u2 / view.approach**3
+        spatial = view.gamma_o * acceleration * u2 / view.approach**2
+    bend = (spatial + math.sqrt(float(view.h @ view.h)) * s_second) / 8.0
+    # |P(y1) - P(y2)| <= scale |v|_max / d_min^2 |y1 - y2| (both points in the part's apparent hull)
+    return float(np.max(view.scale * view.distance / (view.depth * view.depth) * bend))

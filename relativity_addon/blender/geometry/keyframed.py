@@ -381,13 +381,15 @@ def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray
     data.update()
 
 
-def _edge_bound(obj, obj_eval, snap, scene, inputs):
-    """The closed form's bound on the edges' images (pixels) for the closed form's ``inputs``; for
-    the polynomial's, the largest of the bounds of the uniform motions through the origin at the
-    window's centre with the origin's velocity at the window's two ends and centre (the motion
-    departs from each by less than the samples' rounding over the retarded times' spread)."""
+def _edge_bound(obj, obj_eval, snap, scene, inputs, tolerance):
+    """The closed form's bound on the edges' images or bends (pixels; ``tessellation.edge_image_bound``)
+    for the closed form's ``inputs``; for the polynomial's, the largest of the bounds of the uniform
+    motions through the origin at the window's centre with the origin's velocity at the window's two
+    ends and centre (the motion departs from each by less than the samples' rounding over the
+    retarded times' spread), the bends' with the polynomial's largest acceleration over the window."""
     x_o = np.asarray(snap.mesh_observer[1])
     size = tessellation.render_size(scene)
+    acceleration = 0.0
     if not inputs.get("Keyframed"):
         motions = [(np.asarray(cast("tuple[float, float, float]", inputs["Scene Offset"])), inputs["Velocity"])]
     else:
@@ -398,11 +400,14 @@ def _edge_bound(obj, obj_eval, snap, scene, inputs):
             powers = np.arange(1, len(origin))
             w = (powers * u ** (powers - 1)) @ origin[1:] / polynomial.half
             motions.append((origin[0] + polynomial.centre * origin[1] / polynomial.half, tuple(w)))
+        # |d^2 x / ds^2| <= sum p (p - 1) |c_p| / half^2 over the window (|u| <= 1)
+        powers = np.arange(2, len(origin))
+        acceleration = float(powers * (powers - 1) @ np.linalg.norm(origin[2:], axis=1)) / polynomial.half**2
     bound = 0.0
     for offset, velocity in motions:
         at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
         at_t_o[:3, 3] = offset + x_o
-        bound = max(bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, velocity))
+        bound = max(bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, tolerance, velocity, acceleration))
     return bound
 
 
@@ -445,7 +450,7 @@ def update(
         if len(data.vertices) != (0 if codes is None else len(codes)):  # the face codes alone
             modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
-            bound = _edge_bound(obj, obj_eval, snap, scene, inputs)
+            bound = _edge_bound(obj, obj_eval, snap, scene, inputs, measure["Tolerance"])
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
     # one call: the group (full or lean) is chosen once, on every input's new value
     modifier.set_inputs(mod, {**inputs, "Measure Edges": measure is not None, **(measure or {})})

@@ -195,7 +195,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
         "Tolerance": tolerance,
         # the bound knows uniform motion only: a keyframed object's edges are always checked
         "Edges Proven Short": motion.closed_form(obj, scene)
-        and bool(edge_image_bound(obj, matrix, snap, (width, height)) <= PROVEN_MARGIN * tolerance),
+        and bool(edge_image_bound(obj, matrix, snap, (width, height), tolerance) <= PROVEN_MARGIN * tolerance),
     }
 
 
@@ -244,12 +244,22 @@ def _read_rest_bounds(mesh: Mesh) -> tuple[FloatArray, FloatArray, float]:
 
 
 def edge_image_bound(
-    obj: Object, matrix: FloatArray, snap: Snapshot, size: tuple[float, float], velocity: object = None
+    obj: Object,
+    matrix: FloatArray,
+    snap: Snapshot,
+    size: tuple[float, float],
+    tolerance: float,
+    velocity: object = None,
+    acceleration: float = 0.0,
 ) -> float:
-    """``physics/tessellation.edge_image_bound`` of a closed-form object (pixels), inf where it
-    cannot be computed: a velocity change that it clears needs no edge visited. ``velocity``
-    (fraction of c): the uniform motion's, when not the object's setting (keyframed motion uniform
-    over its window, ``keyframed.py``; ``matrix`` then at the observer's time)."""
+    """A bound (pixels) on what the modifier's check and :func:`decide` measure of a closed-form
+    object's edges, inf where it cannot be computed: a velocity change whose bound clears the
+    tolerance needs no edge visited. The image lengths' bound
+    (``physics/tessellation.edge_image_bound``), and where that does not clear ``tolerance`` the
+    bends' (``edge_bend_bound``: no edge then needs subdividing either), whichever is less.
+    ``velocity`` (fraction of c): the uniform motion's, when not the object's setting (keyframed
+    motion uniform over its window, ``keyframed.py``; ``matrix`` then at the observer's time), with
+    the window's ``acceleration`` (``edge_bend_bound``)."""
     bounds = rest_bounds(obj)
     if bounds is None:
         return float("inf")
@@ -270,12 +280,17 @@ def edge_image_bound(
         snap.camera_matrix,  # the camera's rotation comes from it (a numpy repr took milliseconds)
         window,
         size,
+        tolerance,
+        acceleration,
     )
     last = _last_bound.get(obj.name)
     if last is not None and last[0] == key:
         return last[1]
+    arguments = (*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
     try:
-        bound = tessellation.edge_image_bound(*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+        bound = tessellation.edge_image_bound(*arguments)
+        if not bound <= PROVEN_MARGIN * tolerance:
+            bound = min(bound, tessellation.edge_bend_bound(*arguments, acceleration))
     except ValueError:  # a velocity not below c: the update reports it
         bound = float("inf")
     _last_bound[obj.name] = (key, bound)

@@ -1,4 +1,4 @@
-"""Issue 26: a velocity change on a fine closed-form grid whose edge images the bound
+"""Issue 26: a velocity change on a fine closed-form grid whose edge images (or bends) the bound
 (physics/tessellation.edge_image_bound) shows short visits no edge: the add-on sets the modifier's
 ``Edges Proven Short`` and runs no measure and no read of the mesh, and the modifier leaves the
 mesh whole without its per-edge check (shown by a tolerance the check would fail: the verdict
@@ -147,13 +147,14 @@ def test_coarse_box_near_the_camera_is_not_cleared(relativity_addon):
     assert vertices > 8
 
 
-def test_keyframed_motion_is_not_cleared_by_the_bound(relativity_addon):
-    """The bound knows uniform motion only (the panel's velocity): the same fine grid moved by its
-    keyframes at 0.6c gets the modifier's per-edge check, never ``Edges Proven Short`` (with the
-    velocity taken as zero, the bound cleared it: its edges stretched by the motion went unchecked)."""
+def test_keyframed_motion_is_bounded_with_its_keys_velocity(relativity_addon, monkeypatch):
+    """The bound knows uniform motion only: the same fine grid moved by its keyframes at 0.6c is
+    bounded with the keys' velocity, not the panel's (zero: with it, the bound cleared its edges
+    stretched and bent by the motion unseen), and cleared by it."""
     import bpy
 
     modifier = gh.addon_module("geometry.modifier")
+    tessellation = gh.addon_module("geometry.tessellation")
     scene, obj = _fine_grid(bpy)
     obj.relativity.beta = (0.0, 0.0, 0.0)
     obj.relativity.motion = "ANIMATION"
@@ -164,9 +165,51 @@ def test_keyframed_motion_is_not_cleared_by_the_bound(relativity_addon):
     for fcurve in compat.action_fcurves(obj.animation_data):
         for point in fcurve.keyframe_points:
             point.interpolation = "LINEAR"
+    velocities = []
+    original = tessellation.edge_image_bound
+
+    def recorded(obj, matrix, snap, size, tolerance, velocity=None, acceleration=0.0):
+        velocities.append(velocity)
+        return original(obj, matrix, snap, size, tolerance, velocity, acceleration)
+
+    monkeypatch.setattr(tessellation, "edge_image_bound", recorded)
     scene.frame_set(12)
     gh.apply_geometry(scene)
-    bpy.context.evaluated_depsgraph_get()
+    verdict, vertices = _verdict(bpy, obj)
     mod = modifier.find_modifier(obj)
     assert compat.modifier_input(*_input(mod, "Measure Edges")), "the modifier checks the edges"
-    assert not compat.modifier_input(*_input(mod, "Edges Proven Short"))
+    keyed = [v for v in velocities if v is not None and abs(float(v[0]) - 0.6) < 1e-3 and abs(float(v[1])) < 1e-6]
+    assert keyed, velocities
+    assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
+    assert verdict is True and vertices == SIDE * SIDE
+
+
+def test_fine_grid_at_a_large_render_size_is_cleared_by_its_bends(relativity_addon, monkeypatch):
+    """The fine grid rendered 1920 x 1440: its edges' images are about 5 px long, so neither the
+    length bound nor the modifier's length check clears them (before the bend bound each velocity
+    change ran the Python measure over every edge: issue 26's 216x at 320 x 240), while they bend by
+    thousandths of a pixel: velocity changes run no measure, read no mesh, and leave it whole."""
+    import bpy
+
+    tessellation = gh.addon_module("geometry.tessellation")
+    modifier = gh.addon_module("geometry.modifier")
+    scene, obj = _fine_grid(bpy)
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 1920, 1440, 100
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    calls = {}
+    for name in ("decide", "_mesh_arrays", "_read_rest_bounds"):
+        _counted(monkeypatch, tessellation, name, calls)
+    for beta in ((0.52, 0.1, 0.0), (0.48, 0.0, 0.1), (0.5, 0.1, 0.0)):
+        obj.relativity.beta = beta
+        verdict, vertices = _verdict(bpy, obj)
+    mod = modifier.find_modifier(obj)
+    assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
+    assert verdict is True and vertices == SIDE * SIDE
+    assert calls == {}, calls
+    # the length check alone fails at this size: the bend bound is what cleared it
+    with _without_addon_handlers(bpy):
+        modifier._give_group(mod, modifier.ensure_node_group())
+        compat.set_modifier_input(*_input(mod, "Edges Proven Short"), False)
+        obj.update_tag()
+        assert _verdict(bpy, obj)[0] is False
