@@ -296,6 +296,28 @@ def _box_view(
     return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h, float(norms[0]), float(norms[1]), gamma_o)
 
 
+def _swept(
+    rest_low: ArrayLike, rest_high: ArrayLike, object_matrix: ArrayLike, object_beta: ArrayLike, sweep: ArrayLike | None
+) -> tuple[FloatArray, FloatArray]:
+    """The rest box, widened (object space) so that the object drawn with its origin anywhere on
+    the segment from the matrix's translation to it plus ``sweep`` (world units) keeps every point
+    inside the box drawn at the translation: ``r = A x + k + t d = A (x + t A^-1 d) + k``."""
+    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
+    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
+    if sweep is None:
+        return low, high
+    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
+    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
+    speed2 = float(w @ w)
+    gamma = 1.0 / math.sqrt(1.0 - speed2) if speed2 < 1.0 else math.inf
+    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed2, 1e-300)
+    try:
+        step = np.linalg.solve(contraction @ matrix[:3, :3], np.asarray(sweep, dtype=np.float64).reshape(3))
+    except np.linalg.LinAlgError:
+        step = np.full(3, np.inf)  # a flattened object: no box holds the sweep
+    return np.minimum(low, low + step), np.maximum(high, high + step)
+
+
 def edge_image_bound(
     rest_low: ArrayLike,
     rest_high: ArrayLike,
@@ -307,6 +329,7 @@ def edge_image_bound(
     world_to_camera: ArrayLike,
     window: tuple[float, float, float, float],
     resolution: tuple[float, float],
+    sweep: ArrayLike | None = None,
 ) -> float:
     """An upper bound, in pixels, on the image length of every edge of a mesh in uniform motion
     (the closed form: docs/performance.md, "A bound on the edges' images"), from its rest shape's
@@ -317,10 +340,15 @@ def edge_image_bound(
 
     The object is drawn with ``object_matrix`` (4, 4) at the observer's time, its rest shape
     contracted along ``object_beta`` (fraction of c) about its origin; the observer moves with
-    ``observer_beta``; docs/physics.md, "Light-travel time" and "Lorentz boost of an event"."""
+    ``observer_beta``; docs/physics.md, "Light-travel time" and "Lorentz boost of an event".
+    ``sweep`` (world units): the bound holds for the origin anywhere from the matrix's translation
+    to that plus ``sweep`` (the observer's later times on a straight world line)."""
+    low, high = _swept(rest_low, rest_high, object_matrix, object_beta, sweep)
+    if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
+        return float("inf")
     view = _box_view(
-        rest_low,
-        rest_high,
+        low,
+        high,
         object_matrix,
         object_beta,
         observer_position,
@@ -370,6 +398,7 @@ def edge_bend_bound(
     window: tuple[float, float, float, float],
     resolution: tuple[float, float],
     acceleration: float = 0.0,
+    sweep: ArrayLike | None = None,
 ) -> float:
     """An upper bound, in pixels, on the bend :func:`edge_levels` measures on every edge left whole
     (:func:`segment_bends` with one piece: the image of the apparent midpoint against the image of
@@ -380,9 +409,11 @@ def edge_bend_bound(
 
     ``acceleration``: where the origin's world line is not straight, a bound on ``|d^2 x / d(ct)^2|``
     (per unit length) over the light-travel times the edges span, ``object_beta`` the velocity the
-    line is measured from (keyframed motion over its window)."""
-    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
-    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
+    line is measured from (keyframed motion over its window); ``sweep``: as for
+    :func:`edge_image_bound`."""
+    low, high = _swept(rest_low, rest_high, object_matrix, object_beta, sweep)
+    if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
+        return float("inf")
     lows, highs = _parts(low, high, float(longest_edge))
     view = _box_view(
         lows, highs, object_matrix, object_beta, observer_position, observer_beta, world_to_camera, window, resolution

@@ -316,3 +316,47 @@ def test_bend_bound_with_an_accelerating_origin(accel, direction):
         measured,
     )
     assert abs(measured - largest(np.zeros(3))) > 0.005 * measured
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_swept_bounds_hold_along_the_sweep(seed):
+    """With ``sweep`` the bounds hold for the origin anywhere on the segment: the segments' image
+    lengths and bends measured at five places along it, the object moved there, never exceed them."""
+    rng = np.random.default_rng(100 + seed)
+    low, high, matrix, u, x_o, beta_o, rotation = _random_case(rng)
+    longest = float(rng.uniform(0.01, 0.3)) * float(np.min(high - low))
+    a, b = _segments(rng, low, high, longest, 2000)
+    longest = max(longest, float(np.max(np.linalg.norm(b - a, axis=1))))
+    sweep = rng.normal(size=3) * rng.uniform(0.05, 1.0)
+    args = (low, high, longest, matrix, u, x_o, beta_o, rotation, WINDOW, RESOLUTION)
+    length = tessellation.edge_image_bound(*args, sweep=sweep)
+    bend = tessellation.edge_bend_bound(*args, sweep=sweep)
+    assert length >= tessellation.edge_image_bound(*args) or not np.isfinite(length)
+    for t in np.linspace(0.0, 1.0, 5):
+        moved = matrix.copy()
+        moved[:3, 3] += t * sweep
+
+        def seen(p, moved=moved):
+            return _seen_in_camera(p, moved, u, x_o, beta_o, rotation)
+
+        if np.isfinite(length):
+            assert np.all(_pixels(seen(a))[1] > 0.0) and np.all(_pixels(seen(b))[1] > 0.0)
+            measured = float(np.max(np.linalg.norm(_pixels(seen(b))[0] - _pixels(seen(a))[0], axis=1)))
+            assert length >= measured, (t, length, measured)
+        if np.isfinite(bend):
+            assert bend >= float(np.max(_bends(a, b, seen))), t
+
+
+def test_swept_bound_covers_the_grid_brought_closer():
+    """The 4 m grid 5 m ahead at 0.5c, swept 3.5 m towards the camera: its edges' images at the end of
+    the sweep are about 3x longer than at its start, beyond the bound's slack at the start (so a bound
+    that left the sweep out would fail here), and the swept bound holds there."""
+    rest, edges = _grid(101, 4.0)
+    matrix, x_o, beta = np.eye(4), np.array([0.0, 0.0, 5.0]), (0.5, 0.0, 0.0)
+    args = (rest.min(axis=0), rest.max(axis=0), 0.04, matrix, beta, x_o, np.zeros(3), np.eye(3), WINDOW, RESOLUTION)
+    moved = matrix.copy()
+    moved[2, 3] = 3.5
+    image, _ = _pixels(_seen_in_camera(rest, moved, beta, x_o, np.zeros(3), np.eye(3)))
+    measured = float(np.max(np.linalg.norm(image[edges[:, 1]] - image[edges[:, 0]], axis=1)))
+    assert measured > tessellation.edge_image_bound(*args)
+    assert tessellation.edge_image_bound(*args, sweep=(0.0, 0.0, 3.5)) >= measured

@@ -206,7 +206,9 @@ CHUNK_EDGES = 1 << 20  # edges whose lengths are computed at once
 # rest shape; forgotten when Blender evaluates the object's geometry again for a reason the add-on
 # did not announce (:func:`note_updates`).
 _rest_bounds: dict[str, tuple] = {}
-_last_bound: dict[str, tuple] = {}  # object name -> (the bound's inputs, the bound)
+# object name -> (the bound's inputs but the origin, the origin, the sweep it holds over or None, the
+# bound, whether a sweep failed to clear the tolerance for these inputs)
+_last_bound: dict[str, tuple] = {}
 _announced: set[str] = set()
 
 
@@ -251,6 +253,7 @@ def edge_image_bound(
     tolerance: float,
     velocity: object = None,
     acceleration: float = 0.0,
+    sweep: FloatArray | None = None,
 ) -> float:
     """A bound (pixels) on what the modifier's check and :func:`decide` measure of a closed-form
     object's edges, inf where it cannot be computed: a velocity change whose bound clears the
@@ -259,7 +262,9 @@ def edge_image_bound(
     bends' (``edge_bend_bound``: no edge then needs subdividing either), whichever is less.
     ``velocity`` (fraction of c): the uniform motion's, when not the object's setting (keyframed
     motion uniform over its window, ``keyframed.py``; ``matrix`` then at the observer's time), with
-    the window's ``acceleration`` (``edge_bend_bound``)."""
+    the window's ``acceleration`` (``edge_bend_bound``). ``sweep`` (world units): the origin's way
+    over the next frames on a straight world line; a bound over all of it that clears the
+    tolerance is kept for every origin on it (a frame step computes none)."""
     bounds = rest_bounds(obj)
     if bounds is None:
         return float("inf")
@@ -273,7 +278,7 @@ def edge_image_bound(
         bounds[0].tobytes(),
         bounds[1].tobytes(),
         bounds[2],
-        matrix.tobytes(),
+        matrix[:3, :3].tobytes(),
         beta,
         tuple(x_o),
         tuple(beta_o),
@@ -283,18 +288,49 @@ def edge_image_bound(
         tolerance,
         acceleration,
     )
+    origin = matrix[:3, 3]
     last = _last_bound.get(obj.name)
-    if last is not None and last[0] == key:
-        return last[1]
-    arguments = (*bounds, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+    if last is not None and last[0] == key and _on_way(origin, last[1], last[2]):
+        return last[3]
+    low, high, longest = bounds
+    arguments = (low, high, longest, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+    # a sweep did not clear the tolerance with these inputs: not tried again
+    failed = bool(last is not None and last[0] == key and last[4])
+    use_sweep = sweep is not None and not failed
     try:
-        bound = tessellation.edge_image_bound(*arguments)
-        if not bound <= PROVEN_MARGIN * tolerance:
-            bound = min(bound, tessellation.edge_bend_bound(*arguments, acceleration))
+        bound = _bound(arguments, tolerance, acceleration, sweep if use_sweep else None)
+        if use_sweep and not bound <= PROVEN_MARGIN * tolerance:
+            failed, use_sweep = True, False
+            bound = _bound(arguments, tolerance, acceleration, None)
     except ValueError:  # a velocity not below c: the update reports it
-        bound = float("inf")
-    _last_bound[obj.name] = (key, bound)
+        bound, use_sweep = float("inf"), False
+    _last_bound[obj.name] = (key, origin.copy(), sweep if use_sweep else None, bound, failed)
     return bound
+
+
+def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:
+    """The lengths' bound, or where it does not clear the tolerance the least of it and the bends'."""
+    low, high, longest, matrix, beta, x_o, beta_o, rotation, window, size = arguments
+    view = (matrix, beta, x_o, beta_o, rotation, window, size)
+    bound = tessellation.edge_image_bound(low, high, longest, *view, sweep=sweep)
+    if not bound <= PROVEN_MARGIN * tolerance:
+        bend = tessellation.edge_bend_bound(low, high, longest, *view, acceleration=acceleration, sweep=sweep)
+        bound = min(bound, bend)
+    return bound
+
+
+def _on_way(origin: FloatArray, start: FloatArray, sweep: FloatArray | None) -> bool:
+    """Whether ``origin`` is ``start`` or on the segment from it along ``sweep`` (float rounding allowed
+    across it: far below anything the bounds resolve)."""
+    if np.array_equal(origin, start):
+        return True
+    if sweep is None:
+        return False
+    moved = origin - start
+    along = float(moved @ sweep) / max(float(sweep @ sweep), 1e-300)
+    across = moved - along * sweep
+    scale = 1e-9 * (1.0 + float(np.abs(start).max()) + float(np.abs(sweep).max()))
+    return -1e-9 <= along <= 1.0 + 1e-9 and float(np.abs(across).max()) <= scale
 
 
 def announce(obj: Object) -> None:

@@ -168,9 +168,9 @@ def test_keyframed_motion_is_bounded_with_its_keys_velocity(relativity_addon, mo
     velocities = []
     original = tessellation.edge_image_bound
 
-    def recorded(obj, matrix, snap, size, tolerance, velocity=None, acceleration=0.0):
+    def recorded(obj, matrix, snap, size, tolerance, velocity=None, *rest):
         velocities.append(velocity)
-        return original(obj, matrix, snap, size, tolerance, velocity, acceleration)
+        return original(obj, matrix, snap, size, tolerance, velocity, *rest)
 
     monkeypatch.setattr(tessellation, "edge_image_bound", recorded)
     scene.frame_set(12)
@@ -213,3 +213,40 @@ def test_fine_grid_at_a_large_render_size_is_cleared_by_its_bends(relativity_add
         compat.set_modifier_input(*_input(mod, "Edges Proven Short"), False)
         obj.update_tag()
         assert _verdict(bpy, obj)[0] is False
+
+
+def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monkeypatch):
+    """On straight keys the bound is taken over the origin's way through the next frames
+    (``keyframed.SWEEP_FRAMES``): stepping through them computes no bound and the verdict holds;
+    a step past them computes one again."""
+    import bpy
+
+    modifier = gh.addon_module("geometry.modifier")
+    tessellation = gh.addon_module("geometry.tessellation")
+    keyframed = gh.addon_module("geometry.keyframed")
+    scene, obj = _fine_grid(bpy)
+    obj.relativity.beta = (0.0, 0.0, 0.0)
+    obj.relativity.motion = "ANIMATION"
+    step = 0.6 * C / FPS  # metres per frame at 0.6c
+    for frame, x in ((-40, 0.3 - 52 * step), (80, 0.3 + 68 * step)):
+        obj.location.x = x
+        obj.keyframe_insert("location", frame=frame)
+    for fcurve in compat.action_fcurves(obj.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    calls = {}
+    _counted(monkeypatch, tessellation.tessellation, "edge_image_bound", calls)
+    mod = modifier.find_modifier(obj)
+    for frame in range(13, 12 + keyframed.SWEEP_FRAMES):
+        scene.frame_set(frame)
+        verdict, vertices = _verdict(bpy, obj)
+        assert compat.modifier_input(*_input(mod, "Edges Proven Short")), frame
+        assert verdict is True and vertices == SIDE * SIDE
+    assert calls == {}, calls
+    scene.frame_set(12 + 3 * keyframed.SWEEP_FRAMES)
+    bpy.context.evaluated_depsgraph_get()
+    assert calls.get("edge_image_bound", 0) >= 1
+    assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
