@@ -263,19 +263,19 @@ def _box_view(
     s = (np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=-1)) - along) / (1.0 - speed * speed)
     s_high = s.max(axis=1)
     centre = r.sum(axis=1)
-    toward = centre / np.maximum(np.linalg.norm(centre, axis=1), 1e-300)[:, None]
-    s_low = np.maximum(0.0, np.einsum("kcj,kj->kc", r, toward).min(axis=1)) / (1.0 + speed)  # |r| <= (1 + |w|) s
-    # convex: at least its tangent plane at the box's centre, least at a corner (grad s = n / (1 + n.w))
+    toward = centre / np.maximum(np.sqrt((centre * centre).sum(axis=-1)), 1e-300)[:, None]
+    s_low = np.maximum(0.0, (r * toward[:, None, :]).sum(axis=-1).min(axis=1)) / (1.0 + speed)  # |r| <= (1 + |w|) s
+    # convex: at least its tangent plane at the box's centre, least at a corner (grad s = n / (1 + n.w),
+    # 1 + n.w >= 1 - |w| > 0)
     mid = centre / 8.0
     mid_along = mid @ w
     s_mid = (np.sqrt(mid_along * mid_along + (1.0 - speed * speed) * (mid * mid).sum(axis=-1)) - mid_along) / (
         1.0 - speed * speed
     )
-    with np.errstate(divide="ignore", invalid="ignore"):
-        n_mid = (mid - s_mid[:, None] * w) / s_mid[:, None]
-        grad = n_mid / (1.0 + n_mid @ w)[:, None]
-        tangent = s_mid + np.einsum("kcj,kj->kc", r - mid[:, None, :], grad).min(axis=1)
-    s_low = np.where(np.isfinite(tangent), np.maximum(s_low, tangent), s_low)
+    n_mid = (mid - s_mid[:, None] * w) / np.maximum(s_mid, 1e-300)[:, None]
+    grad = n_mid / (1.0 + n_mid @ w)[:, None]
+    tangent = s_mid + ((r - mid[:, None, :]) * grad[:, None, :]).sum(axis=-1).min(axis=1)
+    s_low = np.maximum(s_low, np.where(s_mid > 0.0, tangent, 0.0))
     # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
     boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
     h = gamma_o * beta_o - boost @ w
@@ -287,13 +287,29 @@ def _box_view(
     left, right, bottom, top = window
     width, height = resolution
     scale = max(width / (right - left), height / (top - bottom))
-    norms = np.linalg.svd(np.stack((boost @ a, matrix[:3, :3])), compute_uv=False)[:, 0]
+    norm_ba, norm_m = _norms(boost, a, matrix)
     # 1 + n.w = 1 - w.w + r.w / s (n = (r - s w) / s): r.w linear, least at a corner; s_low <= s <= s_high
     least_along = along.min(axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        least_ratio = np.where(least_along < 0.0, least_along / s_low, least_along / s_high)
-        approach = np.maximum(1.0 - speed, np.where(s_low > 0.0, 1.0 - speed * speed + least_ratio, 0.0))
-    return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h, float(norms[0]), float(norms[1]), gamma_o)
+    least_ratio = np.where(least_along < 0.0, least_along / np.maximum(s_low, 1e-300), least_along / s_high)
+    approach = np.maximum(1.0 - speed, np.where(s_low > 0.0, 1.0 - speed * speed + least_ratio, 0.0))
+    return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h, norm_ba, norm_m, gamma_o)
+
+
+# (B A, M) as bytes -> their largest singular values: the same for every part and every frame step
+_known_norms: dict[bytes, tuple[float, float]] = {}
+
+
+def _norms(boost: FloatArray, a: FloatArray, matrix: FloatArray) -> tuple[float, float]:
+    """``||B A||`` and ``||M||`` (largest singular values), kept: two SVDs per call cost more than the rest."""
+    ba = boost @ a
+    key = ba.tobytes() + matrix[:3, :3].tobytes()
+    known = _known_norms.get(key)
+    if known is None:
+        norms = np.linalg.svd(np.stack((ba, matrix[:3, :3])), compute_uv=False)[:, 0]
+        if len(_known_norms) > 4096:
+            _known_norms.clear()
+        known = _known_norms[key] = (float(norms[0]), float(norms[1]))
+    return known
 
 
 def _swept(

@@ -390,11 +390,11 @@ def _edge_bound(obj, obj_eval, snap, scene, inputs, tolerance):
     x_o = np.asarray(snap.mesh_observer[1])
     size = tessellation.render_size(scene)
     acceleration = 0.0
-    sweep = None
+    way = None
     if not inputs.get("Keyframed"):
         velocity = np.asarray(cast("tuple[float, float, float]", inputs["Velocity"]), dtype=np.float64)
         motions = [(np.asarray(cast("tuple[float, float, float]", inputs["Scene Offset"])), inputs["Velocity"])]
-        sweep = _sweep(obj, obj_eval, velocity * snap.speed_of_light / animation.frames_per_second(scene))
+        way = velocity * snap.speed_of_light / animation.frames_per_second(scene)  # a frame's, world units
     else:
         polynomial = _polynomials[obj.session_uid]
         origin = polynomial.coefficients[:, :, 3]  # (D + 1, 3): the origin relative to the observer
@@ -411,28 +411,9 @@ def _edge_bound(obj, obj_eval, snap, scene, inputs, tolerance):
         at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
         at_t_o[:3, 3] = offset + x_o
         bound = max(
-            bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, tolerance, velocity, acceleration, sweep)
+            bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, tolerance, velocity, acceleration, way)
         )
     return bound
-
-
-# Straight keys: the edges' bound is taken over the origin's way through this many frames to come (a
-# frame step on the line then computes none), at most the object's own size (the bound's box grows by it).
-SWEEP_FRAMES = 8
-
-
-def _sweep(obj, obj_eval, per_frame):
-    """The origin's way over the next ``SWEEP_FRAMES`` frames (``per_frame``: world units a frame),
-    shortened to the object's size, or None (no rest box: the bound is not computed)."""
-    bounds = tessellation.rest_bounds(obj)
-    if bounds is None:
-        return None
-    size = float(np.linalg.norm(bounds[1] - bounds[0])) * float(
-        np.linalg.norm(motion.matrix_array(obj_eval.matrix_world)[:3, :3], 2)
-    )
-    way = per_frame * SWEEP_FRAMES
-    length = float(np.linalg.norm(way))
-    return way if length <= size else way * (size / max(length, 1e-300))
 
 
 def update(

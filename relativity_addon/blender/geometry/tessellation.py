@@ -253,7 +253,7 @@ def edge_image_bound(
     tolerance: float,
     velocity: object = None,
     acceleration: float = 0.0,
-    sweep: FloatArray | None = None,
+    way: FloatArray | None = None,
 ) -> float:
     """A bound (pixels) on what the modifier's check and :func:`decide` measure of a closed-form
     object's edges, inf where it cannot be computed: a velocity change whose bound clears the
@@ -262,9 +262,10 @@ def edge_image_bound(
     bends' (``edge_bend_bound``: no edge then needs subdividing either), whichever is less.
     ``velocity`` (fraction of c): the uniform motion's, when not the object's setting (keyframed
     motion uniform over its window, ``keyframed.py``; ``matrix`` then at the observer's time), with
-    the window's ``acceleration`` (``edge_bend_bound``). ``sweep`` (world units): the origin's way
-    over the next frames on a straight world line; a bound over all of it that clears the
-    tolerance is kept for every origin on it (a frame step computes none)."""
+    the window's ``acceleration`` (``edge_bend_bound``). ``way`` (world units): the origin's way
+    through one frame on a straight world line: the bound is taken over the next frames' way
+    (:func:`_sweep`), and one that clears the tolerance is kept for every origin on it (a frame step
+    on the line computes none)."""
     bounds = rest_bounds(obj)
     if bounds is None:
         return float("inf")
@@ -294,6 +295,7 @@ def edge_image_bound(
         return last[3]
     low, high, longest = bounds
     arguments = (low, high, longest, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
+    sweep = None if way is None else _sweep(low, high, matrix, np.asarray(way, dtype=np.float64))
     # a sweep did not clear the tolerance with these inputs: not tried again
     failed = bool(last is not None and last[0] == key and last[4])
     use_sweep = sweep is not None and not failed
@@ -306,6 +308,21 @@ def edge_image_bound(
         bound, use_sweep = float("inf"), False
     _last_bound[obj.name] = (key, origin.copy(), sweep if use_sweep else None, bound, failed)
     return bound
+
+
+# Straight keys: the edges' bound is taken over the origin's way through up to this many frames to
+# come, and up to SWEEP_SIZES times the object's size (the bound's box grows by the sweep), one frame's
+# at least.
+SWEEP_FRAMES = 8
+SWEEP_SIZES = 4.0
+
+
+def _sweep(low: FloatArray, high: FloatArray, matrix: FloatArray, way: FloatArray) -> FloatArray:
+    """The origin's way over the frames the bound is taken for (world units)."""
+    size = float(np.sqrt(((high - low) ** 2).sum() * (matrix[:3, :3] ** 2).sum()))  # at least the box's
+    step = float(np.sqrt(way @ way))
+    frames = SWEEP_FRAMES if step * SWEEP_FRAMES <= SWEEP_SIZES * size else max(1, int(SWEEP_SIZES * size / step))
+    return way * frames
 
 
 def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:

@@ -217,13 +217,12 @@ def test_fine_grid_at_a_large_render_size_is_cleared_by_its_bends(relativity_add
 
 def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monkeypatch):
     """On straight keys the bound is taken over the origin's way through the next frames
-    (``keyframed.SWEEP_FRAMES``): stepping through them computes no bound and the verdict holds;
+    (``tessellation.SWEEP_FRAMES``): stepping through them computes no bound and the verdict holds;
     a step past them computes one again."""
     import bpy
 
     modifier = gh.addon_module("geometry.modifier")
     tessellation = gh.addon_module("geometry.tessellation")
-    keyframed = gh.addon_module("geometry.keyframed")
     scene, obj = _fine_grid(bpy)
     obj.relativity.beta = (0.0, 0.0, 0.0)
     obj.relativity.motion = "ANIMATION"
@@ -240,13 +239,13 @@ def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monke
     calls = {}
     _counted(monkeypatch, tessellation.tessellation, "edge_image_bound", calls)
     mod = modifier.find_modifier(obj)
-    for frame in range(13, 12 + keyframed.SWEEP_FRAMES):
+    for frame in range(13, 12 + tessellation.SWEEP_FRAMES):
         scene.frame_set(frame)
         verdict, vertices = _verdict(bpy, obj)
         assert compat.modifier_input(*_input(mod, "Edges Proven Short")), frame
         assert verdict is True and vertices == SIDE * SIDE
     assert calls == {}, calls
-    scene.frame_set(12 + 3 * keyframed.SWEEP_FRAMES)
+    scene.frame_set(12 + 3 * tessellation.SWEEP_FRAMES)
     bpy.context.evaluated_depsgraph_get()
     assert calls.get("edge_image_bound", 0) >= 1
     assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
