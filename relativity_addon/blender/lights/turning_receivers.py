@@ -96,13 +96,26 @@ def spin_warning(obj: Object, scene: Scene, c: float) -> str | None:
     """One line when the object moves and its own Euler rotation keys turn it so fast that the
     simultaneity left out puts its rim :data:`MIN_SPIN_LAG` or more off (``beta beta_rim`` radians,
     both bounded from the keys: ``animation.fastest_key_rates``; the rim its farthest vertex from the
-    origin, read only where its box's farthest corner passes), else None. No evaluation, no solve."""
+    origin, read only where its box's farthest corner passes), else None. Where the keys give no
+    bound (quaternion or axis-angle rotation, other easing, F-curve modifiers) and its own rotation
+    keys vary, the line without the angle. No evaluation, no solve."""
     settings = obj.relativity
     if settings.motion not in ("CONSTANT", "ANIMATION") or not world_lines.turns(obj, scene):
         return None
     rates = animation.fastest_key_rates(obj)
-    if rates is None:
-        return None
+    if rates is None:  # quaternion or axis-angle keys, other easing, F-curve modifiers: not bounded
+        moves = (
+            any(settings.beta)
+            if settings.motion == "CONSTANT"
+            else animation.keys_vary(obj, ("location", "delta_location"))
+        )
+        if not moves or not animation.keys_vary(obj, ("rotation", "delta_rotation")):
+            return None
+        return (
+            f"{obj.name!r} spins while it moves: its spin is drawn in the scene's time, not its own (the "
+            "relativity of simultaneity is left out); how far off its rim is cannot be read off these "
+            "keys (quaternion, axis-angle, eased other than Bezier, or modifiers) (docs/proper-time.md)"
+        )
     fps = animation.frames_per_second(scene)
     speed = math.hypot(*settings.beta) if settings.motion == "CONSTANT" else rates[0] * fps / c
     linear = world_lines.matrix_array(obj.matrix_world)[:3, :3]

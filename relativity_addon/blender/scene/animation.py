@@ -264,6 +264,22 @@ def fastest_key_rates(obj: Object) -> tuple[float, float] | None:
     return float(np.linalg.norm(location)), turn
 
 
+def keys_vary(obj: Object, prefixes: tuple[str, ...]) -> bool:
+    """Whether a live channel of the object's own action whose path starts with one of ``prefixes``
+    (``("rotation", "delta_rotation")``: any rotation mode) holds differing key values or handles, or
+    has modifiers (its parents' keys are not read)."""
+    for (path, _index), fcurve in _transform_fcurves(obj).items():
+        if not path.startswith(prefixes):
+            continue
+        if len(fcurve.modifiers):
+            return True
+        points = fcurve.keyframe_points
+        values = {float(v) for point in points for v in (point.co[1], point.handle_left[1], point.handle_right[1])}
+        if len(values) > 1:
+            return True
+    return False
+
+
 def _steepest(fcurve: FCurve) -> float | None:
     """The largest slope (value per frame) of an F-curve between its keys: a Bezier segment's
     derivative lies within its control polygon's slopes (the hodograph's convex hull); None where a

@@ -212,28 +212,41 @@ def test_turning_sphere_lamp_doppler_with_each_points_velocity(relativity_addon,
         assert lines == []
 
 
-@pytest.mark.parametrize("spin", ["about X", "about Z", "slow", "at rest"])
+@pytest.mark.parametrize("spin", ["about X", "about Z", "slow", "at rest", "quaternion", "quaternion held"])
 def test_spin_left_rigid_in_scene_time_is_said(relativity_addon, factory_blender, spin):
     """The own animation of a moving body is drawn at the origin's clock for every vertex, so the
     relativity of simultaneity across it is left out (docs/proper-time.md): a point a rest distance
     ``x`` ahead of the origin is drawn ``omega beta x / c`` radians late, ``beta beta_rim`` at the
     rim (0.5c, rim 0.31c: 0.157 rad, 9.0 degrees). The sphere's panel (Active Object) names it with
     that angle, read off its keys; nothing for the slow spin (0.9 degrees, under the one-degree bar)
-    or the spinning sphere at rest."""
+    or the spinning sphere at rest. Keyed as quaternions the spin gives no bound off its keys: the
+    line names it without the angle; quaternion keys that hold one orientation give none."""
     bpy = factory_blender
     turn = TURN / 10.0 if spin == "slow" else TURN
     scene, _ = _turning_sphere(bpy, "CONSTANT", 1, False, turn, 2 if spin == "about Z" else 0)
     sphere = scene.objects["Sphere"]
     if spin == "at rest":
         sphere.relativity.beta = (0.0, 0.0, 0.0)
+    if spin.startswith("quaternion"):  # the same keys as quaternions (or held at the first one)
+        sphere.animation_data_clear()
+        sphere.rotation_mode = "QUATERNION"
+        for frame in range(-47, 50, 4):  # a key every 4 frames: a quaternion holds a turn below half a circle
+            t = (frame - 13) / 24.0
+            angle = 0.0 if spin == "quaternion held" else turn * t
+            sphere.rotation_quaternion = (math.cos(angle / 2.0), math.sin(angle / 2.0), 0.0, 0.0)
+            sphere.keyframe_insert("rotation_quaternion", frame=frame)
+        scene.frame_set(13)
     effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
     effect.apply(scene)
     lines = [line for line in effect.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
     print(spin, lines)
-    if spin in ("slow", "at rest"):
+    if spin in ("slow", "at rest", "quaternion held"):
         assert lines == []
         return
     assert len(lines) == 1 and "docs/proper-time.md" in lines[0]
+    if spin == "quaternion":
+        assert "cannot be read off these keys" in lines[0]
+        return
     named = float(lines[0].split("up to about ")[1].split(" degrees")[0])
     expected = math.degrees(per_point.BETA * turn * 1.0 / per_point.C)  # beta beta_rim, the keys' rim
     assert expected == pytest.approx(9.0, abs=0.1)
