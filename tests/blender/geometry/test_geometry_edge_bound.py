@@ -67,6 +67,22 @@ def _fine_grid(bpy):
     return scene, obj
 
 
+def _keyed_grid(bpy, last):
+    """The fine grid moved by two linear location keys at 0.6c (frames -40 and ``last``), its panel
+    velocity zero."""
+    scene, obj = _fine_grid(bpy)
+    obj.relativity.beta = (0.0, 0.0, 0.0)
+    obj.relativity.motion = "ANIMATION"
+    step = 0.6 * C / FPS  # metres per frame at 0.6c
+    for frame in (-40, last):
+        obj.location.x = 0.3 + (frame - 12) * step
+        obj.keyframe_insert("location", frame=frame)
+    for fcurve in compat.action_fcurves(obj.animation_data):
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    return scene, obj
+
+
 def test_velocity_change_on_a_fine_grid_visits_no_edge(relativity_addon, monkeypatch):
     import bpy
 
@@ -155,16 +171,7 @@ def test_keyframed_motion_is_bounded_with_its_keys_velocity(relativity_addon, mo
 
     modifier = gh.addon_module("geometry.modifier")
     tessellation = gh.addon_module("geometry.tessellation")
-    scene, obj = _fine_grid(bpy)
-    obj.relativity.beta = (0.0, 0.0, 0.0)
-    obj.relativity.motion = "ANIMATION"
-    step = 0.6 * C / FPS  # metres per frame at 0.6c
-    for frame, x in ((-40, 0.3 - 52 * step), (40, 0.3 + 28 * step)):
-        obj.location.x = x
-        obj.keyframe_insert("location", frame=frame)
-    for fcurve in compat.action_fcurves(obj.animation_data):
-        for point in fcurve.keyframe_points:
-            point.interpolation = "LINEAR"
+    scene, obj = _keyed_grid(bpy, 40)
     velocities = []
     original = tessellation.edge_image_bound
 
@@ -223,16 +230,7 @@ def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monke
 
     modifier = gh.addon_module("geometry.modifier")
     tessellation = gh.addon_module("geometry.tessellation")
-    scene, obj = _fine_grid(bpy)
-    obj.relativity.beta = (0.0, 0.0, 0.0)
-    obj.relativity.motion = "ANIMATION"
-    step = 0.6 * C / FPS  # metres per frame at 0.6c
-    for frame, x in ((-40, 0.3 - 52 * step), (80, 0.3 + 68 * step)):
-        obj.location.x = x
-        obj.keyframe_insert("location", frame=frame)
-    for fcurve in compat.action_fcurves(obj.animation_data):
-        for point in fcurve.keyframe_points:
-            point.interpolation = "LINEAR"
+    scene, obj = _keyed_grid(bpy, 80)
     scene.frame_set(12)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
