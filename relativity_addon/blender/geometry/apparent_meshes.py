@@ -235,11 +235,8 @@ def update_object(
                 _deferred.add(obj.name)
                 cache.data[names.SIGNATURE_KEY] = ""  # computed at the next sync
                 return 0
-            if not in_frame_change and not closed:
-                # the new subdivision's rest positions (a closed-form object reads none: its inputs do
-                # not depend on them; evaluating again here, in a depsgraph handler, crashed Blender 4.5
-                # when the modifier's group had just changed from the lean one to the full one)
-                depsgraph = bpy.context.evaluated_depsgraph_get()
+            if not in_frame_change and not closed:  # a closed-form object reads no rest position
+                depsgraph = bpy.context.evaluated_depsgraph_get()  # (4.5 crashed: docs/performance.md)
     except ValueError as error:  # the physics core's checks (superluminal motion, NaN)
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     codes = tessellation.face_codes(cache, mod) if decision is None else decision.codes
