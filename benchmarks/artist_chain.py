@@ -32,13 +32,14 @@ is divided by that round's plain time, and the median ratio is printed with the 
 the printed rows name it. ``--lamp`` adds a sun to both scenes: the lamp stage then adds a
 light-linked copy of it per moving object (Blender links at most 64). ``--profile FILE`` writes
 a cProfile of a Set Up, a velocity change and a frame step of the first case (read it with
-``python -m pstats FILE``).
+``python -m pstats FILE``), and one of each step alone in ``FILE.setup``, ``FILE.velocity``, ``FILE.frame``.
 """
 
 import argparse
 import cProfile
 import math
 import os
+import pstats
 import resource
 import statistics
 import subprocess
@@ -266,11 +267,18 @@ def measure_case(bpy, options, kind, size, motion):
 
     alternate("frame step", frame_step, lambda r: plain_rewrite(bpy, plain_scene, plain, 1e-3))
     if options.profile:
-        profile = cProfile.Profile()
-        profile.runcall(run_setup, 0)
-        profile.runcall(velocity_change, 0)
-        profile.runcall(frame_step, options.rounds + 1)
-        profile.dump_stats(options.profile)
+        # one file per step (FILE.setup, FILE.velocity, FILE.frame) and FILE with the three together
+        files = []
+        for suffix, step, argument in (
+            ("setup", run_setup, 0),
+            ("velocity", velocity_change, 0),
+            ("frame", frame_step, options.rounds + 1),
+        ):
+            profile = cProfile.Profile()
+            profile.runcall(step, argument)
+            files.append(f"{options.profile}.{suffix}")
+            profile.dump_stats(files[-1])
+        pstats.Stats(*files).dump_stats(options.profile)
         options.profile = None
     alternate(
         "F12",
