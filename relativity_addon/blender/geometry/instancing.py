@@ -34,11 +34,16 @@ def _may_instance(obj: Object) -> bool:
     system, or geometry nodes of the user's (cheap: tells which scenes need the instance scan)."""
     if obj.instance_type != "NONE" or len(getattr(obj, "particle_systems", ())):
         return True
-    modifiers = obj.modifiers
-    if not len(modifiers):
-        return False
-    ours = modifier.find_modifier(obj)
-    return any(each.type == "NODES" and each != ours for each in modifiers)
+    ours = False  # the add-on's own modifier: the first geometry-nodes one with its group (find_modifier)
+    for each in obj.modifiers:
+        if each.type != "NODES":
+            continue
+        group = each.node_group
+        if not ours and group is not None and group.name in modifier.GROUPS:
+            ours = True
+            continue
+        return True
+    return False
 
 
 def _instanced_by_settings(obj: Object) -> Iterator[Object]:
@@ -67,14 +72,16 @@ def _instancing(
     drawn: Callable[[Object], bool],
     evaluated: set[str],
     scene_objects: Iterable[Object],
+    instancers: list[Object] | None = None,
 ) -> tuple[Object | None, Object] | None:
     """``(instancer, source)``: an instancer among ``scene_objects`` that draws again an object for
     which ``drawn`` is true (by its settings: a collection instance, a particle system, in the scene
     or not) or, in the evaluated scene, one named in ``evaluated``; ``(None, source)``: an object
     named in ``evaluated`` that draws instances or other components the modifier does not move;
-    None when neither happens."""
-    # only these can draw anything again (one pass over the scene, cheap per object)
-    instancers = [obj for obj in scene_objects if _may_instance(obj)]
+    None when neither happens. ``instancers``: :func:`_may_instance`'s of ``scene_objects``, when
+    already listed."""
+    if instancers is None:  # only these can draw anything again (one pass over the scene)
+        instancers = [obj for obj in scene_objects if _may_instance(obj)]
     for instancer in instancers:
         for source in _instanced_by_settings(instancer):
             if drawn(source):
@@ -97,7 +104,10 @@ def _instancing(
 
 
 def instancing_problem(
-    depsgraph: Depsgraph | None, objects: Iterable[Object], scene_objects: Iterable[Object]
+    depsgraph: Depsgraph | None,
+    objects: Iterable[Object],
+    scene_objects: Iterable[Object],
+    instancers: list[Object] | None = None,
 ) -> str | None:
     """Why the evaluated scene (``depsgraph``, evaluated if None and needed) cannot be drawn right
     (one line), or None: one of the moving ``objects`` (those with their own velocity) draws
@@ -107,7 +117,7 @@ def instancing_problem(
     computed where the object itself is (or, for an object only instanced, none). Objects drawn by
     a collection instance or a particle system are checked by their settings, in the scene or not."""
     moving = {obj.name for obj in objects if moving_objects.has_own_velocity(obj)}
-    found = _instancing(depsgraph, moving_objects.has_own_velocity, moving, scene_objects)
+    found = _instancing(depsgraph, moving_objects.has_own_velocity, moving, scene_objects, instancers)
     if found is None:
         return None
     instancer, source = found
@@ -120,7 +130,10 @@ def instancing_problem(
 
 
 def preview_instancing_problem(
-    depsgraph: Depsgraph | None, objects: Iterable[Object], scene_objects: Iterable[Object]
+    depsgraph: Depsgraph | None,
+    objects: Iterable[Object],
+    scene_objects: Iterable[Object],
+    instancers: list[Object] | None = None,
 ) -> str | None:
     """The same for the boosted-mesh preview of a moving observer, where every mesh of ``objects``
     (the applied ones, moving or not) is drawn as seen from the moving camera: an instance of one of
@@ -134,6 +147,7 @@ def preview_instancing_problem(
         lambda obj: obj.type == "MESH" and (obj.name in applied or obj.name not in in_scene),
         applied,
         scene_objects,
+        instancers,
     )
     if found is None:
         return None
@@ -168,8 +182,9 @@ def check_instancing(
     :func:`instancing_warnings`)."""
     if evaluate:
         objects = applied_objects(scene)
-        _instancing_problems[scene.name] = instancing_problem(depsgraph, objects, scene.objects)
-        _preview_problems[scene.name] = preview_instancing_problem(depsgraph, objects, scene.objects)
+        instancers = [obj for obj in scene.objects if _may_instance(obj)]  # once for both checks
+        _instancing_problems[scene.name] = instancing_problem(depsgraph, objects, scene.objects, instancers)
+        _preview_problems[scene.name] = preview_instancing_problem(depsgraph, objects, scene.objects, instancers)
     problem = _instancing_problems.get(scene.name)
     if problem is not None:
         raise RelativityError(problem)

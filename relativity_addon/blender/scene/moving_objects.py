@@ -3,6 +3,7 @@ refusal naming the others (read by ``snapshot.read``)."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -143,7 +144,7 @@ def fastest_speed(scene: Scene) -> float:
             continue
         settings = obj.relativity
         if settings.motion == "CONSTANT":
-            speed = float(np.linalg.norm(np.asarray(tuple(settings.beta), dtype=np.float64)))
+            speed = math.hypot(*settings.beta)  # (a numpy norm per object: 5 us, a tenth of a 1,000-mesh sync)
         else:
             speed = _keyframed_speed(obj, scene)
         fastest = max(fastest, speed)
