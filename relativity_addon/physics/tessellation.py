@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .apparent import lorentz_contraction_matrix
 from .arrays import ArrayLike, BoolArray, FloatArray, IndexArray
 
 # rest points (M, 3) -> apparent positions (M, 3), any frame the projection takes
@@ -229,6 +230,14 @@ class _BoxView(NamedTuple):
     gamma_o: float
 
 
+def _light_distance(r: FloatArray, along: FloatArray, speed: float) -> FloatArray:
+    """``s = c tau`` of points ``r`` (relative to the observer, at its time) moving with ``w``
+    (``along = r . w``, ``|w| = speed < 1``): the root of ``|r - s w| = s``,
+    ``retarded.light_travel_time_uniform`` with ``Delta = -r`` and ``c = 1`` (that one validates its
+    inputs: too slow here, per box and part)."""
+    return (np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=-1)) - along) / (1.0 - speed * speed)
+
+
 def _box_view(
     rest_low: ArrayLike,
     rest_high: ArrayLike,
@@ -253,14 +262,16 @@ def _box_view(
         raise ValueError("velocities must be below the speed of light")
     gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
     # r = A x + k: the rest point at the observer's time, relative to the observer
+    # apparent.lorentz_contraction_matrix(w) written out: that one validates w (a third of this
+    # function's time; w was checked above)
     contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
     a = contraction @ matrix[:3, :3]
     k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
-    r = np.where(_CORNER_BITS, high, low) @ a.T + k  # (K, 8, 3)
+    r = np.asarray(np.where(_CORNER_BITS, high, low) @ a.T + k, dtype=np.float64)  # (K, 8, 3)
     # s = c tau from |r - s w| = s (docs/physics.md with Delta = -r): convex in r, so largest at a
     # corner of the box's image
     along = r @ w
-    s = (np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=-1)) - along) / (1.0 - speed * speed)
+    s = _light_distance(r, along, speed)
     s_high = s.max(axis=1)
     centre = r.sum(axis=1)
     toward = centre / np.maximum(np.sqrt((centre * centre).sum(axis=-1)), 1e-300)[:, None]
@@ -268,10 +279,7 @@ def _box_view(
     # convex: at least its tangent plane at the box's centre, least at a corner (grad s = n / (1 + n.w),
     # 1 + n.w >= 1 - |w| > 0)
     mid = centre / 8.0
-    mid_along = mid @ w
-    s_mid = (np.sqrt(mid_along * mid_along + (1.0 - speed * speed) * (mid * mid).sum(axis=-1)) - mid_along) / (
-        1.0 - speed * speed
-    )
+    s_mid = _light_distance(mid, mid @ w, speed)
     n_mid = (mid - s_mid[:, None] * w) / np.maximum(s_mid, 1e-300)[:, None]
     grad = n_mid / (1.0 + n_mid @ w)[:, None]
     tangent = s_mid + ((r - mid[:, None, :]) * grad[:, None, :]).sum(axis=-1).min(axis=1)
@@ -323,10 +331,10 @@ def _swept(
     if sweep is None:
         return low, high
     matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
-    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
-    speed2 = float(w @ w)
-    gamma = 1.0 / math.sqrt(1.0 - speed2) if speed2 < 1.0 else math.inf
-    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed2, 1e-300)
+    try:
+        contraction = lorentz_contraction_matrix(object_beta)
+    except ValueError:  # not below c: the box view refuses it
+        return low, high
     try:
         step = np.linalg.solve(contraction @ matrix[:3, :3], np.asarray(sweep, dtype=np.float64).reshape(3))
     except np.linalg.LinAlgError:
