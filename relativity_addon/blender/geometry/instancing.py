@@ -34,12 +34,11 @@ def _may_instance(obj: Object) -> bool:
     system, or geometry nodes of the user's (cheap: tells which scenes need the instance scan)."""
     if obj.instance_type != "NONE" or len(getattr(obj, "particle_systems", ())):
         return True
-    ours = False  # the add-on's own modifier: the first geometry-nodes one with its group (find_modifier)
+    ours = False  # the add-on's own modifier: the first that runs its group (find_modifier)
     for each in obj.modifiers:
         if each.type != "NODES":
             continue
-        group = each.node_group
-        if not ours and group is not None and group.name in modifier.GROUPS:
+        if not ours and modifier.is_relativity_modifier(each):
             ours = True
             continue
         return True

@@ -97,9 +97,14 @@ def group_generation() -> int:
     return _generation[0]
 
 
+def is_relativity_modifier(modifier: Modifier) -> bool:
+    """Whether ``modifier`` runs one of the add-on's node groups (the full or the lean one)."""
+    return modifier.type == "NODES" and modifier.node_group is not None and modifier.node_group.name in GROUPS
+
+
 def find_modifier(obj: Object) -> Modifier | None:
     for modifier in obj.modifiers:
-        if modifier.type == "NODES" and modifier.node_group is not None and modifier.node_group.name in GROUPS:
+        if is_relativity_modifier(modifier):
             return modifier
     return None
 
