@@ -105,11 +105,9 @@ def spin_warning(obj: Object, scene: Scene, c: float) -> str | None:
     rates = animation.fastest_key_rates(obj)
     if rates is None:  # quaternion or axis-angle keys, other easing, F-curve modifiers: not bounded
         moves = (
-            any(settings.beta)
-            if settings.motion == "CONSTANT"
-            else animation.keys_vary(obj, ("location", "delta_location"))
+            any(settings.beta) if settings.motion == "CONSTANT" else animation.keys_vary(obj, animation.LOCATION_PATHS)
         )
-        if not moves or not animation.keys_vary(obj, ("rotation", "delta_rotation")):
+        if not moves or not animation.keys_vary(obj, animation.ROTATION_PREFIXES):
             return None
         return (
             f"{obj.name!r} spins while it moves: its spin is drawn in the scene's time, not its own (the "

@@ -25,6 +25,8 @@ from ...physics import transforms
 from ..common import compat
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
     import numpy.typing as npt
     from bpy.types import FCurve, Object, Scene
 
@@ -243,6 +245,7 @@ def has_own_animation(obj: Object, scene: Scene | None = None) -> bool:
 
 
 EULER_PATHS = frozenset(("rotation_euler", "delta_rotation_euler"))
+ROTATION_PREFIXES = ("rotation", "delta_rotation")  # the rotation channels of every mode
 
 
 def fastest_key_rates(obj: Object) -> tuple[float, float] | None:
@@ -259,15 +262,16 @@ def fastest_key_rates(obj: Object) -> tuple[float, float] | None:
             location[index] += steepest
         elif path in EULER_PATHS:
             turn += steepest
-        elif path.startswith(("rotation", "delta_rotation")):
+        elif path.startswith(ROTATION_PREFIXES):
             return None
     return float(np.linalg.norm(location)), turn
 
 
-def keys_vary(obj: Object, prefixes: tuple[str, ...]) -> bool:
+def keys_vary(obj: Object, prefixes: Iterable[str]) -> bool:
     """Whether a live channel of the object's own action whose path starts with one of ``prefixes``
-    (``("rotation", "delta_rotation")``: any rotation mode) holds differing key values or handles, or
-    has modifiers (its parents' keys are not read)."""
+    (:data:`ROTATION_PREFIXES`: any rotation mode; :data:`LOCATION_PATHS`) holds differing key values
+    or handles, or has modifiers (its parents' keys are not read)."""
+    prefixes = tuple(prefixes)
     for (path, _index), fcurve in _transform_fcurves(obj).items():
         if not path.startswith(prefixes):
             continue
