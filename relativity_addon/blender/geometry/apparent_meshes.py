@@ -27,7 +27,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ..common import busy, names
-from ..scene import snapshot
+from ..scene import animation, snapshot
 from . import changes, clip_end, instancing, keyframed, modifier, motion, tessellation
 from .modifier import applied_objects
 
@@ -145,13 +145,11 @@ def object_signature(
         # and, for keyframed motion, whether every retarded time lay inside the modifier's intervals
         window = keyframed.window_found(evaluated) if expected[1] is None else expected[1]
         verdict = (short, window) if keyframed_on else short
-        if fingerprint is not None:
-            pass
-        elif (closed or keyframed_on) and (not measured or short):
+        if fingerprint is None and (closed or keyframed_on) and (not measured or short):
             # the modifier computes the positions from the rest shape, and no decision reads it:
             # only noted, so that geometry_key stays while Blender does not evaluate it again
             _note_unread(evaluated)
-        else:
+        elif fingerprint is None:
             fingerprint = _rest_fingerprint(evaluated)
     parts = [
         None if closed else snap.frame,  # the closed form depends on the observer's event, not on the time
@@ -171,6 +169,8 @@ def object_signature(
         else None,
         _render_size(snap) if relativity.use_adaptive_tessellation else None,
         relativity.samples_per_frame,
+        # the keys: an edit leaving the current frame's place changes the past the window reads
+        hash(animation.keyframes_signature(obj)) if relativity.motion == "ANIMATION" else None,
         snap.fps,
         relativity.use_deformation,
         relativity.use_proper_time,

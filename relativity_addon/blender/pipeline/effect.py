@@ -313,7 +313,7 @@ def sync(
         return None
     if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
         return last_snapshot(scene)
-    with modifier.listed_once():  # the applied meshes listed once for the whole sync
+    with modifier.listed_once(), animation.signed_once():  # the meshes listed, their keys read, once a sync
         apparent_meshes.unlink_caches()  # brought into a collection by Append
         method = applied_method(scene)
         if not snapshot.in_final_render(scene):

@@ -15,6 +15,8 @@ these matrices.
 from __future__ import annotations
 
 import math
+import threading
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,7 +27,7 @@ from ...physics import transforms
 from ..common import compat
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Iterable, Iterator
 
     import numpy.typing as npt
     from bpy.types import FCurve, Object, Scene
@@ -142,11 +144,36 @@ def world_matrices(
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
+_signed = threading.local()  # .signatures: object session_uid -> its keyframes signature, inside signed_once()
+
+
+@contextmanager
+def signed_once() -> Iterator[None]:
+    """Inside: :func:`keyframes_signature` reads each object's keys once (a sync edits no key; its
+    stages asked up to three times per object: issue 26's 1,000 keyframed objects)."""
+    outer = getattr(_signed, "signatures", None)
+    _signed.signatures = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _signed.signatures = outer
+
+
 def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
     cache key; None when an F-curve has modifiers (their settings are not in the key). A channel
     an F-curve animates enters by its keys alone, not by its current value: that value changes at
     every frame step, which changes no key (the evaluation reads the keys, :func:`basis_matrices`)."""
+    signatures = getattr(_signed, "signatures", None)
+    if signatures is None:
+        return _keyframes_signature(obj)
+    uid = obj.session_uid
+    if uid not in signatures:
+        signatures[uid] = _keyframes_signature(obj)
+    return signatures[uid]
+
+
+def _keyframes_signature(obj):
     parts = []
     while obj is not None:
         animated = set(_transform_fcurves(obj))
