@@ -28,7 +28,7 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import animation, snapshot
-from . import changes, clip_end, instancing, keyframed, modifier, motion, tessellation
+from . import changes, clip_end, instancing, keyframed, modifier, motion, straight_steps, tessellation
 from .modifier import applied_objects
 
 if TYPE_CHECKING:
@@ -151,15 +151,15 @@ def object_signature(
             _note_unread(evaluated)
         elif fingerprint is None:
             fingerprint = _rest_fingerprint(evaluated)
-    parts = [
+    parts = [  # the frame and the matrix first: straight_steps.step writes them for a frame step
         None if closed else snap.frame,  # the closed form depends on the observer's event, not on the time
+        tuple(map(tuple, evaluated.matrix_world)),
         snap.speed_of_light,
         snap.beta,
         snap.camera,
         snap.camera_matrix,
         snap.exact_camera,
         snap.shutter_time if snap.exact_camera else 0.0,
-        tuple(map(tuple, evaluated.matrix_world)),
         relativity.enabled,
         relativity.motion,
         tuple(relativity.beta),
@@ -212,6 +212,7 @@ def update_object(
     positions wait for the next sync (:func:`deferred`): the handlers and the batch script sync
     again outside the frame change."""
     _deferred.discard(obj.name)
+    straight_steps.forget(obj)
     changes.note_changed(obj.session_uid)  # its cache is written: read again until a sync finds it current
     mod, cache = modifier.ensure_modifier(obj)
     checked = keyframed.verdicts_made(mod)  # none yet at Set Up: the update then expects its own
@@ -247,7 +248,8 @@ def update_object(
     obj_eval = obj.evaluated_get(depsgraph)
     if in_modifier and keyframed.update(obj, depsgraph, snap, scene, mod, cache, codes, measure):
         expected = (short, None if checked[1] or not keyframed.is_on(mod) else True)  # the window holds its bound
-        cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=expected)
+        signature = cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=expected)
+        straight_steps.remember(obj, scene_key(snap), snap, signature, tuple(map(tuple, obj_eval.matrix_world)))
         for key in (names.ERROR_KEY, names.WARNING_KEY):
             if key in cache.data:
                 del cache.data[key]
@@ -358,17 +360,21 @@ def update(
         objects = applied_objects(scene)
         evaluated = None
         current: dict[int, bool] = {}
+        key = scene_key(snap)
+        stepping = in_frame_change and depsgraph is not None  # a frame change: its depsgraph reports what moved
         if only_changed and objects:
             # The signatures hold the evaluated rest shapes: without the handler's depsgraph, the
             # scene's, evaluated now, which also reports Blender's pending updates (note_updates)
             # before the current objects are taken (update_object evaluates again after its edits).
             evaluated = _evaluated(depsgraph)
-            current = changes.current_objects(
-                scene.name, scene_key(snap), snap.frame, in_frame_change and depsgraph is not None
-            )
+            current = changes.current_objects(scene.name, key, snap.frame, stepping)
         for obj in objects:
             uid = obj.session_uid
             if uid in current:
+                continue
+            if stepping and only_changed and straight_steps.step(obj, key, snap, _evaluated(depsgraph)):
+                current[uid] = False  # up to date at this frame (straight keys: its offsets set)
+                updated += 1
                 continue
             data = modifier.cache_data(obj)
             if (
@@ -513,9 +519,9 @@ def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object
     orphans = []
     if objects is None:
         _skipped_empty.pop(scene.name, None)
-        orphans = orphan_caches()
+        orphans = modifier.orphan_caches()
         instancing.forget(scene.name)
-    objects = [*applied_objects(scene), *unlinked_objects()] if objects is None else objects
+    objects = [*applied_objects(scene), *modifier.unlinked_objects()] if objects is None else objects
     later: list = []
     restored = [obj for obj in objects if modifier.remove_object_effect(obj, later)]
     modifier.remove_later(later)
@@ -523,38 +529,3 @@ def remove(scene: Scene, objects: Iterable[Object] | None = None) -> list[Object
         modifier.remove_cache(cache)
     modifier.remove_unused_group()
     return restored
-
-
-_object_count = [-1]  # bpy.data.objects' length at the last look for linked caches
-
-
-def unlink_caches() -> None:
-    """Cache objects belong to no collection (the modifier is their only user). Append instantiates
-    the loose objects it brings into the active collection, where a cache shows as a second,
-    visible mesh: take them out again. Looks only when the number of objects changed."""
-    if len(bpy.data.objects) == _object_count[0]:
-        return
-    _object_count[0] = len(bpy.data.objects)
-    for obj in bpy.data.objects:
-        if obj.name.startswith(names.CACHE_PREFIX) and obj.library is None and modifier.is_cache(obj):
-            for collection in obj.users_collection:
-                collection.objects.unlink(obj)
-
-
-def unlinked_objects() -> list[Object]:
-    """Meshes of this file carrying the modifier but in no scene (unlinked while set up): linked
-    back, they would draw a stale apparent geometry and set the scene up again."""
-    return [
-        obj
-        for obj in bpy.data.objects
-        if obj.type == "MESH"
-        and obj.library is None
-        and not obj.users_scene
-        and not modifier.is_cache(obj)
-        and modifier.find_modifier(obj) is not None
-    ]
-
-
-def orphan_caches() -> list[Object]:
-    """Cache objects no modifier uses any more (their object was deleted while set up)."""
-    return [obj for obj in bpy.data.objects if obj.library is None and obj.users == 0 and modifier.is_cache(obj)]

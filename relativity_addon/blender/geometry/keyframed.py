@@ -179,6 +179,7 @@ def modifier_inputs(
     point is seen there). Raises RelativityError."""
     t_o, x_o, beta_o = snap.mesh_observer  # behind the exact camera: the scene frame
     c = snap.speed_of_light
+    _lines.pop(obj.session_uid, None)
     motion.check_parent_motion(obj)
     fps = animation.frames_per_second(scene)
     step = 1.0 / (int(obj.relativity.samples_per_frame) * fps)
@@ -326,11 +327,29 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
     if not (first_frame <= low * fps and high * fps <= last_frame):
         return None  # the window reaches past the line (the intervals decide: a change of velocity in it)
     _last_tau[obj.session_uid] = tau
+    # the observer's latest time this line still holds the window (the window's ends rise with t_o)
+    ahead = t_o + tessellation.SWEEP_FRAMES / fps
+    later = sampling.uniform_motion_window(start, per_frame * fps, size, step, ahead, x_o, c, reach, MAX_INTERVALS)
+    if later is not None and first_frame <= later[0] * fps and later[1] * fps <= last_frame:
+        _lines[obj.session_uid] = (start, per_frame, shape, fps, t_o, ahead)
     matrix = motion.matrix_array(obj_eval.matrix_world)
     origin = start + per_frame * (t_o * fps)
     beta_o, x_o = np.asarray(beta_o, dtype=np.float64), np.asarray(x_o, dtype=np.float64)
     closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
     return {"Keyframed": False, "Closed Form": True, **closed}
+
+
+# Object session_uid -> (line start, way per frame, held 3x3, fps, the observer's time of the update,
+# the latest time the line holds the window) of its last update on the closed form of straight keys
+# (``_uniform_over_window``); read by ``straight_steps`` (a frame step on the line sets three inputs).
+_lines: dict[int, tuple[FloatArray, FloatArray, FloatArray, float, float, float]] = {}
+
+
+def steppable_line(obj: Object) -> tuple[FloatArray, FloatArray, FloatArray, float, float, float] | None:
+    """The object's line of its last update (:data:`_lines`) where that update proved every edge short
+    over the origin's way to come (``tessellation.swept_bound``), else None."""
+    line = _lines.get(obj.session_uid)
+    return line if line is not None and tessellation.swept_bound(obj) is not None else None
 
 
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
@@ -457,6 +476,8 @@ def update(
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
             bound = _edge_bound(obj, obj_eval, snap, scene, inputs, measure["Tolerance"])
             measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
+    if measure is None or not measure["Edges Proven Short"]:  # the modifier's verdict decides: no step
+        _lines.pop(obj.session_uid, None)
     # one call: the group (full or lean) is chosen once, on every input's new value
     modifier.set_inputs(mod, {**inputs, "Measure Edges": measure is not None, **(measure or {})})
     if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays

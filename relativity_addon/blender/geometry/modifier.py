@@ -311,6 +311,15 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
     return changed
 
 
+def write_inputs(mod: Modifier, wanted: dict[str, object]) -> None:
+    """Set the modifier's number or vector inputs (by interface name, each in its group: the full and the
+    lean group hold them alike) as :func:`set_inputs` stores them, rounded to float32, comparing nothing."""
+    for name, value in wanted.items():
+        rounded = _float32s(value)
+        stored = tuple(rounded) if hasattr(value, "__len__") else rounded[0]
+        compat.set_modifier_input(mod, _identifier(mod.node_group, name), stored)
+
+
 def _float32s(value: object) -> list[float]:
     """A number or a sequence of numbers rounded to float32 (the sockets' precision), as a list of
     Python floats: compared and written without a numpy array per input (some twenty inputs per
@@ -476,3 +485,38 @@ def _write_face_codes(mesh, count, face_codes):
     values = np.zeros(count, dtype=np.float32)
     values[count - len(face_codes) :] = face_codes
     attribute.data.foreach_set("value", values)
+
+
+_object_count = [-1]  # bpy.data.objects' length at the last look for linked caches
+
+
+def unlink_caches() -> None:
+    """Cache objects belong to no collection (the modifier is their only user). Append instantiates
+    the loose objects it brings into the active collection, where a cache shows as a second,
+    visible mesh: take them out again. Looks only when the number of objects changed."""
+    if len(bpy.data.objects) == _object_count[0]:
+        return
+    _object_count[0] = len(bpy.data.objects)
+    for obj in bpy.data.objects:
+        if obj.name.startswith(names.CACHE_PREFIX) and obj.library is None and is_cache(obj):
+            for collection in obj.users_collection:
+                collection.objects.unlink(obj)
+
+
+def unlinked_objects() -> list[Object]:
+    """Meshes of this file carrying the modifier but in no scene (unlinked while set up): linked
+    back, they would draw a stale apparent geometry and set the scene up again."""
+    return [
+        obj
+        for obj in bpy.data.objects
+        if obj.type == "MESH"
+        and obj.library is None
+        and not obj.users_scene
+        and not is_cache(obj)
+        and find_modifier(obj) is not None
+    ]
+
+
+def orphan_caches() -> list[Object]:
+    """Cache objects no modifier uses any more (their object was deleted while set up)."""
+    return [obj for obj in bpy.data.objects if obj.library is None and obj.users == 0 and is_cache(obj)]

@@ -179,9 +179,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
     ):
         return None
     matrix = motion.matrix_array(obj_eval.matrix_world)
-    rotation = np.asarray(snap.world_to_camera, dtype=np.float64)
-    view = rotation @ matrix[:3, :3]
-    offset = rotation @ (matrix[:3, 3] - np.asarray(snap.mesh_observer[1], dtype=np.float64))
+    view = np.asarray(snap.world_to_camera, dtype=np.float64) @ matrix[:3, :3]
     left, right, bottom, top = snap.projection[1:5]
     width, height = render_size(scene)
     tolerance = float(settings.tessellation_tolerance)
@@ -189,7 +187,7 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
         "Camera X": tuple(view[:, 0]),
         "Camera Y": tuple(view[:, 1]),
         "Camera Z": tuple(view[:, 2]),
-        "Camera Offset": tuple(offset),
+        "Camera Offset": camera_offset(matrix, snap),
         "Pixel Scale": (width / (right - left), height / (top - bottom), 1.0),
         "Window Low": (left, bottom, 0.0),
         "Tolerance": tolerance,
@@ -197,6 +195,13 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
         "Edges Proven Short": motion.closed_form(obj, scene)
         and bool(edge_image_bound(obj, matrix, snap, (width, height), tolerance) <= PROVEN_MARGIN * tolerance),
     }
+
+
+def camera_offset(matrix: FloatArray, snap: Snapshot) -> tuple[float, ...]:
+    """The edge check's ``Camera Offset``: the object's origin (world ``matrix``) from the observer, in
+    the camera's axes."""
+    rotation = np.asarray(snap.world_to_camera, dtype=np.float64)
+    return tuple(rotation @ (matrix[:3, 3] - np.asarray(snap.mesh_observer[1], dtype=np.float64)))
 
 
 # The bound must clear the tolerance by this much (the modifier measures in float32).
@@ -291,7 +296,8 @@ def edge_image_bound(
     )
     origin = matrix[:3, 3]
     last = _last_bound.get(obj.name)
-    if last is not None and last[0] == key and _on_way(origin, last[1], last[2]):
+    # (a full update past the way's first half sweeps again: a frame step's record gets the new way)
+    if last is not None and last[0] == key and on_way(origin, last[1], last[2], 0.5):
         return last[3]
     low, high, longest = bounds
     arguments = (low, high, longest, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
@@ -314,7 +320,7 @@ def edge_image_bound(
 # come, and up to SWEEP_SIZES times the object's size (the bound's box grows by the sweep), one frame's
 # at least.
 SWEEP_FRAMES = 8
-SWEEP_SIZES = 4.0
+SWEEP_SIZES = 16.0
 
 
 def _sweep(low: FloatArray, high: FloatArray, matrix: FloatArray, way: FloatArray) -> FloatArray:
@@ -336,9 +342,16 @@ def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: Float
     return bound
 
 
-def _on_way(origin: FloatArray, start: FloatArray, sweep: FloatArray | None) -> bool:
-    """Whether ``origin`` is ``start`` or on the segment from it along ``sweep`` (float rounding allowed
-    across it: far below anything the bounds resolve)."""
+def swept_bound(obj: Object) -> tuple[FloatArray, FloatArray] | None:
+    """``(origin, sweep)``: the segment of origins over which the object's last edges' bound holds
+    (:func:`edge_image_bound` with ``way``), or None (no sweep)."""
+    last = _last_bound.get(obj.name)
+    return None if last is None or last[2] is None else (last[1], last[2])
+
+
+def on_way(origin: FloatArray, start: FloatArray, sweep: FloatArray | None, part: float = 1.0) -> bool:
+    """Whether ``origin`` is ``start`` or on the segment from it along ``sweep`` (its first ``part``;
+    float rounding allowed across it: far below anything the bounds resolve)."""
     if np.array_equal(origin, start):
         return True
     if sweep is None:
@@ -347,7 +360,7 @@ def _on_way(origin: FloatArray, start: FloatArray, sweep: FloatArray | None) -> 
     along = float(moved @ sweep) / max(float(sweep @ sweep), 1e-300)
     across = moved - along * sweep
     scale = 1e-9 * (1.0 + float(np.abs(start).max()) + float(np.abs(sweep).max()))
-    return -1e-9 <= along <= 1.0 + 1e-9 and float(np.abs(across).max()) <= scale
+    return -1e-9 <= along <= part + 1e-9 and float(np.abs(across).max()) <= scale
 
 
 def announce(obj: Object) -> None:

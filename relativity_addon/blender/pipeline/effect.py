@@ -76,7 +76,7 @@ def is_applied(scene: Scene) -> bool:
         return True
     if any(applied_method(other) is not None for other in bpy.data.scenes if other != scene):
         return False  # the pieces are another set-up scene's: its own Remove takes them
-    if exact_camera.applied_camera_data() or apparent_meshes.orphan_caches():
+    if exact_camera.applied_camera_data() or modifier.orphan_caches():
         return True
     return any(_stored_by_add_on(block) for block in _local_blocks()) or _named_by_add_on()
 
@@ -314,7 +314,7 @@ def sync(
     if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
         return last_snapshot(scene)
     with modifier.listed_once(), animation.signed_once():  # the meshes listed, their keys read, once a sync
-        apparent_meshes.unlink_caches()  # brought into a collection by Append
+        modifier.unlink_caches()  # brought into a collection by Append
         method = applied_method(scene)
         if not snapshot.in_final_render(scene):
             _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)

@@ -28,6 +28,7 @@ from bpy.app.handlers import persistent
 from ..camera import exact_camera
 from ..common import busy
 from ..geometry import apparent_meshes, keyframed
+from ..scene import animation
 from . import effect, render_notice, stages
 
 if TYPE_CHECKING:
@@ -42,14 +43,25 @@ def _sync(scene, **options):
         return None
 
 
+# (scene, frame, subframe, {object session_uid: keys signature}) of the last frame_change_pre: its
+# frame_change_post reads no key again (between the two, Blender evaluates the frame, no script runs).
+_keys_read: list[tuple | None] = [None]
+
+
 @persistent
 def frame_change_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
-    _sync(scene, update_geometry=False)
+    kept: dict[int, object] = {}
+    with animation.signed_once(kept):
+        _sync(scene, update_geometry=False)
+    _keys_read[0] = (scene.name, scene.frame_current, scene.frame_subframe, kept)
 
 
 @persistent
 def frame_change_post(scene: Scene, depsgraph: Depsgraph | None = None) -> None:
-    _sync(scene, depsgraph=depsgraph, in_frame_change=True)
+    read, _keys_read[0] = _keys_read[0], None
+    same = read is not None and read[:3] == (scene.name, scene.frame_current, scene.frame_subframe)
+    with animation.signed_once(read[3] if same and read is not None else None):
+        _sync(scene, depsgraph=depsgraph, in_frame_change=True)
     if apparent_meshes.deferred() and not bpy.app.background:
         # positions of a new subdivision, computed outside the frame change (the batch script
         # syncs after each frame change itself; timers do not run in the background)

@@ -51,6 +51,7 @@ TRANSFORM_PATHS = frozenset(
         "delta_scale",
     )
 )
+_SORTED_TRANSFORM_PATHS = tuple(sorted(TRANSFORM_PATHS))
 # The channels that are an object's world line; the others (rotation, scale) are its own animation,
 # which plays at its proper time (``world_lines``).
 LOCATION_PATHS = frozenset(("location", "delta_location"))
@@ -148,11 +149,12 @@ _signed = threading.local()  # .signatures: object session_uid -> its keyframes 
 
 
 @contextmanager
-def signed_once() -> Iterator[None]:
+def signed_once(kept: dict[int, object] | None = None) -> Iterator[None]:
     """Inside: :func:`keyframes_signature` reads each object's keys once (a sync edits no key; its
-    stages asked up to three times per object: issue 26's 1,000 keyframed objects)."""
+    stages asked up to three times per object: issue 26's 1,000 keyframed objects), into ``kept``
+    when given (a frame change's two syncs share one: no script runs between them)."""
     outer = getattr(_signed, "signatures", None)
-    _signed.signatures = {} if outer is None else outer
+    _signed.signatures = outer if outer is not None else {} if kept is None else kept
     try:
         yield
     finally:
@@ -203,6 +205,7 @@ def _keyframes_signature(obj):
                         ),
                     )
                 )
+        paths = {path for path, _index in animated}
         parts.append(
             (
                 tuple(map(tuple, obj.matrix_parent_inverse)),
@@ -210,7 +213,9 @@ def _keyframes_signature(obj):
                 obj.parent_type,
                 *(
                     tuple(None if (path, i) in animated else value for i, value in enumerate(getattr(obj, path)))
-                    for path in sorted(TRANSFORM_PATHS)
+                    if path in paths
+                    else tuple(getattr(obj, path))
+                    for path in _SORTED_TRANSFORM_PATHS
                 ),
             )
         )
