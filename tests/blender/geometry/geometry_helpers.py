@@ -22,6 +22,22 @@ def addon_module(name):
     return importlib.import_module(f"{ADDON_MODULE}.blender.{name}")
 
 
+def count_calls(monkeypatch, hooked, counts=lambda _name, _result: 1):
+    """Hooks on ``hooked`` ((module, name) pairs) that add ``counts(name, result)`` per call to the
+    returned {name: count}."""
+    calls = dict.fromkeys((name for _module, name in hooked), 0)
+    for module, name in hooked:
+        original = getattr(module, name)
+
+        def counted(*args, _original=original, _name=name, **kwargs):
+            result = _original(*args, **kwargs)
+            calls[_name] += counts(_name, result)
+            return result
+
+        monkeypatch.setattr(module, name, counted)
+    return calls
+
+
 def apply_geometry(scene, objects=None):
     """Set the scene up for Apparent Geometry as the Set Up button does (``effect.apply``)."""
     scene.relativity.method = "GEOMETRY"

@@ -57,16 +57,7 @@ def _seen(rest, matrix, u, x_o, beta_o):
 def _count_passes(monkeypatch):
     motion = gh.addon_module("geometry.motion")
     modifier = gh.addon_module("geometry.modifier")
-    calls = {"apparent_world_positions": 0, "write_cache": 0}
-    for module, name in ((motion, "apparent_world_positions"), (modifier, "write_cache")):
-        original = getattr(module, name)
-
-        def counted(*args, _original=original, _name=name, **kwargs):
-            calls[_name] += 1
-            return _original(*args, **kwargs)
-
-        monkeypatch.setattr(module, name, counted)
-    return calls
+    return gh.count_calls(monkeypatch, ((motion, "apparent_world_positions"), (modifier, "write_cache")))
 
 
 def _grid_mesh(bpy, name, side, width):

@@ -36,6 +36,18 @@ def _uniform_mover(bpy, scene, adaptive):
     return obj
 
 
+def _set_up_mover(bpy):
+    """The adaptive mover set up at frame 12 behind the observer moving at OBSERVER, evaluated:
+    (scene, camera, mover)."""
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = OBSERVER
+    obj = _uniform_mover(bpy, scene, adaptive=True)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    return scene, camera, obj
+
+
 @pytest.mark.parametrize("adaptive", [False, True])
 def test_uniform_keyframed_motion_takes_the_closed_form(relativity_addon, monkeypatch, adaptive):
     import bpy
@@ -153,12 +165,7 @@ def test_straight_keys_found_without_sampling_give_the_intervals_inputs(relativi
     keyframed = gh.addon_module("geometry.keyframed")
     sampling = keyframed.sampling
     animation = gh.addon_module("scene.animation")
-    scene, _camera = gh.slow_light_scene(bpy, C, FPS)
-    scene.relativity.beta = OBSERVER
-    obj = _uniform_mover(bpy, scene, adaptive=True)
-    scene.frame_set(12)
-    gh.apply_geometry(scene)
-    bpy.context.evaluated_depsgraph_get()
+    scene, _camera, obj = _set_up_mover(bpy)
     frames = (12, 13, 14, 20, 30, 60, 75, 90, 13)
     calls = {"motion_intervals": 0, "world_matrices": 0}
     for module, name in ((sampling, "motion_intervals"), (animation, "world_matrices")):

@@ -6,25 +6,17 @@ a parent moved by a script, a key inserted by a script together with the frame s
 
 import numpy as np
 from test_geometry_keyframed_modifier import FPS, OBSERVER, C, _seen
-from test_geometry_keyframed_uniform import _inputs, _uniform_mover
+from test_geometry_keyframed_uniform import _inputs, _set_up_mover, _uniform_mover
 
 import geometry_helpers as gh
 
 
 def _counted_updates(monkeypatch):
+    """{"update_object": full updates, "step": frame steps the records took}."""
     meshes = gh.addon_module("geometry.apparent_meshes")
     steps = gh.addon_module("geometry.straight_steps")
-    calls = {"update_object": 0, "step": 0}
-    for module, name in ((meshes, "update_object"), (steps, "step")):
-        original = getattr(module, name)
-
-        def counted(*args, _original=original, _name=name, **kwargs):
-            result = _original(*args, **kwargs)
-            calls[_name] += 1 if _name == "update_object" or result else 0
-            return result
-
-        monkeypatch.setattr(module, name, counted)
-    return calls
+    hooked = ((meshes, "update_object"), (steps, "step"))
+    return gh.count_calls(monkeypatch, hooked, lambda name, result: int(name == "update_object" or bool(result)))
 
 
 def _check(bpy, obj, camera, frame):
@@ -38,12 +30,7 @@ def _check(bpy, obj, camera, frame):
 def test_frame_steps_on_straight_keys_set_the_offsets_alone(relativity_addon, monkeypatch):
     import bpy
 
-    scene, camera = gh.slow_light_scene(bpy, C, FPS)
-    scene.relativity.beta = OBSERVER
-    obj = _uniform_mover(bpy, scene, adaptive=True)
-    scene.frame_set(12)
-    gh.apply_geometry(scene)
-    bpy.context.evaluated_depsgraph_get()
+    scene, camera, obj = _set_up_mover(bpy)
     calls = _counted_updates(monkeypatch)
     for frame in range(13, 31):
         scene.frame_set(frame)
