@@ -151,9 +151,8 @@ def object_signature(
             _note_unread(evaluated)
         elif fingerprint is None:
             fingerprint = _rest_fingerprint(evaluated)
-    parts = [  # the frame and the matrix first: straight_steps.step writes them for a frame step
-        None if closed else snap.frame,  # the closed form depends on the observer's event, not on the time
-        tuple(map(tuple, evaluated.matrix_world)),
+    frame = None if closed else snap.frame  # the closed form depends on the observer's event, not on the time
+    parts = [  # after the frame and the matrix (straight_steps.step writes them anew for a frame step)
         snap.speed_of_light,
         snap.beta,
         snap.camera,
@@ -178,7 +177,7 @@ def object_signature(
         fingerprint,
         verdict,
     ]
-    return repr(parts)
+    return straight_steps.signature_head(frame, tuple(map(tuple, evaluated.matrix_world))) + repr(parts)[1:]
 
 
 def _render_size(snap: Snapshot) -> tuple[float, float] | None:

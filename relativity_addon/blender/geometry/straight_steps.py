@@ -44,9 +44,9 @@ ROUNDING = 4e-6
 _records: dict[int, tuple] = {}
 
 
-def _head(frame: float, matrix: tuple) -> str:
-    """The start of an object's signature (``apparent_meshes.object_signature``: the frame and the
-    evaluated world matrix come first)."""
+def signature_head(frame: float | None, matrix: tuple) -> str:
+    """The start of an object's signature (``apparent_meshes.object_signature`` writes its frame and
+    evaluated world matrix first, with this): what a step writes anew."""
     return f"[{frame!r}, {matrix!r}, "
 
 
@@ -55,11 +55,11 @@ def remember(obj: Object, key: object, snap: Snapshot, signature: str, matrix: t
     world matrix) if it took the closed form of straight keys with its edges proven short over the
     way to come (``keyframed.steppable_line``)."""
     line = keyframed.steppable_line(obj)
-    head = _head(snap.frame, matrix)
-    if line is None or not signature.startswith(head):
+    head = signature_head(snap.frame, matrix)
+    keys = animation.keyframes_signature(obj)  # (None: keys with F-curve modifiers, not compared)
+    if line is None or keys is None or not signature.startswith(head):
         return
     start, per_frame, shape, fps, t_low, t_high = line
-    keys = animation.keyframes_signature(obj)
     _records[obj.session_uid] = (key, keys, start, per_frame, shape, fps, t_low, t_high, signature[len(head) :])
 
 
@@ -75,7 +75,7 @@ def step(obj: Object, key: object, snap: Snapshot, depsgraph: Depsgraph) -> bool
         return False
     _key, keys, start, per_frame, shape, fps, t_low, t_high, tail = record
     t_o, x_o, beta_o = snap.mesh_observer
-    if not t_low <= t_o <= t_high or keys is None or animation.keyframes_signature(obj) != keys:
+    if not t_low <= t_o <= t_high or animation.keyframes_signature(obj) != keys:
         return False
     obj_eval = obj.evaluated_get(depsgraph)
     matrix = motion.matrix_array(obj_eval.matrix_world)
@@ -95,7 +95,7 @@ def step(obj: Object, key: object, snap: Snapshot, depsgraph: Depsgraph) -> bool
         return False
     offsets = {name: inputs[name] for name in ("Scene Offset", "Local Offset")}
     modifier.write_inputs(mod, {**offsets, "Camera Offset": tessellation.camera_offset(matrix, snap)})
-    data[names.SIGNATURE_KEY] = _head(snap.frame, tuple(tuple(row) for row in obj_eval.matrix_world)) + tail
+    data[names.SIGNATURE_KEY] = signature_head(snap.frame, tuple(tuple(row) for row in obj_eval.matrix_world)) + tail
     tessellation.announce(obj)  # the next evaluation is the add-on's: the rest box stays
     obj.update_tag(refresh={"DATA"})  # the modifier's inputs: its geometry alone (the frame moved the rest)
     return True
