@@ -367,13 +367,13 @@ def update(
             # before the current objects are taken (update_object evaluates again after its edits).
             evaluated = _evaluated(depsgraph)
             current = changes.current_objects(scene.name, key, snap.frame, stepping)
+        if stepping and only_changed:  # straight keys: their offsets set, up to date at this frame
+            stepped = straight_steps.step([o for o in objects if o.session_uid not in current], key, snap, depsgraph)
+            current.update(dict.fromkeys(stepped, False))
+            updated += len(stepped)
         for obj in objects:
             uid = obj.session_uid
             if uid in current:
-                continue
-            if stepping and only_changed and straight_steps.step(obj, key, snap, _evaluated(depsgraph)):
-                current[uid] = False  # up to date at this frame (straight keys: its offsets set)
-                updated += 1
                 continue
             data = modifier.cache_data(obj)
             if (

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..common import names
 from ..scene import lens
-from . import changes, modifier, motion
+from . import changes, modifier
 from .modifier import applied_objects
 
 if TYPE_CHECKING:
@@ -46,14 +46,18 @@ def _round_up(value):
     return math.ceil(value / step - 1e-9) * step
 
 
-def bounds_depth(snap: Snapshot, obj_eval: Object) -> float:
-    """The largest depth along the view axis (scene units) of the corners of the evaluated mesh's
+def bounds_depths(snap: Snapshot, evaluated: list[Object]) -> list[float]:
+    """The largest depth along the view axis (scene units) of the corners of each evaluated mesh's
     bounds (the apparent positions of a closed-form object), 0 when none is ahead: at least the
-    farthest vertex's depth (a bound: the corners need not lie in the camera's view)."""
-    corners = np.array([tuple(corner) for corner in obj_eval.bound_box], dtype=np.float64)
-    world = motion.to_world(motion.matrix_array(obj_eval.matrix_world), corners)
-    depth = -(snap.world_to_camera @ (world - snap.camera_position).T)[2]
-    return float(max(depth.max(initial=0.0), 0.0))
+    farthest vertex's depth (a bound: the corners need not lie in the camera's view). One numpy pass
+    over the objects (a 1,000-object frame step takes every object's)."""
+    if not evaluated:
+        return []
+    corners = np.array([[tuple(corner) for corner in obj_eval.bound_box] for obj_eval in evaluated], dtype=np.float64)
+    matrices = np.array([tuple(map(tuple, obj_eval.matrix_world)) for obj_eval in evaluated], dtype=np.float64)
+    world = np.einsum("nij,nkj->nki", matrices[:, :3, :3], corners) + matrices[:, None, :3, 3]
+    depth = -np.einsum("j,nkj->nk", np.asarray(snap.world_to_camera, dtype=np.float64)[2], world - snap.camera_position)
+    return np.maximum(depth.max(axis=1), 0.0).tolist()
 
 
 # Object session_uid -> (the farthest seen depth last taken for it, the camera it was taken for:
@@ -69,7 +73,7 @@ def note_depth(obj: Object, snap: Snapshot, depth: float) -> None:
 def clip_end_warnings(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None = None) -> list[str]:
     """One line when the boosted meshes reach beyond the camera's Clip End (they are cut off in the
     viewport and the boosted-mesh render), naming the farthest mesh and the Clip End it needs.
-    A closed-form object's depth is its evaluated bounds' (:func:`bounds_depth`), taken from a
+    A closed-form object's depth is its evaluated bounds' (:func:`bounds_depths`), taken from a
     handler's evaluated ``depsgraph`` for another camera or when Blender evaluated the object again
     (``changes.moved``), and kept for the syncs without one; the others' come from their updates
     (:func:`note_depth`)."""
@@ -79,24 +83,30 @@ def clip_end_warnings(scene: Scene, snap: Snapshot, depsgraph: Depsgraph | None 
     view = (snap.camera, snap.camera_matrix)
     moved = changes.moved() if depsgraph is not None else set()
     depths = []
+    taken = []  # (uid, name, cache mesh, evaluated object): the closed-form objects' depths taken now
     for obj in applied_objects(scene):
         uid = obj.session_uid
         known = _depths.get(uid)
         if known is not None and uid not in moved and (known[1] == view or depsgraph is None):
             depths.append((known[0], obj.name))
             continue
-        data = modifier.cache_data(obj)
+        mod = modifier.find_modifier(obj)
+        data = modifier.cache_data(obj, mod) if mod is not None else None
         if data is None:
             continue
-        closed = modifier.closed_form_on(modifier.find_modifier(obj))
+        closed = modifier.closed_form_on(mod)
         if depsgraph is not None and closed:
-            depth = bounds_depth(snap, obj.evaluated_get(depsgraph))
-            if data.get(names.DEPTH_KEY) != depth:
-                data[names.DEPTH_KEY] = depth
-        depth = float(data.get(names.DEPTH_KEY, 0.0))
+            taken.append((uid, obj.name, data, obj.evaluated_get(depsgraph)))
+            continue
         # the cache's depth is the last update's (for this camera) unless the modifier computes it
+        depth = float(data.get(names.DEPTH_KEY, 0.0))
         _depths[uid] = (depth, view if depsgraph is not None or not closed else None)
         depths.append((depth, obj.name))
+    for (uid, name, data, _obj_eval), depth in zip(taken, bounds_depths(snap, [t[3] for t in taken]), strict=True):
+        if data.get(names.DEPTH_KEY) != depth:
+            data[names.DEPTH_KEY] = depth
+        _depths[uid] = (depth, view)
+        depths.append((depth, name))
     moved.clear()
     depth, name = max(depths, default=(0.0, ""))
     if depth <= camera.data.clip_end:

@@ -327,11 +327,14 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
     if not (first_frame <= low * fps and high * fps <= last_frame):
         return None  # the window reaches past the line (the intervals decide: a change of velocity in it)
     _last_tau[obj.session_uid] = tau
-    # the observer's latest time this line still holds the window (the window's ends rise with t_o)
-    ahead = t_o + tessellation.SWEEP_FRAMES / fps
-    later = sampling.uniform_motion_window(start, per_frame * fps, size, step, ahead, x_o, c, reach, MAX_INTERVALS)
-    if later is not None and first_frame <= later[0] * fps and later[1] * fps <= last_frame:
-        _lines[obj.session_uid] = (start, per_frame, shape, fps, t_o, ahead)
+    # the observer's latest time this line still holds the window (the window's ends rise with t_o):
+    # the sweep's frames ahead, else half as many (a change of velocity that near)
+    for frames in (tessellation.SWEEP_FRAMES, tessellation.SWEEP_FRAMES // 2):
+        ahead = t_o + frames / fps
+        later = sampling.uniform_motion_window(start, per_frame * fps, size, step, ahead, x_o, c, reach, MAX_INTERVALS)
+        if later is not None and first_frame <= later[0] * fps and later[1] * fps <= last_frame:
+            _lines[obj.session_uid] = (start, per_frame, shape, fps, t_o, ahead)
+            break
     matrix = motion.matrix_array(obj_eval.matrix_world)
     origin = start + per_frame * (t_o * fps)
     beta_o, x_o = np.asarray(beta_o, dtype=np.float64), np.asarray(x_o, dtype=np.float64)

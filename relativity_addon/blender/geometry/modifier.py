@@ -157,16 +157,18 @@ def moving_objects(scene: Scene) -> list[Object]:
     return found
 
 
-def cache_object(obj: Object) -> Object | None:
-    modifier = find_modifier(obj)
+def cache_object(obj: Object, modifier: Modifier | None = None) -> Object | None:
+    """The cache object of ``obj`` (of its ``modifier``, found when not given), or None."""
+    modifier = modifier or find_modifier(obj)
     if modifier is None:
         return None
     return compat.modifier_input(modifier, _identifier(modifier.node_group, "Cache"))
 
 
-def cache_data(obj: Object) -> ID | None:
-    """The cache mesh of ``obj`` (where its update state and bakes live), or None."""
-    cache = cache_object(obj)
+def cache_data(obj: Object, modifier: Modifier | None = None) -> ID | None:
+    """The cache mesh of ``obj`` (where its update state and bakes live; ``modifier``: its modifier,
+    found when not given), or None."""
+    cache = cache_object(obj, modifier)
     return cache.data if cache is not None else None
 
 
@@ -313,11 +315,12 @@ def set_inputs(mod: Modifier, wanted: dict[str, object]) -> bool:
 
 def write_inputs(mod: Modifier, wanted: dict[str, object]) -> None:
     """Set the modifier's number or vector inputs (by interface name, each in its group: the full and the
-    lean group hold them alike) as :func:`set_inputs` stores them, rounded to float32, comparing nothing."""
+    lean group hold them alike) to ``wanted``'s values, already rounded to float32 as :func:`set_inputs`
+    stores them (tuples of Python floats), comparing nothing."""
+    group = mod.node_group
+    identifiers = _input_identifiers(group)
     for name, value in wanted.items():
-        rounded = _float32s(value)
-        stored = tuple(rounded) if hasattr(value, "__len__") else rounded[0]
-        compat.set_modifier_input(mod, _identifier(mod.node_group, name), stored)
+        compat.set_modifier_input(mod, identifiers.get(name) or _identifier(group, name), value)
 
 
 def _float32s(value: object) -> list[float]:

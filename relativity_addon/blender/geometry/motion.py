@@ -210,9 +210,28 @@ def uniform_motion_inputs(
     retarded times, ``keyframed.py``): at the observer's time the origin is at ``origin`` (scene) and
     the rest shape's 3x3 is ``shape``, contracted along ``w`` (the velocity, fraction of c); seen from
     the observer at ``x_o`` moving with ``beta_o``, in the object space of the world ``matrix``."""
-    beta_o = np.asarray(beta_o, dtype=np.float64)
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = np.asarray(matrix, dtype=np.float64)
+    inverse, to_local, fixed = _uniform_parts_of(shape, w, beta_o, matrix)
+    offset = np.asarray(origin, dtype=np.float64) - x_o
+    return {
+        **fixed,
+        "Scene Offset": _vector(offset),
+        "Local Offset": _vector(to_local @ offset + inverse @ (x_o - matrix[:3, 3])),
+    }
+
+
+def uniform_offset_maps(
+    shape: FloatArray, w: FloatArray, beta_o: FloatArray, matrix: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """``(N, N B)`` of :func:`uniform_motion_inputs` (N the inverse of the object's 3x3, B the boost):
+    ``Local Offset`` is ``N B (origin - x_o) + N (x_o - the matrix's translation)``."""
+    inverse, to_local, _fixed = _uniform_parts_of(shape, w, beta_o, np.asarray(matrix, dtype=np.float64))
+    return inverse, to_local
+
+
+def _uniform_parts_of(shape, w, beta_o, matrix):
+    beta_o = np.asarray(beta_o, dtype=np.float64)
     shape, w = np.asarray(shape, dtype=np.float64), np.asarray(w, dtype=np.float64)
     key = b"".join(np.ascontiguousarray(a).tobytes() for a in (shape, w, beta_o, matrix[:3, :3]))
     known = _uniform_parts.get(key)
@@ -220,13 +239,7 @@ def uniform_motion_inputs(
         known = _uniform_parts[key] = _uniform_motion_parts(shape, w, beta_o, matrix)
         if len(_uniform_parts) > 4096:  # more objects, or velocities, than a sync passes over
             _uniform_parts.clear()
-    inverse, to_local, fixed = known
-    offset = np.asarray(origin, dtype=np.float64) - x_o
-    return {
-        **fixed,
-        "Scene Offset": _vector(offset),
-        "Local Offset": _vector(to_local @ offset + inverse @ (x_o - matrix[:3, 3])),
-    }
+    return known
 
 
 def _vector(values):

@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     import numpy.typing as npt
     from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
 
-    from ...physics.arrays import FloatArray
+    from ...physics.arrays import BoolArray, FloatArray
     from ..scene.snapshot import Snapshot
 
 SUBDIVIDED, ACROSS_SEAM = 1.0, 2.0  # face codes (0: left as it is)
@@ -212,7 +212,7 @@ CHUNK_EDGES = 1 << 20  # edges whose lengths are computed at once
 # did not announce (:func:`note_updates`).
 _rest_bounds: dict[str, tuple] = {}
 # object name -> (the bound's inputs but the origin, the origin, the sweep it holds over or None, the
-# bound, whether a sweep failed to clear the tolerance for these inputs)
+# bound, how many of the sweeps (:func:`_sweeps`) failed to clear the tolerance for these inputs)
 _last_bound: dict[str, tuple] = {}
 _announced: set[str] = set()
 
@@ -301,34 +301,38 @@ def edge_image_bound(
         return last[3]
     low, high, longest = bounds
     arguments = (low, high, longest, matrix, beta, x_o, beta_o, snap.world_to_camera, window, size)
-    sweep = None if way is None else _sweep(low, high, matrix, np.asarray(way, dtype=np.float64))
-    # a sweep did not clear the tolerance with these inputs: not tried again
-    failed = bool(last is not None and last[0] == key and last[4])
-    use_sweep = sweep is not None and not failed
+    sweeps = [] if way is None else _sweeps(low, high, matrix, np.asarray(way, dtype=np.float64))
+    # the sweeps that did not clear the tolerance with these inputs: not tried again
+    tried = last[4] if last is not None and last[0] == key else 0
+    kept = None
     try:
-        bound = _bound(arguments, tolerance, acceleration, sweep if use_sweep else None)
-        if use_sweep and not bound <= PROVEN_MARGIN * tolerance:
-            failed, use_sweep = True, False
+        for sweep in sweeps[tried:]:
+            bound = _bound(arguments, tolerance, acceleration, sweep)
+            if bound <= PROVEN_MARGIN * tolerance:
+                kept = sweep
+                break
+            tried += 1
+        if kept is None:
             bound = _bound(arguments, tolerance, acceleration, None)
     except ValueError:  # a velocity not below c: the update reports it
-        bound, use_sweep = float("inf"), False
-    _last_bound[obj.name] = (key, origin.copy(), sweep if use_sweep else None, bound, failed)
+        bound, kept = float("inf"), None
+    _last_bound[obj.name] = (key, origin.copy(), kept, bound, tried)
     return bound
 
 
 # Straight keys: the edges' bound is taken over the origin's way through up to this many frames to
 # come, and up to SWEEP_SIZES times the object's size (the bound's box grows by the sweep), one frame's
-# at least.
-SWEEP_FRAMES = 8
-SWEEP_SIZES = 16.0
+# at least; where that bound does not clear the tolerance, over half that way.
+SWEEP_FRAMES = 16
+SWEEP_SIZES = 32.0
 
 
-def _sweep(low: FloatArray, high: FloatArray, matrix: FloatArray, way: FloatArray) -> FloatArray:
-    """The origin's way over the frames the bound is taken for (world units)."""
+def _sweeps(low: FloatArray, high: FloatArray, matrix: FloatArray, way: FloatArray) -> list[FloatArray]:
+    """The origin's ways over the frames the bound is taken for (world units), longest first."""
     size = float(np.sqrt(((high - low) ** 2).sum() * (matrix[:3, :3] ** 2).sum()))  # at least the box's
     step = float(np.sqrt(way @ way))
     frames = SWEEP_FRAMES if step * SWEEP_FRAMES <= SWEEP_SIZES * size else max(1, int(SWEEP_SIZES * size / step))
-    return way * frames
+    return [way * frames] + ([way * (frames // 2)] if frames > 1 else [])
 
 
 def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:
@@ -356,11 +360,17 @@ def on_way(origin: FloatArray, start: FloatArray, sweep: FloatArray | None, part
         return True
     if sweep is None:
         return False
-    moved = origin - start
-    along = float(moved @ sweep) / max(float(sweep @ sweep), 1e-300)
-    across = moved - along * sweep
-    scale = 1e-9 * (1.0 + float(np.abs(start).max()) + float(np.abs(sweep).max()))
-    return -1e-9 <= along <= part + 1e-9 and float(np.abs(across).max()) <= scale
+    return bool(on_ways(np.asarray(origin)[None], np.asarray(start)[None], np.asarray(sweep)[None], part)[0])
+
+
+def on_ways(origins: FloatArray, starts: FloatArray, sweeps: FloatArray, part: float = 1.0) -> BoolArray:
+    """:func:`on_way` of each row of ``origins`` (N, 3), ``starts`` and ``sweeps``."""
+    moved = origins - starts
+    along = (moved * sweeps).sum(axis=1) / np.maximum((sweeps * sweeps).sum(axis=1), 1e-300)
+    across = moved - along[:, None] * sweeps
+    scale = 1e-9 * (1.0 + np.abs(starts).max(axis=1) + np.abs(sweeps).max(axis=1))
+    inside = (along >= -1e-9) & (along <= part + 1e-9) & (np.abs(across).max(axis=1) <= scale)
+    return (origins == starts).all(axis=1) | inside
 
 
 def announce(obj: Object) -> None:

@@ -295,6 +295,7 @@ def sync(
     attach_new_materials: bool = False,
     before_render: bool = False,
     in_frame_change: bool = False,
+    record: bool = True,
 ) -> Snapshot | None:
     """Bring the applied render path up to date with the scene at its current frame.
 
@@ -303,7 +304,9 @@ def sync(
     them) are recomputed; ``attach_new_materials`` attaches the Doppler colour to materials added
     since Set Up; ``before_render`` (``render_pre``) also writes what only a render reads (the
     world's direction image); ``in_frame_change`` (``frame_change_post``): the depsgraph is not
-    evaluated again (``apparent_meshes.update_object``).
+    evaluated again (``apparent_meshes.update_object``); ``record=False`` (``frame_change_pre``) takes
+    no warnings for the panel: the frame change's ``frame_change_post`` takes them, with the new
+    frame's meshes (a pass over every mesh: issue 26's 1,000 objects).
     Never raises."""
     if depsgraph is not None:
         # also while computing: what Blender evaluated again (a render's fresh depsgraph: only
@@ -338,7 +341,8 @@ def sync(
                 exact_camera.invalidate(scene.camera)
             _refused(scene, error)
             return None
-        _record(scene, snap, depsgraph)
+        if record:
+            _record(scene, snap, depsgraph)
         return snap
 
 

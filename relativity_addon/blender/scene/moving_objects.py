@@ -139,6 +139,7 @@ def fastest_speed(scene: Scene) -> float:
     the scene's frame range (every quarter frame; kept while its keyframes are the same). Below 1:
     what reaches the speed of light is refused elsewhere."""
     fastest = 0.0
+    keyed = None  # (frame range, fps, c): read once for every keyframed object
     for obj in scene.objects:
         if not has_own_velocity(obj):
             continue
@@ -146,20 +147,22 @@ def fastest_speed(scene: Scene) -> float:
         if settings.motion == "CONSTANT":
             speed = math.hypot(*settings.beta)  # (a numpy norm per object: 5 us, a tenth of a 1,000-mesh sync)
         else:
-            speed = _keyframed_speed(obj, scene)
+            if keyed is None:
+                c = float(scene.relativity.speed_of_light)
+                keyed = (scene.frame_start, scene.frame_end, animation.frames_per_second(scene), c)
+            speed = _keyframed_speed(obj, keyed)
         fastest = max(fastest, speed)
     return min(fastest, 1.0 - 1e-9)
 
 
-def _keyframed_speed(obj, scene):
-    c = float(scene.relativity.speed_of_light)
-    fps = animation.frames_per_second(scene)
-    key = (animation.keyframes_signature(obj), scene.frame_start, scene.frame_end, fps, c)
+def _keyframed_speed(obj, keyed):
+    start, end, fps, c = keyed
+    key = (animation.keyframes_signature(obj), *keyed)
     known = _keyframed_speeds.get(obj.name)
     if key[0] is not None and known is not None and known[0] == key:
         return known[1]
-    count = min(int((scene.frame_end - scene.frame_start) / _SPEED_STEP_FRAMES) + 2, _SPEED_SAMPLES)
-    frames = np.linspace(scene.frame_start - _SPEED_STEP_FRAMES, scene.frame_end, count)
+    count = min(int((end - start) / _SPEED_STEP_FRAMES) + 2, _SPEED_SAMPLES)
+    frames = np.linspace(start - _SPEED_STEP_FRAMES, end, count)
     try:
         positions = animation.world_matrices(obj, frames)[:, :3, 3]
     except RelativityError:  # a motion its keyframes do not give: refused where it is drawn

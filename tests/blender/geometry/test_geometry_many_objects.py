@@ -55,7 +55,13 @@ def _count_work(monkeypatch):
     hook(meshes, "object_signature", "signature", lambda args: args[1])
     hook(meshes, "update_object", "update", lambda args: args[1])
     hook(compat, "set_modifier_input", "input written", lambda args: args[0].id_data)
-    hook(clip_end, "bounds_depth", "depth", lambda args: args[1])
+    depths = clip_end.bounds_depths
+
+    def counted_depths(snap, evaluated):
+        work["depth"].update(obj.original.name for obj in evaluated)
+        return depths(snap, evaluated)
+
+    monkeypatch.setattr(clip_end, "bounds_depths", counted_depths)
     hook(effect, "_mesh_warnings", "warnings", lambda args: args[1])
     return work
 

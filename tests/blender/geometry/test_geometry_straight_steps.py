@@ -12,11 +12,11 @@ import geometry_helpers as gh
 
 
 def _counted_updates(monkeypatch):
-    """{"update_object": full updates, "step": frame steps the records took}."""
+    """{"update_object": full updates, "step": objects the records stepped}."""
     meshes = gh.addon_module("geometry.apparent_meshes")
     steps = gh.addon_module("geometry.straight_steps")
     hooked = ((meshes, "update_object"), (steps, "step"))
-    return gh.count_calls(monkeypatch, hooked, lambda name, result: int(name == "update_object" or bool(result)))
+    return gh.count_calls(monkeypatch, hooked, lambda name, result: 1 if name == "update_object" else len(result))
 
 
 def _check(bpy, obj, camera, frame):
