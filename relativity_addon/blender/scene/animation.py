@@ -178,17 +178,20 @@ def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
 def _keyframes_signature(obj):
     parts = []
     while obj is not None:
-        animated = set(_transform_fcurves(obj))
+        animated = set()  # the live transform channels (_transform_fcurves), from the same pass
         animation_data = obj.animation_data
         if animation_data is not None and animation_data.action is not None:
             for fcurve in compat.action_fcurves(animation_data):
                 if len(fcurve.modifiers):
                     return None
+                path, index, mute = fcurve.data_path, fcurve.array_index, fcurve.mute
+                if path in TRANSFORM_PATHS and not mute and len(fcurve.keyframe_points):
+                    animated.add((path, index))
                 parts.append(
                     (
-                        fcurve.data_path,
-                        fcurve.array_index,
-                        fcurve.mute,
+                        path,
+                        index,
+                        mute,
                         fcurve.extrapolation,
                         tuple(
                             (

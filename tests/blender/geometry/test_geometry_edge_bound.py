@@ -8,6 +8,7 @@ and the measure subdivide it; test_adaptive_tessellation.py renders its outline)
 
 from contextlib import contextmanager
 
+import numpy as np
 from test_geometry_closed_form import _grid_mesh
 from test_object_type_sweep import _link
 
@@ -246,4 +247,52 @@ def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monke
     scene.frame_set(12 + 3 * tessellation.SWEEP_FRAMES)
     bpy.context.evaluated_depsgraph_get()
     assert calls.get("edge_image_bound", 0) >= 1
+    assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
+
+
+def test_straight_keys_keep_half_the_sweep_where_the_whole_does_not_clear(relativity_addon, monkeypatch):
+    """Where the bound over the origin's whole way to come (``SWEEP_FRAMES``) does not clear the
+    tolerance (made so here: the bound over it is refused), the bound over the way's first half is
+    kept: frame steps through that half compute no bound and the verdict holds; a full update past it
+    bounds the half way again, and does not try the whole way again for the same inputs."""
+    import bpy
+
+    modifier = gh.addon_module("geometry.modifier")
+    tessellation = gh.addon_module("geometry.tessellation")
+    scene, obj = _keyed_grid(bpy, 200)
+    per_frame = 0.6 * C / FPS
+    whole = tessellation.SWEEP_FRAMES * per_frame  # (the grid is far larger than a frame's way)
+    tried = {"whole": 0, "half": 0}
+    bound = tessellation._bound
+
+    def refusing(arguments, tolerance, acceleration, sweep):
+        if sweep is not None:
+            length = float(np.linalg.norm(sweep))
+            if abs(length - whole) < 1e-6 * whole:
+                tried["whole"] += 1
+                return float("inf")
+            assert abs(length - whole / 2) < 1e-6 * whole, (length, whole)
+            tried["half"] += 1
+        return bound(arguments, tolerance, acceleration, sweep)
+
+    monkeypatch.setattr(tessellation, "_bound", refusing)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    assert tried["whole"] >= 1 and tried["half"] >= 1, tried
+    start, sweep = tessellation.swept_bound(obj)
+    np.testing.assert_allclose(np.linalg.norm(sweep), whole / 2, rtol=1e-6)
+    after_setup = dict(tried)
+    calls = {}
+    _counted(monkeypatch, tessellation.tessellation, "edge_image_bound", calls)
+    mod = modifier.find_modifier(obj)
+    for frame in range(13, 12 + tessellation.SWEEP_FRAMES // 2):
+        scene.frame_set(frame)
+        verdict, vertices = _verdict(bpy, obj)
+        assert compat.modifier_input(*_input(mod, "Edges Proven Short")), frame
+        assert verdict is True and vertices == SIDE * SIDE
+    assert calls == {} and tried == after_setup, (calls, tried)
+    scene.frame_set(12 + tessellation.SWEEP_FRAMES)
+    bpy.context.evaluated_depsgraph_get()
+    assert tried["half"] > after_setup["half"] and tried["whole"] == after_setup["whole"], tried
     assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
