@@ -54,7 +54,7 @@ def bounds_depths(snap: Snapshot, evaluated: list[Object]) -> list[float]:
     if not evaluated:
         return []
     corners = np.array([[tuple(corner) for corner in obj_eval.bound_box] for obj_eval in evaluated], dtype=np.float64)
-    matrices = np.array([tuple(map(tuple, obj_eval.matrix_world)) for obj_eval in evaluated], dtype=np.float64)
+    matrices = np.array([[tuple(row) for row in obj_eval.matrix_world] for obj_eval in evaluated], dtype=np.float64)
     world = np.einsum("nij,nkj->nki", matrices[:, :3, :3], corners) + matrices[:, None, :3, 3]
     depth = -np.einsum("j,nkj->nk", np.asarray(snap.world_to_camera, dtype=np.float64)[2], world - snap.camera_position)
     return np.maximum(depth.max(axis=1), 0.0).tolist()

@@ -92,16 +92,17 @@ def step(objects: Iterable[Object], key: object, snap: Snapshot, depsgraph: Deps
         swept = tessellation.swept_bound(obj)
         if swept is None or animation.keyframes_signature(obj) != record[1]:
             continue
-        found.append((obj, record, tuple(map(tuple, obj.evaluated_get(depsgraph).matrix_world)), swept))
+        found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
     if not found:
         return set()
-    records, matrices, swept = ([item[k] for item in found] for k in (1, 2, 3))
-    offsets = _offsets(records, np.array(matrices), swept, snap)
+    offsets = _offsets(
+        [item[1] for item in found], np.array([item[2] for item in found]), [item[3] for item in found], snap
+    )
     stepped = set()
     for (obj, record, matrix, _swept), values in zip(found, offsets, strict=True):
         mod = modifier.find_modifier(obj) if values is not None else None
         data = modifier.cache_data(obj, mod) if mod is not None else None
-        if data is None:
+        if mod is None or data is None:
             continue
         modifier.write_inputs(mod, dict(zip(OFFSETS, values, strict=True)))
         data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + record[8]
