@@ -168,8 +168,9 @@ def object_signature(
         else None,
         _render_size(snap) if relativity.use_adaptive_tessellation else None,
         relativity.samples_per_frame,
-        # the keys: an edit leaving the current frame's place changes the past the window reads
-        hash(animation.keyframes_signature(obj)) if relativity.motion == "ANIMATION" else None,
+        # the keys: an edit leaving the current frame's place changes the past the window reads (also the
+        # own rotation keys of a Constant Velocity mesh: its spin at the retarded times)
+        hash(animation.keyframes_signature(obj)) if obj.animation_data is not None else None,
         snap.fps,
         relativity.use_deformation,
         relativity.use_proper_time,

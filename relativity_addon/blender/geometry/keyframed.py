@@ -73,7 +73,7 @@ def _matrix_function(obj, scene, fps, step, c, signature):
         clock = motion.path_clock(obj, fps, step, c)
         return lambda times: animation.world_matrices(obj, times * fps, own_frames=clock(times) * fps)
     function = lambda times: animation.world_matrices(obj, times * fps)  # noqa: E731
-    return function if signature is None else _kept_samples(obj, (signature, fps, step), function, step)
+    return _kept_samples(obj, (signature, fps, step), function, step)
 
 
 # Object session_uid -> (keyframes signature, {name: value}): what the keys alone decide (where they
@@ -83,13 +83,10 @@ _facts: dict[int, tuple[object, dict[str, object]]] = {}
 
 
 def _keyed_facts(obj: Object, signature: object) -> dict[str, object]:
-    """The object's kept facts (:data:`_facts`; a new dict for keys with F-curve modifiers, whose
-    ``signature`` is None: nothing kept)."""
+    """The object's kept facts (:data:`_facts`), new when its keys' ``signature`` changed."""
     known = _facts.get(obj.session_uid)
-    if signature is None or known is None or known[0] != signature:
-        known = (signature, {})
-        if signature is not None:
-            _facts[obj.session_uid] = known
+    if known is None or known[0] != signature:
+        known = _facts[obj.session_uid] = (signature, {})
     return known[1]
 
 
@@ -265,15 +262,13 @@ def _window(obj, scene, signature, facts, corners, event):
     None where there is none or no rest box); None for the Python path (too many intervals, or
     intervals before the keys start moving the object). Raises RelativityError."""
     fps, step, t_o, x_o, c, reach = event
-    key = None
-    if signature is not None:  # keys with F-curve modifiers: nothing kept
-        box = None if corners is None else tuple(float(v) for v in np.ravel(corners))
-        proper = bool(obj.relativity.use_proper_time)
-        event_key = (fps, step, float(t_o), tuple(float(v) for v in x_o), float(c), float(reach))
-        key = (signature, proper, *event_key, box, MAX_INTERVALS)
-        kept = _windows.get(obj.session_uid)
-        if kept is not None and kept[0] == key:
-            return kept[1]
+    box = None if corners is None else tuple(float(v) for v in np.ravel(corners))
+    proper = bool(obj.relativity.use_proper_time)
+    event_key = (fps, step, float(t_o), tuple(float(v) for v in x_o), float(c), float(reach))
+    key = (signature, proper, *event_key, box, MAX_INTERVALS)
+    kept = _windows.get(obj.session_uid)
+    if kept is not None and kept[0] == key:
+        return kept[1]
     try:
         function = _matrix_function(obj, scene, fps, step, c, signature)
         guess = _last_tau.get(obj.session_uid)
@@ -294,8 +289,7 @@ def _window(obj, scene, signature, facts, corners, event):
         grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
         x_o = np.asarray(x_o, dtype=np.float64)
         found = _window_polynomial(pieces, corners, grid_now, grid_per_distance, x_o, reach, step, c)
-    if key is not None:
-        _windows[obj.session_uid] = (key, (pieces, line, found))
+    _windows[obj.session_uid] = (key, (pieces, line, found))
     return pieces, line, found
 
 

@@ -341,7 +341,7 @@ def _path_clock(obj, fps, step, c):
     outside it, so stepping through frames evaluates only the new ones."""
     signature = animation.keyframes_signature(obj)
     key = (obj.name, fps, step, c, signature)
-    table = _clock_tables.get(obj.name) if signature is not None else None
+    table = _clock_tables.get(obj.name)
     if table is None or table["key"] != key:
         table = {"key": key, "spacing": step}
         _clock_tables[obj.name] = table

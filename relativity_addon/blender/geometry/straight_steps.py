@@ -63,8 +63,8 @@ def remember(obj: Object, key: object, snap: Snapshot, signature: str, matrix: t
     way to come (``keyframed.steppable_line``)."""
     line = keyframed.steppable_line(obj)
     head = signature_head(snap.frame, matrix)
-    keys = animation.keyframes_signature(obj)  # (None: keys with F-curve modifiers, not compared)
-    if line is None or keys is None or not signature.startswith(head):
+    keys = animation.keyframes_signature(obj)
+    if line is None or not signature.startswith(head):
         return
     start, per_frame, shape, fps, t_low, t_high = line
     held = np.array(matrix, dtype=np.float64)

@@ -455,9 +455,14 @@ def _record(scene, snap, depsgraph=None):
 
 
 def _mesh_warnings(scene, obj, snap):
-    """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change."""
+    """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change (the
+    spin's line reads the keys, c and fps: a key edited away from the current frame, or c changed,
+    left it stale before)."""
     inputs = (
         tuple(snap.camera_position),
+        snap.speed_of_light,
+        snap.fps,
+        hash(animation.keyframes_signature(obj)) if obj.animation_data is not None else None,  # (the spin's keys)
         obj.relativity.motion,
         tuple(obj.relativity.beta),
         tuple(map(tuple, obj.matrix_world)),

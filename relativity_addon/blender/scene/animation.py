@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import threading
 from contextlib import contextmanager
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from mathutils import Matrix
@@ -161,9 +161,9 @@ def signed_once(kept: dict[int, object] | None = None) -> Iterator[None]:
         _signed.signatures = outer
 
 
-def keyframes_signature(obj: Object) -> tuple[object, ...] | None:
+def keyframes_signature(obj: Object) -> tuple[object, ...]:
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
-    cache key; None when an F-curve has modifiers (their settings are not in the key). A channel
+    cache key: the F-curves' keys and their modifiers' settings (:func:`_settings_of`). A channel
     an F-curve animates enters by its keys alone, not by its current value: that value changes at
     every frame step, which changes no key (the evaluation reads the keys, :func:`basis_matrices`)."""
     signatures = getattr(_signed, "signatures", None)
@@ -182,10 +182,9 @@ def _keyframes_signature(obj):
         animation_data = obj.animation_data
         if animation_data is not None and animation_data.action is not None:
             for fcurve in compat.action_fcurves(animation_data):
-                if len(fcurve.modifiers):
-                    return None
                 path, index, mute = fcurve.data_path, fcurve.array_index, fcurve.mute
-                if path in TRANSFORM_PATHS and not mute and len(fcurve.keyframe_points):
+                modifiers = tuple(_settings_of(modifier) for modifier in fcurve.modifiers)
+                if path in TRANSFORM_PATHS and not mute and (len(fcurve.keyframe_points) or modifiers):
                     animated.add((path, index))
                 parts.append(
                     (
@@ -193,6 +192,7 @@ def _keyframes_signature(obj):
                         index,
                         mute,
                         fcurve.extrapolation,
+                        modifiers,
                         tuple(
                             (
                                 tuple(p.co),
@@ -224,6 +224,26 @@ def _keyframes_signature(obj):
         )
         obj = obj.parent
     return tuple(parts)
+
+
+def _settings_of(struct: Any) -> tuple[object, ...]:
+    """Every value of an F-curve modifier (or of an item of its collections: an envelope's control
+    points), arrays as tuples: what it does to its curve, as a key (a curve with modifiers used to give
+    no signature, and the camera's proper time, kept under it, held its value when a modifier's
+    settings were edited)."""
+    values: list[object] = [struct.bl_rna.identifier]
+    for prop in struct.bl_rna.properties:
+        name = prop.identifier
+        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER":  # (and the panel's state)
+            continue
+        value = getattr(struct, name)
+        if prop.type == "COLLECTION":
+            values.append(tuple(_settings_of(item) for item in value))
+        elif getattr(prop, "is_array", False):
+            values.append(tuple(value))
+        else:
+            values.append(value)
+    return tuple(values)
 
 
 def off_keys(obj: Object, frame: float) -> bool:

@@ -251,3 +251,40 @@ def test_spin_left_rigid_in_scene_time_is_said(relativity_addon, factory_blender
     expected = math.degrees(per_point.BETA * turn * 1.0 / per_point.C)  # beta beta_rim, the keys' rim
     assert expected == pytest.approx(9.0, abs=0.1)
     assert named == pytest.approx(expected, abs=1.0)
+
+
+def test_spin_line_follows_c_and_a_key_edited_away_from_the_frame(relativity_addon, factory_blender):
+    """The spin's line (above) is kept while the mesh's inputs stay: c and the rotation keys are among
+    them. At ten times c the lag is a tenth (0.9 degrees: no line); a key edited away from the
+    current frame (the turn from frame 13 on twice as fast, frame 13's orientation the same) doubles
+    the named angle. Before, both left the line as it was until the mesh's matrix changed."""
+    bpy = factory_blender
+    scene, _ = _turning_sphere(bpy, "CONSTANT", 1, False, TURN, 0)
+    sphere = scene.objects["Sphere"]
+    effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+    effect.apply(scene)
+
+    def named():
+        bpy.context.evaluated_depsgraph_get()  # the edit's depsgraph update syncs
+        lines = [line for line in effect.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
+        assert len(lines) <= 1, lines
+        return float(lines[0].split("up to about ")[1].split(" degrees")[0]) if lines else None
+
+    expected = math.degrees(per_point.BETA * TURN * 1.0 / per_point.C)
+    assert named() == pytest.approx(expected, abs=1.0)
+    scene.relativity.speed_of_light = 10.0 * per_point.C
+    assert named() is None
+    scene.relativity.speed_of_light = per_point.C
+    assert named() == pytest.approx(expected, abs=1.0)
+
+    sphere.keyframe_insert("rotation_euler", index=0, frame=13)  # at its value there (0)
+    _linear(bpy, sphere)
+    matrix = [tuple(row) for row in sphere.matrix_world]
+    compat = importlib.import_module(f"{ADDON_MODULE}.blender.common.compat")
+    curve = next(c for c in compat.action_fcurves(sphere.animation_data) if c.data_path == "rotation_euler")
+    last = max(curve.keyframe_points, key=lambda point: point.co[0])
+    last.co[1] *= 2.0
+    curve.update()
+    scene.frame_set(13)
+    assert [tuple(row) for row in sphere.matrix_world] == matrix
+    assert named() == pytest.approx(2.0 * expected, abs=1.5)

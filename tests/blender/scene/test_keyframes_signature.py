@@ -46,3 +46,26 @@ def test_a_frame_step_keeps_the_signature_and_a_key_edit_changes_it(animation, f
     assert animation.keyframes_signature(child) == before
     parent.keyframe_insert("location", index=0, frame=60)  # a key of the parent at its value at 17
     assert animation.keyframes_signature(child) != before
+
+
+def test_f_curve_modifiers_settings_enter_the_signature(animation, factory_blender):
+    """A curve with modifiers gave no signature (None), so a cache keyed on it held its value when a
+    modifier's settings were edited: their settings are in it now, an envelope's points too."""
+    bpy = factory_blender
+    obj = _keyed(bpy, "Noisy")
+    curve = next(c for c in animation.compat.action_fcurves(obj.animation_data) if c.data_path == "location")
+    noise = curve.modifiers.new("NOISE")
+    envelope = curve.modifiers.new("ENVELOPE")
+    point = envelope.control_points.add(10)
+    point.min, point.max = -1.0, 1.0
+    before = animation.keyframes_signature(obj)
+    assert before is not None
+    noise.strength = 2.5
+    assert animation.keyframes_signature(obj) != before
+    noise.strength = 1.0
+    assert animation.keyframes_signature(obj) == before
+    point.max = 2.0
+    assert animation.keyframes_signature(obj) != before
+    point.max = 1.0
+    envelope.show_expanded = not envelope.show_expanded  # the panel's state moves nothing
+    assert animation.keyframes_signature(obj) == before
