@@ -2,7 +2,7 @@
 
     python benchmarks/artist_chain.py [--sizes 0.5M,2M,8M] [--scenes grid,objects]
         [--motions constant,keyframed,eased] [--tessellation default|0|N] [--rounds 3]
-        [--resolution 64x48] [--samples 4] [--lamp] [--no-memory] [--profile chain.prof]
+        [--resolution 64x48] [--samples 4] [--lamp] [--no-memory] [--profile chain.prof] [--parts 12]
 
 Generated scenes: one grid mesh of about SIZE vertices, or SIZE / 2,000 small grids of 2,025
 vertices each (1,000 objects at 2M), each a mesh of its own, 5 m in front of the camera, with
@@ -33,6 +33,9 @@ the printed rows name it. ``--lamp`` adds a sun to both scenes: the lamp stage t
 light-linked copy of it per moving object (Blender links at most 64). ``--profile FILE`` writes
 a cProfile of a Set Up, a velocity change and a frame step of the first case (read it with
 ``python -m pstats FILE``), and one of each step alone in ``FILE.setup``, ``FILE.velocity``, ``FILE.frame``.
+``--parts N`` times N more velocity changes and N frame steps of the first case, each with the
+add-on's parts (:data:`PARTS`) timed by ``time.perf_counter`` around them, unprofiled, and prints
+the milliseconds per step each took (nested: a sync holds the others).
 """
 
 import argparse
@@ -211,6 +214,59 @@ def plain_rewrite(bpy, scene, objects, offset):
     return read_vertex(bpy, objects[0], depsgraph)
 
 
+# (module under relativity_addon.blender, function): the add-on's parts ``--parts`` times.
+PARTS = (
+    ("pipeline.effect", "sync"),
+    ("pipeline.effect", "_record"),
+    ("scene.snapshot", "read"),
+    ("geometry.apparent_meshes", "update"),
+    ("geometry.apparent_meshes", "update_object"),
+    ("geometry.straight_steps", "step"),
+    ("geometry.clip_end", "clip_end_warnings"),
+    ("geometry.instancing", "check_instancing"),
+    ("geometry.changes", "cache_notes"),
+    ("scene.moving_objects", "fastest_speed"),
+    ("scene.animation", "_keyframes_signature"),
+)
+
+
+@contextmanager
+def timed_parts():
+    """Inside: every function of :data:`PARTS` adds its wall time and calls to the yielded
+    {name: [seconds, calls]} (module attributes replaced: callers look them up at each call)."""
+    import importlib
+
+    totals = {}
+    replaced = []
+    for module_name, name in PARTS:
+        module = importlib.import_module(f"relativity_addon.blender.{module_name}")
+        original = getattr(module, name)
+        total = totals[f"{module_name.split('.')[-1]}.{name}"] = [0.0, 0]
+
+        def timed_part(*args, _original=original, _total=total, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _original(*args, **kwargs)
+            finally:
+                _total[0] += time.perf_counter() - start
+                _total[1] += 1
+
+        setattr(module, name, timed_part)
+        replaced.append((module, name, original))
+    try:
+        yield totals
+    finally:
+        for module, name, original in replaced:
+            setattr(module, name, original)
+
+
+def print_parts(label, steps, walls, totals):
+    print(f"\n{label}: {steps} steps, median {statistics.median(walls):.3f} s (parts in ms per step, calls per step)")
+    for name, (seconds, calls) in sorted(totals.items(), key=lambda item: -item[1][0]):
+        if calls:
+            print(f"  {name:40s} {seconds / steps * 1e3:8.1f} ms  {calls / steps:8.1f}")
+
+
 def timed(function, *args):
     start = time.perf_counter()
     function(*args)
@@ -281,6 +337,15 @@ def measure_case(bpy, options, kind, size, motion):
         pstats.Stats(*files).dump_stats(options.profile)
         options.profile = None
         effect_scene.relativity.beta = (0.0, 0.0, 0.0)  # (the profiled velocity change's): F12 at rest
+        bpy.context.evaluated_depsgraph_get()
+    if options.parts:
+        steps = (("velocity change", velocity_change, 0), ("frame step", frame_step, options.rounds + 2))
+        for label, step, first in steps:
+            with timed_parts() as totals:
+                walls = [timed(step, first + k) for k in range(options.parts)]
+            print_parts(f"{kind}, {motion} motion, {label}", options.parts, walls, totals)
+        options.parts = 0
+        effect_scene.relativity.beta = (0.0, 0.0, 0.0)
         bpy.context.evaluated_depsgraph_get()
     alternate(
         "F12",
@@ -379,6 +444,7 @@ def main():
     parser.add_argument("--no-memory", action="store_true")
     parser.add_argument("--lamp", action="store_true", help="a sun in each scene (the lamp stage's copies)")
     parser.add_argument("--profile", default=None)
+    parser.add_argument("--parts", type=int, default=0, help="time the add-on's parts over N more steps")
     parser.add_argument("--child-memory", default=None, help=argparse.SUPPRESS)
     options = parser.parse_args()
     options.tessellation_text = options.tessellation
