@@ -36,7 +36,7 @@ def test_frame_steps_on_straight_keys_set_the_offsets_alone(relativity_addon, mo
         scene.frame_set(frame)
         _check(bpy, obj, camera, frame)
         assert _inputs(obj) == {"Closed Form": True, "Keyframed": False}
-    # the edges' sweep holds for 8 frames ahead: a full update at most every few frames
+    # the edges' sweep holds for SWEEP_FRAMES (16) frames ahead: a full update at most every few frames
     assert calls["step"] >= 12, calls
     assert calls["update_object"] >= 1, calls
 
