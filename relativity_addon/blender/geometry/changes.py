@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any, cast
 import bpy
 
 from ..common import names
+from ..scene import animation
 from . import modifier
 
 if TYPE_CHECKING:
@@ -83,17 +84,7 @@ def _same_in_render(evaluated: Any) -> bool:
         return False
     if [tuple(row) for row in evaluated.matrix_world] != [tuple(row) for row in obj.matrix_world]:
         return False
-    return _settings(evaluated.relativity) == _settings(obj.relativity)
-
-
-def _settings(settings: Any) -> tuple:
-    """Every property of an object's relativity settings (arrays as tuples)."""
-    values = []
-    for prop in settings.bl_rna.properties:
-        if prop.identifier != "rna_type":
-            value = getattr(settings, prop.identifier)
-            values.append(tuple(value) if getattr(prop, "is_array", False) else value)
-    return tuple(values)
+    return animation.settings_key(evaluated.relativity) == animation.settings_key(obj.relativity)
 
 
 def note_updates(depsgraph: Depsgraph) -> None:

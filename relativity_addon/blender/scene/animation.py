@@ -163,7 +163,7 @@ def signed_once(kept: dict[int, object] | None = None) -> Iterator[None]:
 
 def keyframes_signature(obj: Object) -> tuple[object, ...]:
     """Everything of the object's (and its parents') keyframes and transform that moves it, as a
-    cache key: the F-curves' keys and their modifiers' settings (:func:`_settings_of`). A channel
+    cache key: the F-curves' keys and their modifiers' settings (:func:`settings_key`). A channel
     an F-curve animates enters by its keys alone, not by its current value: that value changes at
     every frame step, which changes no key (the evaluation reads the keys, :func:`basis_matrices`)."""
     signatures = getattr(_signed, "signatures", None)
@@ -183,7 +183,7 @@ def _keyframes_signature(obj):
         if animation_data is not None and animation_data.action is not None:
             for fcurve in compat.action_fcurves(animation_data):
                 path, index, mute = fcurve.data_path, fcurve.array_index, fcurve.mute
-                modifiers = tuple(_settings_of(modifier) for modifier in fcurve.modifiers)
+                modifiers = tuple(settings_key(modifier) for modifier in fcurve.modifiers)
                 if path in TRANSFORM_PATHS and not mute and (len(fcurve.keyframe_points) or modifiers):
                     animated.add((path, index))
                 parts.append(
@@ -226,19 +226,19 @@ def _keyframes_signature(obj):
     return tuple(parts)
 
 
-def _settings_of(struct: Any) -> tuple[object, ...]:
-    """Every value of an F-curve modifier (or of an item of its collections: an envelope's control
-    points), arrays as tuples: what it does to its curve, as a key (a curve with modifiers used to give
-    no signature, and the camera's proper time, kept under it, held its value when a modifier's
-    settings were edited)."""
+def settings_key(struct: Any) -> tuple[object, ...]:
+    """Every value of an RNA struct (an F-curve modifier, an object's relativity settings; the items
+    of its collections, an envelope's control points, likewise; no pointers, nor the panel's state),
+    arrays as tuples: what it holds, as a key (a curve with modifiers used to give no keys' signature,
+    and the camera's proper time, kept under it, held its value when a modifier's settings were edited)."""
     values: list[object] = [struct.bl_rna.identifier]
     for prop in struct.bl_rna.properties:
         name = prop.identifier
-        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER":  # (and the panel's state)
+        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER":
             continue
         value = getattr(struct, name)
         if prop.type == "COLLECTION":
-            values.append(tuple(_settings_of(item) for item in value))
+            values.append(tuple(settings_key(item) for item in value))
         elif getattr(prop, "is_array", False):
             values.append(tuple(value))
         else:
