@@ -130,7 +130,7 @@ def _offsets(records, matrices, swept, snap):
     origin = start + per_frame * (t_o * fps)[:, None]  # as keyframed._uniform_over_window computes it
     ok &= tessellation.on_ways(origin, np.array([s[0] for s in swept]), np.array([s[1] for s in swept]))
     offset = origin - x_o
-    local = np.einsum("nij,nj->ni", to_local, offset) + np.einsum("nij,nj->ni", inverse, x_o - translation)
-    camera = (np.asarray(snap.world_to_camera, dtype=np.float64) @ (translation - x_o).T).T
+    local = motion.uniform_local_offsets(offset, x_o, translation, inverse, to_local)
+    camera = tessellation.camera_offsets(translation, snap)
     values = np.stack([offset, local, camera], axis=1).astype(np.float32).astype(np.float64).tolist()
     return [tuple(map(tuple, rows)) if good else None for rows, good in zip(values, ok.tolist(), strict=True)]

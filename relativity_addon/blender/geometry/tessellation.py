@@ -200,8 +200,13 @@ def edge_measure_inputs(scene: Scene, obj: Object, obj_eval: Object, snap: Snaps
 def camera_offset(matrix: FloatArray, snap: Snapshot) -> tuple[float, ...]:
     """The edge check's ``Camera Offset``: the object's origin (world ``matrix``) from the observer, in
     the camera's axes."""
+    return tuple(camera_offsets(np.asarray(matrix, dtype=np.float64)[None, :3, 3], snap)[0].tolist())
+
+
+def camera_offsets(translations: FloatArray, snap: Snapshot) -> FloatArray:
+    """:func:`camera_offset` of each object origin (rows of ``translations``, N x 3)."""
     rotation = np.asarray(snap.world_to_camera, dtype=np.float64)
-    return tuple(rotation @ (matrix[:3, 3] - np.asarray(snap.mesh_observer[1], dtype=np.float64)))
+    return (translations - np.asarray(snap.mesh_observer[1], dtype=np.float64)) @ rotation.T
 
 
 # The bound must clear the tolerance by this much (the modifier measures in float32).
