@@ -212,7 +212,7 @@ def uniform_motion_inputs(
     the observer at ``x_o`` moving with ``beta_o``, in the object space of the world ``matrix``."""
     x_o = np.asarray(x_o, dtype=np.float64)
     matrix = np.asarray(matrix, dtype=np.float64)
-    inverse, to_local, fixed = _uniform_parts_of(shape, w, beta_o, matrix)
+    inverse, to_local, fixed = uniform_parts(shape, w, beta_o, matrix)
     offset = np.asarray(origin, dtype=np.float64) - x_o
     local = uniform_local_offsets(offset[None], x_o, matrix[None, :3, 3], inverse[None], to_local[None])[0]
     return {**fixed, "Scene Offset": _vector(offset), "Local Offset": _vector(local)}
@@ -223,20 +223,15 @@ def uniform_local_offsets(
 ) -> FloatArray:
     """``Local Offset`` of :func:`uniform_motion_inputs` for each row (N, 3): ``N B (origin - x_o) + N (x_o -
     the matrix's translation)``, ``offsets`` the origins less ``x_o``, ``inverses`` N and ``to_locals`` N B
-    (N, 3, 3; :func:`uniform_offset_maps`). A frame step of many meshes takes them in one pass."""
+    (N, 3, 3; :func:`uniform_parts`). A frame step of many meshes takes them in one pass."""
     return np.einsum("nij,nj->ni", to_locals, offsets) + np.einsum("nij,nj->ni", inverses, x_o - translations)
 
 
-def uniform_offset_maps(
+def uniform_parts(
     shape: FloatArray, w: FloatArray, beta_o: FloatArray, matrix: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """``(N, N B)`` of :func:`uniform_motion_inputs` (N the inverse of the object's 3x3, B the boost):
-    ``Local Offset`` is ``N B (origin - x_o) + N (x_o - the matrix's translation)``."""
-    inverse, to_local, _fixed = _uniform_parts_of(shape, w, beta_o, np.asarray(matrix, dtype=np.float64))
-    return inverse, to_local
-
-
-def _uniform_parts_of(shape, w, beta_o, matrix):
+) -> tuple[FloatArray, FloatArray, dict[str, tuple[float, ...] | float]]:
+    """``(N, N B, the inputs that depend on neither the origin nor the observer's place)`` of
+    :func:`uniform_motion_inputs` (N the inverse of the object's 3x3, B the boost), kept per inputs."""
     beta_o = np.asarray(beta_o, dtype=np.float64)
     shape, w = np.asarray(shape, dtype=np.float64), np.asarray(w, dtype=np.float64)
     key = b"".join(np.ascontiguousarray(a).tobytes() for a in (shape, w, beta_o, matrix[:3, :3]))

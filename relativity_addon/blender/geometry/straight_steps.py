@@ -69,7 +69,7 @@ def remember(obj: Object, key: object, snap: Snapshot, signature: str, matrix: t
     start, per_frame, shape, fps, t_low, t_high = line
     held = np.array(matrix, dtype=np.float64)
     w = per_frame * fps / snap.speed_of_light
-    maps = motion.uniform_offset_maps(shape, w, snap.mesh_observer[2], held)  # as the full update's inputs
+    maps = motion.uniform_parts(shape, w, snap.mesh_observer[2], held)[:2]  # as the full update's inputs
     tail = signature[len(head) :]
     _records[obj.session_uid] = (key, keys, start, per_frame, shape, fps, t_low, t_high, tail, held[:3, :3], *maps)
 
