@@ -297,9 +297,11 @@ def panel_lines(scene: Scene) -> list[str]:
     """The N-panel's lines for set-up ``scene`` as of its last sync (what it leaves approximate or
     out): the scene's, then each set-up object's, named."""
     effect = addon_module("pipeline.effect")
+    mesh_notes = addon_module("pipeline.mesh_notes")
     lines = list(effect.scene_warnings(scene))
     for obj in scene.objects:
-        lines += [line if obj.name in line else f"{obj.name!r}: {line}" for line in effect.object_warnings(scene, obj)]
+        notes = mesh_notes.object_warnings(scene, obj)
+        lines += [line if obj.name in line else f"{obj.name!r}: {line}" for line in notes]
     return lines
 
 

@@ -434,10 +434,12 @@ def update_after_bake(scene: Scene, obj: Object) -> None:
 _skipped_empty = {}
 
 
-def scene_errors(scene: Scene) -> list[str]:
+def scene_errors(scene: Scene, notes: list | None = None) -> list[str]:
     """One-line errors of the last update of each object (empty when every cache is current), and
-    the meshes left out for having nothing to draw."""
-    errors = [error for _obj, error, _warning in changes.cache_notes(scene) if error is not None]
+    the meshes left out for having nothing to draw; ``notes``: ``changes.cache_notes``' when read."""
+    errors = [
+        error for _obj, error, _warning in (changes.cache_notes(scene) if notes is None else notes) if error is not None
+    ]
     for name in _skipped_empty.get(scene.name, ()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "MESH" and modifier.find_modifier(obj) is None:
@@ -445,10 +447,14 @@ def scene_errors(scene: Scene) -> list[str]:
     return errors
 
 
-def update_warnings(scene: Scene) -> list[str]:
+def update_warnings(scene: Scene, notes: list | None = None) -> list[str]:
     """One-line warnings of the last update of each object that did not fail (what it drew that is
     not the motion the user likely means: keys starting too late); they stop no render."""
-    return [warning for _obj, error, warning in changes.cache_notes(scene) if warning and error is None]
+    return [
+        warning
+        for _obj, error, warning in (changes.cache_notes(scene) if notes is None else notes)
+        if warning and error is None
+    ]
 
 
 def apply(scene: Scene, snap: Snapshot, objects: Iterable[Object] | None = None) -> list[Object]:

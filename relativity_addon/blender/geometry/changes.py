@@ -33,6 +33,9 @@ if TYPE_CHECKING:
 _current: dict[str, tuple[object, float, dict[int, bool]]] = {}
 # Objects (session_uid) Blender evaluated again since the clip-end depth was last taken from them.
 _moved: set[int] = set()
+# Objects (session_uid) whose settings changed or whose cache an update wrote since a sync last
+# took them (:func:`take_noted`: ``pipeline/settled.py``).
+_noted: set[int] = set()
 
 
 class _Updates:
@@ -107,8 +110,16 @@ def note_updates(depsgraph: Depsgraph) -> None:
 def note_changed(uid: int) -> None:
     """An object's settings changed (its update callback runs before Blender tags the object)."""
     _moved.add(uid)
+    _noted.add(uid)
     for _key, _frame, current in _current.values():
         current.pop(uid, None)
+
+
+def take_noted() -> set[int]:
+    """The objects (session_uid) :func:`note_changed` named since the last call; the set starts again."""
+    taken = set(_noted)
+    _noted.clear()
+    return taken
 
 
 def current_objects(scene_name: str, key: object, frame: float, frame_reported: bool) -> dict[int, bool]:

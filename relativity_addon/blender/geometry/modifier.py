@@ -129,6 +129,11 @@ def listed_once() -> Iterator[None]:
         _listed.scenes = outer
 
 
+def listed_as(scene: Scene, objects: tuple[Object, ...]) -> None:
+    """Inside :func:`listed_once`: ``objects`` are the scene's applied meshes (a sync that knows them)."""
+    _listed.scenes[scene.name] = objects
+
+
 def applied_objects(scene: Scene) -> list[Object]:
     """The scene's meshes carrying the modifier; linked objects are the library's (set up there or
     not), never this file's."""

@@ -349,7 +349,7 @@ def write(scene: Scene, snap: Snapshot) -> int:
     lit = sorted({mover.name for _, mover in pairs} | set(moving_lit))
     if lit:
         rest_normals.write(scene, [scene.objects[name] for name in lit], snap)
-    else:
+    elif rest_normals.written(scene):
         rest_normals.remove(scene)
     if not pairs:
         return 0

@@ -197,6 +197,13 @@ def write(scene: Scene, objects: Sequence[Object], snap: Snapshot) -> None:
             attach(slot.material, group)
 
 
+def written(scene: Scene) -> bool:
+    """Whether anything of this stage may be in the file: its record on the scene or its shader
+    group (what :func:`write` makes first); a sync with nothing lit skips :func:`remove`'s pass over
+    every material and mesh otherwise (issue 26: 2 ms a sync on 1,000 meshes)."""
+    return KEY in scene or names.REST_NORMAL_GROUP in bpy.data.node_groups or bool(_written)
+
+
 def remove(scene: Scene) -> None:
     """Detach the group from every material, delete the attributes the stage added and the group."""
     _written.clear()

@@ -29,10 +29,9 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, changes, clip_end, instancing, modifier, shape_keys, tessellation
-from ..lights import turning_receivers
+from ..geometry import apparent_meshes, changes, clip_end, instancing, modifier, tessellation
 from ..scene import animation, moving_objects, snapshot, traveller
-from . import bake, render_notice
+from . import bake, mesh_notes, render_notice, settled
 from .stages import STAGES, Sync
 
 if TYPE_CHECKING:
@@ -42,12 +41,12 @@ if TYPE_CHECKING:
 
     from ..scene.snapshot import Snapshot
 
-# Scene name -> (snapshot or None, warnings) of its last sync; mesh name -> (inputs, warnings).
+# Scene name -> (snapshot or None, warnings) of its last sync.
 _scene_status = {}
-_object_warnings = {}
 _final_render_valid = {}  # scene name -> whether its last exact final render's camera was valid
 _traveller_times = {}  # scene name -> the observer's proper time at the last synced frame
 _setup_notices = {}  # scene name -> why switching the Method did not set the scene up again
+_record_parts = {}  # scene name -> the warnings before and after the meshes' records (_mesh_records)
 
 
 def applied_method(scene: Scene) -> str | None:
@@ -308,15 +307,26 @@ def sync(
     no warnings for the panel: the frame change's ``frame_change_post`` takes them, with the new
     frame's meshes (a pass over every mesh: issue 26's 1,000 objects).
     Never raises."""
+    reported = None
     if depsgraph is not None:
         # also while computing: what Blender evaluated again (a render's fresh depsgraph: only
         # the meshes whose inputs differ from the viewport's; no shading-only update: changes.reported)
-        apparent_meshes.note_updates(changes.reported(depsgraph))
+        reported = changes.reported(depsgraph)
+        apparent_meshes.note_updates(reported)
     if busy.is_computing():
         return None
+    noted = changes.take_noted()  # (settled.py)
     if bake.holds_geometry(scene):  # played back as baked, with its camera: nothing to write until Remove
         return last_snapshot(scene)
-    with modifier.listed_once(), animation.signed_once():  # the meshes listed, their keys read, once a sync
+    full = update_geometry and record and not (before_render or in_frame_change)
+    # the meshes listed, their keys and settings read, once a sync
+    with modifier.listed_once(), animation.signed_once(), moving_objects.checked_once():
+        applied = settled.holds(scene, reported, noted) if full and reported is not None else None
+        if applied is not None:
+            modifier.listed_as(scene, applied)
+            snap = _settled_sync(scene, depsgraph)
+            if snap is not None:
+                return snap
         modifier.unlink_caches()  # brought into a collection by Append
         method = applied_method(scene)
         if not snapshot.in_final_render(scene):
@@ -343,7 +353,26 @@ def sync(
             return None
         if record:
             _record(scene, snap, depsgraph)
+        if full and method == "GEOMETRY":
+            settled.remember(scene, snap, noted | changes.take_noted())
+        else:
+            settled.forget(scene)
         return snap
+
+
+def _settled_sync(scene, depsgraph):
+    """A depsgraph update of what the last full sync took (``settled.py``): the reported meshes'
+    signatures (an update if the modifier's verdict differs: then a full sync follows), their
+    clip-end depths and caches' notes; the rest of the panel's records kept. None: sync in full."""
+    snap = last_snapshot(scene)
+    parts = _record_parts.get(scene.name)
+    if snap is None or parts is None:  # (settled: set up for Apparent Geometry at the last full sync)
+        return None
+    if apparent_meshes.update(scene, snap, depsgraph, only_changed=True):
+        return None
+    middle = _mesh_records(scene, snap, depsgraph)
+    _scene_status[scene.name] = (snap, parts[0] + middle + parts[1])
+    return snap
 
 
 def setting_changed(scene: Scene) -> None:
@@ -367,11 +396,11 @@ def object_changed(scene: Scene, obj: Object) -> None:
     geometry, a changed blackbody temperature re-attaches its materials, then sync. Never raises."""
     changes.note_changed(obj.session_uid)  # Blender tags the object after this callback
     if (
-        applied_method(scene) == "GEOMETRY"
-        and obj.type == "MESH"
+        obj.type == "MESH"
         and obj.relativity.enabled
         and not obj.relativity.moves_with_camera
         and modifier.find_modifier(obj) is None
+        and applied_method(scene) == "GEOMETRY"  # (last: it lists the scene's meshes)
     ):
         try:
             apparent_meshes.apply(scene, snapshot.read(scene), [obj])
@@ -431,58 +460,33 @@ def _record(scene, snap, depsgraph=None):
             warnings.append(f"Lamps, shadows and the world are not relativistic in this render: {problem}")
             if snap.exposure_mode == "COMPENSATED":
                 warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
-    warnings += apparent_meshes.scene_errors(scene)
+    head = list(warnings)
+    middle = _mesh_records(scene, snap, depsgraph)
+    warnings = []
     if snap.method == "GEOMETRY":
-        warnings += clip_end.clip_end_warnings(scene, snap, depsgraph)
-        warnings += apparent_meshes.update_warnings(scene)
         warnings += instancing.instancing_warnings(scene, snap)
         warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
     for stage in STAGES:
         warnings += stage.warnings(scene, snap)
-    _scene_status[scene.name] = (snap, warnings)
+    _record_parts[scene.name] = (head, warnings)
+    _scene_status[scene.name] = (snap, head + middle + warnings)
     try:
         _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)
     except (RelativityError, ValueError):
         _traveller_times.pop(scene.name, None)
     if snap.method == "GEOMETRY":
-        eye = tuple(snap.camera_position)
-        for obj in scene.objects:
-            if obj.type == "MESH" and obj.relativity.enabled:
-                known = _object_warnings.get(obj.name)
-                if known is not None and known[0][0] == eye and changes.is_current(scene.name, obj.session_uid):
-                    continue  # an applied mesh Blender did not update since its warnings were made
-                _object_warnings[obj.name] = _mesh_warnings(scene, obj, snap)
+        mesh_notes.take(scene, snap)
 
 
-def _mesh_warnings(scene, obj, snap):
-    """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change (the
-    spin's line reads the keys, c and fps: a key edited away from the current frame, or c changed,
-    left it stale before)."""
-    inputs = (
-        tuple(snap.camera_position),
-        snap.speed_of_light,
-        snap.fps,
-        hash(animation.keyframes_signature(obj)) if obj.animation_data is not None else None,  # (the spin's keys)
-        obj.relativity.motion,
-        tuple(obj.relativity.beta),
-        tuple(map(tuple, obj.matrix_world)),
-        obj.data.name,
-        len(obj.data.edges),
-        obj.relativity.tessellation,
-        obj.relativity.use_adaptive_tessellation and tessellation.warning(obj),
-        modifier.find_modifier(obj) is not None,
-    )
-    known = _object_warnings.get(obj.name)
-    if known is not None and known[0] == inputs:
-        return known
-    coarse = tessellation.coarse_mesh_warning(obj, snap.camera_position)
-    spin = turning_receivers.spin_warning(obj, scene, snap.speed_of_light)
-    return inputs, [line for line in (coarse, spin) if line]
-
-
-def _shape_key_warnings(obj):
-    warning = shape_keys.scene_time_warning(obj)
-    return [warning] if warning else []
+def _mesh_records(scene, snap, depsgraph):
+    """The records an evaluation of the meshes changes: their updates' errors and warnings, the
+    Clip End their evaluated bounds need."""
+    notes = changes.cache_notes(scene)  # (read once for both)
+    found = apparent_meshes.scene_errors(scene, notes)
+    if snap.method == "GEOMETRY":
+        found += clip_end.clip_end_warnings(scene, snap, depsgraph)
+        found += apparent_meshes.update_warnings(scene, notes)
+    return found
 
 
 def _status(scene):
@@ -511,35 +515,3 @@ def scene_warnings(scene: Scene) -> list[str]:
     """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
     sync)."""
     return list(_status(scene)[1])
-
-
-def object_warnings(scene: Scene, obj: Object | None) -> list[str]:
-    """Warnings for the active object on the apparent-geometry path: its last update error, a bake
-    it needs, a mesh too coarse to curve (as of the last sync), shape keys left at scene time."""
-    if obj is None or obj.type != "MESH" or scene.relativity.method != "GEOMETRY":
-        return []
-    warnings = list(_object_warnings.get(obj.name, ((), []))[1])
-    error = modifier.object_error(obj)
-    status = bake_status(scene, obj)
-    if error is not None:  # the last update failed: the viewport shows an older state
-        warnings.append(error)
-    elif status is not None and status[1] is None and status[2] is not None:
-        warnings.append(status[2])
-    return warnings + _shape_key_warnings(obj)
-
-
-def bake_status(scene: Scene, obj: Object) -> tuple[str, str | None, str | None] | None:
-    """For an ANIMATION mesh: (bake operator, what is baked or None, why a bake is needed or None);
-    None for other objects."""
-    settings = obj.relativity
-    if obj.type != "MESH" or settings.motion != "ANIMATION":
-        return None
-    if settings.use_deformation:
-        baked = "Deformation baked" if modifier.bake_mesh(obj) is not None else None
-        return "relativity.bake_deformation", baked, "Deforming mesh: press Bake Deformation"
-    baked = modifier.motion_bake_range(obj)
-    if baked is not None:
-        return "relativity.bake_motion", f"Motion baked: frames {baked[0]:g} to {baked[1]:g}", None
-    problem = animation.keyframe_motion_problem(obj, scene)
-    needed = f"{problem}: keyframes are not its motion, press Bake Motion" if problem else None
-    return "relativity.bake_motion", None, needed

@@ -4,6 +4,8 @@ refusal naming the others (read by ``snapshot.read``)."""
 from __future__ import annotations
 
 import math
+import threading
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -12,6 +14,8 @@ from ...errors import RelativityError
 from . import animation, emitting_meshes
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
+
     from bpy.types import Object, Scene
 
 
@@ -37,10 +41,36 @@ TYPE_LABELS = {
 DRAWS_NOTHING = ("EMPTY", "CAMERA", "SPEAKER", "LIGHT_PROBE", "LIGHTPROBE", "ARMATURE", "LATTICE")
 
 
+_checked = threading.local()  # .found: object pointer -> has_own_velocity, inside checked_once()
+
+
+@contextmanager
+def checked_once() -> Iterator[None]:
+    """Inside: :func:`has_own_velocity` reads each object's settings once (a sync changes none;
+    the snapshot, the clamping stage and the instancing check each ask about every object)."""
+    outer = getattr(_checked, "found", None)
+    _checked.found = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _checked.found = outer
+
+
 def has_own_velocity(obj: Object) -> bool:
     """Whether the object's settings give it its own motion: ``relativity.enabled`` with Constant
     Velocity of nonzero ``beta``, or with Animation (its keyframes or motion bake are its world
     line). What the Apparent Geometry path moves (for meshes) and the exact camera cannot."""
+    found = getattr(_checked, "found", None)
+    if found is None:
+        return _own_velocity(obj)
+    key = obj.as_pointer()
+    known = found.get(key)
+    if known is None:
+        known = found[key] = _own_velocity(obj)
+    return known
+
+
+def _own_velocity(obj):
     settings = obj.relativity
     if not settings.enabled or settings.motion == "STATIC":
         return False

@@ -1,7 +1,7 @@
 """The N-panel: View3D > Sidebar > Relativity, with sub-panels as Blender's own panels have them.
 
 Nothing here computes: the warnings come from the effect's last sync (``effect.scene_warnings``,
-``effect.object_warnings``), and so does the speed taken from the camera's animation.
+``mesh_notes.object_warnings``), and so does the speed taken from the camera's animation.
 """
 
 import math
@@ -10,7 +10,7 @@ import textwrap
 from bpy.types import Context, Panel
 
 from ..common import osl
-from ..pipeline import bake, effect, render_notice
+from ..pipeline import bake, effect, mesh_notes, render_notice
 from ..scene import cockpit
 
 CHARACTER_WIDTH = 7.0  # pixels per character of the sidebar's text at UI scale 1 (a mean)
@@ -249,13 +249,13 @@ class RELATIVITY_PT_object(_RelativityPanel, Panel):
         if settings.use_adaptive_tessellation:
             column.prop(settings, "tessellation_tolerance")
         column.prop(settings, "temperature", text="Temperature")
-        bake = effect.bake_status(context.scene, obj)
+        bake = mesh_notes.bake_status(context.scene, obj)
         if bake is not None:
             operator, baked, _ = bake
             if baked is not None:
                 column.label(text=baked, icon="CHECKMARK")
             column.operator(operator, icon="REC")
-        for warning in effect.object_warnings(context.scene, obj):
+        for warning in mesh_notes.object_warnings(context.scene, obj):
             _message(layout, context, warning)
 
 

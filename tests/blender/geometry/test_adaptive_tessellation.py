@@ -238,14 +238,14 @@ def test_too_few_levels_are_named_in_pixels(relativity_addon, factory_blender):
     """At Tessellation 1 the box's edges still bend beyond the tolerance: the panel's warning
     names the error left in pixels; at the default (4 levels) there is none."""
     bpy = factory_blender
-    effect = gh.addon_module("pipeline.effect")
+    mesh_notes = gh.addon_module("pipeline.mesh_notes")
     scene, _, box, _ = _box_scene(bpy, tessellation=1)
     gh.apply_geometry(scene)
-    warnings = effect.object_warnings(scene, box)
+    warnings = mesh_notes.object_warnings(scene, box)
     print(warnings)
     assert len(warnings) == 1 and "px at Tessellation 1" in warnings[0] and "raise Tessellation" in warnings[0]
     box.relativity.tessellation = 4
-    assert effect.object_warnings(scene, box) == []
+    assert mesh_notes.object_warnings(scene, box) == []
 
 
 def test_an_unchanged_decision_evaluates_nothing_again(relativity_addon, factory_blender):

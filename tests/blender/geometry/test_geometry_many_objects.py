@@ -40,7 +40,7 @@ def _count_work(monkeypatch):
     meshes = gh.geometry_module()
     compat = gh.addon_module("common.compat")
     clip_end = gh.addon_module("geometry.clip_end")
-    effect = gh.addon_module("pipeline.effect")
+    mesh_notes = gh.addon_module("pipeline.mesh_notes")
 
     def hook(module, name, kind, which):
         original = getattr(module, name)
@@ -62,7 +62,7 @@ def _count_work(monkeypatch):
         return depths(snap, evaluated)
 
     monkeypatch.setattr(clip_end, "bounds_depths", counted_depths)
-    hook(effect, "_mesh_warnings", "warnings", lambda args: args[1])
+    hook(mesh_notes, "mesh_warnings", "warnings", lambda args: args[1])
     return work
 
 

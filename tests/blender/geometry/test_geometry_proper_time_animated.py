@@ -251,19 +251,19 @@ def test_shape_keys_need_the_mesh_own_vertices(relativity_addon):
     face.relativity.beta = (0.5, 0.0, 0.0)
     face.relativity.tessellation = 1
     scene.frame_set(FRAME)
-    effect = gh.addon_module("pipeline.effect")
+    mesh_notes = gh.addon_module("pipeline.mesh_notes")
     gh.apply_geometry(scene)
     assert gh.geometry_module().scene_errors(scene) == []
     dilated = gh.evaluated_points(bpy, face)[0]
-    (warning,) = [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
+    (warning,) = [w for w in mesh_notes.object_warnings(scene, face) if "shape keys" in w]
     assert "scene's time" in warning and "Tessellation is above 0" in warning
     face.relativity.use_proper_time = False
     scene.frame_set(FRAME)
     assert np.allclose(gh.evaluated_points(bpy, face)[0], dilated, atol=1e-6), "the scene's time, as without it"
-    assert not [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
+    assert not [w for w in mesh_notes.object_warnings(scene, face) if "shape keys" in w]
     face.relativity.use_proper_time = True
     face.relativity.tessellation = 0
-    assert not [w for w in effect.object_warnings(scene, face) if "shape keys" in w]
+    assert not [w for w in mesh_notes.object_warnings(scene, face) if "shape keys" in w]
 
 
 def test_armature_hand_runs_on_proper_time(relativity_addon, tmp_path):

@@ -237,8 +237,9 @@ def test_spin_left_rigid_in_scene_time_is_said(relativity_addon, factory_blender
             sphere.keyframe_insert("rotation_quaternion", frame=frame)
         scene.frame_set(13)
     effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+    mesh_notes = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.mesh_notes")
     effect.apply(scene)
-    lines = [line for line in effect.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
+    lines = [line for line in mesh_notes.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
     print(spin, lines)
     if spin in ("slow", "at rest", "quaternion held"):
         assert lines == []
@@ -262,11 +263,12 @@ def test_spin_line_follows_c_and_a_key_edited_away_from_the_frame(relativity_add
     scene, _ = _turning_sphere(bpy, "CONSTANT", 1, False, TURN, 0)
     sphere = scene.objects["Sphere"]
     effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+    mesh_notes = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.mesh_notes")
     effect.apply(scene)
 
     def named():
         bpy.context.evaluated_depsgraph_get()  # the edit's depsgraph update syncs
-        lines = [line for line in effect.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
+        lines = [line for line in mesh_notes.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
         assert len(lines) <= 1, lines
         return float(lines[0].split("up to about ")[1].split(" degrees")[0]) if lines else None
 
