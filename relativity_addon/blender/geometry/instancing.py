@@ -182,8 +182,14 @@ def check_instancing(
     if evaluate:
         objects = applied_objects(scene)
         instancers = [obj for obj in scene.objects if _may_instance(obj)]  # once for both checks
-        _instancing_problems[scene.name] = instancing_problem(depsgraph, objects, scene.objects, instancers)
-        _preview_problems[scene.name] = preview_instancing_problem(depsgraph, objects, scene.objects, instancers)
+        # (no object that may instance: neither check finds anything, and neither lists the movers)
+        found: tuple[str | None, str | None] = (None, None)
+        if instancers:
+            found = (
+                instancing_problem(depsgraph, objects, scene.objects, instancers),
+                preview_instancing_problem(depsgraph, objects, scene.objects, instancers),
+            )
+        _instancing_problems[scene.name], _preview_problems[scene.name] = found
     problem = _instancing_problems.get(scene.name)
     if problem is not None:
         raise RelativityError(problem)

@@ -136,19 +136,21 @@ def check_object_velocities(scene: Scene, method: str) -> None:
             "Geometry (its final render uses the exact camera)"
         )
     problems = []
-    drawn = [object_label(obj) for obj in moving if obj.type != "MESH" and not draws_nothing(obj)]
+    others = [obj for obj in moving if obj.type != "MESH"]  # (a mesh draws itself: one read a mover)
+    drawn = [object_label(obj) for obj in others if not draws_nothing(obj)]
     if drawn:
         problems.append(
             f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
             f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}"
         )
     for obj in moving:
-        if draws_nothing(obj):
-            problems.append(
-                f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
-                "meshes do not inherit it): set its Motion to Static, give moving meshes their own"
-            )
-        elif obj.type == "MESH" and (instancer := mesh_instancer(obj)) is not None:
+        if obj.type != "MESH":
+            if draws_nothing(obj):
+                problems.append(
+                    f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
+                    "meshes do not inherit it): set its Motion to Static, give moving meshes their own"
+                )
+        elif (instancer := mesh_instancer(obj)) is not None:
             problems.append(
                 f"Mesh {obj.name!r} draws objects by its {instancer}, which cannot move on the "
                 "Apparent Geometry path yet: make them real (Make Instances Real / Convert to Mesh)"
