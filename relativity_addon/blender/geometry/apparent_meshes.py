@@ -152,13 +152,7 @@ def object_signature(
         elif fingerprint is None:
             fingerprint = _rest_fingerprint(evaluated)
     frame = None if closed else snap.frame  # the closed form depends on the observer's event, not on the time
-    parts = [  # after the frame and the matrix (straight_steps.step writes them anew for a frame step)
-        snap.speed_of_light,
-        snap.beta,
-        snap.camera,
-        snap.camera_matrix,
-        snap.exact_camera,
-        snap.shutter_time if snap.exact_camera else 0.0,
+    parts = [  # after the frame, the matrix (straight_steps.step writes them anew) and the scene's parts
         relativity.enabled,
         relativity.motion,
         tuple(relativity.beta),
@@ -178,7 +172,8 @@ def object_signature(
         fingerprint,
         verdict,
     ]
-    return straight_steps.signature_head(frame, tuple(map(tuple, evaluated.matrix_world))) + repr(parts)[1:]
+    head = straight_steps.signature_head(frame, tuple(map(tuple, evaluated.matrix_world)))
+    return f"{head}{_scene_parts(snap)}, {repr(parts)[1:]}"
 
 
 def _render_size(snap: Snapshot) -> tuple[float, float] | None:
@@ -372,16 +367,15 @@ def update(
             stepped = straight_steps.step([o for o in objects if o.session_uid not in current], key, snap, depsgraph)
             current.update(dict.fromkeys(stepped, False))
             updated += len(stepped)
+        seen_as = _scene_parts(snap)
         for obj in objects:
             uid = obj.session_uid
             if uid in current:
                 continue
             data = modifier.cache_data(obj)
-            if (
-                only_changed
-                and data is not None
-                and data.get(names.SIGNATURE_KEY) == object_signature(snap, obj, evaluated)
-            ):
+            stored = data.get(names.SIGNATURE_KEY) if only_changed and data is not None else None
+            # (a signature made for another observer, camera or c cannot be this one: not built again)
+            if stored is not None and seen_as in stored and stored == object_signature(snap, obj, evaluated):
                 current[uid] = motion.closed_form(obj, scene)
                 continue
             if evaluated is None:
@@ -399,6 +393,20 @@ def update(
                     data[names.ERROR_KEY] = str(error)
                     data[names.SIGNATURE_KEY] = object_signature(snap, obj, _evaluated(depsgraph))
     return updated
+
+
+def _scene_parts(snap: Snapshot) -> str:
+    """The text every signature made for this snapshot holds (:func:`object_signature`'s first parts
+    after the frame and matrix, comma-separated as ``repr`` writes them)."""
+    parts = [
+        snap.speed_of_light,
+        snap.beta,
+        snap.camera,
+        snap.camera_matrix,
+        snap.exact_camera,
+        snap.shutter_time if snap.exact_camera else 0.0,
+    ]
+    return repr(parts)[1:-1]
 
 
 def scene_key(snap: Snapshot) -> tuple:
