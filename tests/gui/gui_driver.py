@@ -266,6 +266,17 @@ def steps():
     select_only(sphere)
     yield 1.0
 
+    # 6b. The sphere's own velocity set towards the camera (as the panel's field does) under a short
+    #     Clip End: the window's redraws evaluate it, and the panel names the Clip End it needs (the
+    #     evaluated bounds, taken by the depsgraph update after the callback: pipeline/settled.py).
+    camera.data.clip_end = 30.0
+    yield from draw_and_shoot("10b_clip_end_short")
+    sphere.relativity.beta = (0.0, 0.0, 0.9)
+    yield from draw_and_shoot("10c_towards_camera")
+    sphere.relativity.beta = gui_scene.SPHERE_BETA
+    camera.data.clip_end = 1000.0
+    yield 1.0
+
     # 7. Remove from the button: the scene as before Set Up.
     call("remove", bpy.ops.relativity.remove_all)
     report["after_remove"] = {

@@ -193,6 +193,19 @@ def test_switching_method_and_moving_light_say_why(gui_session):
     assert not any(m.startswith("Still set up") for m in report["panel_messages"]["10_moving_light"])  # Method back
 
 
+def test_velocity_changed_in_the_panel_reaches_its_clip_end_warning(gui_session):
+    """The sphere's own velocity set towards the camera in the running application under a Clip End
+    of 30 m: seen where it was (docs/physics.md: a point approaching at 0.9c at distance d is seen
+    at d / (1 - 0.9), about 51 m here, farther in the moving observer's boosted view), so the panel
+    names the Clip End it needs, after the window's own redraws; none before the change."""
+    report = gui_session.report
+    assert not any("Clip End" in m for m in report["panel_messages"]["10b_clip_end_short"]), report["panel_messages"]
+    said = [m for m in report["panel_messages"]["10c_towards_camera"] if "Clip End" in m]
+    assert len(said) == 1 and "'Mover'" in said[0] and "Clip End 30 m" in said[0], report["panel_messages"]
+    seen = float(said[0].split("seen ")[1].split(" m away")[0])
+    assert seen > 5.0 / (1.0 - 0.9) * 0.8, said[0]
+
+
 def test_remove_from_the_button_restores_the_scene(gui_session):
     report = gui_session.report
     assert "result" in report["operators"]["remove"], report["operators"]

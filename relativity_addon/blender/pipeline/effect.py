@@ -131,6 +131,7 @@ def apply(
         undo()
         raise
     _setup_notices.pop(scene.name, None)
+    settled.forget(scene)
     _record(scene, snap)
     return result
 
@@ -150,6 +151,7 @@ def remove(scene: Scene) -> int:
         removed += bool(exact_camera.remove_data(camera_data))
     _remove_stages(scene)
     snapshot.end_final_render(scene)
+    settled.forget(scene)
     _scene_status.pop(scene.name, None)
     _setup_notices.pop(scene.name, None)
     return removed
@@ -350,6 +352,7 @@ def sync(
             if method == "CAMERA" or snapshot.in_final_render(scene):
                 exact_camera.invalidate(scene.camera)
             _refused(scene, error)
+            settled.forget(scene)
             return None
         if record:
             _record(scene, snap, depsgraph)
