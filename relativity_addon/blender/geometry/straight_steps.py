@@ -25,7 +25,7 @@ keeps a new one where it may.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -38,6 +38,7 @@ if TYPE_CHECKING:
 
     from bpy.types import Depsgraph, Object
 
+    from ...physics.arrays import FloatArray
     from ..scene.snapshot import Snapshot
 
 # Float32 keys and matrices: the evaluated place may sit this far (relative) off the float64 line.
@@ -46,9 +47,26 @@ ROUNDING = 4e-6
 # edge check's ``tessellation.camera_offset``).
 OFFSETS = ("Scene Offset", "Local Offset", "Camera Offset")
 
-# Object session_uid -> (scene key, keys, line start, way per frame, held 3x3, fps, the observer's earliest
-# and latest time, the signature after its frame and matrix, the evaluated 3x3, its offset maps N and N B).
-_records: dict[int, tuple] = {}
+
+class _Record(NamedTuple):
+    """What a full update of an object on straight keys kept for its frame steps."""
+
+    key: object  # the scene's inputs (``apparent_meshes.scene_key``)
+    keys: object  # its keys (``animation.keyframes_signature``)
+    start: FloatArray  # the keys' line: the origin at frame 0, world units
+    per_frame: FloatArray  # its way per frame
+    shape: FloatArray  # the 3x3 the keys hold (rotation and scale)
+    fps: float
+    t_low: float  # the observer's earliest and latest time (seconds) the window's look-ahead holds
+    t_high: float
+    tail: str  # the signature after its frame and matrix
+    held: FloatArray  # the evaluated 3x3 of the update
+    inverse: FloatArray  # the offset maps N and N B (``motion.uniform_parts``)
+    to_local: FloatArray
+
+
+# Object session_uid -> its record.
+_records: dict[int, _Record] = {}
 
 
 def signature_head(frame: float | None, matrix: tuple) -> str:
@@ -71,7 +89,9 @@ def remember(obj: Object, key: object, snap: Snapshot, signature: str, matrix: t
     w = per_frame * fps / snap.speed_of_light
     maps = motion.uniform_parts(shape, w, snap.mesh_observer[2], held)[:2]  # as the full update's inputs
     tail = signature[len(head) :]
-    _records[obj.session_uid] = (key, keys, start, per_frame, shape, fps, t_low, t_high, tail, held[:3, :3], *maps)
+    _records[obj.session_uid] = _Record(
+        key, keys, start, per_frame, shape, fps, t_low, t_high, tail, held[:3, :3], *maps
+    )
 
 
 def forget(obj: Object) -> None:
@@ -83,14 +103,14 @@ def step(objects: Iterable[Object], key: object, snap: Snapshot, depsgraph: Deps
     snapshot's frame, and its signature. Returns their session_uids (the others: a full update)."""
     if busy.rendering():  # (a render's update measures no edge)
         return set()
-    t_o, x_o, _beta_o = snap.mesh_observer
+    t_o = snap.mesh_observer[0]
     found = []  # (object, record, evaluated world matrix, swept bound)
     for obj in objects:
         record = _records.get(obj.session_uid)
-        if record is None or record[0] != key or not record[6] <= t_o <= record[7]:
+        if record is None or record.key != key or not record.t_low <= t_o <= record.t_high:
             continue
         swept = tessellation.swept_bound(obj)
-        if swept is None or animation.keyframes_signature(obj) != record[1]:
+        if swept is None or animation.keyframes_signature(obj) != record.keys:
             continue
         found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
     if not found:
@@ -105,7 +125,7 @@ def step(objects: Iterable[Object], key: object, snap: Snapshot, depsgraph: Deps
         if mod is None or data is None:
             continue
         modifier.write_inputs(mod, dict(zip(OFFSETS, values, strict=True)))
-        data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + record[8]
+        data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + record.tail
         tessellation.announce(obj)  # the next evaluation is the add-on's: the rest box stays
         obj.update_tag(refresh={"DATA"})  # the modifier's inputs: its geometry alone (the frame moved the rest)
         stepped.add(obj.session_uid)
@@ -117,9 +137,11 @@ def _offsets(records, matrices, swept, snap):
     frame, or None where its world matrix left the keys' line, its 3x3 the held one, or the origin
     the edges' swept bound. One numpy pass over the objects, the full update's arithmetic."""
     t_o, x_o = snap.mesh_observer[0], np.asarray(snap.mesh_observer[1], dtype=np.float64)
-    start, per_frame = np.array([r[2] for r in records]), np.array([r[3] for r in records])
-    shape, fps = np.array([r[4] for r in records]), np.array([r[5] for r in records])
-    held, inverse, to_local = (np.array([r[k] for r in records]) for k in (9, 10, 11))
+    start, per_frame = np.array([r.start for r in records]), np.array([r.per_frame for r in records])
+    shape, fps = np.array([r.shape for r in records]), np.array([r.fps for r in records])
+    held, inverse, to_local = (
+        np.array([getattr(r, name) for r in records]) for name in ("held", "inverse", "to_local")
+    )
     translation = matrices[:, :3, 3]
     # where the keys' line puts the origin at this frame; the matrix on it, its 3x3 the held one
     place = start + per_frame * snap.frame
