@@ -114,7 +114,8 @@ def is_cache(obj: Object) -> bool:
     return obj.type == "MESH" and obj.data is not None and names.OWNER_KEY in obj.data
 
 
-_listed = threading.local()  # .scenes: scene name -> its applied objects, inside listed_once()
+# .scenes, inside listed_once(): scene name -> its applied objects, (name, "moving") -> the moving ones
+_listed = threading.local()
 
 
 @contextmanager
@@ -151,7 +152,12 @@ def applied_objects(scene: Scene) -> list[Object]:
 
 
 def moving_objects(scene: Scene) -> list[Object]:
-    """The scene's set-up meshes that have a motion of their own (cheap: no positions)."""
+    """The scene's set-up meshes that have a motion of their own (cheap: no positions; listed once
+    inside :func:`listed_once`, where the lamp and bounce stages ask three times)."""
+    scenes = getattr(_listed, "scenes", None)
+    key = (scene.name, "moving")
+    if scenes is not None and key in scenes:
+        return list(scenes[key])
     found = []
     for obj in applied_objects(scene):
         settings = obj.relativity
@@ -159,6 +165,8 @@ def moving_objects(scene: Scene) -> list[Object]:
             settings.motion == "ANIMATION" and not settings.use_deformation
         ):
             found.append(obj)
+    if scenes is not None:
+        scenes[key] = tuple(found)
     return found
 
 
