@@ -395,10 +395,9 @@ def update(
     return updated
 
 
-def _scene_parts(snap: Snapshot) -> str:
-    """The text every signature made for this snapshot holds (:func:`object_signature`'s first parts
-    after the frame and matrix, comma-separated as ``repr`` writes them)."""
-    parts = [
+def _seen_from(snap: Snapshot) -> list:
+    """The observer's part of every signature and of the scene key: c, its velocity, the camera."""
+    return [
         snap.speed_of_light,
         snap.beta,
         snap.camera,
@@ -406,7 +405,12 @@ def _scene_parts(snap: Snapshot) -> str:
         snap.exact_camera,
         snap.shutter_time if snap.exact_camera else 0.0,
     ]
-    return repr(parts)[1:-1]
+
+
+def _scene_parts(snap: Snapshot) -> str:
+    """The text every signature made for this snapshot holds (:func:`object_signature`'s first parts
+    after the frame and matrix, comma-separated as ``repr`` writes them)."""
+    return repr(_seen_from(snap))[1:-1]
 
 
 def scene_key(snap: Snapshot) -> tuple:
@@ -414,12 +418,7 @@ def scene_key(snap: Snapshot) -> tuple:
     stays, an object Blender did not update keeps its signature (``changes.py``)."""
     return (
         snap.scene,
-        snap.speed_of_light,
-        snap.beta,
-        snap.camera,
-        snap.camera_matrix,
-        snap.exact_camera,
-        snap.shutter_time if snap.exact_camera else 0.0,
+        *_seen_from(snap),
         snap.projection,
         _render_size(snap),
         snap.fps,

@@ -20,20 +20,19 @@ kept on the cache mesh too (``bakes.py``), so they go with the effect when it is
 
 from __future__ import annotations
 
-import threading
 from array import array
-from contextlib import contextmanager
 from typing import TYPE_CHECKING, cast
 
 import bpy
 import numpy as np
 
-from ..common import compat, names
+from ..common import compat, names, once
 from ..common.nodes import ensure_group, interface_identifier, remove_unused_groups
 from .node_group import LEAN_WHEN, lean_node_group_spec, node_group_spec
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable, Iterator
+    from collections.abc import Iterable
+    from contextlib import AbstractContextManager
 
     from bpy.types import ID, Depsgraph, Mesh, Modifier, NodeTree, Object, Scene
 
@@ -114,31 +113,27 @@ def is_cache(obj: Object) -> bool:
     return obj.type == "MESH" and obj.data is not None and names.OWNER_KEY in obj.data
 
 
-# .scenes, inside listed_once(): scene name -> its applied objects, (name, "moving") -> the moving ones
-_listed = threading.local()
+# Inside listed_once(): scene name -> its applied objects, (name, "moving") -> the moving ones.
+_listed = once.Once()
 
 
-@contextmanager
-def listed_once() -> Iterator[None]:
+def listed_once() -> AbstractContextManager[None]:
     """Inside: :func:`applied_objects` lists each scene's meshes once (a sync adds or removes no
     modifier), not again in every part that asks."""
-    outer = getattr(_listed, "scenes", None)
-    _listed.scenes = {} if outer is None else outer
-    try:
-        yield
-    finally:
-        _listed.scenes = outer
+    return _listed.kept()
 
 
 def listed_as(scene: Scene, objects: tuple[Object, ...]) -> None:
     """Inside :func:`listed_once`: ``objects`` are the scene's applied meshes (a sync that knows them)."""
-    _listed.scenes[scene.name] = objects
+    scenes = _listed.values()
+    if scenes is not None:
+        scenes[scene.name] = objects
 
 
 def applied_objects(scene: Scene) -> list[Object]:
     """The scene's meshes carrying the modifier; linked objects are the library's (set up there or
     not), never this file's."""
-    scenes = getattr(_listed, "scenes", None)
+    scenes = _listed.values()
     if scenes is not None and scene.name in scenes:
         return list(scenes[scene.name])
     found = [
@@ -154,7 +149,7 @@ def applied_objects(scene: Scene) -> list[Object]:
 def moving_objects(scene: Scene) -> list[Object]:
     """The scene's set-up meshes that have a motion of their own (cheap: no positions; listed once
     inside :func:`listed_once`, where the lamp and bounce stages ask three times)."""
-    scenes = getattr(_listed, "scenes", None)
+    scenes = _listed.values()
     key = (scene.name, "moving")
     if scenes is not None and key in scenes:
         return list(scenes[key])

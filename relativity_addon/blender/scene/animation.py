@@ -15,8 +15,6 @@ these matrices.
 from __future__ import annotations
 
 import math
-import threading
-from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -24,10 +22,11 @@ from mathutils import Matrix
 
 from ...errors import RelativityError
 from ...physics import transforms
-from ..common import compat
+from ..common import compat, once
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable, Iterator
+    from collections.abc import Iterable
+    from contextlib import AbstractContextManager
 
     import numpy.typing as npt
     from bpy.types import FCurve, Object, Scene
@@ -145,20 +144,14 @@ def world_matrices(
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
-_signed = threading.local()  # .signatures: object session_uid -> its keyframes signature, inside signed_once()
+_signed = once.Once()  # object session_uid -> its keyframes signature, inside signed_once()
 
 
-@contextmanager
-def signed_once(kept: dict[int, object] | None = None) -> Iterator[None]:
+def signed_once(kept: dict[int, object] | None = None) -> AbstractContextManager[None]:
     """Inside: :func:`keyframes_signature` reads each object's keys once (a sync edits no key; its
     stages asked up to three times per object: issue 26's 1,000 keyframed objects), into ``kept``
     when given (a frame change's two syncs share one: no script runs between them)."""
-    outer = getattr(_signed, "signatures", None)
-    _signed.signatures = outer if outer is not None else {} if kept is None else kept
-    try:
-        yield
-    finally:
-        _signed.signatures = outer
+    return _signed.kept(kept)
 
 
 def keyframes_signature(obj: Object) -> tuple[object, ...]:
@@ -166,7 +159,7 @@ def keyframes_signature(obj: Object) -> tuple[object, ...]:
     cache key: the F-curves' keys and their modifiers' settings (:func:`settings_key`). A channel
     an F-curve animates enters by its keys alone, not by its current value: that value changes at
     every frame step, which changes no key (the evaluation reads the keys, :func:`basis_matrices`)."""
-    signatures = getattr(_signed, "signatures", None)
+    signatures = _signed.values()
     if signatures is None:
         return _keyframes_signature(obj)
     uid = obj.session_uid

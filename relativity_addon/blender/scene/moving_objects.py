@@ -4,17 +4,16 @@ refusal naming the others (read by ``snapshot.read``)."""
 from __future__ import annotations
 
 import math
-import threading
-from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import RelativityError
+from ..common import once
 from . import animation, emitting_meshes
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from contextlib import AbstractContextManager
 
     from bpy.types import Object, Scene
 
@@ -41,26 +40,20 @@ TYPE_LABELS = {
 DRAWS_NOTHING = ("EMPTY", "CAMERA", "SPEAKER", "LIGHT_PROBE", "LIGHTPROBE", "ARMATURE", "LATTICE")
 
 
-_checked = threading.local()  # .found: object pointer -> has_own_velocity, inside checked_once()
+_checked = once.Once()  # object pointer -> has_own_velocity, inside checked_once()
 
 
-@contextmanager
-def checked_once() -> Iterator[None]:
+def checked_once() -> AbstractContextManager[None]:
     """Inside: :func:`has_own_velocity` reads each object's settings once (a sync changes none;
     the snapshot, the clamping stage and the instancing check each ask about every object)."""
-    outer = getattr(_checked, "found", None)
-    _checked.found = {} if outer is None else outer
-    try:
-        yield
-    finally:
-        _checked.found = outer
+    return _checked.kept()
 
 
 def has_own_velocity(obj: Object) -> bool:
     """Whether the object's settings give it its own motion: ``relativity.enabled`` with Constant
     Velocity of nonzero ``beta``, or with Animation (its keyframes or motion bake are its world
     line). What the Apparent Geometry path moves (for meshes) and the exact camera cannot."""
-    found = getattr(_checked, "found", None)
+    found = _checked.values()
     if found is None:
         return _own_velocity(obj)
     key = obj.as_pointer()
