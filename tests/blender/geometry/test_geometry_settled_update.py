@@ -11,6 +11,7 @@ evaluated depth the warning about Clip End needs (docs/physics.md: a point appro
 along the line of sight at distance ``d`` is seen where it was, at ``d / (1 - beta)``).
 """
 
+import numpy as np
 import pytest
 from test_geometry_edits_after_setup import _add_instancing, _refused_at_sync
 from test_geometry_many_objects import _scene
@@ -82,3 +83,26 @@ def test_an_edit_by_script_after_the_callback_is_synced_in_full(relativity_addon
     edited = movers[1] if which == "changed" else movers[4]
     _add_instancing(bpy, scene, edited, "PARTICLES")
     _refused_at_sync(bpy, scene, edited.name)
+
+
+def test_undo_of_a_velocity_change_draws_the_old_velocity_again(relativity_addon, factory_blender):
+    """A velocity change (its callback's full sync, then the settled update), then Undo: the mesh is
+    drawn where it was before the change, to the float, and the Clip End warning goes with it."""
+    bpy = factory_blender
+    scene, movers = _set_up(bpy)
+    before = gh.evaluated_points(bpy, movers[2])[0]
+    bpy.ops.ed.undo_push(message="set up")
+    movers[2].relativity.beta = (0.0, 0.0, 0.9)
+    bpy.context.evaluated_depsgraph_get()
+    bpy.ops.ed.undo_push(message="velocity")
+    assert len(_clip_end_lines(scene)) == 1
+    moved = gh.evaluated_points(bpy, movers[2])[0]
+    assert np.abs(moved - before).max() > 1.0, "the change moved the mesh"
+
+    bpy.ops.ed.undo()
+    bpy.context.evaluated_depsgraph_get()
+    scene = bpy.context.scene
+    mover = scene.objects["Mover 2"]  # (undo reads the file's state again: new Python objects)
+    assert tuple(mover.relativity.beta) == pytest.approx((0.3, 0.0, 0.0))
+    np.testing.assert_allclose(gh.evaluated_points(bpy, mover)[0], before, atol=1e-6)
+    assert _clip_end_lines(scene) == []
