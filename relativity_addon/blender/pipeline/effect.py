@@ -153,6 +153,7 @@ def remove(scene: Scene) -> int:
     snapshot.end_final_render(scene)
     settled.forget(scene)
     _scene_status.pop(scene.name, None)
+    _record_parts.pop(scene.name, None)
     _setup_notices.pop(scene.name, None)
     return removed
 
@@ -367,9 +368,9 @@ def _settled_sync(scene, depsgraph):
     """A depsgraph update of what the last full sync took (``settled.py``): the reported meshes'
     signatures (an update if the modifier's verdict differs: then a full sync follows), their
     clip-end depths and caches' notes; the rest of the panel's records kept. None: sync in full."""
-    snap = last_snapshot(scene)
     parts = _record_parts.get(scene.name)
-    if snap is None or parts is None:  # (settled: set up for Apparent Geometry at the last full sync)
+    snap = _scene_status.get(scene.name, (None,))[0] if parts is not None else None  # (no record taken here)
+    if snap is None:  # (settled: set up for Apparent Geometry at the last full sync)
         return None
     if apparent_meshes.update(scene, snap, depsgraph, only_changed=True):
         return None

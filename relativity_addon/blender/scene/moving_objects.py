@@ -128,17 +128,12 @@ def check_object_velocities(scene: Scene, method: str) -> None:
             f"{subject}: the Exact Camera method photographs a static scene; choose Apparent "
             "Geometry (its final render uses the exact camera)"
         )
-    problems = []
-    others = [obj for obj in moving if obj.type != "MESH"]  # (a mesh draws itself: one read a mover)
-    drawn = [object_label(obj) for obj in others if not draws_nothing(obj)]
-    if drawn:
-        problems.append(
-            f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
-            f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}"
-        )
+    drawn, problems = [], []  # (one read of a mover's type: a mesh draws itself)
     for obj in moving:
         if obj.type != "MESH":
-            if draws_nothing(obj):
+            if not draws_nothing(obj):
+                drawn.append(object_label(obj))
+            else:
                 problems.append(
                     f"{object_label(obj)} has its own velocity but draws nothing (children and deformed "
                     "meshes do not inherit it): set its Motion to Static, give moving meshes their own"
@@ -148,6 +143,12 @@ def check_object_velocities(scene: Scene, method: str) -> None:
                 f"Mesh {obj.name!r} draws objects by its {instancer}, which cannot move on the "
                 "Apparent Geometry path yet: make them real (Make Instances Real / Convert to Mesh)"
             )
+    if drawn:
+        problems.insert(
+            0,
+            f"{_named(drawn)} cannot move on the Apparent Geometry path yet (only meshes do): "
+            f"convert {'it to a mesh' if len(drawn) == 1 else 'them to meshes'}",
+        )
     if problems:
         raise RelativityError("; ".join(problems))
 
