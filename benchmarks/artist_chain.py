@@ -217,7 +217,7 @@ def plain_rewrite(bpy, scene, objects, offset):
 # (module under relativity_addon.blender, function): the add-on's parts ``--parts`` times.
 PARTS = (
     ("pipeline.effect", "sync"),
-    ("pipeline.effect", "_record"),
+    ("pipeline.records", "record"),
     ("scene.snapshot", "read"),
     ("geometry.apparent_meshes", "update"),
     ("geometry.apparent_meshes", "update_object"),

@@ -9,7 +9,7 @@ came out 0.49 of what Cycles was asked to render at 0.5c with that clamp
 (tests/blender/lights/test_interreflection.py). While the effect is applied, each non-zero clamp
 is the user's value times the brightest ``D^4`` in any direction, ``(gamma (1 + beta))^4`` of the
 observer, times ``(gamma (1 + beta))^6`` of the fastest object or light with its own velocity
-(``moving_objects.fastest_speed``; the relative factor of two frames is at most the product, and
+(``Snapshot.fastest_object``; the relative factor of two frames is at most the product, and
 a lamp's light on a moving object gains eq. 18's ``D^2`` before the object's ``D^4``); a
 value the user types meanwhile becomes the user's value; removing the effect gives the user's
 values back.
@@ -21,7 +21,6 @@ import math
 from typing import TYPE_CHECKING
 
 from ..common import names
-from ..scene import moving_objects
 
 if TYPE_CHECKING:
     from bpy.types import Scene
@@ -39,7 +38,7 @@ def factor(scene: Scene, snap: Snapshot) -> float:
         return 1.0
     observer = snap.speed if snap.method == "GEOMETRY" or snap.exact_camera else 0.0
     lights = [math.hypot(*light.beta) for light in snap.moving_lights]
-    source = max([moving_objects.fastest_speed(scene), *lights])
+    source = max([snap.fastest_object, *lights])
     return _brightest(observer, 4) * _brightest(min(source, 1.0 - 1e-9), 6)
 
 

@@ -115,6 +115,11 @@ def note_changed(uid: int) -> None:
         current.pop(uid, None)
 
 
+def noted() -> frozenset[int]:
+    """The objects :func:`note_changed` named since :func:`take_noted` last took them (kept)."""
+    return frozenset(_noted)
+
+
 def take_noted() -> set[int]:
     """The objects (session_uid) :func:`note_changed` named since the last call; the set starts again."""
     taken = set(_noted)

@@ -533,8 +533,8 @@ def warnings(scene: Scene, snap: Snapshot) -> list[str]:
             f"Light {unshifted} reaches moving objects unshifted (eq. 18 not applied: 0.86x of it across "
             "the motion at 0.5c, far more off along it; docs/lamp-doppler.md)"
         )
-    used = light_linking_collections(scene)
-    if used > MAX_LIGHT_LINKING and KEY in scene:
+    used = light_linking_collections(scene) if KEY in scene else 0  # (a pass over the objects)
+    if used > MAX_LIGHT_LINKING:
         found.append(
             f"Lamps on moving objects need {used} light-linking collections, over Cycles' {MAX_LIGHT_LINKING}: "
             "some moving objects are lit wrongly; use fewer lamps or fewer moving objects"

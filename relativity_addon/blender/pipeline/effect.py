@@ -21,6 +21,8 @@ renders black, never a wrong image).
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from typing import TYPE_CHECKING
 
 import bpy
@@ -29,9 +31,9 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
-from ..geometry import apparent_meshes, changes, clip_end, instancing, modifier, tessellation
-from ..scene import animation, moving_objects, snapshot, traveller
-from . import bake, mesh_notes, render_notice, settled
+from ..geometry import apparent_meshes, changes, instancing, modifier, tessellation
+from ..scene import animation, census, moving_objects, snapshot
+from . import bake, records, render_notice, settled
 from .stages import STAGES, Sync
 
 if TYPE_CHECKING:
@@ -41,12 +43,8 @@ if TYPE_CHECKING:
 
     from ..scene.snapshot import Snapshot
 
-# Scene name -> (snapshot or None, warnings) of its last sync.
-_scene_status = {}
 _final_render_valid = {}  # scene name -> whether its last exact final render's camera was valid
-_traveller_times = {}  # scene name -> the observer's proper time at the last synced frame
 _setup_notices = {}  # scene name -> why switching the Method did not set the scene up again
-_record_parts = {}  # scene name -> the warnings before and after the meshes' records (_mesh_records)
 
 
 def applied_method(scene: Scene) -> str | None:
@@ -132,7 +130,7 @@ def apply(
         raise
     _setup_notices.pop(scene.name, None)
     settled.forget(scene)
-    _record(scene, snap)
+    records.record(scene, snap)
     return result
 
 
@@ -152,8 +150,7 @@ def remove(scene: Scene) -> int:
     _remove_stages(scene)
     snapshot.end_final_render(scene)
     settled.forget(scene)
-    _scene_status.pop(scene.name, None)
-    _record_parts.pop(scene.name, None)
+    records.forget(scene)
     _setup_notices.pop(scene.name, None)
     return removed
 
@@ -178,7 +175,7 @@ def bake_for_render_anywhere(scene: Scene, first: int, last: int) -> dict[str, i
         counts = bake.bake(scene, first, last, lambda: sync(scene, before_render=True))
     else:
         counts = _bake_geometry(scene, first, last, exact)
-    _record(scene, snapshot.read(scene))
+    records.record(scene, snapshot.read(scene))
     return counts
 
 
@@ -335,14 +332,17 @@ def sync(
         if not snapshot.in_final_render(scene):
             _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)
         try:
-            snap = snapshot.read(scene, depsgraph)
-            if method is not None and method != snap.method:
-                # applied with the other method (the setting changed where no callback ran)
-                raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
-            if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
-                exact_camera.write(scene, snap)
-            if method == "GEOMETRY":
-                instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
+            with census.taken():  # (the read side: the stages below may add or remove objects)
+                snap = snapshot.read(scene, depsgraph)
+                if method is not None and method != snap.method:
+                    # applied with the other method (the setting changed where no callback ran)
+                    raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
+                if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
+                    exact_camera.write(scene, snap)
+                if method == "GEOMETRY":
+                    instancing.check_instancing(
+                        scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap)
+                    )
             if method == "GEOMETRY" and update_geometry:
                 apparent_meshes.update(scene, snap, depsgraph, only_changed=True, in_frame_change=in_frame_change)
             if method is not None:
@@ -356,7 +356,8 @@ def sync(
             settled.forget(scene)
             return None
         if record:
-            _record(scene, snap, depsgraph)
+            with census.taken():
+                records.record(scene, snap, depsgraph)
         if full and method == "GEOMETRY":
             settled.remember(scene, snap, noted | changes.take_noted())
         else:
@@ -368,15 +369,49 @@ def _settled_sync(scene, depsgraph):
     """A depsgraph update of what the last full sync took (``settled.py``): the reported meshes'
     signatures (an update if the modifier's verdict differs: then a full sync follows), their
     clip-end depths and caches' notes; the rest of the panel's records kept. None: sync in full."""
-    parts = _record_parts.get(scene.name)
-    snap = _scene_status.get(scene.name, (None,))[0] if parts is not None else None  # (no record taken here)
+    snap = records.recorded_snapshot(scene)
     if snap is None:  # (settled: set up for Apparent Geometry at the last full sync)
         return None
     if apparent_meshes.update(scene, snap, depsgraph, only_changed=True):
         return None
-    middle = _mesh_records(scene, snap, depsgraph)
-    _scene_status[scene.name] = (snap, parts[0] + middle + parts[1])
+    records.take_meshes(scene, snap, depsgraph)
+    settled.renew(scene)
     return snap
+
+
+def velocity_changed(scene: Scene, obj: Object) -> None:
+    """Update callback of an object's Constant Velocity: :func:`object_changed`, but where the
+    velocity changes again on a mesh the scene's record holds (``settled.velocity_holds``: a slider
+    dragged), that mesh's update, the stages and their warnings only, from the last snapshot with
+    the new fastest speed (the depsgraph update after it takes the mesh's records). Never raises."""
+    changes.note_changed(obj.session_uid)
+    tessellation.announce(obj)  # (as object_changed)
+    snap = records.recorded_snapshot(scene)
+    held = None
+    if snap is not None and snap.method == "GEOMETRY" and not snap.exact_camera and not busy.is_computing():
+        held = settled.velocity_holds(scene, obj, changes.noted())
+    if held is None or snap is None:
+        object_changed(scene, obj)
+        return
+    changes.take_noted()
+    applied, before = held
+    speed, top = math.hypot(*obj.relativity.beta), snap.fastest_object
+    with modifier.listed_once(), animation.signed_once(), moving_objects.checked_once():
+        modifier.listed_as(scene, applied)
+        # the fastest mover: this one, or the one before if this one was slower, else read again
+        fastest = speed if speed >= top else top if before < top else moving_objects.fastest_speed(scene)
+        snap = dataclasses.replace(snap, fastest_object=min(fastest, 1.0 - 1e-9))
+        try:
+            apparent_meshes.update(scene, snap, only_changed=True)
+            for stage in STAGES:
+                stage.write(scene, snap, Sync())
+        except RelativityError as error:
+            _refused(scene, error)
+            settled.forget(scene)
+            return
+        records.take_stages(scene, snap)  # (Static meshes and instancing: as they were)
+    if changes.take_noted() - {obj.session_uid}:  # (the update notes the mesh whose cache it wrote)
+        settled.forget(scene)
 
 
 def setting_changed(scene: Scene) -> None:
@@ -440,82 +475,9 @@ def setup_notice(scene: Scene) -> str | None:
 
 
 def _refused(scene, error):
-    status = (None, [str(error)])
-    repeated = _scene_status.get(scene.name) == status  # said at the last sync: once on the console
-    if (applied_method(scene) is not None or snapshot.in_final_render(scene)) and not repeated:
-        print(f"Relativity: {error}")  # a scene never set up: the panel only
-    _scene_status[scene.name] = status
+    records.refused(scene, error, applied_method(scene) is not None or snapshot.in_final_render(scene))
 
 
-def _record(scene, snap, depsgraph=None):
-    warnings = []
-    if scene.render.engine == "CYCLES" and scene.cycles.device == "GPU":
-        warnings.append("Cycles renders OSL cameras on the CPU (or OptiX) only: set Device to CPU")
-    if snap.method == "CAMERA":
-        camera_object = scene.objects.get(snap.camera)
-        problem = camera_object and exact_camera.type_problem(camera_object.name, camera_object.data)
-        if problem:
-            warnings.append(problem[0].upper() + problem[1:])
-    if snap.exact_camera:
-        warnings += exact_camera.lens_warnings(scene.objects.get(snap.camera))
-    if snap.method == "GEOMETRY":
-        problem = final_render_problem(scene, snap)
-        if snap.speed > 0.0 and problem is not None:
-            warnings.append(f"Lamps, shadows and the world are not relativistic in this render: {problem}")
-            if snap.exposure_mode == "COMPENSATED":
-                warnings.append("Compensated exposure is applied by the exact camera only: not in this render")
-    head = list(warnings)
-    middle = _mesh_records(scene, snap, depsgraph)
-    warnings = []
-    if snap.method == "GEOMETRY":
-        warnings += instancing.instancing_warnings(scene, snap)
-        warnings += filter(None, (moving_objects.static_but_keyframed(obj, scene) for obj in scene.objects))
-    for stage in STAGES:
-        warnings += stage.warnings(scene, snap)
-    _record_parts[scene.name] = (head, warnings)
-    _scene_status[scene.name] = (snap, head + middle + warnings)
-    try:
-        _traveller_times[scene.name] = traveller.proper_time_at(scene, snap.frame)
-    except (RelativityError, ValueError):
-        _traveller_times.pop(scene.name, None)
-    if snap.method == "GEOMETRY":
-        mesh_notes.take(scene, snap)
-
-
-def _mesh_records(scene, snap, depsgraph):
-    """The records an evaluation of the meshes changes: their updates' errors and warnings, the
-    Clip End their evaluated bounds need."""
-    notes = changes.cache_notes(scene)  # (read once for both)
-    found = apparent_meshes.scene_errors(scene, notes)
-    if snap.method == "GEOMETRY":
-        found += clip_end.clip_end_warnings(scene, snap, depsgraph)
-        found += apparent_meshes.update_warnings(scene, notes)
-    return found
-
-
-def _status(scene):
-    """(snapshot or None, warnings) of the scene's last sync; checked now if it has not synced
-    since the file was opened."""
-    if scene.name not in _scene_status:
-        try:
-            _record(scene, snapshot.read(scene))
-        except RelativityError as error:
-            _scene_status[scene.name] = (None, [str(error)])
-    return _scene_status[scene.name]
-
-
-def last_snapshot(scene: Scene) -> Snapshot | None:
-    """The snapshot of the scene's last sync, or None if that sync was refused."""
-    return _status(scene)[0]
-
-
-def traveller_time(scene: Scene) -> float | None:
-    """The observer's proper time (seconds, 0 at frame 0) at the scene's last synced frame, or None."""
-    _status(scene)
-    return _traveller_times.get(scene.name)
-
-
-def scene_warnings(scene: Scene) -> list[str]:
-    """One-line problems that stop or falsify a relativistic render of ``scene`` (as of its last
-    sync)."""
-    return list(_status(scene)[1])
+last_snapshot = records.last_snapshot
+traveller_time = records.traveller_time
+scene_warnings = records.scene_warnings

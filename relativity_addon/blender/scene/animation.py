@@ -219,15 +219,16 @@ def _keyframes_signature(obj):
     return tuple(parts)
 
 
-def settings_key(struct: Any) -> tuple[object, ...]:
+def settings_key(struct: Any, leave_out: tuple[str, ...] = ()) -> tuple[object, ...]:
     """Every value of an RNA struct (an F-curve modifier, an object's relativity settings; the items
     of its collections, an envelope's control points, likewise; no pointers, nor the panel's state),
     arrays as tuples: what it holds, as a key (a curve with modifiers used to give no keys' signature,
-    and the camera's proper time, kept under it, held its value when a modifier's settings were edited)."""
+    and the camera's proper time, kept under it, held its value when a modifier's settings were edited).
+    ``leave_out``: settings of ``struct`` itself not in the key."""
     values: list[object] = [struct.bl_rna.identifier]
     for prop in struct.bl_rna.properties:
         name = prop.identifier
-        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER":
+        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER" or name in leave_out:
             continue
         value = getattr(struct, name)
         if prop.type == "COLLECTION":

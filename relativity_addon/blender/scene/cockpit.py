@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from . import census
+
 if TYPE_CHECKING:
     from bpy.types import Object, Scene
 
@@ -31,4 +33,6 @@ def offered(scene: Scene, obj: Object) -> bool:
 
 def object_names(scene: Scene) -> tuple[str, ...]:
     """The scene's objects that move with the camera, lights included, sorted by name."""
-    return tuple(sorted(obj.name for obj in scene.objects if moves_with_camera(obj) and obj.type != "CAMERA"))
+    return tuple(
+        sorted(entry.obj.name for entry in census.entries(scene) if entry.with_camera and entry.type != "CAMERA")
+    )

@@ -10,7 +10,7 @@ import numpy as np
 
 from ...errors import RelativityError
 from ..common import once
-from . import animation, emitting_meshes
+from . import animation, census, emitting_meshes
 
 if TYPE_CHECKING:
     from contextlib import AbstractContextManager
@@ -45,7 +45,8 @@ _checked = once.Once()  # object pointer -> has_own_velocity, inside checked_onc
 
 def checked_once() -> AbstractContextManager[None]:
     """Inside: :func:`has_own_velocity` reads each object's settings once (a sync changes none;
-    the snapshot, the clamping stage and the instancing check each ask about every object)."""
+    the instancing checks ask about the applied objects and what instancers draw; the snapshot's
+    checks read ``census.entries``)."""
     return _checked.kept()
 
 
@@ -64,10 +65,7 @@ def has_own_velocity(obj: Object) -> bool:
 
 
 def _own_velocity(obj):
-    settings = obj.relativity
-    if not settings.enabled or settings.motion == "STATIC":
-        return False
-    return settings.motion == "ANIMATION" or any(float(b) != 0.0 for b in settings.beta)
+    return census.own_velocity(obj.relativity)
 
 
 def object_label(obj: Object) -> str:
@@ -111,7 +109,7 @@ def check_object_velocities(scene: Scene, method: str) -> None:
     with the exact camera every object but lights (the moving-light stage takes those); with
     Apparent Geometry every moving object that is not a mesh, and meshes drawing particles or
     instances, which the modifier leaves where they are."""
-    moving = [obj for obj in scene.objects if obj.type != "LIGHT" and has_own_velocity(obj)]
+    moving = [entry.obj for entry in census.entries(scene) if entry.own_velocity and entry.type != "LIGHT"]
     if not moving:
         return
     if method == "CAMERA":
@@ -166,17 +164,16 @@ def fastest_speed(scene: Scene) -> float:
     what reaches the speed of light is refused elsewhere."""
     fastest = 0.0
     keyed = None  # (frame range, fps, c): read once for every keyframed object
-    for obj in scene.objects:
-        if not has_own_velocity(obj):
+    for entry in census.entries(scene):
+        if not entry.own_velocity:
             continue
-        settings = obj.relativity
-        if settings.motion == "CONSTANT":
-            speed = math.hypot(*settings.beta)  # (a numpy norm per object: 5 us, a tenth of a 1,000-mesh sync)
+        if entry.motion == "CONSTANT":
+            speed = math.hypot(*entry.beta)  # (a numpy norm per object: 5 us, a tenth of a 1,000-mesh sync)
         else:
             if keyed is None:
                 c = float(scene.relativity.speed_of_light)
                 keyed = (scene.frame_start, scene.frame_end, animation.frames_per_second(scene), c)
-            speed = _keyframed_speed(obj, keyed)
+            speed = _keyframed_speed(entry.obj, keyed)
         fastest = max(fastest, speed)
     return min(fastest, 1.0 - 1e-9)
 

@@ -25,7 +25,7 @@ from ...errors import RelativityError
 from ...physics import exposure
 from ...physics.shutter import ShutterModel
 from ..common import compat, names, osl
-from . import animation, cockpit, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
+from . import animation, census, cockpit, emitting_meshes, illuminants, lens, moving_objects, sources, temperatures
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Sequence
@@ -112,6 +112,9 @@ class Snapshot:
     cockpit: tuple[str, ...] = ()
     # moving lights' stand-ins: strips along the path (CONTINUOUS) or point lamps (BLENDED)
     moving_light_shadows: str = "BLENDED"
+    # the largest speed |beta| among the objects with their own velocity (``moving_objects.fastest_speed``:
+    # the clamping stage's bound), read with the objects' other checks
+    fastest_object: float = 0.0
 
     @property
     def time(self) -> float:
@@ -333,9 +336,11 @@ def moving_lights(
     for a light at or above the speed of light. A light moving with the camera moves uniformly with the observer's
     velocity ``observer`` at the frame."""
     found = []
-    for obj in scene.objects:
-        motion = obj.relativity.motion
-        if emitting_meshes.is_emitter_light(obj) and not obj.hide_render:
+    for entry in census.entries(scene):
+        if entry.type != "LIGHT" and not entry.emitter_light:
+            continue  # (only lights and emitting meshes are moving lights)
+        obj, motion = entry.obj, entry.motion
+        if entry.emitter_light and not obj.hide_render:
             found += _emitter_light(scene, obj, frame, depsgraph)
             continue
         if obj.type == "LIGHT" and cockpit.moves_with_camera(obj) and not light_render_hidden(obj):
@@ -545,4 +550,5 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
         stereo=lens.stereo_eyes(scene),
         cockpit=cockpit.object_names(scene),
         moving_light_shadows=settings.moving_light_shadows,
+        fastest_object=moving_objects.fastest_speed(scene),
     )

@@ -14,6 +14,7 @@ import math
 from typing import TYPE_CHECKING
 
 from ...errors import RelativityError
+from . import census
 
 if TYPE_CHECKING:
     from bpy.types import Scene
@@ -27,11 +28,11 @@ def _refuse(owner, setting, value):
 
 def check_temperatures(scene: Scene) -> None:
     """RelativityError (one line) for the first temperature setting of ``scene`` that is not a number."""
-    for obj in scene.objects:
-        temperature = float(obj.relativity.temperature)
+    for entry in census.entries(scene):
+        obj, temperature = entry.obj, entry.temperature
         if not math.isfinite(temperature):
             _refuse(f"Object {obj.name!r}", "Blackbody Temperature", temperature)
-        light = obj.data if obj.type == "LIGHT" else None
+        light = obj.data if entry.type == "LIGHT" else None
         if light is not None and light.use_temperature and not math.isfinite(float(light.temperature)):
             _refuse(f"Light {obj.name!r}", "Temperature", float(light.temperature))
     settings = scene.relativity

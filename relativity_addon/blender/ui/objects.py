@@ -34,6 +34,12 @@ def _settings_changed(self, context):
         effect.object_changed(scene, self.id_data)
 
 
+def _velocity_changed(self, context):
+    scene = getattr(context, "scene", None)
+    if scene is not None:
+        effect.velocity_changed(scene, self.id_data)
+
+
 class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
     enabled: BoolProperty(
         name="Apparent Geometry",
@@ -48,7 +54,7 @@ class RELATIVITY_PG_object_settings(bpy.types.PropertyGroup):
         default="STATIC",
         update=_settings_changed,
     )
-    beta: velocity_property("Constant velocity", _settings_changed)
+    beta: velocity_property("Constant velocity", _velocity_changed)
     temperature: FloatProperty(
         name="Blackbody Temperature",
         description="Emitter temperature in kelvin for Doppler-shifted blackbody emission (0: not an emitter)",
