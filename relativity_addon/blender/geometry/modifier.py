@@ -146,6 +146,18 @@ def applied_objects(scene: Scene) -> list[Object]:
     return found
 
 
+def any_applied(scene: Scene) -> bool:
+    """Whether the scene holds a mesh carrying the modifier (:func:`applied_objects` not empty;
+    stops at the first)."""
+    scenes = _listed.values()
+    if scenes is not None and scene.name in scenes:
+        return bool(scenes[scene.name])
+    return any(
+        obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
+        for obj in scene.objects
+    )
+
+
 def moving_objects(scene: Scene) -> list[Object]:
     """The scene's set-up meshes that have a motion of their own (cheap: no positions; listed once
     inside :func:`listed_once`, where the lamp and bounce stages ask three times)."""

@@ -504,7 +504,7 @@ def _remove_copies(scene):
 
 def warnings(scene: Scene, snap: Snapshot) -> list[str]:
     """What this stage does not render right, one line each."""
-    if snap.method != "GEOMETRY" or not modifier.applied_objects(scene):
+    if snap.method != "GEOMETRY" or not modifier.any_applied(scene):
         return []
     found = [
         f"Light {obj.name!r} uses light linking: its light on moving objects is not Doppler shifted (eq. 18)"

@@ -58,7 +58,7 @@ def applied_method(scene: Scene) -> str | None:
         and not exact_camera.is_render_only(camera_object.data)
     ):
         return "CAMERA"
-    if modifier.applied_objects(scene):
+    if modifier.any_applied(scene):
         return "GEOMETRY"
     return None
 

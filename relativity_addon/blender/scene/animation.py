@@ -225,19 +225,40 @@ def settings_key(struct: Any, leave_out: tuple[str, ...] = ()) -> tuple[object, 
     arrays as tuples: what it holds, as a key (a curve with modifiers used to give no keys' signature,
     and the camera's proper time, kept under it, held its value when a modifier's settings were edited).
     ``leave_out``: settings of ``struct`` itself not in the key."""
-    values: list[object] = [struct.bl_rna.identifier]
-    for prop in struct.bl_rna.properties:
-        name = prop.identifier
-        if name in ("rna_type", "show_expanded", "active") or prop.type == "POINTER" or name in leave_out:
+    identifier = struct.bl_rna.identifier
+    values: list[object] = [identifier]
+    for name, kind in _key_fields(struct, identifier):
+        if name in leave_out:
             continue
         value = getattr(struct, name)
-        if prop.type == "COLLECTION":
+        if kind == "COLLECTION":
             values.append(tuple(settings_key(item) for item in value))
-        elif getattr(prop, "is_array", False):
+        elif kind == "ARRAY":
             values.append(tuple(value))
         else:
             values.append(value)
     return tuple(values)
+
+
+# RNA struct identifier -> (property name, "COLLECTION" / "ARRAY" / "VALUE") of what settings_key
+# reads (walking ``bl_rna.properties`` took most of a key: 20 us for the relativity settings).
+_fields: dict[tuple[str, int], tuple[tuple[str, str], ...]] = {}
+
+
+def _key_fields(struct, identifier):
+    properties = struct.bl_rna.properties
+    key = (identifier, len(properties))  # (a struct registered again with other settings: read again)
+    known = _fields.get(key)
+    if known is None:
+        known = _fields[key] = tuple(
+            (
+                prop.identifier,
+                "COLLECTION" if prop.type == "COLLECTION" else "ARRAY" if getattr(prop, "is_array", False) else "VALUE",
+            )
+            for prop in properties
+            if prop.identifier not in ("rna_type", "show_expanded", "active") and prop.type != "POINTER"
+        )
+    return known
 
 
 def off_keys(obj: Object, frame: float) -> bool:

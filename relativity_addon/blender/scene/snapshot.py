@@ -478,6 +478,11 @@ def read(scene: Scene, depsgraph: Depsgraph | None = None, objects_for: str | No
     cannot be rendered with correct physics. ``objects_for`` checks the objects' own velocities for
     that method instead of the scene's (the Apparent Geometry bakes read ``"GEOMETRY"``: they are
     that path's tools, used before the method is chosen)."""
+    with census.taken():  # (the objects' settings read once for every check below)
+        return _read(scene, depsgraph, objects_for)
+
+
+def _read(scene, depsgraph, objects_for):
     settings = scene.relativity
     c = check_speed_of_light(settings.speed_of_light)
     camera = active_camera(scene)
