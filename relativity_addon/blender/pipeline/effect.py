@@ -388,7 +388,8 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
     tessellation.announce(obj)  # (as object_changed)
     snap = records.recorded_snapshot(scene)
     held = None
-    if snap is not None and snap.method == "GEOMETRY" and not snap.exact_camera and not busy.is_computing():
+    usable = snap is not None and snap.method == "GEOMETRY" and not snap.exact_camera
+    if usable and not busy.is_computing() and not bake.holds_geometry(scene):  # (baked: played back as it is)
         held = settled.velocity_holds(scene, obj, changes.noted())
     if held is None or snap is None:
         object_changed(scene, obj)

@@ -169,3 +169,22 @@ def test_undo_of_a_velocity_change_draws_the_old_velocity_again(relativity_addon
     assert tuple(mover.relativity.beta) == pytest.approx((0.3, 0.0, 0.0))
     np.testing.assert_allclose(gh.evaluated_points(bpy, mover)[0], before, atol=1e-6)
     assert _clip_end_lines(scene) == []
+
+
+def test_a_velocity_dragged_after_a_bake_leaves_the_baked_meshes(relativity_addon, factory_blender, tmp_path):
+    """Baked for Render Anywhere, the meshes are played back as baked until Remove: a velocity
+    dragged then (the second change would otherwise write that mesh only) moves nothing."""
+    bpy = factory_blender
+    scene, movers = _set_up(bpy)
+    movers[2].relativity.beta = (0.4, 0.0, 0.0)
+    bpy.context.evaluated_depsgraph_get()
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "baked.blend"))
+    effect = gh.addon_module("pipeline.effect")
+    effect.bake_for_render_anywhere(scene, scene.frame_current, scene.frame_current)
+    scene = bpy.context.scene
+    mover = scene.objects["Mover 2"]
+    baked = gh.evaluated_points(bpy, mover)[0]
+    for beta in ((0.6, 0.0, 0.0), (0.1, 0.0, 0.5)):
+        mover.relativity.beta = beta
+        bpy.context.evaluated_depsgraph_get()
+        np.testing.assert_allclose(gh.evaluated_points(bpy, mover)[0], baked, atol=1e-6)
