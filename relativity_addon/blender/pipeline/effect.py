@@ -33,7 +33,7 @@ from ..colour import doppler_colour
 from ..common import busy, compat, names
 from ..geometry import apparent_meshes, changes, instancing, modifier, tessellation
 from ..scene import animation, census, moving_objects, snapshot
-from . import bake, records, render_notice, settled
+from . import bake, mesh_notes, records, render_notice, settled
 from .stages import STAGES, Sync
 
 if TYPE_CHECKING:
@@ -411,6 +411,7 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
             settled.forget(scene)
             return
         records.take_stages(scene, snap)  # (Static meshes and instancing: as they were)
+        mesh_notes.take_for(scene, obj, snap)  # (its spin's line reads the velocity)
     if changes.take_noted() - {obj.session_uid}:  # (the update notes the mesh whose cache it wrote)
         settled.forget(scene)
 

@@ -31,6 +31,11 @@ def take(scene: Scene, snap: Snapshot) -> None:
             _object_warnings[obj.name] = mesh_warnings(scene, obj, snap)
 
 
+def take_for(scene: Scene, obj: Object, snap: Snapshot) -> None:
+    """The notes of one mesh whose settings changed (a dragged velocity: ``effect.velocity_changed``)."""
+    _object_warnings[obj.name] = mesh_warnings(scene, obj, snap)
+
+
 def mesh_warnings(scene: Scene, obj: Object, snap: Snapshot) -> tuple[tuple, list[str]]:
     """(inputs, warnings) of a mesh; the edges are measured again only when the inputs change (the
     spin's line reads the keys, c and fps: a key edited away from the current frame, or c changed,

@@ -290,3 +290,37 @@ def test_spin_line_follows_c_and_a_key_edited_away_from_the_frame(relativity_add
     scene.frame_set(13)
     assert [tuple(row) for row in sphere.matrix_world] == matrix
     assert named() == pytest.approx(2.0 * expected, abs=1.5)
+
+
+def test_spin_line_follows_a_dragged_velocity(relativity_addon, factory_blender, monkeypatch):
+    """The spin's lag is ``beta beta_rim``: with the sphere's velocity dragged to half and then back
+    (a callback writing that mesh only at least once: ``effect.velocity_changed``; the sphere plays
+    its own keys, so its cache is written and the update after it syncs in full), the named angle
+    halves and comes back."""
+    bpy = factory_blender
+    scene, _ = _turning_sphere(bpy, "CONSTANT", 1, False, TURN, 0)
+    sphere = scene.objects["Sphere"]
+    effect = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.effect")
+    records = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.records")
+    mesh_notes = importlib.import_module(f"{ADDON_MODULE}.blender.pipeline.mesh_notes")
+    effect.apply(scene)
+    bpy.context.evaluated_depsgraph_get()
+    dragged = []
+    original = records.take_stages
+    monkeypatch.setattr(records, "take_stages", lambda *args: dragged.append(1) or original(*args))
+
+    def named():
+        bpy.context.evaluated_depsgraph_get()
+        lines = [line for line in mesh_notes.object_warnings(scene, sphere) if "'Sphere' spins while it moves" in line]
+        assert len(lines) <= 1, lines
+        return float(lines[0].split("up to about ")[1].split(" degrees")[0]) if lines else None
+
+    expected = math.degrees(per_point.BETA * TURN * 1.0 / per_point.C)
+    beta = tuple(sphere.relativity.beta)
+    sphere.relativity.beta = tuple(0.9 * b for b in beta)  # (a first change: in full where not known)
+    bpy.context.evaluated_depsgraph_get()
+    sphere.relativity.beta = tuple(0.5 * b for b in beta)
+    assert named() == pytest.approx(0.5 * expected, abs=0.6)
+    sphere.relativity.beta = beta
+    assert named() == pytest.approx(expected, abs=1.0)
+    assert dragged, "a change after the first was written as a drag"
