@@ -273,7 +273,10 @@ def steps():
     yield from draw_and_shoot("10b_clip_end_short")
     sphere.relativity.beta = (0.0, 0.0, 0.9)
     yield from draw_and_shoot("10c_towards_camera")
+    # 6c. Dragged back (a second change: that mesh and the stages only, effect.velocity_changed): the
+    #     warning goes with the speed once the window's redraw evaluates it.
     sphere.relativity.beta = gui_scene.SPHERE_BETA
+    yield from draw_and_shoot("10d_velocity_back")
     camera.data.clip_end = 1000.0
     yield 1.0
 

@@ -204,6 +204,8 @@ def test_velocity_changed_in_the_panel_reaches_its_clip_end_warning(gui_session)
     assert len(said) == 1 and "'Mover'" in said[0] and "Clip End 30 m" in said[0], report["panel_messages"]
     seen = float(said[0].split("seen ")[1].split(" m away")[0])
     assert seen > 5.0 / (1.0 - 0.9) * 0.8, said[0]
+    # dragged back to its velocity of 10b (the callback writing that mesh only): the line goes
+    assert not any("Clip End" in m for m in report["panel_messages"]["10d_velocity_back"]), report["panel_messages"]
 
 
 def test_remove_from_the_button_restores_the_scene(gui_session):
