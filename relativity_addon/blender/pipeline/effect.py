@@ -410,9 +410,15 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
             _refused(scene, error)
             settled.forget(scene)
             return
-        records.take_stages(scene, snap)  # (Static meshes and instancing: as they were)
-        mesh_notes.take_for(scene, obj, snap)  # (its spin's line reads the velocity)
-    if changes.take_noted() - {obj.session_uid}:  # (the update notes the mesh whose cache it wrote)
+        except ReferenceError:  # a kept mesh removed since (an undo that kept the object count)
+            snap = None
+        else:
+            records.take_stages(scene, snap)  # (Static meshes and instancing: as they were)
+            mesh_notes.take_for(scene, obj, snap)  # (its spin's line reads the velocity)
+    if snap is None:  # the full way, with the scene's meshes listed again
+        settled.forget(scene)
+        object_changed(scene, obj)
+    elif changes.take_noted() - {obj.session_uid}:  # (the update notes the mesh whose cache it wrote)
         settled.forget(scene)
 
 

@@ -188,3 +188,22 @@ def test_a_velocity_dragged_after_a_bake_leaves_the_baked_meshes(relativity_addo
         mover.relativity.beta = beta
         bpy.context.evaluated_depsgraph_get()
         np.testing.assert_allclose(gh.evaluated_points(bpy, mover)[0], baked, atol=1e-6)
+
+
+def test_a_velocity_dragged_after_a_mesh_was_swapped_by_script_goes_the_full_way(relativity_addon, monkeypatch):
+    """A script deletes a set-up mesh and adds an empty (the scene's object count the same), then
+    drags a velocity before any evaluation: the record's meshes are no longer the scene's, so the
+    change goes the full way (no error from the removed mesh), and the mesh moves."""
+    import bpy
+
+    scene, movers = _set_up(bpy)
+    movers[2].relativity.beta = (0.4, 0.0, 0.0)
+    bpy.context.evaluated_depsgraph_get()
+    before = gh.evaluated_points(bpy, movers[2])[0]
+    bpy.data.objects.remove(movers[5])
+    scene.collection.objects.link(bpy.data.objects.new("Stand-in empty", None))
+    full = _count_full_syncs(monkeypatch)
+    movers[2].relativity.beta = (0.6, 0.0, 0.0)
+    assert full == [scene.name], full
+    after = gh.evaluated_points(bpy, movers[2])[0]
+    assert np.abs(after - before).max() > 0.01
