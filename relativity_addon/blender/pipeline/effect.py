@@ -395,13 +395,11 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
         object_changed(scene, obj)
         return
     changes.take_noted()
-    applied, before = held
-    speed, top = math.hypot(*obj.relativity.beta), snap.fastest_object
+    applied = held
     with modifier.listed_once(), animation.signed_once(), moving_objects.checked_once():
         modifier.listed_as(scene, applied)
-        # the fastest mover: this one, or the one before if this one was slower, else read again
-        fastest = speed if speed >= top else top if before < top else moving_objects.fastest_speed(scene)
-        snap = dataclasses.replace(snap, fastest_object=min(fastest, 1.0 - 1e-9))
+        fastest = moving_objects.fastest_speed_with(scene, obj, math.hypot(*obj.relativity.beta))
+        snap = dataclasses.replace(snap, fastest_object=fastest)
         try:
             apparent_meshes.update(scene, snap, only_changed=True)
             for stage in STAGES:

@@ -128,11 +128,11 @@ def holds(scene: Scene, depsgraph: Depsgraph, noted: set[int]) -> tuple[Object, 
     return known[4]
 
 
-def velocity_holds(scene: Scene, obj: Object, noted: set[int]) -> tuple[tuple[Object, ...], float] | None:
-    """(the scene's applied meshes, the object's speed before) when the change ``noted`` (``changes.
-    take_noted``: this object alone) is a Constant Velocity changed on an applied mesh the scene's
-    record holds, moving before and after, below c, nothing else of it changed (see the module);
-    else None. On None the record is forgotten (a full sync follows); else it holds the new velocity."""
+def velocity_holds(scene: Scene, obj: Object, noted: frozenset[int]) -> tuple[Object, ...] | None:
+    """The scene's applied meshes when the change ``noted`` (``changes.noted``: this object alone)
+    is a Constant Velocity changed on an applied mesh the scene's record holds, moving before and
+    after, below c, nothing else of it changed (see the module); else None. On None the record is
+    forgotten (a full sync follows); else it holds the new velocity."""
     known = _settled.get(scene.name)
     _held.pop(scene.name, None)
     uid = obj.session_uid
@@ -157,4 +157,4 @@ def velocity_holds(scene: Scene, obj: Object, noted: set[int]) -> tuple[tuple[Ob
         forget(scene)
         return None
     known[2][uid] = now
-    return known[4], math.hypot(*before[2])
+    return known[4]

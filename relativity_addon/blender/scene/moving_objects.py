@@ -162,8 +162,8 @@ def fastest_speed(scene: Scene) -> float:
     lights): Constant Velocity's setting; with Animation the fastest its keyframes move it over
     the scene's frame range (every quarter frame; kept while its keyframes are the same). Below 1:
     what reaches the speed of light is refused elsewhere."""
-    fastest = 0.0
     keyed = None  # (frame range, fps, c): read once for every keyframed object
+    speeds = _speeds[scene.name] = {}
     for entry in census.entries(scene):
         if not entry.own_velocity:
             continue
@@ -174,8 +174,28 @@ def fastest_speed(scene: Scene) -> float:
                 c = float(scene.relativity.speed_of_light)
                 keyed = (scene.frame_start, scene.frame_end, animation.frames_per_second(scene), c)
             speed = _keyframed_speed(entry.obj, keyed)
-        fastest = max(fastest, speed)
-    return min(fastest, 1.0 - 1e-9)
+        speeds[entry.obj.session_uid] = speed
+    return _fastest(speeds)
+
+
+# Scene name -> {object session_uid: speed} of its movers as :func:`fastest_speed` last read them.
+_speeds: dict[str, dict[int, float]] = {}
+
+
+def fastest_speed_with(scene: Scene, obj: Object, speed: float) -> float:
+    """:func:`fastest_speed` with ``obj``'s speed now ``speed`` and every other mover's as the last
+    :func:`fastest_speed` of ``scene`` read it (a velocity dragged on one mesh, the others unchanged
+    since: ``settled.velocity_holds``); read again where there was none."""
+    speeds = _speeds.get(scene.name)
+    if speeds is None:
+        return fastest_speed(scene)
+    speeds[obj.session_uid] = speed
+    return _fastest(speeds)
+
+
+def _fastest(speeds: dict[int, float]) -> float:
+    # (a speed that is not a number counts for none: it is refused where it is drawn)
+    return min(max((speed for speed in speeds.values() if speed == speed), default=0.0), 1.0 - 1e-9)
 
 
 def _keyframed_speed(obj, keyed):
