@@ -136,14 +136,14 @@ def applied_objects(scene: Scene) -> list[Object]:
     scenes = _listed.values()
     if scenes is not None and scene.name in scenes:
         return list(scenes[scene.name])
-    found = [
-        obj
-        for obj in scene.objects
-        if obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
-    ]
+    found = [obj for obj in scene.objects if _applied(obj)]
     if scenes is not None:
         scenes[scene.name] = tuple(found)
     return found
+
+
+def _applied(obj: Object) -> bool:
+    return obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
 
 
 def any_applied(scene: Scene) -> bool:
@@ -152,10 +152,7 @@ def any_applied(scene: Scene) -> bool:
     scenes = _listed.values()
     if scenes is not None and scene.name in scenes:
         return bool(scenes[scene.name])
-    return any(
-        obj.type == "MESH" and obj.library is None and find_modifier(obj) is not None and not is_cache(obj)
-        for obj in scene.objects
-    )
+    return any(_applied(obj) for obj in scene.objects)
 
 
 def moving_objects(scene: Scene) -> list[Object]:

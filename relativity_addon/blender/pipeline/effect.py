@@ -32,7 +32,7 @@ from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, compat, names
 from ..geometry import apparent_meshes, changes, instancing, modifier, tessellation
-from ..scene import animation, census, moving_objects, snapshot
+from ..scene import animation, moving_objects, snapshot
 from . import bake, mesh_notes, records, render_notice, settled
 from .stages import STAGES, Sync
 
@@ -332,17 +332,14 @@ def sync(
         if not snapshot.in_final_render(scene):
             _remove_render_only_camera(scene)  # left by a render that did not end (a file saved then)
         try:
-            with census.taken():  # (the read side: the stages below may add or remove objects)
-                snap = snapshot.read(scene, depsgraph)
-                if method is not None and method != snap.method:
-                    # applied with the other method (the setting changed where no callback ran)
-                    raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
-                if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
-                    exact_camera.write(scene, snap)
-                if method == "GEOMETRY":
-                    instancing.check_instancing(
-                        scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap)
-                    )
+            snap = snapshot.read(scene, depsgraph)
+            if method is not None and method != snap.method:
+                # applied with the other method (the setting changed where no callback ran)
+                raise RelativityError(f"Set up again: the scene is set up for {_method_name(scene, method)}")
+            if method == "CAMERA" or (method == "GEOMETRY" and snap.exact_camera):
+                exact_camera.write(scene, snap)
+            if method == "GEOMETRY":
+                instancing.check_instancing(scene, depsgraph, evaluate=update_geometry, preview=_preview(scene, snap))
             if method == "GEOMETRY" and update_geometry:
                 apparent_meshes.update(scene, snap, depsgraph, only_changed=True, in_frame_change=in_frame_change)
             if method is not None:
@@ -356,8 +353,7 @@ def sync(
             settled.forget(scene)
             return None
         if record:
-            with census.taken():
-                records.record(scene, snap, depsgraph)
+            records.record(scene, snap, depsgraph)
         if full and method == "GEOMETRY":
             settled.remember(scene, snap, noted | changes.take_noted())
         else:
@@ -387,15 +383,14 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
     changes.note_changed(obj.session_uid)
     tessellation.announce(obj)  # (as object_changed)
     snap = records.recorded_snapshot(scene)
-    held = None
+    applied = None
     usable = snap is not None and snap.method == "GEOMETRY" and not snap.exact_camera
     if usable and not busy.is_computing() and not bake.holds_geometry(scene):  # (baked: played back as it is)
-        held = settled.velocity_holds(scene, obj, changes.noted())
-    if held is None or snap is None:
+        applied = settled.velocity_holds(scene, obj, changes.noted())
+    if applied is None or snap is None:
         object_changed(scene, obj)
         return
     changes.take_noted()
-    applied = held
     with modifier.listed_once(), animation.signed_once(), moving_objects.checked_once():
         modifier.listed_as(scene, applied)
         fastest = moving_objects.fastest_speed_with(scene, obj, math.hypot(*obj.relativity.beta))

@@ -4,9 +4,10 @@ A sync asks about every object of the scene in many places: which have their own
 snapshot's check, the clamping stage's fastest speed), which are lights or emitters (the moving
 lights), which move with the camera (the cockpit), their blackbody temperatures (the checks, the
 colour stage), which Static meshes may be keyframed (the panel). Each pass read the same settings
-again: on 1,000 objects, about a millisecond each. Inside :func:`taken` (``effect.sync`` opens
-it) :func:`entries` reads them once per scene; outside it every call reads the scene afresh. A
-sync changes no setting, so what it reads stays true while it runs.
+again: on 1,000 objects, about a millisecond each. Inside :func:`taken` (``snapshot.read`` and
+``records.record`` open it) :func:`entries` reads them once per scene; outside it every call reads
+the scene afresh. Neither changes a setting, so what it reads stays true while it runs (not kept
+across the stages' writes, which add and delete objects).
 """
 
 from __future__ import annotations
