@@ -18,7 +18,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .apparent import lorentz_contraction_matrix
 from .arrays import ArrayLike, BoolArray, FloatArray, IndexArray
 
 # rest points (M, 3) -> apparent positions (M, 3), any frame the projection takes
@@ -209,33 +208,42 @@ _EYE3.flags.writeable = False
 
 
 class _BoxView(NamedTuple):
-    """What both edge bounds need of a mesh in uniform motion over rest boxes (one value per box
-    where an array): the pixels per unit of ``|v| / d`` (``scale``), the largest distance and least
-    depth of the apparent points (``distance``, ``depth``; ``depth <= 0``: not every point is in
-    front), the least light-travel distance ``s_low``, a lower bound on ``1 + n.w`` (``approach``,
-    ``n`` the unit vector from the observer to the emission), the motion's ``speed`` and ``gamma``,
-    ``h`` (``e' = B r + s h``), the norms of ``B A`` and of the object's 3x3 matrix and the
-    observer's ``gamma_o``."""
+    """What both edge bounds need of meshes in uniform motion over rest boxes (one value per box, or
+    per object where every box is one object's: arrays that broadcast over the boxes): the pixels per
+    unit of ``|v| / d`` (``scale``), the largest distance and least depth of the apparent points
+    (``distance``, ``depth``; ``depth <= 0``: not every point is in front), the least light-travel
+    distance ``s_low``, a lower bound on ``1 + n.w`` (``approach``, ``n`` the unit vector from the
+    observer to the emission), the motion's ``speed`` and ``gamma``, ``|h|`` (``e' = B r + s h``), the
+    norms of ``B A`` and of the object's 3x3 matrix and the observer's ``gamma_o``."""
 
     scale: float
     distance: FloatArray
     depth: FloatArray
     s_low: FloatArray
     approach: FloatArray
-    speed: float
-    gamma: float
-    h: FloatArray
-    norm_ba: float
-    norm_m: float
+    speed: FloatArray
+    gamma: FloatArray
+    h_norm: FloatArray
+    norm_ba: FloatArray
+    norm_m: FloatArray
     gamma_o: float
 
 
-def _light_distance(r: FloatArray, along: FloatArray, speed: float) -> FloatArray:
+def _light_distance(r: FloatArray, along: FloatArray, speed: FloatArray) -> FloatArray:
     """``s = c tau`` of points ``r`` (relative to the observer, at its time) moving with ``w``
     (``along = r . w``, ``|w| = speed < 1``): the root of ``|r - s w| = s``,
     ``retarded.light_travel_time_uniform`` with ``Delta = -r`` and ``c = 1`` (that one validates its
     inputs: too slow here, per box and part)."""
     return (np.sqrt(along * along + (1.0 - speed * speed) * (r * r).sum(axis=-1)) - along) / (1.0 - speed * speed)
+
+
+def _contractions(w: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(speed, gamma, contraction)`` of velocities ``w`` (N, 3) below c: ``apparent.lorentz_contraction_matrix``
+    written out for N at once (that one validates one velocity: a third of a box view's time)."""
+    speed_squared = (w * w).sum(axis=1)
+    gamma = 1.0 / np.sqrt(1.0 - speed_squared)
+    factor = (gamma - 1.0) / gamma / np.maximum(speed_squared, 1e-300)
+    return np.sqrt(speed_squared), gamma, _EYE3 - factor[:, None, None] * (w[:, :, None] * w[:, None, :])
 
 
 def _box_view(
@@ -251,27 +259,26 @@ def _box_view(
 ) -> _BoxView:
     """Rest boxes (``rest_low``/``rest_high``: ``(3,)`` or ``(K, 3)``) seen through the closed form
     (docs/performance.md, "A bound on the edges' images", steps 1-6, and "A bound on the edges'
-    bends")."""
+    bends"), drawn with ``object_matrix`` (``(4, 4)``, or ``(K, 4, 4)``: each box its own object's)
+    and moving with ``object_beta`` (``(3,)`` or ``(K, 3)``)."""
     low = np.asarray(rest_low, dtype=np.float64).reshape(-1, 1, 3)
     high = np.asarray(rest_high, dtype=np.float64).reshape(-1, 1, 3)
-    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
-    w = np.asarray(object_beta, dtype=np.float64).reshape(3)
+    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(-1, 4, 4)
+    w = np.asarray(object_beta, dtype=np.float64).reshape(-1, 3)
     beta_o = np.asarray(observer_beta, dtype=np.float64).reshape(3)
-    speed, speed_o = math.sqrt(float(w @ w)), math.sqrt(float(beta_o @ beta_o))
-    if not (speed < 1.0 and speed_o < 1.0):
+    speed_o = math.sqrt(float(beta_o @ beta_o))
+    if not (np.all((w * w).sum(axis=1) < 1.0) and speed_o < 1.0):
         raise ValueError("velocities must be below the speed of light")
-    gamma, gamma_o = 1.0 / math.sqrt(1.0 - speed * speed), 1.0 / math.sqrt(1.0 - speed_o * speed_o)
+    speed, gamma, contraction = _contractions(w)
+    gamma_o = 1.0 / math.sqrt(1.0 - speed_o * speed_o)
     # r = A x + k: the rest point at the observer's time, relative to the observer
-    # apparent.lorentz_contraction_matrix(w) written out: that one validates w (a third of this
-    # function's time; w was checked above)
-    contraction = _EYE3 - (gamma - 1.0) / gamma * np.outer(w, w) / max(speed * speed, 1e-300)
-    a = contraction @ matrix[:3, :3]
-    k = matrix[:3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
-    r = np.asarray(np.where(_CORNER_BITS, high, low) @ a.T + k, dtype=np.float64)  # (K, 8, 3)
+    a = contraction @ matrix[:, :3, :3]
+    k = matrix[:, :3, 3] - np.asarray(observer_position, dtype=np.float64).reshape(3)
+    r = np.where(_CORNER_BITS, high, low) @ a.transpose(0, 2, 1) + k[:, None, :]  # (K, 8, 3)
     # s = c tau from |r - s w| = s (docs/physics.md with Delta = -r): convex in r, so largest at a
     # corner of the box's image
-    along = r @ w
-    s = _light_distance(r, along, speed)
+    along = (r * w[:, None, :]).sum(axis=-1)
+    s = _light_distance(r, along, speed[:, None])
     s_high = s.max(axis=1)
     centre = r.sum(axis=1)
     toward = centre / np.maximum(np.sqrt((centre * centre).sum(axis=-1)), 1e-300)[:, None]
@@ -279,67 +286,121 @@ def _box_view(
     # convex: at least its tangent plane at the box's centre, least at a corner (grad s = n / (1 + n.w),
     # 1 + n.w >= 1 - |w| > 0)
     mid = centre / 8.0
-    s_mid = _light_distance(mid, mid @ w, speed)
+    s_mid = _light_distance(mid, (mid * w).sum(axis=-1), speed)
     n_mid = (mid - s_mid[:, None] * w) / np.maximum(s_mid, 1e-300)[:, None]
-    grad = n_mid / (1.0 + n_mid @ w)[:, None]
+    grad = n_mid / (1.0 + (n_mid * w).sum(axis=-1))[:, None]
     tangent = s_mid + ((r - mid[:, None, :]) * grad[:, None, :]).sum(axis=-1).min(axis=1)
     s_low = np.maximum(s_low, np.where(s_mid > 0.0, tangent, 0.0))
     # the emission event boosted: e' = B r + s h, with |e'| = gamma_o (s + beta_o . e) <= gamma_o (1 + |beta_o|) s
     boost = _EYE3 + (gamma_o * gamma_o / (gamma_o + 1.0)) * np.outer(beta_o, beta_o)
-    h = gamma_o * beta_o - boost @ w
+    h = gamma_o * beta_o - w @ boost  # (B symmetric: B w)
     forward = -np.asarray(world_to_camera, dtype=np.float64).reshape(3, 3)[2]
-    ahead, ahead_s = r @ (boost @ forward), float(forward @ h)
+    ahead, ahead_s = r @ (boost @ forward), h @ forward
     # depth f.e': concave in r when f.h <= 0 (least at a corner), else at least its linear part's least
-    depth = (ahead + s * ahead_s).min(axis=1) if ahead_s <= 0.0 else ahead.min(axis=1) + s_low * ahead_s
+    depth = np.where(ahead_s <= 0.0, (ahead + s * ahead_s[:, None]).min(axis=1), ahead.min(axis=1) + s_low * ahead_s)
     distance = gamma_o * (1.0 + speed_o) * s_high
     left, right, bottom, top = window
     width, height = resolution
     scale = max(width / (right - left), height / (top - bottom))
-    norm_ba, norm_m = _norms(boost, a, matrix)
+    norm_ba, norm_m = _norms(np.matmul(boost, a), matrix[:, :3, :3])
     # 1 + n.w = 1 - w.w + r.w / s (n = (r - s w) / s): r.w linear, least at a corner; s_low <= s <= s_high
     least_along = along.min(axis=1)
     least_ratio = np.where(least_along < 0.0, least_along / np.maximum(s_low, 1e-300), least_along / s_high)
     approach = np.maximum(1.0 - speed, np.where(s_low > 0.0, 1.0 - speed * speed + least_ratio, 0.0))
-    return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h, norm_ba, norm_m, gamma_o)
+    h_norm = np.sqrt((h * h).sum(axis=-1))
+    return _BoxView(scale, distance, depth, s_low, approach, speed, gamma, h_norm, norm_ba, norm_m, gamma_o)
 
 
 # (B A, M) as bytes -> their largest singular values: the same for every part and every frame step
-_known_norms: dict[bytes, tuple[float, float]] = {}
+_known_norms: dict[bytes, tuple[FloatArray, FloatArray]] = {}
 
 
-def _norms(boost: FloatArray, a: FloatArray, matrix: FloatArray) -> tuple[float, float]:
-    """``||B A||`` and ``||M||`` (largest singular values), kept: two SVDs per call cost more than the rest."""
-    ba = boost @ a
-    key = ba.tobytes() + matrix[:3, :3].tobytes()
-    known = _known_norms.get(key)
+def _norms(ba: FloatArray, shape: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``||B A||`` and ``||M||`` (largest singular values) of each object's (N, 3, 3); one object's
+    kept: two SVDs per call cost more than the rest of a box view."""
+    key = ba.tobytes() + shape.tobytes() if len(ba) == 1 else None
+    known = _known_norms.get(key) if key is not None else None
     if known is None:
-        norms = np.linalg.svd(np.stack((ba, matrix[:3, :3])), compute_uv=False)[:, 0]
-        if len(_known_norms) > 4096:
-            _known_norms.clear()
-        known = _known_norms[key] = (float(norms[0]), float(norms[1]))
+        norms = np.linalg.svd(np.concatenate((ba, shape)), compute_uv=False)[:, 0]
+        known = (norms[: len(ba)], norms[len(ba) :])
+        if key is not None:
+            if len(_known_norms) > 4096:
+                _known_norms.clear()
+            _known_norms[key] = known
     return known
 
 
 def _swept(
-    rest_low: ArrayLike, rest_high: ArrayLike, object_matrix: ArrayLike, object_beta: ArrayLike, sweep: ArrayLike | None
+    rest_low: FloatArray,
+    rest_high: FloatArray,
+    object_matrix: FloatArray,
+    object_beta: FloatArray,
+    sweep: FloatArray | None,
 ) -> tuple[FloatArray, FloatArray]:
-    """The rest box, widened (object space) so that the object drawn with its origin anywhere on
-    the segment from the matrix's translation to it plus ``sweep`` (world units) keeps every point
-    inside the box drawn at the translation: ``r = A x + k + t d = A (x + t A^-1 d) + k``."""
-    low = np.asarray(rest_low, dtype=np.float64).reshape(3)
-    high = np.asarray(rest_high, dtype=np.float64).reshape(3)
+    """The rest boxes (N, 3), widened (object space) so that each object drawn with its origin anywhere
+    on the segment from its matrix's translation to it plus ``sweep`` (N, 3; world units) keeps every
+    point inside the box drawn at the translation: ``r = A x + k + t d = A (x + t A^-1 d) + k``."""
     if sweep is None:
-        return low, high
-    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(4, 4)
+        return rest_low, rest_high
+    w = np.asarray(object_beta, dtype=np.float64)
+    below = (w * w).sum(axis=1) < 1.0  # (not below c: the box view refuses it)
+    a = _contractions(np.where(below[:, None], w, 0.0))[2] @ object_matrix[:, :3, :3]
     try:
-        contraction = lorentz_contraction_matrix(object_beta)
-    except ValueError:  # not below c: the box view refuses it
-        return low, high
-    try:
-        step = np.linalg.solve(contraction @ matrix[:3, :3], np.asarray(sweep, dtype=np.float64).reshape(3))
-    except np.linalg.LinAlgError:
-        step = np.full(3, np.inf)  # a flattened object: no box holds the sweep
-    return np.minimum(low, low + step), np.maximum(high, high + step)
+        step = np.linalg.solve(a, sweep[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:  # a flattened object: no box holds the sweep
+        flat = np.linalg.det(a) == 0.0
+        step = np.linalg.solve(np.where(flat[:, None, None], _EYE3, a), sweep[:, :, None])[:, :, 0]
+        step[flat] = np.inf
+    return np.minimum(rest_low, rest_low + step), np.maximum(rest_high, rest_high + step)
+
+
+def edge_image_bounds(
+    rest_lows: ArrayLike,
+    rest_highs: ArrayLike,
+    longest_edges: ArrayLike,
+    object_matrices: ArrayLike,
+    object_betas: ArrayLike,
+    observer_position: ArrayLike,
+    observer_beta: ArrayLike,
+    world_to_camera: ArrayLike,
+    window: tuple[float, float, float, float],
+    resolution: tuple[float, float],
+    sweeps: ArrayLike | None = None,
+) -> FloatArray:
+    """:func:`edge_image_bound` of N meshes at once (rows: each mesh's rest box ``(N, 3)``, longest
+    edge ``(N,)``, matrix ``(N, 4, 4)``, velocity ``(N, 3)`` and sweep ``(N, 3)``), seen by one observer
+    and camera: one numpy pass (an observer's velocity change on 1,000 meshes, issue 26). Raises
+    ValueError where a velocity is not below c."""
+    matrices = np.asarray(object_matrices, dtype=np.float64).reshape(-1, 4, 4)
+    betas = np.asarray(object_betas, dtype=np.float64).reshape(-1, 3)
+    lows = np.asarray(rest_lows, dtype=np.float64).reshape(-1, 3)
+    highs = np.asarray(rest_highs, dtype=np.float64).reshape(-1, 3)
+    sweep = None if sweeps is None else np.asarray(sweeps, dtype=np.float64).reshape(-1, 3)
+    low, high = _swept(lows, highs, matrices, betas, sweep)
+    bounds = np.full(len(low), np.inf)
+    finite = np.isfinite(low).all(axis=1) & np.isfinite(high).all(axis=1)
+    if not finite.any():
+        return bounds
+    if finite.all():  # (no copies: one mesh's bound at each full update)
+        finite = slice(None)
+    view = _box_view(
+        low[finite],
+        high[finite],
+        matrices[finite],
+        betas[finite],
+        observer_position,
+        observer_beta,
+        world_to_camera,
+        window,
+        resolution,
+    )
+    in_front = view.depth > 1e-9 * view.distance
+    depth = np.where(in_front, view.depth, 1.0)
+    # |d pixels| <= scale |v| / depth^2 |dv|;  De' = B A + h (A^T n)^T / (1 + n.w), n = e / s
+    stretch = view.norm_ba + view.h_norm * view.norm_m * view.gamma * (1.0 + view.speed)
+    longest = np.asarray(longest_edges, dtype=np.float64).reshape(-1)[finite]
+    bounds[finite] = np.where(in_front, view.scale * view.distance / (depth * depth) * stretch * longest, np.inf)
+    return bounds
 
 
 def edge_image_bound(
@@ -367,26 +428,8 @@ def edge_image_bound(
     ``observer_beta``; docs/physics.md, "Light-travel time" and "Lorentz boost of an event".
     ``sweep`` (world units): the bound holds for the origin anywhere from the matrix's translation
     to that plus ``sweep`` (the observer's later times on a straight world line)."""
-    low, high = _swept(rest_low, rest_high, object_matrix, object_beta, sweep)
-    if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
-        return float("inf")
-    view = _box_view(
-        low,
-        high,
-        object_matrix,
-        object_beta,
-        observer_position,
-        observer_beta,
-        world_to_camera,
-        window,
-        resolution,
-    )
-    distance, depth = float(view.distance[0]), float(view.depth[0])
-    if not depth > 1e-9 * distance:
-        return float("inf")
-    # |d pixels| <= scale |v| / depth^2 |dv|;  De' = B A + h (A^T n)^T / (1 + n.w), n = e / s
-    stretch = view.norm_ba + math.sqrt(float(view.h @ view.h)) * view.norm_m * view.gamma * (1.0 + view.speed)
-    return view.scale * distance / (depth * depth) * stretch * float(longest_edge)
+    view = (object_matrix, object_beta, observer_position, observer_beta, world_to_camera, window, resolution)
+    return float(edge_image_bounds(rest_low, rest_high, [longest_edge], *view, sweep)[0])
 
 
 # The bend bound splits the rest box into up to this many parts along each of its axes (each part
@@ -435,10 +478,17 @@ def edge_bend_bound(
     (per unit length) over the light-travel times the edges span, ``object_beta`` the velocity the
     line is measured from (keyframed motion over its window); ``sweep``: as for
     :func:`edge_image_bound`."""
-    low, high = _swept(rest_low, rest_high, object_matrix, object_beta, sweep)
+    matrix = np.asarray(object_matrix, dtype=np.float64).reshape(1, 4, 4)
+    low, high = _swept(
+        np.asarray(rest_low, dtype=np.float64).reshape(1, 3),
+        np.asarray(rest_high, dtype=np.float64).reshape(1, 3),
+        matrix,
+        np.asarray(object_beta, dtype=np.float64).reshape(1, 3),
+        None if sweep is None else np.asarray(sweep, dtype=np.float64).reshape(1, 3),
+    )
     if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
         return float("inf")
-    lows, highs = _parts(low, high, float(longest_edge))
+    lows, highs = _parts(low[0], high[0], float(longest_edge))
     view = _box_view(
         lows, highs, object_matrix, object_beta, observer_position, observer_beta, world_to_camera, window, resolution
     )
@@ -455,6 +505,6 @@ def edge_bend_bound(
         # a |s'|^2 / (1 + n.w) (docs/performance.md)
         s_second = s_second + acceleration * u2 / view.approach**3
         spatial = view.gamma_o * acceleration * u2 / view.approach**2
-    bend = (spatial + math.sqrt(float(view.h @ view.h)) * s_second) / 8.0
+    bend = (spatial + view.h_norm * s_second) / 8.0
     # |P(y1) - P(y2)| <= scale |v|_max / d_min^2 |y1 - y2| (both points in the part's apparent hull)
     return float(np.max(view.scale * view.distance / (view.depth * view.depth) * bend))

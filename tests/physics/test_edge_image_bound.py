@@ -343,3 +343,47 @@ def test_swept_bound_covers_the_grid_brought_closer():
     measured = float(np.max(np.linalg.norm(image[edges[:, 1]] - image[edges[:, 0]], axis=1)))
     assert measured > tessellation.edge_image_bound(*args)
     assert tessellation.edge_image_bound(*args, sweep=(0.0, 0.0, 3.5)) >= measured
+
+
+def _objects_before_one_camera(rng, count):
+    """``count`` rest boxes, matrices and velocities placed ahead of one observer and camera."""
+    _, _, _, _, x_o, beta_o, rotation = _random_case(rng)
+    lows, highs, matrices, velocities = [], [], [], []
+    for _ in range(count):
+        low, high, matrix, u, _, _, _ = _random_case(rng)
+        ahead = np.array([rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0), -1.0]) * rng.uniform(3.0, 12.0)
+        matrix[:3, 3] = x_o + rotation.T @ ahead  # (the camera's rows are its axes in the world)
+        lows.append(low), highs.append(high), matrices.append(matrix), velocities.append(u)
+    return np.array(lows), np.array(highs), np.array(matrices), np.array(velocities), x_o, beta_o, rotation
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_many_objects_at_once_hold_each_ones_measured_images(seed):
+    """``edge_image_bounds`` of 40 meshes before one observer (the observer's velocity changed on
+    many objects at once): each row holds that mesh's measured segment images along its sweep, and is
+    the one-mesh bound; a row not below c refuses the whole call."""
+    rng = np.random.default_rng(200 + seed)
+    lows, highs, matrices, velocities, x_o, beta_o, rotation = _objects_before_one_camera(rng, 40)
+    longest = rng.uniform(0.01, 0.3, size=40) * np.min(highs - lows, axis=1)
+    # towards the camera, half the way or more: the images grow along the sweep beyond the bound's slack
+    sweeps = (x_o - matrices[:, :3, 3]) * rng.uniform(0.5, 0.7, size=(40, 1))
+    view = (x_o, beta_o, rotation, WINDOW, RESOLUTION)
+    bounds = tessellation.edge_image_bounds(lows, highs, longest, matrices, velocities, *view, sweeps)
+    assert np.isfinite(bounds).sum() >= 30, bounds
+    for row in range(40):
+        low, high, matrix, u = lows[row], highs[row], matrices[row], velocities[row]
+        one = tessellation.edge_image_bound(low, high, longest[row], matrix, u, *view, sweep=sweeps[row])
+        assert bounds[row] == pytest.approx(one, rel=1e-12) or not (np.isfinite(one) or np.isfinite(bounds[row]))
+        if not np.isfinite(bounds[row]):
+            continue
+        a, b = _segments(rng, low, high, longest[row], 500)
+        for t in (0.0, 0.5, 1.0):
+            moved = matrix.copy()
+            moved[:3, 3] += t * sweeps[row]
+            image_a, depth_a = _pixels(_seen_in_camera(a, moved, u, x_o, beta_o, rotation))
+            image_b, depth_b = _pixels(_seen_in_camera(b, moved, u, x_o, beta_o, rotation))
+            assert np.all(depth_a > 0.0) and np.all(depth_b > 0.0)
+            assert bounds[row] >= float(np.max(np.linalg.norm(image_b - image_a, axis=1))), (row, t)
+    velocities[7] = (0.0, 1.0, 0.0)
+    with pytest.raises(ValueError, match="below the speed of light"):
+        tessellation.edge_image_bounds(lows, highs, longest, matrices, velocities, *view, sweeps)
