@@ -244,7 +244,7 @@ def update_object(
     if in_modifier and keyframed.update(obj, depsgraph, snap, scene, mod, cache, codes, measure):
         expected = (short, None if checked[1] or not keyframed.is_on(mod) else True)  # the window holds its bound
         signature = cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=expected)
-        straight_steps.remember(obj, scene_key(snap), snap, signature, tuple(map(tuple, obj_eval.matrix_world)))
+        straight_steps.remember(obj, steps_scene(snap), snap, signature, tuple(map(tuple, obj_eval.matrix_world)))
         for key in (names.ERROR_KEY, names.WARNING_KEY):
             if key in cache.data:
                 del cache.data[key]
@@ -363,8 +363,12 @@ def update(
             # before the current objects are taken (update_object evaluates again after its edits).
             evaluated = _evaluated(depsgraph)
             current = changes.current_objects(scene.name, key, snap.frame, stepping)
-        if stepping and only_changed:  # straight keys: their offsets set, up to date at this frame
-            stepped = straight_steps.step([o for o in objects if o.session_uid not in current], key, snap, depsgraph)
+        if only_changed and objects:
+            # straight keys: their offsets set, up to date at this frame; outside a frame change, those of
+            # another observer's velocity turned (the boost's inputs set too)
+            waiting = [o for o in objects if o.session_uid not in current]
+            turning = not stepping
+            stepped = straight_steps.step(waiting, steps_scene(snap, key), snap, evaluated, turning)
             current.update(dict.fromkeys(stepped, False))
             updated += len(stepped)
         seen_as = _scene_parts(snap)
@@ -415,7 +419,8 @@ def _scene_parts(snap: Snapshot) -> str:
 
 def scene_key(snap: Snapshot) -> tuple:
     """What every object's signature takes from the snapshot and the scene but the frame: while it
-    stays, an object Blender did not update keeps its signature (``changes.py``)."""
+    stays, an object Blender did not update keeps its signature (``changes.py``). Its third part is
+    the observer's velocity (``steps_scene``)."""
     return (
         snap.scene,
         *_seen_from(snap),
@@ -424,6 +429,13 @@ def scene_key(snap: Snapshot) -> tuple:
         snap.fps,
         modifier.group_generation(),
     )
+
+
+def steps_scene(snap: Snapshot, key: tuple | None = None) -> straight_steps.Scene:
+    """The scene's key of the snapshot (``key`` when given), the same without the observer's velocity
+    and the scene's parts of its signatures: what ``straight_steps`` compares its records with."""
+    key = scene_key(snap) if key is None else key
+    return straight_steps.Scene(key, (*key[:2], None, *key[3:]), _scene_parts(snap))
 
 
 def _evaluated(depsgraph: Depsgraph | None) -> Depsgraph:

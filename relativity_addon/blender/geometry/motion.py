@@ -257,14 +257,9 @@ def _uniform_motion_parts(shape, w, beta_o, matrix):
     depend on the origin or the observer's place)`` of :func:`uniform_motion_inputs`."""
     # r = A x_rest + k: the point at the observer's time, relative to the observer
     scene = apparent.lorentz_contraction_matrix(w) @ shape
-    # the emission event (-s, e = r - s w) boosted: e' = B e + gamma s beta_o (Lorentz boost)
-    gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
-    boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
     # object space: N (x_o + e' - t), N the inverse of the object's 3x3
     inverse = affine_inverse(matrix)[:3, :3]
-    to_local = inverse @ boost
-    local = to_local @ scene
-    seen = apparent.velocity_seen_by_observer(w, beta_o).reshape(-1, 3)[0]
+    to_local, seen_parts = observer_parts(scene[None], w[None], beta_o, inverse[None])
     fixed = {
         "Scene X": _vector(scene[:, 0]),
         "Scene Y": _vector(scene[:, 1]),
@@ -273,13 +268,32 @@ def _uniform_motion_parts(shape, w, beta_o, matrix):
         "Inverse Gamma Squared": 1.0 - float(w @ w),
         # one form for every point: no per-point choice (4 of the closed form's 19 nodes per point)
         "Folded": 1.0 / (1.0 - float(np.sqrt(w @ w))) <= FOLD_LIMIT,
-        "Local X": _vector(local[:, 0]),
-        "Local Y": _vector(local[:, 1]),
-        "Local Z": _vector(local[:, 2]),
-        "Delay Direction": _vector(gamma * (inverse @ beta_o) - to_local @ w),
-        "Seen Velocity": _vector(seen),
+        **{name: _vector(values[0]) for name, values in zip(OBSERVER_INPUTS, seen_parts, strict=True)},
     }
-    return inverse, to_local, fixed
+    return inverse, to_local[0], fixed
+
+
+# The closed form's inputs that depend on the observer's velocity (and on the object), besides ``Local
+# Offset``: what an observer's velocity change sets (``straight_steps``), in :func:`observer_parts`' order.
+OBSERVER_INPUTS = ("Local X", "Local Y", "Local Z", "Delay Direction", "Seen Velocity")
+
+
+def observer_parts(
+    scene: FloatArray, w: FloatArray, beta_o: FloatArray, inverse: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """For N objects (``scene``: each rest shape's 3x3 contracted, ``A``; ``w`` its velocity;
+    ``inverse``, N: the inverse of its world 3x3) seen by an observer moving with ``beta_o``:
+    ``N B`` (N, 3, 3; B the boost) and the values of :data:`OBSERVER_INPUTS` (5, N, 3). The emission
+    event (-s, e = r - s w) boosted: e' = B e + gamma s beta_o (Lorentz boost), in object space
+    N (x_o + e' - t)."""
+    beta_o = np.asarray(beta_o, dtype=np.float64)
+    gamma = 1.0 / np.sqrt(1.0 - float(beta_o @ beta_o))
+    boost = np.eye(3) + (gamma * gamma / (gamma + 1.0)) * np.outer(beta_o, beta_o)
+    to_local = inverse @ boost
+    local = to_local @ scene
+    delay = gamma * (inverse @ beta_o) - np.einsum("nij,nj->ni", to_local, w)
+    seen = apparent.velocity_seen_by_observer(w, beta_o).reshape(-1, 3)
+    return to_local, np.stack((local[:, :, 0], local[:, :, 1], local[:, :, 2], delay, seen))
 
 
 def keyframes_start_warning(obj: Object, scene: Scene, earliest_time: float) -> str | None:

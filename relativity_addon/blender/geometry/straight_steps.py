@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, NamedTuple
 
+import bpy
 import numpy as np
 
 from ..common import busy, names
@@ -52,6 +53,7 @@ class _Record(NamedTuple):
     """What a full update of an object on straight keys kept for its frame steps."""
 
     key: object  # the scene's inputs (``apparent_meshes.scene_key``)
+    still: object  # the same but the observer's velocity (a turn keeps it)
     keys: object  # its keys (``animation.keyframes_signature``)
     start: FloatArray  # the keys' line: the origin at frame 0, world units
     per_frame: FloatArray  # its way per frame
@@ -59,10 +61,12 @@ class _Record(NamedTuple):
     fps: float
     t_low: float  # the observer's earliest and latest time (seconds) the window's look-ahead holds
     t_high: float
-    tail: str  # the signature after its frame and matrix
+    tail: str  # the signature after its frame, matrix and the scene's parts
     held: FloatArray  # the evaluated 3x3 of the update
     inverse: FloatArray  # the offset maps N and N B (``motion.uniform_parts``)
     to_local: FloatArray
+    w: FloatArray  # the keys' velocity, fraction of c
+    scene: FloatArray  # the rest shape's 3x3 contracted along it (``Scene X/Y/Z``)
 
 
 # Object session_uid -> its record.
@@ -75,22 +79,46 @@ def signature_head(frame: float | None, matrix: tuple) -> str:
     return f"[{frame!r}, {matrix!r}, "
 
 
-def remember(obj: Object, key: object, snap: Snapshot, signature: str, matrix: tuple) -> None:
+class Scene(NamedTuple):
+    """What the records are compared with: the snapshot's ``apparent_meshes.scene_key``, the same
+    without the observer's velocity, and the scene's parts of every signature (``_scene_parts``)."""
+
+    key: object
+    still: object
+    seen_as: str
+
+
+def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: tuple) -> None:
     """Keep what a full update of ``obj`` found (``signature`` stored with ``matrix``, its evaluated
     world matrix) if it took the closed form of straight keys with its edges proven short over the
     way to come (``keyframed.steppable_line``)."""
     line = keyframed.steppable_line(obj)
-    head = signature_head(snap.frame, matrix)
+    head = signature_head(snap.frame, matrix) + scene.seen_as
     keys = animation.keyframes_signature(obj)
     if line is None or not signature.startswith(head):
         return
     start, per_frame, shape, fps, t_low, t_high = line
     held = np.array(matrix, dtype=np.float64)
     w = per_frame * fps / snap.speed_of_light
-    maps = motion.uniform_parts(shape, w, snap.mesh_observer[2], held)[:2]  # as the full update's inputs
+    inverse, to_local, fixed = motion.uniform_parts(shape, w, snap.mesh_observer[2], held)  # as the full update's
+    contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
     tail = signature[len(head) :]
     _records[obj.session_uid] = _Record(
-        key, keys, start, per_frame, shape, fps, t_low, t_high, tail, held[:3, :3], *maps
+        scene.key,
+        scene.still,
+        keys,
+        start,
+        per_frame,
+        shape,
+        fps,
+        t_low,
+        t_high,
+        tail,
+        held[:3, :3],
+        inverse,
+        to_local,
+        w,
+        contracted,
     )
 
 
@@ -98,16 +126,25 @@ def forget(obj: Object) -> None:
     _records.pop(obj.session_uid, None)
 
 
-def step(objects: Iterable[Object], key: object, snap: Snapshot, depsgraph: Depsgraph) -> set[int]:
+def step(
+    objects: Iterable[Object], scene: Scene, snap: Snapshot, depsgraph: Depsgraph, turning: bool = False
+) -> set[int]:
     """Set the closed form's offsets of every object of ``objects`` whose record holds at the
-    snapshot's frame, and its signature. Returns their session_uids (the others: a full update)."""
+    snapshot's frame, and its signature. Returns their session_uids (the others: a full update).
+
+    ``turning`` (a sync that is not a frame change's): only the records of another observer's velocity
+    are taken, their boost's inputs (``motion.OBSERVER_INPUTS``) set too and the edges' bound taken
+    again over the way to come, for all of them at once (``tessellation.prove_over_ways``); a record
+    of this velocity is current or needs its full update then."""
     if busy.rendering():  # (a render's update measures no edge)
         return set()
     t_o = snap.mesh_observer[0]
     found = []  # (object, record, evaluated world matrix, swept bound)
     for obj in objects:
         record = _records.get(obj.session_uid)
-        if record is None or record.key != key or not record.t_low <= t_o <= record.t_high:
+        if record is None or not record.t_low <= t_o <= record.t_high:
+            continue
+        if (record.key == scene.key) == turning or (turning and record.still != scene.still):
             continue
         swept = tessellation.swept_bound(obj)
         if swept is None or animation.keyframes_signature(obj) != record.keys:
@@ -115,33 +152,56 @@ def step(objects: Iterable[Object], key: object, snap: Snapshot, depsgraph: Deps
         found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
     if not found:
         return set()
-    offsets = _offsets(
-        [item[1] for item in found], np.array([item[2] for item in found]), [item[3] for item in found], snap
-    )
+    records, matrices = [item[1] for item in found], np.array([item[2] for item in found])
+    turned = _turned(records, [item[0] for item in found], matrices, snap) if turning else None
+    offsets = _offsets(records, matrices, [item[3] for item in found], snap, turned)
     stepped = set()
-    for (obj, record, matrix, _swept), values in zip(found, offsets, strict=True):
+    for row, ((obj, record, matrix, _swept), values) in enumerate(zip(found, offsets, strict=True)):
         mod = modifier.find_modifier(obj) if values is not None else None
         data = modifier.cache_data(obj, mod) if mod is not None else None
-        if mod is None or data is None:
+        if mod is None or data is None or values is None:
             continue
-        modifier.write_inputs(mod, dict(zip(OFFSETS, values, strict=True)))
-        data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + record.tail
+        wanted = dict(zip(OFFSETS, values, strict=True))
+        if turned is not None:
+            wanted.update(zip(motion.OBSERVER_INPUTS, turned[1][row], strict=True))
+            _records[obj.session_uid] = record._replace(key=scene.key, to_local=turned[0][row])
+        modifier.write_inputs(mod, wanted)
+        data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + scene.seen_as + record.tail
         tessellation.announce(obj)  # the next evaluation is the add-on's: the rest box stays
         obj.update_tag(refresh={"DATA"})  # the modifier's inputs: its geometry alone (the frame moved the rest)
         stepped.add(obj.session_uid)
     return stepped
 
 
-def _offsets(records, matrices, swept, snap):
+def _turned(records, objects, matrices, snap):
+    """For an observer's velocity change: ``(N B per record, its OBSERVER_INPUTS as float32-rounded
+    tuples per record (None where the edges' bound no longer clears its tolerance over the way to come)``,
+    one numpy pass over the records (``motion.observer_parts``, ``tessellation.prove_over_ways``)."""
+    beta_o = np.asarray(snap.mesh_observer[2], dtype=np.float64)
+    inverse, w = np.array([r.inverse for r in records]), np.array([r.w for r in records])
+    to_local, parts = motion.observer_parts(np.array([r.scene for r in records]), w, beta_o, inverse)
+    # the bound at the origin's place now (the full update's _edge_bound: the matrix at the observer's time)
+    at_t_o = matrices.copy()
+    start, per_frame = np.array([r.start for r in records]), np.array([r.per_frame for r in records])
+    fps = np.array([r.fps for r in records])
+    at_t_o[:, :3, 3] = start + per_frame * (snap.mesh_observer[0] * fps)[:, None]
+    scene = bpy.data.scenes.get(snap.scene)
+    size = tessellation.render_size(scene) if scene is not None else (0.0, 0.0)
+    proven = tessellation.prove_over_ways(objects, at_t_o, w, per_frame, snap, size)
+    values = parts.transpose(1, 0, 2).astype(np.float32).astype(np.float64).tolist()
+    return to_local, [tuple(map(tuple, rows)) if ok else None for rows, ok in zip(values, proven, strict=True)]
+
+
+def _offsets(records, matrices, swept, snap, turned=None):
     """Per record: the three inputs (float32-rounded tuples, :data:`OFFSETS`) for the snapshot's
     frame, or None where its world matrix left the keys' line, its 3x3 the held one, or the origin
-    the edges' swept bound. One numpy pass over the objects, the full update's arithmetic."""
+    the edges' swept bound (``turned``: the turn's, whose bound was taken at the origin now). One numpy
+    pass over the objects, the full update's arithmetic."""
     t_o, x_o = snap.mesh_observer[0], np.asarray(snap.mesh_observer[1], dtype=np.float64)
     start, per_frame = np.array([r.start for r in records]), np.array([r.per_frame for r in records])
     shape, fps = np.array([r.shape for r in records]), np.array([r.fps for r in records])
-    held, inverse, to_local = (
-        np.array([getattr(r, name) for r in records]) for name in ("held", "inverse", "to_local")
-    )
+    held, inverse = np.array([r.held for r in records]), np.array([r.inverse for r in records])
+    to_local = np.array([r.to_local for r in records]) if turned is None else turned[0]
     translation = matrices[:, :3, 3]
     # where the keys' line puts the origin at this frame; the matrix on it, its 3x3 the held one
     place = start + per_frame * snap.frame
@@ -150,7 +210,10 @@ def _offsets(records, matrices, swept, snap):
     ok = (np.abs(translation - place).max(axis=1) <= scale) & (np.abs(turn - shape).max(axis=(1, 2)) <= scale)
     ok &= (turn == held).all(axis=(1, 2))  # (the offset maps are the held matrix's)
     origin = start + per_frame * (t_o * fps)[:, None]  # as keyframed._uniform_over_window computes it
-    ok &= tessellation.on_ways(origin, np.array([s[0] for s in swept]), np.array([s[1] for s in swept]))
+    if turned is None:
+        ok &= tessellation.on_ways(origin, np.array([s[0] for s in swept]), np.array([s[1] for s in swept]))
+    else:
+        ok &= np.array([values is not None for values in turned[1]])
     offset = origin - x_o
     local = motion.uniform_local_offsets(offset, x_o, translation, inverse, to_local)
     camera = tessellation.camera_offsets(translation, snap)

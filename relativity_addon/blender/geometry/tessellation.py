@@ -283,22 +283,8 @@ def edge_image_bound(
     if velocity is not None:
         beta = tuple(map(float, cast("tuple[float, float, float]", velocity)))
     _t_o, x_o, beta_o = snap.mesh_observer
-    window = cast("tuple[float, float, float, float]", tuple(snap.projection[1:5]))
-    # a frame step changes none of these for most objects: the last bound stands
-    key = (
-        bounds[0].tobytes(),
-        bounds[1].tobytes(),
-        bounds[2],
-        matrix[:3, :3].tobytes(),
-        beta,
-        tuple(x_o),
-        tuple(beta_o),
-        snap.camera_matrix,  # the camera's rotation comes from it (a numpy repr took milliseconds)
-        window,
-        size,
-        tolerance,
-        acceleration,
-    )
+    window = _window(snap)
+    key = _bound_key(bounds, matrix, beta, snap, size, tolerance, acceleration)
     origin = matrix[:3, 3]
     last = _last_bound.get(obj.name)
     # (a full update past the way's first half sweeps again: a frame step's record gets the new way)
@@ -323,6 +309,92 @@ def edge_image_bound(
         bound, kept = float("inf"), None
     _last_bound[obj.name] = (key, origin.copy(), kept, bound, tried)
     return bound
+
+
+def _window(snap: Snapshot) -> tuple[float, float, float, float]:
+    return cast("tuple[float, float, float, float]", tuple(snap.projection[1:5]))
+
+
+def _bound_key(
+    bounds: tuple, matrix: FloatArray, beta: tuple, snap: Snapshot, size: tuple, tolerance: float, acceleration: float
+) -> tuple:
+    """What an object's edges' bound depends on but its origin: while it stays (a frame step, for most
+    objects), the last bound stands."""
+    _t_o, x_o, beta_o = snap.mesh_observer
+    return (
+        bounds[0].tobytes(),
+        bounds[1].tobytes(),
+        bounds[2],
+        matrix[:3, :3].tobytes(),
+        beta,
+        tuple(x_o),
+        tuple(beta_o),
+        snap.camera_matrix,  # the camera's rotation comes from it (a numpy repr took milliseconds)
+        _window(snap),
+        size,
+        tolerance,
+        acceleration,
+    )
+
+
+def prove_over_ways(
+    objects: list[Object],
+    matrices: FloatArray,
+    velocities: FloatArray,
+    ways: FloatArray,
+    snap: Snapshot,
+    size: tuple[float, float],
+) -> list[bool]:
+    """:func:`edge_image_bound` of many objects in uniform motion at once (``matrices`` (N, 4, 4) at the
+    observer's time, ``velocities`` (N, 3) fractions of c, ``ways`` (N, 3) their origins' way through a
+    frame), only over a sweep (:func:`_sweeps`): for each object, whether it clears the object's
+    tolerance, kept as its last bound (:func:`swept_bound`) where it does. The lengths' bound for all at
+    once, the bends' for each whose lengths' bound does not clear (:func:`_bound`). The others (no rest
+    box, or no sweep clearing) are left to their full update (the bound without a sweep, and else the
+    modifier's check). An observer's velocity change on many objects (issue 26)."""
+    count = len(objects)
+    proven = [False] * count
+    rests = {row: rest for row, obj in enumerate(objects) if (rest := rest_bounds(obj)) is not None}
+    tolerances = np.array([float(obj.relativity.tessellation_tolerance) for obj in objects])
+    sweeps = [
+        _sweeps(rests[row][0], rests[row][1], matrices[row], ways[row]) if row in rests else [] for row in range(count)
+    ]
+    _t_o, x_o, beta_o = snap.mesh_observer
+    window = _window(snap)
+    view = (x_o, beta_o, snap.world_to_camera, window, size)
+    for tried in (0, 1):  # the longer sweep first, then half of it where that did not clear
+        rows = [row for row in range(count) if not proven[row] and len(sweeps[row]) > tried]
+        if not rows:
+            break
+        lows, highs, longest = (np.array([rests[row][part] for row in rows]) for part in range(3))
+        try:
+            bounds = tessellation.edge_image_bounds(
+                lows,
+                highs,
+                longest,
+                matrices[rows],
+                velocities[rows],
+                *view,
+                np.array([sweeps[row][tried] for row in rows]),
+            )
+        except ValueError:  # a velocity not below c: the full update reports it
+            return proven
+        for row, bound in zip(rows, bounds.tolist(), strict=True):
+            if not bound <= PROVEN_MARGIN * tolerances[row]:  # the bends' bound then, one object's (as _bound)
+                rest, matrix, sweep = rests[row], matrices[row], sweeps[row][tried]
+                try:
+                    bend = tessellation.edge_bend_bound(
+                        *rest, matrix, velocities[row], x_o, beta_o, snap.world_to_camera, window, size, sweep=sweep
+                    )
+                except ValueError:
+                    return proven
+                bound = min(bound, bend)
+            if bound <= PROVEN_MARGIN * tolerances[row]:
+                proven[row] = True
+                beta = tuple(velocities[row].tolist())
+                key = _bound_key(rests[row], matrices[row], beta, snap, size, float(tolerances[row]), 0.0)
+                _last_bound[objects[row].name] = (key, matrices[row, :3, 3].copy(), sweeps[row][tried], bound, tried)
+    return proven
 
 
 # Straight keys: the edges' bound is taken over the origin's way through up to this many frames to

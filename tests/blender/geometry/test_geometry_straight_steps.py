@@ -2,10 +2,12 @@
 last update kept (``straight_steps.step``), not a full update. What the mesh shows must be where
 docs/physics.md puts it (``_seen`` of the keyframed tests) at every frame stepped, and the step must
 give way to the full update wherever its record does not hold: the window reaching a change of velocity,
-a parent moved by a script, a key inserted by a script together with the frame step."""
+a parent moved by a script, a key inserted by a script together with the frame step. An observer's
+velocity change turns the records (the boost's inputs set with the offsets, the edges' bound taken again
+for all of them at once) instead of a full update."""
 
 import numpy as np
-from test_geometry_keyframed_modifier import FPS, OBSERVER, C, _seen
+from test_geometry_keyframed_modifier import FPS, OBSERVER, OBSERVER_CHANGED, C, _seen
 from test_geometry_keyframed_uniform import _inputs, _set_up_mover, _uniform_mover
 
 import geometry_helpers as gh
@@ -19,9 +21,9 @@ def _counted_updates(monkeypatch):
     return gh.count_calls(monkeypatch, hooked, lambda name, result: 1 if name == "update_object" else len(result))
 
 
-def _check(bpy, obj, camera, frame):
+def _check(bpy, obj, camera, frame, observer=OBSERVER):
     rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
-    expected, velocity = _seen(obj, rest, frame / FPS, np.array(camera.matrix_world.translation), OBSERVER)
+    expected, velocity = _seen(obj, rest, frame / FPS, np.array(camera.matrix_world.translation), observer)
     positions, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
     np.testing.assert_allclose(positions, expected, atol=1e-4)
     np.testing.assert_allclose(beta, velocity, atol=1e-4)
@@ -81,3 +83,38 @@ def test_a_step_gives_way_to_a_moved_parent_and_a_new_key(relativity_addon, monk
     scene.frame_set(16)
     assert calls["update_object"] > before, calls
     _check(bpy, obj, camera, 16)
+
+
+def test_an_observer_velocity_change_turns_the_records(relativity_addon, monkeypatch):
+    """The observer's velocity changed in the panel (the keyframed scene of issue 26's benchmark): the
+    mesh shows the new observer's view (docs/physics.md's boost of the retarded emission, solved in the
+    test) with no full update, and the frame steps after it keep stepping; back at the first velocity,
+    the first view."""
+    import bpy
+
+    scene, camera, obj = _set_up_mover(bpy)
+    scene.frame_set(13)
+    _check(bpy, obj, camera, 13)
+    steps = gh.addon_module("geometry.straight_steps")
+    calls = _counted_updates(monkeypatch)
+    turned = []
+    original = steps.step
+
+    def step(objects, seen, snap, depsgraph, turning=False):
+        result = original(objects, seen, snap, depsgraph, turning)
+        turned.extend(result if turning else ())
+        return result
+
+    monkeypatch.setattr(steps, "step", step)
+    scene.relativity.beta = OBSERVER_CHANGED
+    _check(bpy, obj, camera, 13, OBSERVER_CHANGED)
+    assert turned == [obj.session_uid], turned
+    assert calls["update_object"] == 0, calls
+    assert _inputs(obj) == {"Closed Form": True, "Keyframed": False}
+    for frame in (14, 15):
+        scene.frame_set(frame)
+        _check(bpy, obj, camera, frame, OBSERVER_CHANGED)
+    assert calls["update_object"] == 0, calls
+    scene.relativity.beta = OBSERVER
+    _check(bpy, obj, camera, 15)
+    assert len(turned) == 2 and calls["update_object"] == 0, (turned, calls)
