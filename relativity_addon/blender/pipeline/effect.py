@@ -30,7 +30,7 @@ import bpy
 from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
-from ..common import busy, compat, names
+from ..common import busy, collector, compat, names
 from ..geometry import apparent_meshes, changes, instancing, modifier, tessellation
 from ..scene import animation, moving_objects, snapshot
 from . import bake, mesh_notes, records, render_notice, settled
@@ -100,6 +100,7 @@ def _named_by_add_on():
     )
 
 
+@collector.paused()
 def apply(
     scene: Scene, frame_range: tuple[int, int] | None = None, objects: Iterable[Object] | None = None
 ) -> Object | list[Object]:
@@ -286,6 +287,7 @@ def _remove_render_only_camera(scene):
         exact_camera.remove(camera_object)
 
 
+@collector.paused()
 def sync(
     scene: Scene,
     depsgraph: Depsgraph | None = None,
@@ -375,6 +377,7 @@ def _settled_sync(scene, depsgraph):
     return snap
 
 
+@collector.paused()
 def velocity_changed(scene: Scene, obj: Object) -> None:
     """Update callback of an object's Constant Velocity: :func:`object_changed`, but where the
     velocity changes again on a mesh the scene's record holds (``settled.velocity_holds``: a slider
