@@ -47,11 +47,18 @@ def modifier_input(modifier: Modifier, identifier: str) -> Any:
 
 
 def set_modifier_input(modifier: Modifier, identifier: str, value: Any) -> None:
+    set_modifier_inputs(modifier, {identifier: value})
+
+
+def set_modifier_inputs(modifier: Modifier, values: dict[str, Any]) -> None:
+    """Several inputs of one modifier (``identifier: value``): where they live is looked up once."""
     inputs = _modifier_inputs(modifier)
     if inputs is not None:
-        getattr(inputs, identifier).value = value
+        for identifier, value in values.items():
+            getattr(inputs, identifier).value = value
     else:
-        modifier[identifier] = value
+        for identifier, value in values.items():
+            modifier[identifier] = value
 
 
 def action_channelbag(animation_data: AnimData | None) -> ActionChannelbag | None:

@@ -181,6 +181,9 @@ def _render_size(snap: Snapshot) -> tuple[float, float] | None:
     return tessellation.render_size(scene) if scene is not None else None
 
 
+# Scene name -> the scene's key (:func:`scene_key`) at its last update.
+_last_keys: dict[str, tuple] = {}
+
 # Objects whose new subdivision's positions wait for a sync outside ``frame_change_post``.
 _deferred: set[str] = set()
 
@@ -363,11 +366,13 @@ def update(
             # before the current objects are taken (update_object evaluates again after its edits).
             evaluated = _evaluated(depsgraph)
             current = changes.current_objects(scene.name, key, snap.frame, stepping)
-        if only_changed and objects:
-            # straight keys: their offsets set, up to date at this frame; outside a frame change, those of
-            # another observer's velocity turned (the boost's inputs set too)
+        # straight keys: their offsets set, up to date at this frame; outside a frame change, where the
+        # scene's key changed since its last update, those of another observer's velocity turned (the
+        # boost's inputs set too: every record of the last key was turned or given way then)
+        turning = not stepping and _last_keys.get(scene.name) != key
+        _last_keys[scene.name] = key
+        if only_changed and objects and (stepping or turning):
             waiting = [o for o in objects if o.session_uid not in current]
-            turning = not stepping
             stepped = straight_steps.step(waiting, steps_scene(snap, key), snap, evaluated, turning)
             current.update(dict.fromkeys(stepped, False))
             updated += len(stepped)

@@ -336,8 +336,9 @@ def write_inputs(mod: Modifier, wanted: dict[str, object]) -> None:
     stores them (tuples of Python floats), comparing nothing."""
     group = mod.node_group
     identifiers = _input_identifiers(group)
-    for name, value in wanted.items():
-        compat.set_modifier_input(mod, identifiers.get(name) or _identifier(group, name), value)
+    compat.set_modifier_inputs(
+        mod, {identifiers.get(name) or _identifier(group, name): value for name, value in wanted.items()}
+    )
 
 
 def _float32s(value: object) -> list[float]:

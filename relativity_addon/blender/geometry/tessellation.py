@@ -352,48 +352,59 @@ def prove_over_ways(
     once, the bends' for each whose lengths' bound does not clear (:func:`_bound`). The others (no rest
     box, or no sweep clearing) are left to their full update (the bound without a sweep, and else the
     modifier's check). An observer's velocity change on many objects (issue 26)."""
-    count = len(objects)
-    proven = [False] * count
+    proven = [False] * len(objects)
     rests = {row: rest for row, obj in enumerate(objects) if (rest := rest_bounds(obj)) is not None}
-    tolerances = np.array([float(obj.relativity.tessellation_tolerance) for obj in objects])
-    sweeps = [
-        _sweeps(rests[row][0], rests[row][1], matrices[row], ways[row]) if row in rests else [] for row in range(count)
-    ]
+    rows = np.array(sorted(rests), dtype=np.int64)
+    if not len(rows):
+        return proven
+    lows, highs = np.array([rests[row][0] for row in rows]), np.array([rests[row][1] for row in rows])
+    longest = np.array([rests[row][2] for row in rows])
+    tolerances = PROVEN_MARGIN * np.array([float(objects[row].relativity.tessellation_tolerance) for row in rows])
+    frames = _sweep_frames(lows, highs, matrices[rows], ways[rows])
     _t_o, x_o, beta_o = snap.mesh_observer
     window = _window(snap)
     view = (x_o, beta_o, snap.world_to_camera, window, size)
-    for tried in (0, 1):  # the longer sweep first, then half of it where that did not clear
-        rows = [row for row in range(count) if not proven[row] and len(sweeps[row]) > tried]
-        if not rows:
+    left = np.ones(len(rows), dtype=bool)  # not proven yet
+    for tried, parts in enumerate((frames, frames // 2)):  # the longer sweep first, then half of it
+        left &= parts > 0
+        if not left.any():
             break
-        lows, highs, longest = (np.array([rests[row][part] for row in rows]) for part in range(3))
+        sweeps = ways[rows] * parts[:, None]
         try:
             bounds = tessellation.edge_image_bounds(
-                lows,
-                highs,
-                longest,
-                matrices[rows],
-                velocities[rows],
+                lows[left],
+                highs[left],
+                longest[left],
+                matrices[rows[left]],
+                velocities[rows[left]],
                 *view,
-                np.array([sweeps[row][tried] for row in rows]),
+                sweeps[left],
             )
         except ValueError:  # a velocity not below c: the full update reports it
             return proven
-        for row, bound in zip(rows, bounds.tolist(), strict=True):
-            if not bound <= PROVEN_MARGIN * tolerances[row]:  # the bends' bound then, one object's (as _bound)
-                rest, matrix, sweep = rests[row], matrices[row], sweeps[row][tried]
+        for index, bound in zip(np.flatnonzero(left).tolist(), bounds.tolist(), strict=True):
+            row = int(rows[index])
+            if not bound <= tolerances[index]:  # the bends' bound then, one object's (as _bound)
                 try:
                     bend = tessellation.edge_bend_bound(
-                        *rest, matrix, velocities[row], x_o, beta_o, snap.world_to_camera, window, size, sweep=sweep
+                        *rests[row],
+                        matrices[row],
+                        velocities[row],
+                        x_o,
+                        beta_o,
+                        snap.world_to_camera,
+                        window,
+                        size,
+                        sweep=sweeps[index],
                     )
                 except ValueError:
                     return proven
                 bound = min(bound, bend)
-            if bound <= PROVEN_MARGIN * tolerances[row]:
+            if bound <= tolerances[index]:
                 proven[row] = True
-                beta = tuple(velocities[row].tolist())
-                key = _bound_key(rests[row], matrices[row], beta, snap, size, float(tolerances[row]), 0.0)
-                _last_bound[objects[row].name] = (key, matrices[row, :3, 3].copy(), sweeps[row][tried], bound, tried)
+                # (no key: the next full update takes its bound again; the sweep holds)
+                _last_bound[objects[row].name] = (None, matrices[row, :3, 3].copy(), sweeps[index], bound, tried)
+        left = ~np.array([proven[row] for row in rows.tolist()])
     return proven
 
 
@@ -406,10 +417,19 @@ SWEEP_SIZES = 32.0
 
 def _sweeps(low: FloatArray, high: FloatArray, matrix: FloatArray, way: FloatArray) -> list[FloatArray]:
     """The origin's ways over the frames the bound is taken for (world units), longest first."""
-    size = float(np.sqrt(((high - low) ** 2).sum() * (matrix[:3, :3] ** 2).sum()))  # at least the box's
-    step = float(np.sqrt(way @ way))
-    frames = SWEEP_FRAMES if step * SWEEP_FRAMES <= SWEEP_SIZES * size else max(1, int(SWEEP_SIZES * size / step))
+    frames = int(_sweep_frames(low[None], high[None], matrix[None], way[None])[0])
     return [way * frames] + ([way * (frames // 2)] if frames > 1 else [])
+
+
+def _sweep_frames(lows: FloatArray, highs: FloatArray, matrices: FloatArray, ways: FloatArray) -> np.ndarray:
+    """How many frames each object's longest sweep spans (:func:`_sweeps`; rows: the objects)."""
+    sizes = np.sqrt(
+        ((highs - lows) ** 2).sum(axis=1) * (matrices[:, :3, :3] ** 2).sum(axis=(1, 2))
+    )  # the box's at least
+    steps = np.sqrt((ways * ways).sum(axis=1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fewer = np.maximum(1, np.nan_to_num(SWEEP_SIZES * sizes / steps, posinf=SWEEP_FRAMES).astype(np.int64))
+    return np.where(steps * SWEEP_FRAMES <= SWEEP_SIZES * sizes, SWEEP_FRAMES, fewer)
 
 
 def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:

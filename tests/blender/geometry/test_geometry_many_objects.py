@@ -36,7 +36,7 @@ def _scene(bpy, tessellation):
 
 def _count_work(monkeypatch):
     """Patch the per-mesh work of a sync; returns {kind: Counter of object names}."""
-    work = {kind: Counter() for kind in ("signature", "update", "input written", "depth", "warnings")}
+    work = {kind: Counter() for kind in ("signature", "update", "turned", "input written", "depth", "warnings")}
     meshes = gh.geometry_module()
     compat = gh.addon_module("common.compat")
     clip_end = gh.addon_module("geometry.clip_end")
@@ -63,6 +63,17 @@ def _count_work(monkeypatch):
 
     monkeypatch.setattr(clip_end, "bounds_depths", counted_depths)
     hook(mesh_notes, "mesh_warnings", "warnings", lambda args: args[1])
+    steps = gh.addon_module("geometry.straight_steps")
+    step = steps.step
+
+    def counted_steps(objects, *args, **kwargs):
+        objects = list(objects)
+        done = step(objects, *args, **kwargs)
+        if args[3:4] == (True,) or kwargs.get("turning"):  # an observer's velocity change: recomputed
+            work["turned"].update(obj.name for obj in objects if obj.session_uid in done)
+        return done
+
+    monkeypatch.setattr(steps, "step", counted_steps)
     return work
 
 
@@ -168,7 +179,8 @@ def test_observer_change_on_many_keyframed_meshes_evaluates_once(relativity_addo
         bpy.app.handlers.depsgraph_update_post.remove(handler)
     after = _points(bpy, movers)
 
-    assert work["update"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
+    # (each updated, or its record of straight keys turned: straight_steps)
+    assert work["update"] + work["turned"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
     assert len(evaluations) <= 2, f"{len(evaluations)} depsgraph evaluations for {COUNT} meshes ({_done(work)})"
     for k in range(COUNT):
         assert np.abs(after[k] - before[k]).max() > 1e-3, f"Mover {k} did not move"
@@ -193,8 +205,9 @@ def test_observer_change_builds_each_signature_once_before_the_evaluation(relati
 
     scene.relativity.beta = (-0.3, 0.1, 0.0)  # the callback's sync, before Blender evaluates
 
-    assert work["update"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
-    assert work["signature"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
+    # (each updated, or its record of straight keys turned: straight_steps; a turn builds none)
+    assert work["update"] + work["turned"] == Counter({f"Mover {k}": 1 for k in range(COUNT)}), _done(work)
+    assert work["signature"] == work["update"], _done(work)
     bpy.context.evaluated_depsgraph_get()
     after = _points(bpy, movers)
     gh.remove_effect(scene)

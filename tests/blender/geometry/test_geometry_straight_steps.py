@@ -7,6 +7,7 @@ velocity change turns the records (the boost's inputs set with the offsets, the 
 for all of them at once) instead of a full update."""
 
 import numpy as np
+import pytest
 from test_geometry_keyframed_modifier import FPS, OBSERVER, OBSERVER_CHANGED, C, _seen
 from test_geometry_keyframed_uniform import _inputs, _set_up_mover, _uniform_mover
 
@@ -118,3 +119,58 @@ def test_an_observer_velocity_change_turns_the_records(relativity_addon, monkeyp
     scene.relativity.beta = OBSERVER
     _check(bpy, obj, camera, 15)
     assert len(turned) == 2 and calls["update_object"] == 0, (turned, calls)
+
+
+def test_undo_of_an_observer_velocity_change_draws_the_old_view(relativity_addon, factory_blender):
+    """An observer's velocity change (the records turned), then Undo: the mesh is drawn as before the
+    change, to the float, and a frame step after it is still the physics' view at the old velocity."""
+    bpy = factory_blender
+    scene, camera, obj = _set_up_mover(bpy)
+    scene.frame_set(13)
+    before = gh.evaluated_points(bpy, obj)[0]
+    bpy.ops.ed.undo_push(message="set up")
+    scene.relativity.beta = OBSERVER_CHANGED
+    bpy.context.evaluated_depsgraph_get()
+    bpy.ops.ed.undo_push(message="velocity")
+    assert np.abs(gh.evaluated_points(bpy, obj)[0] - before).max() > 0.1, "the change moved the mesh"
+
+    bpy.ops.ed.undo()
+    bpy.context.evaluated_depsgraph_get()
+    scene, obj = bpy.context.scene, bpy.context.scene.objects["Mover"]
+    assert tuple(scene.relativity.beta) == pytest.approx(OBSERVER)
+    np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], before, atol=1e-6)
+    scene.frame_set(14)
+    _check(bpy, obj, scene.camera, 14)
+
+
+def test_an_observer_velocity_change_in_a_sunlit_scene(relativity_addon, monkeypatch):
+    """A sun in the scene (the lamp stage's light-linked copy of it for the mover): the turned mesh is
+    the physics' view at the new velocity, and the sun's copy stays what a Set Up at that velocity makes
+    (its colour and place: the sun's light on the mover does not depend on the observer)."""
+    import bpy
+
+    scene, camera, obj = _set_up_mover(bpy)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.rotation_euler = (0.6, 0.3, 0.0)
+    scene.collection.objects.link(sun)
+    scene.frame_set(13)
+    lamps = gh.addon_module("lights.lamps_on_moving_objects")
+
+    def copies():
+        found = [o for o in scene.objects if lamps.is_copy(o)]
+        return {o.name: (tuple(o.data.color), tuple(map(tuple, o.matrix_world))) for o in found}
+
+    bpy.context.evaluated_depsgraph_get()
+    first = copies()
+    calls = _counted_updates(monkeypatch)
+    scene.relativity.beta = OBSERVER_CHANGED
+    _check(bpy, obj, camera, 13, OBSERVER_CHANGED)
+    assert calls["update_object"] == 0, calls
+    turned = copies()
+    assert turned == first  # (eq. 18's factor is the mover's, in its frame: no observer in it)
+    assert len(turned) == 1, turned
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    for name, (colour, matrix) in copies().items():
+        np.testing.assert_allclose(colour, turned[name][0], rtol=1e-6)
+        np.testing.assert_allclose(matrix, turned[name][1], atol=1e-6)
