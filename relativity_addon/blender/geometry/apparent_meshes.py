@@ -302,7 +302,10 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure,
     if len(cache.data.vertices) != points:  # positions of an update on the cache's path
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         changed = True
-    cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=(short, None))
+    signature = cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=(short, None))
+    if not busy.rendering() and (measure is None or measure["Edges Proven Short"]):  # (an observer's change turns it)
+        matrix = motion.matrix_array(obj_eval.matrix_world)
+        straight_steps.remember_closed_form(obj, steps_scene(snap), snap, signature, matrix, measure is not None)
     for key in (names.ERROR_KEY, names.WARNING_KEY):
         if key in cache.data:
             del cache.data[key]

@@ -25,6 +25,7 @@ keeps a new one where it may.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, NamedTuple
 
 import bpy
@@ -67,6 +68,10 @@ class _Record(NamedTuple):
     to_local: FloatArray
     w: FloatArray  # the keys' velocity, fraction of c
     scene: FloatArray  # the rest shape's 3x3 contracted along it (``Scene X/Y/Z``)
+    # a closed-form object's (Static, Constant Velocity: ``remember_closed_form``) its settings read
+    # (enabled, motion, velocity), else None; its line stands still (no way per frame: turns only)
+    settings: tuple | None = None
+    measured: bool = True  # whether its edges are checked (a turn then takes their bound again)
 
 
 # Object session_uid -> its record.
@@ -122,6 +127,43 @@ def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: 
     )
 
 
+def remember_closed_form(
+    obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: FloatArray, measured: bool
+) -> None:
+    """Keep what a full update of a closed-form object (Static or Constant Velocity without an
+    animation of its own: ``motion.closed_form``) found, for an observer's velocity change (its
+    frame steps change none of its inputs): its origin stands where Blender draws it, with its
+    velocity setting; ``measured``: its edges checked, proven short by the bound (else not kept)."""
+    settings = obj.relativity
+    read = (settings.enabled, settings.motion, settings.beta[:])
+    head = signature_head(None, tuple(map(tuple, matrix.tolist()))) + scene.seen_as
+    if obj.animation_data is not None or not signature.startswith(head):
+        return
+    w = np.array(read[2] if read[1] == "CONSTANT" else (0.0, 0.0, 0.0), dtype=np.float64)
+    shape = matrix[:3, :3].copy()
+    inverse, to_local, fixed = motion.uniform_parts(shape, w, snap.mesh_observer[2], matrix)  # as the update's
+    contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
+    _records[obj.session_uid] = _Record(
+        scene.key,
+        scene.still,
+        None,
+        matrix[:3, 3].copy(),
+        np.zeros(3),
+        shape,
+        1.0,
+        -math.inf,
+        math.inf,
+        signature[len(head) :],
+        shape,
+        inverse,
+        to_local,
+        w,
+        contracted,
+        read,
+        measured,
+    )
+
+
 def forget(obj: Object) -> None:
     _records.pop(obj.session_uid, None)
 
@@ -146,9 +188,17 @@ def step(
             continue
         if (record.key == scene.key) == turning or (turning and record.still != scene.still):
             continue
-        swept = tessellation.swept_bound(obj)
-        if swept is None or animation.keyframes_signature(obj) != record.keys:
-            continue
+        if record.settings is not None:  # a closed-form object's: turns only, while its settings hold
+            relativity = obj.relativity
+            if not turning or obj.animation_data is not None:
+                continue
+            if (relativity.enabled, relativity.motion, relativity.beta[:]) != record.settings:
+                continue
+            swept = None
+        else:
+            swept = tessellation.swept_bound(obj)
+            if swept is None or animation.keyframes_signature(obj) != record.keys:
+                continue
         found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
     if not found:
         return set()
@@ -166,7 +216,8 @@ def step(
             wanted.update(zip(motion.OBSERVER_INPUTS, turned[1][row], strict=True))
             _records[obj.session_uid] = record._replace(key=scene.key, to_local=turned[0][row])
         modifier.write_inputs(mod, wanted)
-        data[names.SIGNATURE_KEY] = signature_head(snap.frame, matrix) + scene.seen_as + record.tail
+        frame = snap.frame if record.settings is None else None  # (a closed form's depends on no frame)
+        data[names.SIGNATURE_KEY] = signature_head(frame, matrix) + scene.seen_as + record.tail
         tessellation.announce(obj)  # the next evaluation is the add-on's: the rest box stays
         obj.update_tag(refresh={"DATA"})  # the modifier's inputs: its geometry alone (the frame moved the rest)
         stepped.add(obj.session_uid)
@@ -187,7 +238,16 @@ def _turned(records, objects, matrices, snap):
     at_t_o[:, :3, 3] = start + per_frame * (snap.mesh_observer[0] * fps)[:, None]
     scene = bpy.data.scenes.get(snap.scene)
     size = tessellation.render_size(scene) if scene is not None else (0.0, 0.0)
-    proven = tessellation.prove_over_ways(objects, at_t_o, w, per_frame, snap, size)
+    measured = [row for row, r in enumerate(records) if r.measured]
+    proven = [True] * len(records)  # (edges not checked: nothing to prove)
+    for row, ok in zip(
+        measured,
+        tessellation.prove_over_ways(
+            [objects[k] for k in measured], at_t_o[measured], w[measured], per_frame[measured], snap, size
+        ),
+        strict=True,
+    ):
+        proven[row] = ok
     values = parts.transpose(1, 0, 2).astype(np.float32).astype(np.float64).tolist()
     return to_local, [tuple(map(tuple, rows)) if ok else None for rows, ok in zip(values, proven, strict=True)]
 

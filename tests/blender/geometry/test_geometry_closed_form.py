@@ -139,3 +139,58 @@ def test_group_of_an_older_version_is_rebuilt_keeping_the_cache(relativity_addon
     obj.relativity.beta = (0.5, 0.2, 0.0)  # a sync: the update sets the closed form's inputs again
     np.testing.assert_allclose(gh.evaluated_points(bpy, obj)[0], before, atol=1e-6)
     assert sum(modifier.is_cache(each) for each in bpy.data.objects) == 1
+
+
+OBSERVER_CHANGED = (-0.3, 0.25, 0.1)
+
+
+@pytest.mark.parametrize(("levels", "adaptive"), CASES)
+def test_observer_velocity_change_turns_every_closed_form_mesh(relativity_addon, monkeypatch, levels, adaptive):
+    """The observer's velocity changed in the panel over a moving and a Static mesh: no full update
+    (their records turned: ``straight_steps``, the boost's inputs set for all at once), each drawn
+    where docs/physics.md puts it for the new observer; an object's velocity changed by a script
+    without its callback (``id_data`` untouched: no note) is not turned but updated in full."""
+    import bpy
+
+    scene, camera = gh.slow_light_scene(bpy, C, FPS)
+    scene.relativity.beta = OBSERVER
+    movers = []
+    for name, motion, place in (("Mover", "CONSTANT", (0.8, -0.4, -5.0)), ("Still", "STATIC", (-0.9, 0.3, -4.0))):
+        mesh = _grid_mesh(bpy, name, 40, 0.6) if adaptive else _cube_mesh(bpy, name, 0.3)
+        obj = _link(bpy, scene, name, mesh)
+        obj.location = place
+        obj.rotation_euler = (0.3, -0.5, 0.9)
+        obj.relativity.motion = motion
+        obj.relativity.use_adaptive_tessellation = adaptive
+        obj.relativity.tessellation = levels
+        movers.append(obj)
+    movers[0].relativity.beta = (0.5, 0.2, 0.0)
+    scene.frame_set(12)
+    gh.apply_geometry(scene)
+    bpy.context.evaluated_depsgraph_get()
+    meshes = gh.addon_module("geometry.apparent_meshes")
+    calls = gh.count_calls(monkeypatch, ((meshes, "update_object"),))
+
+    scene.relativity.beta = OBSERVER_CHANGED  # as the panel does: the update callback runs
+    x_o = np.array(camera.matrix_world.translation)
+    for obj, u in zip(movers, ((0.5, 0.2, 0.0), (0.0, 0.0, 0.0)), strict=True):
+        positions, beta = gh.evaluated_points(bpy, obj, "relativity_beta")
+        matrix = np.array(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).matrix_world)
+        rest = gh.evaluated_attribute(bpy, obj, "relativity_rest")
+        expected, velocity = _seen(rest, matrix, u, x_o, OBSERVER_CHANGED) if any(u) else (None, None)
+        if expected is None:  # at rest: the boosted emission of the point itself (tau = |x_o - p| / c)
+            p = (matrix[:3, :3] @ rest.T).T + matrix[:3, 3]
+            events = np.column_stack((-np.linalg.norm(x_o - p, axis=1), p - x_o)) @ _boost(OBSERVER_CHANGED).T
+            expected, velocity = events[:, 1:] + x_o, -np.asarray(OBSERVER_CHANGED)
+        np.testing.assert_allclose(positions, expected, atol=2e-5)
+        np.testing.assert_allclose(beta, np.broadcast_to(velocity, beta.shape), atol=1e-6)
+    assert calls == {"update_object": 0}, calls
+
+    movers[0].relativity["beta"] = (0.1, 0.0, 0.0)  # no callback, no note
+    scene.relativity.beta = OBSERVER
+    bpy.context.evaluated_depsgraph_get()
+    assert calls["update_object"] >= 1, calls
+    positions = gh.evaluated_points(bpy, movers[0])[0]
+    rest = gh.evaluated_attribute(bpy, movers[0], "relativity_rest")
+    matrix = np.array(movers[0].evaluated_get(bpy.context.evaluated_depsgraph_get()).matrix_world)
+    np.testing.assert_allclose(positions, _seen(rest, matrix, (0.1, 0.0, 0.0), x_o, OBSERVER)[0], atol=2e-5)
