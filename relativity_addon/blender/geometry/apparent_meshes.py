@@ -164,7 +164,7 @@ def object_signature(
         relativity.samples_per_frame,
         # the keys: an edit leaving the current frame's place changes the past the window reads (also the
         # own rotation keys of a Constant Velocity mesh: its spin at the retarded times)
-        hash(animation.keyframes_signature(obj)) if obj.animation_data is not None else None,
+        animation.keyframes_hash(obj) if obj.animation_data is not None else None,
         snap.fps,
         relativity.use_deformation,
         relativity.use_proper_time,

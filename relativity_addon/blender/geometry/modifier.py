@@ -353,7 +353,11 @@ def closed_form_on(mod: Modifier) -> bool:
     """Whether the modifier computes the apparent positions itself (the closed form, or keyframed
     motion: ``keyframed.py``)."""
     group = mod.node_group
-    return any(bool(compat.modifier_input(mod, _identifier(group, name))) for name in ("Closed Form", "Keyframed"))
+    identifiers = _input_identifiers(group)
+    for name in ("Closed Form", "Keyframed"):
+        if compat.modifier_input(mod, identifiers.get(name) or _identifier(group, name)):
+            return True
+    return False
 
 
 def _shared_with_another_object(obj, cache):

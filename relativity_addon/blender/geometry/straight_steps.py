@@ -55,7 +55,7 @@ class _Record(NamedTuple):
 
     key: object  # the scene's inputs (``apparent_meshes.scene_key``)
     still: object  # the same but the observer's velocity (a turn keeps it)
-    keys: object  # its keys (``animation.keyframes_signature``)
+    keys: int | None  # its keys (``animation.keyframes_hash``)
     start: FloatArray  # the keys' line: the origin at frame 0, world units
     per_frame: FloatArray  # its way per frame
     shape: FloatArray  # the 3x3 the keys hold (rotation and scale)
@@ -99,7 +99,7 @@ def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: 
     way to come (``keyframed.steppable_line``)."""
     line = keyframed.steppable_line(obj)
     head = signature_head(snap.frame, matrix) + scene.seen_as
-    keys = animation.keyframes_signature(obj)
+    keys = animation.keyframes_hash(obj)
     if line is None or not signature.startswith(head):
         return
     start, per_frame, shape, fps, t_low, t_high = line
@@ -197,7 +197,7 @@ def step(
             swept = None
         else:
             swept = tessellation.swept_bound(obj)
-            if swept is None or animation.keyframes_signature(obj) != record.keys:
+            if swept is None or animation.keyframes_hash(obj) != record.keys:
                 continue
         found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
     if not found:

@@ -50,7 +50,7 @@ _keys_read: list[tuple | None] = [None]
 
 @persistent
 def frame_change_pre(scene: Scene, _depsgraph: Depsgraph | None = None) -> None:
-    kept: dict[int, object] = {}
+    kept: dict[object, object] = {}
     with animation.signed_once(kept):
         _sync(scene, update_geometry=False, record=False)  # (frame_change_post records)
     _keys_read[0] = (scene.name, scene.frame_current, scene.frame_subframe, kept)

@@ -44,7 +44,7 @@ def mesh_warnings(scene: Scene, obj: Object, snap: Snapshot) -> tuple[tuple, lis
         tuple(snap.camera_position),
         snap.speed_of_light,
         snap.fps,
-        hash(animation.keyframes_signature(obj)) if obj.animation_data is not None else None,  # (the spin's keys)
+        animation.keyframes_hash(obj) if obj.animation_data is not None else None,  # (the spin's keys)
         obj.relativity.motion,
         tuple(obj.relativity.beta),
         tuple(tuple(row) for row in obj.matrix_world),

@@ -147,7 +147,7 @@ def world_matrices(
 _signed = once.Once()  # object session_uid -> its keyframes signature, inside signed_once()
 
 
-def signed_once(kept: dict[int, object] | None = None) -> AbstractContextManager[None]:
+def signed_once(kept: dict[object, object] | None = None) -> AbstractContextManager[None]:
     """Inside: :func:`keyframes_signature` reads each object's keys once (a sync edits no key; its
     stages asked up to three times per object: issue 26's 1,000 keyframed objects), into ``kept``
     when given (a frame change's two syncs share one: no script runs between them)."""
@@ -166,6 +166,18 @@ def keyframes_signature(obj: Object) -> tuple[object, ...]:
     if uid not in signatures:
         signatures[uid] = _keyframes_signature(obj)
     return signatures[uid]
+
+
+def keyframes_hash(obj: Object) -> int:
+    """``hash(keyframes_signature(obj))``, taken once per object inside :func:`signed_once` (a deep
+    tuple's hash is not kept by Python: the syncs' signatures and caches compare it for 1,000 objects)."""
+    signatures = _signed.values()
+    if signatures is None:
+        return hash(_keyframes_signature(obj))
+    key = ("hash", obj.session_uid)
+    if key not in signatures:
+        signatures[key] = hash(keyframes_signature(obj))
+    return signatures[key]
 
 
 def _keyframes_signature(obj):

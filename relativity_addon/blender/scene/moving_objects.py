@@ -200,7 +200,7 @@ def _fastest(speeds: dict[int, float]) -> float:
 
 def _keyframed_speed(obj, keyed):
     start, end, fps, c = keyed
-    key = (animation.keyframes_signature(obj), *keyed)
+    key = (animation.keyframes_hash(obj), *keyed)
     known = _keyframed_speeds.get(obj.name)
     if key[0] is not None and known is not None and known[0] == key:
         return known[1]
