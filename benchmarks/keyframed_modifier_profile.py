@@ -17,7 +17,7 @@ closed-form step costs) and
 ``transform`` (the polynomial's terms by Transform Points on matrices combined from the same inputs,
 as before issue 26's multiply-adds). With ``--motion constant`` (Constant Velocity 0.5c, the closed form
 on the lean group: the edges' bound clears the grid), ``folded`` and ``unfolded``: the modifier's
-``Folded`` on and off (``motion.FOLD_LIMIT``). Process CPU time (Blender's threads, not the wait for a
+``Folded`` on and off (``uniform_motion.FOLD_LIMIT``). Process CPU time (Blender's threads, not the wait for a
 core) is printed beside the wall time.
 Times are of the whole modifier (subdivision check, rest, solve, the velocity, the verdict). The
 grid's linear keys would get the closed form (``animation.straight_keys``): taken out here.

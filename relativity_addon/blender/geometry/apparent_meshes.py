@@ -28,8 +28,9 @@ import numpy as np
 from ...errors import RelativityError
 from ..common import busy, names
 from ..scene import animation, snapshot
-from . import changes, clip_end, instancing, keyframed, modifier, motion, straight_steps, tessellation
+from . import changes, clip_end, edge_bounds, instancing, keyframed, modifier, motion, straight_steps, tessellation
 from .modifier import applied_objects
+from .uniform_motion import closed_form_inputs
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -71,7 +72,7 @@ def note_updates(depsgraph: Depsgraph) -> None:
     (called by every sync that gets a handler's depsgraph, also while the add-on computes), and
     every object it reports updated is no longer current (``changes.py``)."""
     changes.note_updates(depsgraph)
-    tessellation.note_updates(depsgraph)
+    edge_bounds.note_updates(depsgraph)
     if not _known_rest:
         return
     for update in depsgraph.updates:
@@ -180,9 +181,6 @@ def _render_size(snap: Snapshot) -> tuple[float, float] | None:
     scene = bpy.data.scenes.get(snap.scene)
     return tessellation.render_size(scene) if scene is not None else None
 
-
-# Scene name -> the scene's key (:func:`scene_key`) at its last update.
-_last_keys: dict[str, tuple] = {}
 
 # Objects whose new subdivision's positions wait for a sync outside ``frame_change_post``.
 _deferred: set[str] = set()
@@ -293,7 +291,7 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure,
     (:func:`clip_end_warnings`)."""
     obj_eval = obj.evaluated_get(depsgraph)
     try:
-        inputs = motion.closed_form_inputs(obj, obj_eval, snap)
+        inputs = closed_form_inputs(obj, obj_eval, snap)
     except ValueError as error:  # the physics core's checks
         raise RelativityError(f"Object {obj.name!r}: {error}") from None
     changed = modifier.set_closed_form(mod, inputs)
@@ -303,14 +301,12 @@ def _update_closed_form(scene, obj, snap, depsgraph, mod, cache, codes, measure,
         modifier.write_cache(cache.data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         changed = True
     signature = cache.data[names.SIGNATURE_KEY] = object_signature(snap, obj, depsgraph, expected=(short, None))
-    if not busy.rendering() and (measure is None or measure["Edges Proven Short"]):  # (an observer's change turns it)
-        matrix = motion.matrix_array(obj_eval.matrix_world)
-        straight_steps.remember_closed_form(obj, steps_scene(snap), snap, signature, matrix, measure is not None)
+    straight_steps.remember_closed_form(obj, steps_scene(snap), snap, signature, obj_eval, measure)
     for key in (names.ERROR_KEY, names.WARNING_KEY):
         if key in cache.data:
             del cache.data[key]
     if changed:
-        tessellation.announce(obj)
+        edge_bounds.announce(obj)
         obj.update_tag()
     return len(obj_eval.data.vertices)
 
@@ -369,11 +365,8 @@ def update(
             # before the current objects are taken (update_object evaluates again after its edits).
             evaluated = _evaluated(depsgraph)
             current = changes.current_objects(scene.name, key, snap.frame, stepping)
-        # straight keys: their offsets set, up to date at this frame; outside a frame change, where the
-        # scene's key changed since its last update, those of another observer's velocity turned (the
-        # boost's inputs set too: every record of the last key was turned or given way then)
-        turning = not stepping and _last_keys.get(scene.name) != key
-        _last_keys[scene.name] = key
+        # straight keys' offsets set at a frame step; an observer's velocity change turns the records
+        turning = straight_steps.turns(scene.name, key, stepping)
         if only_changed and objects and (stepping or turning):
             waiting = [o for o in objects if o.session_uid not in current]
             stepped = straight_steps.step(waiting, steps_scene(snap, key), snap, evaluated, turning)

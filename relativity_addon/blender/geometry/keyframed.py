@@ -26,7 +26,7 @@ from ...errors import RelativityError
 from ...physics import polynomial_motion, sampling
 from ..common import names
 from ..scene import animation
-from . import modifier, motion, shape_keys, tessellation
+from . import edge_bounds, modifier, motion, shape_keys, tessellation, uniform_motion
 
 if TYPE_CHECKING:
     from bpy.types import Depsgraph, Mesh, Modifier, Object, Scene
@@ -199,7 +199,7 @@ def modifier_inputs(
         # straight keys hold the rotation and scale (one value each): the shape at any frame
         shape = _fact(facts, "held shape", lambda: animation.world_matrices(obj, [t_o * fps])[0, :3, :3])
         origin = start + per_frame * (t_o * fps)
-        closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
+        closed = uniform_motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
         return {"Keyframed": False, "Closed Form": True, **closed}, None
     grid_now, grid_per_distance = t_o / step - pieces.first, 1.0 / (c * step)
     polynomial, form, steps = found if found is not None else (None, None, None)
@@ -237,8 +237,8 @@ def modifier_inputs(
             "Polynomial Centre": form.centre,
             "Polynomial Start Offset": form.start_offset,
             "Polynomial Start Slope": form.start_slope,
-            # the closed forms' towards form on every point (as the closed form's, motion.FOLD_LIMIT)
-            "Folded": 1.0 / (1.0 - pieces.fastest) <= motion.FOLD_LIMIT,
+            # the closed forms' towards form on every point (as the closed form's, uniform_motion.FOLD_LIMIT)
+            "Folded": 1.0 / (1.0 - pieces.fastest) <= uniform_motion.FOLD_LIMIT,
             **{
                 f"Polynomial {power} {part}": vector(form.coefficients[power][:, column])
                 for power in range(polynomial_motion.DEGREE + 1)
@@ -323,7 +323,7 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
     _last_tau[obj.session_uid] = tau
     # the observer's latest time this line still holds the window (the window's ends rise with t_o):
     # the sweep's frames ahead, else half as many (a change of velocity that near)
-    for frames in (tessellation.SWEEP_FRAMES, tessellation.SWEEP_FRAMES // 2):
+    for frames in (edge_bounds.SWEEP_FRAMES, edge_bounds.SWEEP_FRAMES // 2):
         ahead = t_o + frames / fps
         later = sampling.uniform_motion_window(start, per_frame * fps, size, step, ahead, x_o, c, reach, MAX_INTERVALS)
         if later is not None and first_frame <= later[0] * fps and later[1] * fps <= last_frame:
@@ -332,7 +332,7 @@ def _uniform_over_window(obj, obj_eval, facts, snap, fps, step, reach):
     matrix = motion.matrix_array(obj_eval.matrix_world)
     origin = start + per_frame * (t_o * fps)
     beta_o, x_o = np.asarray(beta_o, dtype=np.float64), np.asarray(x_o, dtype=np.float64)
-    closed = motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
+    closed = uniform_motion.uniform_motion_inputs(shape, origin, per_frame * fps / c, matrix, x_o, beta_o)
     return {"Keyframed": False, "Closed Form": True, **closed}
 
 
@@ -344,9 +344,9 @@ _lines: dict[int, tuple[FloatArray, FloatArray, FloatArray, float, float, float]
 
 def steppable_line(obj: Object) -> tuple[FloatArray, FloatArray, FloatArray, float, float, float] | None:
     """The object's line of its last update (:data:`_lines`) where that update proved every edge short
-    over the origin's way to come (``tessellation.swept_bound``), else None."""
+    over the origin's way to come (``edge_bounds.swept_bound``), else None."""
     line = _lines.get(obj.session_uid)
-    return line if line is not None and tessellation.swept_bound(obj) is not None else None
+    return line if line is not None and edge_bounds.swept_bound(obj) is not None else None
 
 
 # Object session_uid -> the window's polynomial at its last update (the edges' bound reads it).
@@ -356,7 +356,7 @@ _polynomials: dict[int, polynomial_motion.WindowPolynomial] = {}
 def _box_corners(obj, facts):
     """The rest box (object space: its low and high corners) of an object whose keys only move it
     (``animation.translates_only``: the polynomial may serve it), else None."""
-    bounds = tessellation.rest_bounds(obj)
+    bounds = edge_bounds.rest_bounds(obj)
     if bounds is None or not _fact(facts, "translates only", lambda: animation.translates_only(obj)):
         return None
     return np.asarray(bounds[0], dtype=np.float64), np.asarray(bounds[1], dtype=np.float64)
@@ -398,7 +398,7 @@ def write_intervals(data: Mesh, coefficients: FloatArray, face_codes: FloatArray
 
 
 def _edge_bound(obj, obj_eval, snap, scene, inputs, tolerance):
-    """The closed form's bound on the edges' images or bends (pixels; ``tessellation.edge_image_bound``)
+    """The closed form's bound on the edges' images or bends (pixels; ``edge_bounds.edge_image_bound``)
     for the closed form's ``inputs``; for the polynomial's, the largest of the bounds of the uniform
     motions through the origin at the window's centre with the origin's velocity at the window's two
     ends and centre (the motion departs from each by less than the samples' rounding over the
@@ -427,7 +427,7 @@ def _edge_bound(obj, obj_eval, snap, scene, inputs, tolerance):
         at_t_o = motion.matrix_array(obj_eval.matrix_world).copy()
         at_t_o[:3, 3] = offset + x_o
         bound = max(
-            bound, tessellation.edge_image_bound(obj, at_t_o, snap, size, tolerance, velocity, acceleration, way)
+            bound, edge_bounds.edge_image_bound(obj, at_t_o, snap, size, tolerance, velocity, acceleration, way)
         )
     return bound
 
@@ -472,11 +472,11 @@ def update(
             modifier.write_cache(data, np.zeros((0, 3)), np.zeros((1, 3)), codes)
         if measure is not None and not measure["Edges Proven Short"]:  # the closed form's bound applies
             bound = _edge_bound(obj, obj_eval, snap, scene, inputs, measure["Tolerance"])
-            measure = {**measure, "Edges Proven Short": bound <= tessellation.PROVEN_MARGIN * measure["Tolerance"]}
+            measure = {**measure, "Edges Proven Short": bound <= edge_bounds.PROVEN_MARGIN * measure["Tolerance"]}
     if measure is None or not measure["Edges Proven Short"]:  # the modifier's verdict decides: no step
         _lines.pop(obj.session_uid, None)
     # one call: the group (full or lean) is chosen once, on every input's new value
     modifier.set_inputs(mod, {**inputs, "Measure Edges": measure is not None, **(measure or {})})
     if coefficients is None:  # the next evaluation (the caller tags the object) is ours: the rest box stays
-        tessellation.announce(obj)
+        edge_bounds.announce(obj)
     return True

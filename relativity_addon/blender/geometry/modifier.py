@@ -7,7 +7,7 @@ never scrambles the mesh); it also copies the cache's ``relativity_beta`` (each 
 relative to the observer) for the Doppler shaders. ``geometry.update_object`` fills the cache.
 For the closed-form motions (``motion.closed_form``: Static, Constant Velocity without an animation
 of its own) the modifier computes the apparent positions itself (``Closed Form`` on, the inputs of
-``motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
+``uniform_motion.closed_form_inputs``), from the rest positions with vector math: a velocity change or a frame
 step sets a few inputs and needs no cache and no pass over the vertices in Python. Where the
 edges' bound clears such a mesh the modifier has the lean group instead (``node_group.LEAN_WHEN``,
 ``names.LEAN_GEOMETRY_GROUP``): the same output from the closed form's nodes alone; :func:`set_inputs`

@@ -10,7 +10,7 @@ from ..common.nodes import Group, Links, Literal, Node, fmath, vmath
 from .keyframed_nodes import KEYFRAMED_INPUTS, keyframed_nodes, window_verdict_nodes
 
 # The closed form's inputs (object space in, object space out; every vector folded in float64 by
-# ``motion.closed_form_inputs``): the point at the observer's time relative to the observer is
+# ``uniform_motion.closed_form_inputs``): the point at the observer's time relative to the observer is
 # ``r = Scene X * x + Scene Y * y + Scene Z * z + Scene Offset`` (scene units), its light-travel
 # distance ``s = c tau`` solves ``|r - s w| = s`` (``w``: Velocity, fraction of c;
 # ``Inverse Gamma Squared = 1 - w.w``) in closed form, and the apparent position in object space
@@ -63,7 +63,7 @@ def _closed_form_nodes() -> dict[str, Node]:
             {"input_type": "FLOAT"},
         ),
         # Folded (a single value: only the side chosen is computed): the towards form on every point,
-        # its cancellation on receding points bounded by motion.FOLD_LIMIT
+        # its cancellation on receding points bounded by uniform_motion.FOLD_LIMIT
         "delay": Node(
             "GeometryNodeSwitch",
             {"Switch": "group.Folded", "False": "delay_per_point.Output", "True": "delay_towards"},

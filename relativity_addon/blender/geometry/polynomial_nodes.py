@@ -12,7 +12,7 @@ closed-form steps: uniform motion through ``x(v)`` with the velocity there, ``x`
 Horner's scheme (one with ``Polynomial One Step``, which ``keyframed.py`` sets where one converges:
 ``polynomial_motion.choose_steps``; else STEPS); the emission point on the last step's uniform
 motion and the velocity the polynomial's at the last ``sigma``. With ``Folded`` (the window slower
-than ``motion.FOLD_LIMIT`` allows) each closed form takes its towards form on every point.
+than ``uniform_motion.FOLD_LIMIT`` allows) each closed form takes its towards form on every point.
 """
 
 from __future__ import annotations

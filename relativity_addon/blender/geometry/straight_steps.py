@@ -2,7 +2,7 @@
 
 Where an object's keys draw one straight line over every retarded time its window reads, the
 modifier computes the closed form of that line (``keyframed._uniform_over_window``); a frame step
-then changes three of its inputs (the origin's offsets, ``motion.uniform_motion_inputs``, and the
+then changes three of its inputs (the origin's offsets, ``uniform_motion.uniform_motion_inputs``, and the
 edge check's ``Camera Offset``) and nothing else while the window stays on the line and the edges'
 bound holds for the origin's new place. The full update (``apparent_meshes.update_object``: the
 keys' line and window found again, the bound, some twenty inputs compared, the signature) cost
@@ -15,7 +15,7 @@ inputs.
 It steps only in a frame change's sync, and only while everything the update read is what it was:
 the scene's inputs (``apparent_meshes.scene_key``: the observer, camera, speed of light, view, node
 groups), the observer's time within the window's look-ahead (``keyframed._lines``), the origin on the
-segment of the edges' swept bound (``tessellation.swept_bound``), the object's evaluated matrix on
+segment of the edges' swept bound (``edge_bounds.swept_bound``), the object's evaluated matrix on
 the keys' line and its held rotation and scale (a script that moved it, a parent, a constraint or a
 driver shows there), and its keys (``animation.keyframes_signature``, read once per sync and once for
 a frame change's two syncs: a frame change reports every animated object and its Action, edited or
@@ -33,7 +33,7 @@ import numpy as np
 
 from ..common import busy, names
 from ..scene import animation
-from . import keyframed, modifier, motion, tessellation
+from . import edge_bounds, keyframed, modifier, motion, tessellation, uniform_motion
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -45,7 +45,7 @@ if TYPE_CHECKING:
 
 # Float32 keys and matrices: the evaluated place may sit this far (relative) off the float64 line.
 ROUNDING = 4e-6
-# The three inputs a step writes, in this order (``motion.uniform_motion_inputs``' two offsets, the
+# The three inputs a step writes, in this order (``uniform_motion.uniform_motion_inputs``' two offsets, the
 # edge check's ``tessellation.camera_offset``).
 OFFSETS = ("Scene Offset", "Local Offset", "Camera Offset")
 
@@ -64,7 +64,7 @@ class _Record(NamedTuple):
     t_high: float
     tail: str  # the signature after its frame, matrix and the scene's parts
     held: FloatArray  # the evaluated 3x3 of the update
-    inverse: FloatArray  # the offset maps N and N B (``motion.uniform_parts``)
+    inverse: FloatArray  # the offset maps N and N B (``uniform_motion.uniform_parts``)
     to_local: FloatArray
     w: FloatArray  # the keys' velocity, fraction of c
     scene: FloatArray  # the rest shape's 3x3 contracted along it (``Scene X/Y/Z``)
@@ -105,7 +105,9 @@ def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: 
     start, per_frame, shape, fps, t_low, t_high = line
     held = np.array(matrix, dtype=np.float64)
     w = per_frame * fps / snap.speed_of_light
-    inverse, to_local, fixed = motion.uniform_parts(shape, w, snap.mesh_observer[2], held)  # as the full update's
+    inverse, to_local, fixed = uniform_motion.uniform_parts(
+        shape, w, snap.mesh_observer[2], held
+    )  # as the full update's
     contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
     tail = signature[len(head) :]
     _records[obj.session_uid] = _Record(
@@ -128,12 +130,16 @@ def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: 
 
 
 def remember_closed_form(
-    obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: FloatArray, measured: bool
+    obj: Object, scene: Scene, snap: Snapshot, signature: str, obj_eval: Object, measure: dict | None
 ) -> None:
     """Keep what a full update of a closed-form object (Static or Constant Velocity without an
     animation of its own: ``motion.closed_form``) found, for an observer's velocity change (its
-    frame steps change none of its inputs): its origin stands where Blender draws it, with its
-    velocity setting; ``measured``: its edges checked, proven short by the bound (else not kept)."""
+    frame steps change none of its inputs): its origin stands where Blender draws it (``obj_eval``),
+    with its velocity setting; kept where its edges are not checked (``measure`` None) or the bound
+    proved them short, and not while rendering (its update sets other inputs)."""
+    if busy.rendering() or (measure is not None and not measure["Edges Proven Short"]):
+        return
+    matrix, measured = motion.matrix_array(obj_eval.matrix_world), measure is not None
     settings = obj.relativity
     read = (settings.enabled, settings.motion, settings.beta[:])
     head = signature_head(None, tuple(map(tuple, matrix.tolist()))) + scene.seen_as
@@ -141,7 +147,7 @@ def remember_closed_form(
         return
     w = np.array(read[2] if read[1] == "CONSTANT" else (0.0, 0.0, 0.0), dtype=np.float64)
     shape = matrix[:3, :3].copy()
-    inverse, to_local, fixed = motion.uniform_parts(shape, w, snap.mesh_observer[2], matrix)  # as the update's
+    inverse, to_local, fixed = uniform_motion.uniform_parts(shape, w, snap.mesh_observer[2], matrix)  # as the update's
     contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
     _records[obj.session_uid] = _Record(
         scene.key,
@@ -164,6 +170,17 @@ def remember_closed_form(
     )
 
 
+# Scene name -> its key (``apparent_meshes.scene_key``) at its last update.
+_last_keys: dict[str, object] = {}
+
+
+def turns(scene_name: str, key: object, stepping: bool) -> bool:
+    """Whether an update outside a frame change (not ``stepping``) turns the records: the scene's key
+    changed since its last update (every record of the last key was turned or gave way then)."""
+    last, _last_keys[scene_name] = _last_keys.get(scene_name), key
+    return not stepping and last != key
+
+
 def forget(obj: Object) -> None:
     _records.pop(obj.session_uid, None)
 
@@ -175,8 +192,8 @@ def step(
     snapshot's frame, and its signature. Returns their session_uids (the others: a full update).
 
     ``turning`` (a sync that is not a frame change's): only the records of another observer's velocity
-    are taken, their boost's inputs (``motion.OBSERVER_INPUTS``) set too and the edges' bound taken
-    again over the way to come, for all of them at once (``tessellation.prove_over_ways``); a record
+    are taken, their boost's inputs (``uniform_motion.OBSERVER_INPUTS``) set too and the edges' bound taken
+    again over the way to come, for all of them at once (``edge_bounds.prove_over_ways``); a record
     of this velocity is current or needs its full update then."""
     if busy.rendering():  # (a render's update measures no edge)
         return set()
@@ -196,7 +213,7 @@ def step(
                 continue
             swept = None
         else:
-            swept = tessellation.swept_bound(obj)
+            swept = edge_bounds.swept_bound(obj)
             if swept is None or animation.keyframes_hash(obj) != record.keys:
                 continue
         found.append((obj, record, tuple(tuple(row) for row in obj.evaluated_get(depsgraph).matrix_world), swept))
@@ -213,12 +230,12 @@ def step(
             continue
         wanted = dict(zip(OFFSETS, values, strict=True))
         if turned is not None:
-            wanted.update(zip(motion.OBSERVER_INPUTS, turned[1][row], strict=True))
+            wanted.update(zip(uniform_motion.OBSERVER_INPUTS, turned[1][row], strict=True))
             _records[obj.session_uid] = record._replace(key=scene.key, to_local=turned[0][row])
         modifier.write_inputs(mod, wanted)
         frame = snap.frame if record.settings is None else None  # (a closed form's depends on no frame)
         data[names.SIGNATURE_KEY] = signature_head(frame, matrix) + scene.seen_as + record.tail
-        tessellation.announce(obj)  # the next evaluation is the add-on's: the rest box stays
+        edge_bounds.announce(obj)  # the next evaluation is the add-on's: the rest box stays
         obj.update_tag(refresh={"DATA"})  # the modifier's inputs: its geometry alone (the frame moved the rest)
         stepped.add(obj.session_uid)
     return stepped
@@ -227,10 +244,10 @@ def step(
 def _turned(records, objects, matrices, snap):
     """For an observer's velocity change: ``(N B per record, its OBSERVER_INPUTS as float32-rounded
     tuples per record (None where the edges' bound no longer clears its tolerance over the way to come)``,
-    one numpy pass over the records (``motion.observer_parts``, ``tessellation.prove_over_ways``)."""
+    one numpy pass over the records (``uniform_motion.observer_parts``, ``edge_bounds.prove_over_ways``)."""
     beta_o = np.asarray(snap.mesh_observer[2], dtype=np.float64)
     inverse, w = np.array([r.inverse for r in records]), np.array([r.w for r in records])
-    to_local, parts = motion.observer_parts(np.array([r.scene for r in records]), w, beta_o, inverse)
+    to_local, parts = uniform_motion.observer_parts(np.array([r.scene for r in records]), w, beta_o, inverse)
     # the bound at the origin's place now (the full update's _edge_bound: the matrix at the observer's time)
     at_t_o = matrices.copy()
     start, per_frame = np.array([r.start for r in records]), np.array([r.per_frame for r in records])
@@ -242,7 +259,7 @@ def _turned(records, objects, matrices, snap):
     proven = [True] * len(records)  # (edges not checked: nothing to prove)
     for row, ok in zip(
         measured,
-        tessellation.prove_over_ways(
+        edge_bounds.prove_over_ways(
             [objects[k] for k in measured], at_t_o[measured], w[measured], per_frame[measured], snap, size
         ),
         strict=True,
@@ -271,11 +288,11 @@ def _offsets(records, matrices, swept, snap, turned=None):
     ok &= (turn == held).all(axis=(1, 2))  # (the offset maps are the held matrix's)
     origin = start + per_frame * (t_o * fps)[:, None]  # as keyframed._uniform_over_window computes it
     if turned is None:
-        ok &= tessellation.on_ways(origin, np.array([s[0] for s in swept]), np.array([s[1] for s in swept]))
+        ok &= edge_bounds.on_ways(origin, np.array([s[0] for s in swept]), np.array([s[1] for s in swept]))
     else:
         ok &= np.array([values is not None for values in turned[1]])
     offset = origin - x_o
-    local = motion.uniform_local_offsets(offset, x_o, translation, inverse, to_local)
+    local = uniform_motion.uniform_local_offsets(offset, x_o, translation, inverse, to_local)
     camera = tessellation.camera_offsets(translation, snap)
     values = np.stack([offset, local, camera], axis=1).astype(np.float32).astype(np.float64).tolist()
     return [tuple(map(tuple, rows)) if good else None for rows, good in zip(values, ok.tolist(), strict=True)]

@@ -31,7 +31,7 @@ from ...errors import RelativityError
 from ..camera import exact_camera
 from ..colour import doppler_colour
 from ..common import busy, collector, compat, names
-from ..geometry import apparent_meshes, changes, instancing, modifier, tessellation
+from ..geometry import apparent_meshes, changes, edge_bounds, instancing, modifier
 from ..scene import animation, moving_objects, snapshot
 from . import bake, mesh_notes, records, render_notice, settled
 from .stages import STAGES, Sync
@@ -384,7 +384,7 @@ def velocity_changed(scene: Scene, obj: Object) -> None:
     dragged), that mesh's update, the stages and their warnings only, from the last snapshot with
     the new fastest speed (the depsgraph update after it takes the mesh's records). Never raises."""
     changes.note_changed(obj.session_uid)
-    tessellation.announce(obj)  # (as object_changed)
+    edge_bounds.announce(obj)  # (as object_changed)
     snap = records.recorded_snapshot(scene)
     applied = None
     usable = snap is not None and snap.method == "GEOMETRY" and not snap.exact_camera
@@ -450,7 +450,7 @@ def object_changed(scene: Scene, obj: Object) -> None:
         except RelativityError as error:
             _refused(scene, error)
             return
-    tessellation.announce(obj)  # the setting's update tags the object: not an edit of its rest shape
+    edge_bounds.announce(obj)  # the setting's update tags the object: not an edit of its rest shape
     sync(scene, attach_new_materials=True)
 
 

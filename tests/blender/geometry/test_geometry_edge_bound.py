@@ -1,5 +1,5 @@
 """Issue 26: a velocity change on a fine closed-form grid whose edge images (or bends) the bound
-(physics/tessellation.edge_image_bound) shows short visits no edge: the add-on sets the modifier's
+(physics/edge_bounds.edge_image_bound) shows short visits no edge: the add-on sets the modifier's
 ``Edges Proven Short`` and runs no measure and no read of the mesh, and the modifier leaves the
 mesh whole without its per-edge check (shown by a tolerance the check would fail: the verdict
 stays, and turns when the bound's input is off). An edit of the mesh is followed (the bound's rest
@@ -93,8 +93,9 @@ def test_velocity_change_on_a_fine_grid_visits_no_edge(relativity_addon, monkeyp
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
     calls = {}
-    for name in ("decide", "_mesh_arrays", "_read_rest_bounds"):
-        _counted(monkeypatch, tessellation, name, calls)
+    edge_bounds = gh.addon_module("geometry.edge_bounds")
+    for module, name in ((tessellation, "decide"), (tessellation, "_mesh_arrays"), (edge_bounds, "_read_rest_bounds")):
+        _counted(monkeypatch, module, name, calls)
 
     for beta in ((0.52, 0.1, 0.0), (0.48, 0.0, 0.1), (0.5, 0.1, 0.0)):  # as the panel does, one after another
         obj.relativity.beta = beta
@@ -128,13 +129,12 @@ def test_an_edit_of_the_mesh_is_read_again(relativity_addon, monkeypatch):
     the bound no longer clears the grid and the modifier's check decides."""
     import bpy
 
-    tessellation = gh.addon_module("geometry.tessellation")
     modifier = gh.addon_module("geometry.modifier")
     scene, obj = _fine_grid(bpy)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
     calls = {}
-    _counted(monkeypatch, tessellation, "_read_rest_bounds", calls)
+    _counted(monkeypatch, gh.addon_module("geometry.edge_bounds"), "_read_rest_bounds", calls)
     for beta in ((0.51, 0.0, 0.0), (0.49, 0.0, 0.0)):
         obj.relativity.beta = beta
         bpy.context.evaluated_depsgraph_get()
@@ -171,16 +171,16 @@ def test_keyframed_motion_is_bounded_with_its_keys_velocity(relativity_addon, mo
     import bpy
 
     modifier = gh.addon_module("geometry.modifier")
-    tessellation = gh.addon_module("geometry.tessellation")
+    edge_bounds = gh.addon_module("geometry.edge_bounds")
     scene, obj = _keyed_grid(bpy, 40)
     velocities = []
-    original = tessellation.edge_image_bound
+    original = edge_bounds.edge_image_bound
 
     def recorded(obj, matrix, snap, size, tolerance, velocity=None, *rest):
         velocities.append(velocity)
         return original(obj, matrix, snap, size, tolerance, velocity, *rest)
 
-    monkeypatch.setattr(tessellation, "edge_image_bound", recorded)
+    monkeypatch.setattr(edge_bounds, "edge_image_bound", recorded)
     scene.frame_set(12)
     gh.apply_geometry(scene)
     verdict, vertices = _verdict(bpy, obj)
@@ -206,8 +206,9 @@ def test_fine_grid_at_a_large_render_size_is_cleared_by_its_bends(relativity_add
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
     calls = {}
-    for name in ("decide", "_mesh_arrays", "_read_rest_bounds"):
-        _counted(monkeypatch, tessellation, name, calls)
+    edge_bounds = gh.addon_module("geometry.edge_bounds")
+    for module, name in ((tessellation, "decide"), (tessellation, "_mesh_arrays"), (edge_bounds, "_read_rest_bounds")):
+        _counted(monkeypatch, module, name, calls)
     for beta in ((0.52, 0.1, 0.0), (0.48, 0.0, 0.1), (0.5, 0.1, 0.0)):
         obj.relativity.beta = beta
         verdict, vertices = _verdict(bpy, obj)
@@ -225,12 +226,13 @@ def test_fine_grid_at_a_large_render_size_is_cleared_by_its_bends(relativity_add
 
 def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monkeypatch):
     """On straight keys the bound is taken over the origin's way through the next frames
-    (``tessellation.SWEEP_FRAMES``): stepping through them computes no bound and the verdict holds;
+    (``edge_bounds.SWEEP_FRAMES``): stepping through them computes no bound and the verdict holds;
     a step past them computes one again."""
     import bpy
 
     modifier = gh.addon_module("geometry.modifier")
     tessellation = gh.addon_module("geometry.tessellation")
+    edge_bounds = gh.addon_module("geometry.edge_bounds")
     scene, obj = _keyed_grid(bpy, 80)
     scene.frame_set(12)
     gh.apply_geometry(scene)
@@ -238,13 +240,13 @@ def test_straight_keys_frame_steps_reuse_the_swept_bound(relativity_addon, monke
     calls = {}
     _counted(monkeypatch, tessellation.tessellation, "edge_image_bound", calls)
     mod = modifier.find_modifier(obj)
-    for frame in range(13, 12 + tessellation.SWEEP_FRAMES):
+    for frame in range(13, 12 + edge_bounds.SWEEP_FRAMES):
         scene.frame_set(frame)
         verdict, vertices = _verdict(bpy, obj)
         assert compat.modifier_input(*_input(mod, "Edges Proven Short")), frame
         assert verdict is True and vertices == SIDE * SIDE
     assert calls == {}, calls
-    scene.frame_set(12 + 3 * tessellation.SWEEP_FRAMES)
+    scene.frame_set(12 + 3 * edge_bounds.SWEEP_FRAMES)
     bpy.context.evaluated_depsgraph_get()
     assert calls.get("edge_image_bound", 0) >= 1
     assert compat.modifier_input(*_input(mod, "Edges Proven Short"))
@@ -259,11 +261,12 @@ def test_straight_keys_keep_half_the_sweep_where_the_whole_does_not_clear(relati
 
     modifier = gh.addon_module("geometry.modifier")
     tessellation = gh.addon_module("geometry.tessellation")
+    edge_bounds = gh.addon_module("geometry.edge_bounds")
     scene, obj = _keyed_grid(bpy, 200)
     per_frame = 0.6 * C / FPS
-    whole = tessellation.SWEEP_FRAMES * per_frame  # (the grid is far larger than a frame's way)
+    whole = edge_bounds.SWEEP_FRAMES * per_frame  # (the grid is far larger than a frame's way)
     tried = {"whole": 0, "half": 0}
-    bound = tessellation._bound
+    bound = edge_bounds._bound
 
     def refusing(arguments, tolerance, acceleration, sweep):
         if sweep is not None:
@@ -275,24 +278,24 @@ def test_straight_keys_keep_half_the_sweep_where_the_whole_does_not_clear(relati
             tried["half"] += 1
         return bound(arguments, tolerance, acceleration, sweep)
 
-    monkeypatch.setattr(tessellation, "_bound", refusing)
+    monkeypatch.setattr(edge_bounds, "_bound", refusing)
     scene.frame_set(12)
     gh.apply_geometry(scene)
     bpy.context.evaluated_depsgraph_get()
     assert tried["whole"] >= 1 and tried["half"] >= 1, tried
-    start, sweep = tessellation.swept_bound(obj)
+    start, sweep = edge_bounds.swept_bound(obj)
     np.testing.assert_allclose(np.linalg.norm(sweep), whole / 2, rtol=1e-6)
     after_setup = dict(tried)
     calls = {}
     _counted(monkeypatch, tessellation.tessellation, "edge_image_bound", calls)
     mod = modifier.find_modifier(obj)
-    for frame in range(13, 12 + tessellation.SWEEP_FRAMES // 2):
+    for frame in range(13, 12 + edge_bounds.SWEEP_FRAMES // 2):
         scene.frame_set(frame)
         verdict, vertices = _verdict(bpy, obj)
         assert compat.modifier_input(*_input(mod, "Edges Proven Short")), frame
         assert verdict is True and vertices == SIDE * SIDE
     assert calls == {} and tried == after_setup, (calls, tried)
-    scene.frame_set(12 + tessellation.SWEEP_FRAMES)
+    scene.frame_set(12 + edge_bounds.SWEEP_FRAMES)
     bpy.context.evaluated_depsgraph_get()
     assert tried["half"] > after_setup["half"] and tried["whole"] == after_setup["whole"], tried
     assert compat.modifier_input(*_input(mod, "Edges Proven Short"))

@@ -1,6 +1,6 @@
 """Issue 26: the closed form's light-travel distance in one form on every point (``Folded``), the
 towards form ``(root - r.w) / (1 - w.w)``, where its rounding on receding points (amplified by at most
-``1 / (1 - |w|)``) stays within ``motion.FOLD_LIMIT`` times float32's; faster, each point takes the
+``1 / (1 - |w|)``) stays within ``uniform_motion.FOLD_LIMIT`` times float32's; faster, each point takes the
 form that avoids cancellation. Either way the evaluated positions and velocities must be where
 docs/physics.md puts them (``_seen`` of test_geometry_closed_form.py: bisection on the light cone,
 the boost), on the full group (a cube, no tessellation) and on the lean group (a grid the edges'

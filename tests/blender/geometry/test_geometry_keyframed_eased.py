@@ -206,7 +206,7 @@ def test_unfolded_closed_forms(relativity_addon, monkeypatch):
     and its velocities are still where docs/physics.md puts them."""
     import bpy
 
-    monkeypatch.setattr(gh.addon_module("geometry.motion"), "FOLD_LIMIT", 1.0)
+    monkeypatch.setattr(gh.addon_module("geometry.uniform_motion"), "FOLD_LIMIT", 1.0)
     scene, camera = gh.slow_light_scene(bpy, C, FPS)
     scene.relativity.beta = OBSERVER
     obj = _eased_mover(bpy, scene, False)
