@@ -174,3 +174,29 @@ def test_an_observer_velocity_change_in_a_sunlit_scene(relativity_addon, monkeyp
     for name, (colour, matrix) in copies().items():
         np.testing.assert_allclose(colour, turned[name][0], rtol=1e-6)
         np.testing.assert_allclose(matrix, turned[name][1], atol=1e-6)
+
+
+def test_observer_velocity_changes_after_opening_the_file_again(
+    relativity_addon, factory_blender, tmp_path, monkeypatch
+):
+    """The records outlive a file (kept per object's session_uid): after the file is opened again (new
+    session_uids), the first observer's velocity change updates the mesh in full, the next one turns it,
+    and both draw the physics' view."""
+    bpy = factory_blender
+    scene, camera, obj = _set_up_mover(bpy)
+    scene.frame_set(13)
+    path = str(tmp_path / "turned.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    scene.relativity.beta = OBSERVER_CHANGED  # a turn in this session
+    bpy.context.evaluated_depsgraph_get()
+    bpy.ops.wm.open_mainfile(filepath=path)
+    scene = bpy.context.scene
+    obj, camera = scene.objects["Mover"], scene.camera
+    calls = _counted_updates(monkeypatch)
+    scene.relativity.beta = OBSERVER_CHANGED
+    _check(bpy, obj, camera, 13, OBSERVER_CHANGED)
+    full = calls["update_object"]
+    assert full >= 1, calls
+    scene.relativity.beta = OBSERVER
+    _check(bpy, obj, camera, 13)
+    assert calls["update_object"] == full and calls["step"] >= 1, calls
