@@ -10,7 +10,7 @@ many meshes at once (:func:`prove_over_ways`).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import bpy
 import numpy as np
@@ -22,6 +22,22 @@ if TYPE_CHECKING:
 
     from ...physics.arrays import BoolArray, FloatArray
     from ..scene.snapshot import Snapshot
+
+    # One mesh's bound's arguments (``physics/tessellation.edge_image_bound``'s, in order): the rest box's low
+    # and high, the longest edge, the world matrix, the velocity, the observer's place and velocity, the
+    # camera's rotation, window and render size.
+    _Arguments = tuple[
+        FloatArray,
+        FloatArray,
+        float,
+        FloatArray,
+        Any,
+        Any,
+        Any,
+        Any,
+        tuple[float, float, float, float],
+        tuple[float, float],
+    ]
 
 # The bound must clear the tolerance by this much (the modifier measures in float32).
 PROVEN_MARGIN = 0.99
@@ -176,8 +192,7 @@ def prove_over_ways(
     tolerances = PROVEN_MARGIN * np.array([float(objects[row].relativity.tessellation_tolerance) for row in rows])
     frames = _sweep_frames(lows, highs, matrices[rows], ways[rows])
     _t_o, x_o, beta_o = snap.mesh_observer
-    window = _window(snap)
-    view = (x_o, beta_o, snap.world_to_camera, window, size)
+    view = (x_o, beta_o, snap.world_to_camera, _window(snap), size)
     left = np.ones(len(rows), dtype=bool)  # not proven yet
     for tried, parts in enumerate((frames, frames // 2)):  # the longer sweep first, then half of it
         left &= parts > 0
@@ -199,21 +214,11 @@ def prove_over_ways(
         for index, bound in zip(np.flatnonzero(left).tolist(), bounds.tolist(), strict=True):
             row = int(rows[index])
             if not bound <= tolerances[index]:  # the bends' bound then, one object's (as _bound)
+                arguments = (*rests[row], matrices[row], velocities[row], *view)
                 try:
-                    bend = tessellation.edge_bend_bound(
-                        *rests[row],
-                        matrices[row],
-                        velocities[row],
-                        x_o,
-                        beta_o,
-                        snap.world_to_camera,
-                        window,
-                        size,
-                        sweep=sweeps[index],
-                    )
+                    bound = min(bound, _bends(arguments, 0.0, sweeps[index]))
                 except ValueError:
                     return proven
-                bound = min(bound, bend)
             if bound <= tolerances[index]:
                 proven[row] = True
                 # (no key: the next full update takes its bound again; the sweep holds)
@@ -246,15 +251,17 @@ def _sweep_frames(lows: FloatArray, highs: FloatArray, matrices: FloatArray, way
     return np.where(steps * SWEEP_FRAMES <= SWEEP_SIZES * sizes, SWEEP_FRAMES, fewer)
 
 
-def _bound(arguments: tuple, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:
+def _bound(arguments: _Arguments, tolerance: float, acceleration: float, sweep: FloatArray | None) -> float:
     """The lengths' bound, or where it does not clear the tolerance the least of it and the bends'."""
-    low, high, longest, matrix, beta, x_o, beta_o, rotation, window, size = arguments
-    view = (matrix, beta, x_o, beta_o, rotation, window, size)
-    bound = tessellation.edge_image_bound(low, high, longest, *view, sweep=sweep)
+    bound = tessellation.edge_image_bound(*arguments, sweep=sweep)
     if not bound <= PROVEN_MARGIN * tolerance:
-        bend = tessellation.edge_bend_bound(low, high, longest, *view, acceleration=acceleration, sweep=sweep)
-        bound = min(bound, bend)
+        bound = min(bound, _bends(arguments, acceleration, sweep))
     return bound
+
+
+def _bends(arguments: _Arguments, acceleration: float, sweep: FloatArray | None) -> float:
+    """The bends' bound (``physics/tessellation.edge_bend_bound``) of :func:`_bound`'s ``arguments``."""
+    return tessellation.edge_bend_bound(*arguments, acceleration=acceleration, sweep=sweep)
 
 
 def swept_bound(obj: Object) -> tuple[FloatArray, FloatArray] | None:

@@ -99,34 +99,11 @@ def remember(obj: Object, scene: Scene, snap: Snapshot, signature: str, matrix: 
     way to come (``keyframed.steppable_line``)."""
     line = keyframed.steppable_line(obj)
     head = signature_head(snap.frame, matrix) + scene.seen_as
-    keys = animation.keyframes_hash(obj)
     if line is None or not signature.startswith(head):
         return
-    start, per_frame, shape, fps, t_low, t_high = line
-    held = np.array(matrix, dtype=np.float64)
-    w = per_frame * fps / snap.speed_of_light
-    inverse, to_local, fixed = uniform_motion.uniform_parts(
-        shape, w, snap.mesh_observer[2], held
-    )  # as the full update's
-    contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
-    tail = signature[len(head) :]
-    _records[obj.session_uid] = _Record(
-        scene.key,
-        scene.still,
-        keys,
-        start,
-        per_frame,
-        shape,
-        fps,
-        t_low,
-        t_high,
-        tail,
-        held[:3, :3],
-        inverse,
-        to_local,
-        w,
-        contracted,
-    )
+    w = line[1] * line[3] / snap.speed_of_light  # the way per frame times fps, over c
+    keys = animation.keyframes_hash(obj)
+    _keep(obj, scene, snap, signature[len(head) :], np.array(matrix, dtype=np.float64), line, w, keys)
 
 
 def remember_closed_form(
@@ -139,33 +116,43 @@ def remember_closed_form(
     proved them short, and not while rendering (its update sets other inputs)."""
     if busy.rendering() or (measure is not None and not measure["Edges Proven Short"]):
         return
-    matrix, measured = motion.matrix_array(obj_eval.matrix_world), measure is not None
-    settings = obj.relativity
-    read = (settings.enabled, settings.motion, settings.beta[:])
+    matrix = motion.matrix_array(obj_eval.matrix_world)
     head = signature_head(None, tuple(map(tuple, matrix.tolist()))) + scene.seen_as
     if obj.animation_data is not None or not signature.startswith(head):
         return
+    settings = obj.relativity
+    read = (settings.enabled, settings.motion, settings.beta[:])
     w = np.array(read[2] if read[1] == "CONSTANT" else (0.0, 0.0, 0.0), dtype=np.float64)
-    shape = matrix[:3, :3].copy()
-    inverse, to_local, fixed = uniform_motion.uniform_parts(shape, w, snap.mesh_observer[2], matrix)  # as the update's
+    line = (matrix[:3, 3].copy(), np.zeros(3), matrix[:3, :3].copy(), 1.0, -math.inf, math.inf)  # standing still
+    _keep(obj, scene, snap, signature[len(head) :], matrix, line, w, None, read, measure is not None)
+
+
+def _keep(obj, scene, snap, tail, matrix, line, w, keys, settings=None, measured=True):
+    """Store ``obj``'s record: ``line`` (its start, way per frame, held 3x3, fps and the observer's
+    times it holds for, as ``keyframed.steppable_line``), ``w`` its velocity, ``matrix`` its evaluated
+    world matrix (4x4), ``tail`` its signature after the frame, matrix and scene's parts; the offset
+    maps and the contracted shape as the full update's (``uniform_motion.uniform_parts``)."""
+    start, per_frame, shape, fps, t_low, t_high = line
+    inverse, to_local, fixed = uniform_motion.uniform_parts(shape, w, snap.mesh_observer[2], matrix)
     contracted = np.array([fixed["Scene X"], fixed["Scene Y"], fixed["Scene Z"]], dtype=np.float64).T
+    held = matrix[:3, :3]
     _records[obj.session_uid] = _Record(
         scene.key,
         scene.still,
-        None,
-        matrix[:3, 3].copy(),
-        np.zeros(3),
+        keys,
+        start,
+        per_frame,
         shape,
-        1.0,
-        -math.inf,
-        math.inf,
-        signature[len(head) :],
-        shape,
+        fps,
+        t_low,
+        t_high,
+        tail,
+        held,
         inverse,
         to_local,
         w,
         contracted,
-        read,
+        settings,
         measured,
     )
 
@@ -256,15 +243,10 @@ def _turned(records, objects, matrices, snap):
     scene = bpy.data.scenes.get(snap.scene)
     size = tessellation.render_size(scene) if scene is not None else (0.0, 0.0)
     measured = [row for row, r in enumerate(records) if r.measured]
-    proven = [True] * len(records)  # (edges not checked: nothing to prove)
-    for row, ok in zip(
-        measured,
-        edge_bounds.prove_over_ways(
-            [objects[k] for k in measured], at_t_o[measured], w[measured], per_frame[measured], snap, size
-        ),
-        strict=True,
-    ):
-        proven[row] = ok
+    proven = np.ones(len(records), dtype=bool)  # (edges not checked: nothing to prove)
+    proven[measured] = edge_bounds.prove_over_ways(
+        [objects[row] for row in measured], at_t_o[measured], w[measured], per_frame[measured], snap, size
+    )
     values = parts.transpose(1, 0, 2).astype(np.float32).astype(np.float64).tolist()
     return to_local, [tuple(map(tuple, rows)) if ok else None for rows, ok in zip(values, proven, strict=True)]
 

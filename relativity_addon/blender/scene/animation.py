@@ -144,7 +144,7 @@ def world_matrices(
     return world_matrices(parent, frames, own_frames) @ parent_inverse @ matrices
 
 
-_signed = once.Once()  # object session_uid -> its keyframes signature, inside signed_once()
+_signed = once.Once()  # object session_uid -> its keys' signature, ("hash", uid) -> its hash, inside signed_once()
 
 
 def signed_once(kept: dict[object, object] | None = None) -> AbstractContextManager[None]:

@@ -202,7 +202,7 @@ def _keyframed_speed(obj, keyed):
     start, end, fps, c = keyed
     key = (animation.keyframes_hash(obj), *keyed)
     known = _keyframed_speeds.get(obj.name)
-    if key[0] is not None and known is not None and known[0] == key:
+    if known is not None and known[0] == key:
         return known[1]
     count = min(int((end - start) / _SPEED_STEP_FRAMES) + 2, _SPEED_SAMPLES)
     frames = np.linspace(start - _SPEED_STEP_FRAMES, end, count)
